@@ -1,0 +1,14 @@
+"""rockstudy: rocking structures in earthquakes.
+
+Housner's rocking block, its linearization and closed forms (Dimitrakopoulos & DeJong 2012),
+the single-ODE formulation (Prieto & Lourenco 2005), dynamically equivalent structures
+(DeJong & Dimitrakopoulos 2014), and parametric studies on top.
+"""
+
+from . import motions, structures
+from .dynamics import RockingResult, simulate
+from .structures import Block
+
+__version__ = "0.1.0"
+
+__all__ = ["Block", "RockingResult", "motions", "simulate", "structures", "__version__"]

@@ -1,0 +1,7 @@
+"""Rocking solvers: event-driven numba kernels, the exact linearized solution, the scipy
+reference, and the batch entry point used by studies."""
+
+from .result import RockingResult
+from .simulate import simulate
+
+__all__ = ["RockingResult", "simulate"]

@@ -1,0 +1,302 @@
+"""Exact piecewise solution of the linearized rocking block under trigonometric pulses (private).
+
+Between impacts, eq. (3.1) of [000] under u_g'' = a_g sin(omega_g t + phi) has the closed form
+(eq. 3.4 of [000], in tau = p t, Omega = omega_g / p, q = a_g / g, side s):
+
+    theta(tau) = alpha s + q / (1 + Omega^2) sin(Omega tau + phi) + A e^-(tau-tau0) + B e^(tau-tau0)
+
+so nothing is integrated: impacts, peaks and overturning are roots of this smooth scalar
+function, bracketed on a grid of at most a quarter forcing period (and 0.5 in tau) and polished
+by safeguarded Newton steps. Free rocking after the pulse is the closed-form map of
+``_rocking.free_rocking_map``; the time to fall is a root of a quadratic in e^tau.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..constants import FALL_ROTATION, G
+from ._rocking import (
+    MODEL_LINEAR,
+    PH_END,
+    PH_OVER,
+    PH_REST,
+    REST_FRACTION,
+    STATUS_OK,
+    _uplift_trig,
+    free_rocking_map,
+)
+
+
+@njit(cache=True, inline="always")
+def _u(k, A, B, c, W, x0, alpha, s, sig):
+    """k-th tau-derivative (k = 0, 1, 2) of u = s theta at sigma = tau - tau0."""
+    em = math.exp(-sig)
+    ep = math.exp(sig)
+    x = W * sig + x0
+    if k == 0:
+        return s * (alpha * s + c * math.sin(x) + A * em + B * ep)
+    if k == 1:
+        return s * (c * W * math.cos(x) - A * em + B * ep)
+    return s * (-c * W * W * math.sin(x) + A * em + B * ep)
+
+
+@njit(cache=True)
+def _root(k, target, sgn, A, B, c, W, x0, alpha, s, lo, hi):
+    """sigma in [lo, hi] where sgn * (u^(k) - target) turns from >= 0 to < 0 (Newton-bisection)."""
+    x = 0.5 * (lo + hi)
+    for _ in range(100):
+        f = _u(k, A, B, c, W, x0, alpha, s, x) - target
+        if sgn * f >= 0.0:
+            lo = x
+        else:
+            hi = x
+        df = _u(k + 1, A, B, c, W, x0, alpha, s, x) if k < 2 else 0.0
+        xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
+        if not lo < xn < hi:
+            xn = 0.5 * (lo + hi)
+        if abs(xn - x) <= 1e-16 * max(1.0, abs(x)) or hi - lo <= 1e-16 * max(1.0, hi):
+            return xn
+        x = xn
+    return x
+
+
+@njit(cache=True)
+def _next_break(x, r0):
+    """Next forcing phase after x where q sin crosses +-alpha (x = r0, pi - r0 mod pi) or peaks
+    (x = pi/2 mod pi). Between these the ground term of u'' has one sign and is monotone, so u'
+    changes sign at most once per grid interval and no impact hides between grid points."""
+    m = x % math.pi
+    base = x - m
+    for b in (r0, 0.5 * math.pi, math.pi - r0, math.pi + r0):
+        if b > m + 1e-12:
+            return base + b
+    return base + math.pi + r0
+
+
+@njit(cache=True, inline="always")
+def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
+    """Append a row (tau0, tau1, A, B, s, q, ends in an impact) to the phase log, if it has room.
+
+    Row 0 holds the number of phases (also those that did not fit).
+    """
+    n = int(rec[0, 0])
+    if n + 1 < rec.shape[0]:
+        rec[n + 1, 0] = tau0
+        rec[n + 1, 1] = tau1
+        rec[n + 1, 2] = A
+        rec[n + 1, 3] = B
+        rec[n + 1, 4] = s
+        rec[n + 1, 5] = q
+        rec[n + 1, 6] = impact
+    rec[0, 0] = n + 1
+
+
+@njit(cache=True)
+def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, max_u, n_imp, rec):
+    """Rock (exactly) from tau0 until rest, overturning or tau_ex (end of pulse or of history).
+
+    theta and v = d theta / d tau are in rad; q = 0 gives free rocking. ``rec`` is a phase log
+    (see :func:`_log_phase`; shape (0, 7) to skip logging). Returns
+    (code, tau, theta, v, s, max_u, n_imp).
+    """
+    c = q / (1.0 + W * W)
+    d = min(0.5, 0.25 * math.pi / W)
+    r0 = math.asin(min(alpha / abs(q), 1.0)) if q != 0.0 else 0.5 * math.pi
+    rest_v = REST_FRACTION * alpha
+    log = rec.shape[0] > 0
+    while True:
+        x0 = W * tau0 + ph
+        X = th0 - alpha * s - c * math.sin(x0)
+        Y = v0 - c * W * math.cos(x0)
+        B = 0.5 * (X + Y)
+        A = 0.5 * (X - Y)
+        sig_end = tau_ex - tau0
+        sa = 0.0
+        va = s * v0
+        s_imp = -1.0
+        while sa < sig_end:
+            sb = min(sa + d, sig_end, _next_break(W * (tau0 + sa) + ph, r0) / W - tau0 - ph / W)
+            ub = _u(0, A, B, c, W, x0, alpha, s, sb)
+            vb = _u(1, A, B, c, W, x0, alpha, s, sb)
+            if ub < 0.0:
+                s_imp = _root(0, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, sb)
+            elif va < 0.0 < vb:
+                s_tr = _root(1, 0.0, -1.0, A, B, c, W, x0, alpha, s, sa, sb)
+                if _u(0, A, B, c, W, x0, alpha, s, s_tr) < 0.0:
+                    s_imp = _root(0, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, s_tr)
+            end = s_imp if s_imp >= 0.0 else sb
+            if va >= 0.0 and _u(1, A, B, c, W, x0, alpha, s, end) <= 0.0:
+                s_pk = _root(1, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, end)
+                max_u = max(max_u, _u(0, A, B, c, W, x0, alpha, s, s_pk))
+            if s_imp >= 0.0:
+                break
+            if ub >= FALL_ROTATION:
+                s_ot = _root(0, FALL_ROTATION, -1.0, A, B, c, W, x0, alpha, s, sa, sb)
+                if log:
+                    _log_phase(rec, tau0, tau0 + s_ot, A, B, s, q, 0.0)
+                return PH_OVER, tau0 + s_ot, s * FALL_ROTATION, 0.0, s, FALL_ROTATION, n_imp
+            max_u = max(max_u, ub)
+            sa = sb
+            va = vb
+        if s_imp < 0.0:
+            u_e = _u(0, A, B, c, W, x0, alpha, s, sig_end)
+            v_e = _u(1, A, B, c, W, x0, alpha, s, sig_end)
+            if log:
+                _log_phase(rec, tau0, tau_ex, A, B, s, q, 0.0)
+            return PH_END, tau_ex, s * u_e, s * v_e, s, max_u, n_imp
+        if log:
+            _log_phase(rec, tau0, tau0 + s_imp, A, B, s, q, 1.0)
+        v_pre = s * _u(1, A, B, c, W, x0, alpha, s, s_imp)
+        n_imp += 1
+        v_post = eta * v_pre
+        tau0 += s_imp
+        th0 = 0.0
+        if abs(v_post) < rest_v:
+            qa = q * math.sin(W * tau0 + ph)
+            if abs(qa) < alpha:
+                return PH_REST, tau0, 0.0, 0.0, s, max_u, n_imp
+            s = -1.0 if qa > 0.0 else 1.0
+            v0 = 0.0
+        else:
+            s = -s
+            v0 = v_post
+
+
+@njit(cache=True)
+def _first_root_above_one(a2, a1, a0):
+    """Smallest root x > 1 of a2 x^2 + a1 x + a0 = 0, or inf."""
+    best = np.inf
+    if a2 == 0.0:
+        if a1 != 0.0 and -a0 / a1 > 1.0:
+            best = -a0 / a1
+        return best
+    disc = a1 * a1 - 4.0 * a2 * a0
+    if disc < 0.0:
+        return best
+    sq = math.sqrt(disc)
+    qq = -0.5 * (a1 + math.copysign(sq, a1))
+    for r in (qq / a2, a0 / qq if qq != 0.0 else np.inf):
+        if 1.0 < r < best:
+            best = r
+    return best
+
+
+@njit(cache=True)
+def _free_fall_time(u, v, alpha, eta):
+    """tau from (u, v) until |theta| = pi/2 in free linearized rocking; (tau, impacts on the way).
+
+    u(sigma) = alpha + A e^-sigma + B e^sigma (eq. 3.5 of [000]); impacts and the fall are
+    roots of quadratics in x = e^sigma.
+    """
+    tau = 0.0
+    for n in range(2):
+        B = 0.5 * (u - alpha + v)
+        A = 0.5 * (u - alpha - v)
+        x_imp = _first_root_above_one(B, alpha, A) if v < 0.0 or u < alpha else np.inf
+        x_ot = _first_root_above_one(B, -(FALL_ROTATION - alpha), A)
+        if x_ot <= x_imp:
+            return tau + math.log(x_ot), n
+        tau += math.log(x_imp)
+        u = 0.0
+        v = eta * abs(B * x_imp - A / x_imp)
+    return np.nan, 2
+
+
+@njit(cache=True)
+def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0):
+    """Linearized block under a trigonometric pulse, exactly.
+
+    With ``use_map`` the free rocking after the pulse is mapped, otherwise it is followed in
+    closed form until rest, overturning or ``t_tail`` [s]. ``rec`` is the phase log of
+    :func:`_trig_phase`. Returns (status, max rotation, overturned, impacts, overturning time).
+    """
+    a_g, w, ph, dur = mp[0], mp[1], mp[2], mp[3]
+    q = a_g / G
+    W = w / p
+    tau_ex = p * dur
+    thr = G * alpha
+    t = 0.0
+    max_u = abs(th_init)
+    n_imp = 0
+    rocking = th_init != 0.0 or om_init != 0.0
+    th = th_init
+    v = om_init / p
+    s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
+    while True:
+        if not rocking:
+            t_up = _uplift_trig(mp, thr, t)
+            if t_up >= dur:
+                return STATUS_OK, max_u, False, n_imp, np.nan
+            s = -1.0 if a_g * math.sin(w * t_up + ph) > 0.0 else 1.0
+            t = t_up
+            th = 0.0
+            v = 0.0
+        rocking = False
+        if t >= dur:
+            break
+        code, tau, th, v, s, max_u, n_imp = _trig_phase(alpha, eta, q, W, ph, tau_ex, p * t,
+                                                        th, v, s, max_u, n_imp, rec)
+        if code == PH_OVER:
+            return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
+        if code == PH_END:
+            break
+        t = tau / p
+    if use_map:
+        over, peak, n_post = free_rocking_map(s * th, s * v * p, p, alpha, eta, MODEL_LINEAR,
+                                              REST_FRACTION * p * alpha)
+        if not over:
+            return STATUS_OK, max(max_u, peak), False, n_imp + n_post, np.nan
+        if rec.shape[0] == 0:
+            tau_f, n_more = _free_fall_time(s * th, s * v, alpha, eta)
+            return STATUS_OK, FALL_ROTATION, True, n_imp + n_more, dur + tau_f / p
+    code, tau, th, v, s, max_u, n_imp = _trig_phase(alpha, eta, 0.0, 1.0, 0.0, p * t_tail,
+                                                    tau_ex, th, v, s, max_u, n_imp, rec)
+    if code == PH_OVER:
+        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
+    return STATUS_OK, max_u, False, n_imp, np.nan
+
+
+@njit(cache=True, parallel=True)
+def trig_batch(p, alpha, eta, mp):
+    """:func:`trig_scene` over rows, in parallel."""
+    n = p.shape[0]
+    status = np.empty(n, np.int8)
+    max_rot = np.empty(n)
+    over = np.empty(n, np.bool_)
+    n_imp = np.empty(n, np.int64)
+    t_ot = np.empty(n)
+    no_log = np.empty((0, 7))
+    for i in prange(n):
+        r = trig_scene(p[i], alpha[i], eta[i], mp[i], True, np.inf, no_log)
+        status[i] = r[0]
+        max_rot[i] = r[1]
+        over[i] = r[2]
+        n_imp[i] = r[3]
+        t_ot[i] = r[4]
+    return status, max_rot, over, n_imp, t_ot
+
+
+def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40):
+    """Evaluate a phase log on a dense grid: (t [s], theta [rad], theta_dot [rad/s], impacts [s]).
+
+    Each phase is sampled at ``points_per_unit`` points per unit of tau = p t (at least 8), and
+    at both ends, so impacts appear twice (before and after the jump of theta_dot).
+    """
+    n = int(rec[0, 0])
+    ts, ths, oms = [np.zeros(1)], [np.full(1, x0[0])], [np.full(1, x0[1])]
+    W = omega / p
+    for tau0, tau1, A, B, s, q, _ in rec[1 : n + 1]:
+        m = max(8, int(np.ceil((tau1 - tau0) * points_per_unit)))
+        sig = np.linspace(0.0, tau1 - tau0, m + 1)
+        c = q / (1.0 + W * W)
+        x = (W * tau0 + phase if q != 0.0 else 0.0) + W * sig
+        em, ep = np.exp(-sig), np.exp(sig)
+        ts.append((tau0 + sig) / p)
+        ths.append(alpha * s + c * np.sin(x) + A * em + B * ep)
+        oms.append(p * (c * W * np.cos(x) - A * em + B * ep))
+    impacts = rec[1 : n + 1][rec[1 : n + 1, 6] == 1.0, 1] / p
+    return np.concatenate(ts), np.concatenate(ths), np.concatenate(oms), impacts

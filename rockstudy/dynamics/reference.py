@@ -1,0 +1,169 @@
+"""The slow reference path: Housner's rocking block integrated by ``scipy.integrate.solve_ivp``.
+
+Independent of the numba kernels in everything but the model itself: scipy's integrators,
+scipy's event location (dense output and Brent's method), uplift times found by Brent's
+method on a scan, and free rocking after the excitation integrated, never mapped.
+It costs milliseconds per scene and is meant for verification at rtol down to 1e-12.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from ..constants import FALL_ROTATION, G
+from ..motions import Motion, Record
+from ._rocking import MODEL_LINEAR, REST_FRACTION
+
+
+def _scalar_acceleration(motion: Motion):
+    """A plain-Python u_g''(t) [m/s^2] for the reference path (zero outside the motion)."""
+    kind, mp, times, samples = motion.kernel_spec()
+    a, w, ph, dur = mp
+    if isinstance(motion, Record):
+        return lambda t: float(np.interp(t, times, samples)) * a if 0.0 <= t <= dur else 0.0
+    if kind == 0:
+        return lambda t: a * math.sin(w * t + ph) if 0.0 <= t <= dur else 0.0
+
+    def ricker(t):
+        x = (math.pi * w * (t - ph)) ** 2
+        return a * (1.0 - 2.0 * x) * math.exp(-x) if 0.0 <= t <= dur else 0.0
+
+    return ricker
+
+
+def _uplift_time(acc, thr, t0, dur, grid):
+    """First t >= t0 with |acc(t)| >= thr, by a scan on ``grid`` and Brent's method."""
+    if abs(acc(t0)) >= thr:
+        return t0
+    pts = np.concatenate([[t0], grid[grid > t0], [dur]])
+    for lo, hi in zip(pts[:-1], pts[1:]):
+        if abs(acc(hi)) >= thr:
+            if hi <= lo:
+                return hi
+            return brentq(lambda t: abs(acc(t)) - thr, lo, hi, xtol=1e-15)
+    return math.inf
+
+
+def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integrator="DOP853",
+                       t_max=None, initial_state=(0.0, 0.0), max_impacts=20000):
+    """Integrate one scene with ``solve_ivp`` and events.
+
+    Parameters
+    ----------
+    p, alpha, eta : float
+        Frequency parameter [rad/s], slenderness [rad] and restitution [-].
+    motion : Motion
+    model : int
+        0 for Housner's nonlinear equation (2.2) of [000], 1 for the linearized (3.1).
+    rtol : float
+        Relative tolerance; the absolute tolerances are rtol * alpha and rtol * p * alpha.
+    integrator : str
+        A ``solve_ivp`` method: "DOP853", "RK45", "LSODA", ...
+    t_max : float, optional
+        End of the free-rocking tail [s]; by default until rest or overturning.
+    initial_state : (float, float)
+        theta [rad] and theta_dot [rad/s] at t = 0; (0, 0) starts at rest.
+
+    Returns
+    -------
+    dict with keys t, theta, theta_dot, max_rotation, overturned, impact_times, overturn_time.
+    """
+    acc = _scalar_acceleration(motion)
+    dur = motion.duration
+    linear = model == MODEL_LINEAR
+    thr = G * alpha if linear else G * math.tan(alpha)
+    omega_rest = REST_FRACTION * p * alpha
+    t_end = math.inf if t_max is None else float(t_max)
+    atol = [rtol * alpha, rtol * p * alpha]
+    if isinstance(motion, Record):
+        grid = np.asarray(motion.time)
+    else:
+        grid = np.linspace(0.0, dur, 4097)
+
+    def rhs(t, y, s):
+        a = acc(t) / G
+        if linear:
+            return [y[1], p * p * (y[0] - alpha * s - a)]
+        x = alpha * s - y[0]
+        return [y[1], -p * p * (math.sin(x) + a * math.cos(x))]
+
+    th, om = (float(x) for x in initial_state)
+    ts, ths, oms, impacts = [0.0], [th], [om], []
+    max_u = abs(th)
+    t = 0.0
+    at_rest = th == 0.0 and om == 0.0
+    s = math.copysign(1.0, th if th != 0.0 else om)
+    while True:
+        if at_rest:
+            t_up = _uplift_time(acc, thr, t, dur, grid)
+            if t_up >= dur:
+                break
+            t, th, om = t_up, 0.0, 0.0
+            s = -1.0 if acc(t) > 0 else 1.0
+            at_rest = False
+            ts.append(t), ths.append(0.0), oms.append(0.0)
+        stop = dur if t < dur else min(t_end, t + 100.0 / p)
+        if t >= stop:
+            break
+
+        def impact(t_, y, s=s):
+            return s * y[0]
+
+        def fall(t_, y, s=s):
+            return s * y[0] - FALL_ROTATION
+
+        def peak(t_, y, s=s):
+            return s * y[1]
+
+        impact.terminal, impact.direction = True, -1
+        fall.terminal, fall.direction = True, 1
+        peak.direction = -1
+        sol = solve_ivp(rhs, (t, stop), [th, om], method=integrator, args=(s,), rtol=rtol,
+                        atol=atol, events=(impact, fall, peak))
+        if sol.status < 0:
+            raise RuntimeError(f"solve_ivp failed: {sol.message}")
+        ts.extend(sol.t[1:]), ths.extend(sol.y[0, 1:]), oms.extend(sol.y[1, 1:])
+        if sol.y_events[2].size:
+            max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
+        if sol.t_events[1].size:
+            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, float(sol.t_events[1][0]))
+        if sol.t_events[0].size:
+            t = float(sol.t_events[0][0])
+            om_pre = float(sol.y_events[0][0, 1])
+            om_post = eta * om_pre
+            impacts.append(t)
+            ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([om_pre, om_post])
+            th = 0.0
+            if abs(om_post) < omega_rest:
+                a = acc(t)
+                if abs(a) < thr:
+                    at_rest = True
+                    om = 0.0
+                    continue
+                s, om = (-1.0 if a > 0 else 1.0), 0.0
+            else:
+                s, om = -s, om_post
+            if len(impacts) > max_impacts:
+                break
+            continue
+        t, th, om = float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1])
+        max_u = max(max_u, s * th)
+        if t >= t_end:
+            break
+    return _pack(ts, ths, oms, max_u, False, impacts, math.nan)
+
+
+def _pack(ts, ths, oms, max_u, over, impacts, t_ot):
+    return {
+        "t": np.asarray(ts),
+        "theta": np.asarray(ths),
+        "theta_dot": np.asarray(oms),
+        "max_rotation": float(max_u),
+        "overturned": bool(over),
+        "impact_times": np.asarray(impacts),
+        "overturn_time": t_ot,
+    }

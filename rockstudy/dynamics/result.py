@@ -1,0 +1,58 @@
+"""The result of one simulation."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class RockingResult:
+    """Response of one rocking structure to one ground motion.
+
+    Attributes
+    ----------
+    t : ndarray
+        Times of the history [s], from the start of the motion. At an impact the time appears
+        twice: before and after the jump of ``theta_dot``.
+    theta, theta_dot : ndarray
+        Rotation [rad] and angular velocity [rad/s]; theta > 0 rocks on the positive pivot.
+    max_rotation : float
+        Max |theta| over the response [rad]; pi/2 when the block overturns.
+    overturned : bool
+        Whether the block fell over (|theta| reached pi/2).
+    impact_times : ndarray
+        Times of the impacts [s].
+    overturn_time : float
+        Time at which |theta| reached pi/2 [s], NaN if the block survived.
+    method : str
+        The method that produced the result.
+    """
+
+    t: np.ndarray
+    theta: np.ndarray
+    theta_dot: np.ndarray
+    max_rotation: float
+    overturned: bool
+    impact_times: np.ndarray
+    overturn_time: float
+    method: str
+    info: dict = field(default_factory=dict)
+
+    @property
+    def n_impacts(self) -> int:
+        """Number of impacts (until rest, overturning or the end of the history)."""
+        return int(self.impact_times.size)
+
+    def summary(self) -> dict:
+        """The scalar outcomes as a JSON-ready dict."""
+        return {
+            "method": self.method,
+            "max_rotation": float(self.max_rotation),
+            "overturned": bool(self.overturned),
+            "n_impacts": self.n_impacts,
+            "first_impact_time": float(self.impact_times[0]) if self.n_impacts else None,
+            "overturn_time": None if np.isnan(self.overturn_time) else float(self.overturn_time),
+            **self.info,
+        }

@@ -1,0 +1,143 @@
+"""``simulate``: one structure, one ground motion, one method."""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+
+from .. import _validate
+from ..constants import FALL_ROTATION
+from ..motions import Motion
+from ..motions import _kernels as mk
+from . import _linear, _rocking
+from .reference import simulate_reference
+from .result import RockingResult
+
+Method = Literal["nonlinear", "linear", "scipy", "scipy-linear"]
+
+
+def rocking_parameters(structure) -> tuple[float, float, float]:
+    """(p [rad/s], alpha [rad], eta [-]) of a block, or of a structure's equivalent block."""
+    if hasattr(structure, "equivalent_block"):
+        structure = structure.equivalent_block()
+    try:
+        return (float(structure.frequency_parameter), float(structure.slenderness),
+                float(structure.restitution))
+    except AttributeError:
+        raise TypeError(
+            "structure must be a rockstudy Block or provide equivalent_block(); "
+            f"got {type(structure).__name__}"
+        ) from None
+
+
+def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+    kind, mp, times, samples = motion.kernel_spec()
+    t_tail = _tail_end(p, eta, motion, t_max)
+    cap = 4096
+    while True:
+        hist = np.empty((cap, 3))
+        imps = np.empty(cap)
+        status, max_rot, over, n_imp, t_ot, nh, ni = _rocking.scene(
+            p, alpha, eta, model, kind, mp, times, samples, rtol, False, t_tail, hist, imps,
+            max_steps, x0[0], x0[1])
+        if nh <= cap and ni <= cap:
+            break
+        cap *= 4
+    if status == _rocking.STATUS_MAX_STEPS:
+        raise RuntimeError(f"{method}: more than max_steps={max_steps} steps in one phase")
+    return RockingResult(hist[:nh, 0].copy(), hist[:nh, 1].copy(), hist[:nh, 2].copy(),
+                         float(max_rot), bool(over), imps[:ni].copy(), float(t_ot), method)
+
+
+def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+    """Exact piecewise solution for trigonometric pulses; the kernel for other motions."""
+    kind, mp, _, _ = motion.kernel_spec()
+    if kind != mk.KIND_TRIG:
+        return _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+    t_tail = _tail_end(p, eta, motion, t_max)
+    cap = 1024
+    while True:
+        rec = np.zeros((cap, 7))
+        status, max_rot, over, n_imp, t_ot = _linear.trig_scene(p, alpha, eta, mp, False,
+                                                                t_tail, rec, x0[0], x0[1])
+        if rec[0, 0] < cap - 1:
+            break
+        cap *= 4
+    t, th, om, impacts = _linear.phase_history(rec, p, alpha, mp[1], mp[2], x0)
+    return RockingResult(t, th, om, float(max_rot), bool(over), impacts, float(t_ot), method,
+                         {"solver": "exact piecewise (eq. 3.4 of [000])"})
+
+
+def _tail_end(p, eta, motion, t_max):
+    """End of the free-rocking history: t_max, or open-ended unless the block never rests."""
+    if t_max is not None:
+        return t_max
+    if eta >= 1.0:
+        return motion.duration + 100.0 / p  # an undamped block never comes to rest
+    return math.inf
+
+
+def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+    r = simulate_reference(p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max,
+                           initial_state=x0)
+    return RockingResult(r["t"], r["theta"], r["theta_dot"], r["max_rotation"], r["overturned"],
+                         r["impact_times"], r["overturn_time"], method)
+
+
+_METHODS = {
+    "nonlinear": (_kernel, _rocking.MODEL_NONLINEAR),
+    "linear": (_linear_exact, _rocking.MODEL_LINEAR),
+    "scipy": (_scipy, _rocking.MODEL_NONLINEAR),
+    "scipy-linear": (_scipy, _rocking.MODEL_LINEAR),
+}
+
+
+def simulate(structure, motion: Motion, method: Method = "nonlinear", rtol: float = 1e-8,
+             t_max: float | None = None, initial_rotation: float = 0.0,
+             initial_velocity: float = 0.0, max_steps: int = 10_000_000) -> RockingResult:
+    """Rock a structure through a ground motion.
+
+    Parameters
+    ----------
+    structure : Block or structure with ``equivalent_block()``
+        The rocking block, described by p, alpha and eta.
+    motion : Motion
+        Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``.
+    method : {"nonlinear", "linear", "scipy", "scipy-linear"}
+        ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven DOP853 kernel.
+        ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
+        trigonometric pulses, the same kernel otherwise.
+        ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
+    rtol : float
+        Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
+    t_max : float, optional
+        End of the history [s]. By default the free rocking after the motion is followed until
+        the block comes to rest or overturns.
+    initial_rotation, initial_velocity : float
+        theta [rad] and theta_dot [rad/s] at t = 0; |theta| < pi/2. Both zero (default): the
+        block starts at rest. Use with :class:`rockstudy.motions.NoMotion` for free rocking.
+    max_steps : int
+        Safety cap on the integrator steps in one rocking phase.
+
+    Returns
+    -------
+    RockingResult
+    """
+    try:
+        runner, model = _METHODS[method]
+    except KeyError:
+        raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}") from None
+    if not isinstance(motion, Motion):
+        raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
+    rtol = _validate.in_open_interval("rtol", rtol, 0.0, 1.0, "(0, 1)")
+    if t_max is not None:
+        t_max = _validate.positive("t_max", t_max)
+    th0 = _validate.in_open_interval("initial_rotation", initial_rotation, -FALL_ROTATION,
+                                     FALL_ROTATION, "(-pi/2, pi/2) rad")
+    om0 = float(initial_velocity)
+    if not math.isfinite(om0):
+        raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
+    p, alpha, eta = rocking_parameters(structure)
+    return runner(p, alpha, eta, motion, model, rtol, t_max, int(max_steps), method, (th0, om0))

@@ -1,0 +1,111 @@
+"""The rigid rectangular rocking block (Housner 1963), as in paper [000] section 2."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .. import _validate
+from ..constants import G
+
+
+def frequency_parameter(half_diagonal: float) -> float:
+    r"""Frequency parameter of a rectangular block, p [rad/s].
+
+    eq. (2.2) of [000]:
+
+    .. math:: p = \sqrt{3 g / (4 R)}
+
+    Parameters
+    ----------
+    half_diagonal : float
+        R, half the diagonal of the block [m].
+    """
+    return math.sqrt(3.0 * G / (4.0 * half_diagonal))
+
+
+def restitution_housner(slenderness: float) -> float:
+    r"""Housner's coefficient of restitution of a rectangular block [-].
+
+    Angular-momentum balance about the new pivot, eq. (2.4) of [000]:
+
+    .. math:: \eta = 1 - \tfrac{3}{2} \sin^2 \alpha
+
+    Parameters
+    ----------
+    slenderness : float
+        alpha, the slenderness angle [rad].
+    """
+    return 1.0 - 1.5 * math.sin(slenderness) ** 2
+
+
+@dataclass(frozen=True)
+class Block:
+    """A free-standing rigid rectangular block that can rock on its two base corners.
+
+    Parameters
+    ----------
+    half_diagonal : float
+        R, half the diagonal of the block [m]; must be > 0.
+    slenderness : float
+        alpha = atan(b / h) [rad]; must lie in (0, pi/2).
+    restitution : float or None
+        eta, the ratio of angular velocities after and before an impact [-], in (0, 1].
+        ``None`` (default) uses Housner's value (2.4) of [000].
+
+    Examples
+    --------
+    >>> blk = Block(half_diagonal=1.0, slenderness=0.2)
+    >>> round(blk.frequency_parameter, 4)
+    2.7124
+    """
+
+    half_diagonal: float
+    slenderness: float
+    restitution: float | None = None
+
+    def __post_init__(self):
+        R = _validate.positive("half_diagonal", self.half_diagonal)
+        alpha = _validate.in_open_interval(
+            "slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad"
+        )
+        eta = restitution_housner(alpha) if self.restitution is None else self.restitution
+        eta = _validate.restitution(eta)
+        object.__setattr__(self, "half_diagonal", R)
+        object.__setattr__(self, "slenderness", alpha)
+        object.__setattr__(self, "restitution", eta)
+
+    @classmethod
+    def from_dimensions(cls, width: float, height: float, restitution: float | None = None):
+        """Build a block from its full width 2b and height 2h [m].
+
+        Parameters
+        ----------
+        width, height : float
+            2b and 2h [m]; both must be > 0.
+        restitution : float or None
+            As in :class:`Block`.
+        """
+        b = _validate.positive("width", width) / 2.0
+        h = _validate.positive("height", height) / 2.0
+        return cls(math.hypot(b, h), math.atan2(b, h), restitution)
+
+    @property
+    def frequency_parameter(self) -> float:
+        """p = sqrt(3 g / 4 R) [rad/s], eq. (2.2) of [000]."""
+        return frequency_parameter(self.half_diagonal)
+
+    @property
+    def width(self) -> float:
+        """2b = 2 R sin(alpha) [m]."""
+        return 2.0 * self.half_diagonal * math.sin(self.slenderness)
+
+    @property
+    def height(self) -> float:
+        """2h = 2 R cos(alpha) [m]."""
+        return 2.0 * self.half_diagonal * math.cos(self.slenderness)
+
+    @property
+    def uplift_acceleration(self) -> float:
+        """Ground acceleration that starts rocking, g tan(alpha) [m/s^2], section 2 of [000]."""
+        return G * math.tan(self.slenderness)
