@@ -19,8 +19,9 @@ def _simulate(args) -> int:
             motion = motion.scaled(args.scale)
     else:
         if args.amplitude is None or args.period is None:
-            print("error: a pulse needs --amplitude and --period (or give --record)",
-                  file=sys.stderr)
+            print(
+                "error: a pulse needs --amplitude and --period (or give --record)", file=sys.stderr
+            )
             return 2
         cls = PULSES[args.pulse]
         kw = {"cycles": args.cycles} if args.pulse in ("sine", "cosine") else {}
@@ -50,8 +51,9 @@ def main(argv=None) -> int:
     sim.add_argument("--cycles", type=int, default=1)
     sim.add_argument("--record", help="a PEER .AT2 file or a two-column (t [s], a [g]) file")
     sim.add_argument("--scale", type=float, default=1.0, help="factor on the record")
-    sim.add_argument("--method", default="nonlinear",
-                     choices=["nonlinear", "linear", "scipy", "scipy-linear"])
+    sim.add_argument(
+        "--method", default="nonlinear", choices=["nonlinear", "linear", "scipy", "scipy-linear"]
+    )
     sim.add_argument("--rtol", type=float, default=1e-8)
     sim.add_argument("--json", action="store_true", help="print the summary as JSON")
     demo = sub.add_parser("demo", help="the demo job: a plot and a JSON summary")
@@ -64,8 +66,10 @@ def main(argv=None) -> int:
 
         s = run(args.out)
         for method, r in s["results"].items():
-            print(f"{method:10s} max|theta| = {r['max_rotation']:.6f} rad, overturned = "
-                  f"{r['overturned']}, impacts = {r['n_impacts']}, {r['seconds'] * 1e3:.2f} ms")
+            print(
+                f"{method:10s} max|theta| = {r['max_rotation']:.6f} rad, overturned = "
+                f"{r['overturned']}, impacts = {r['n_impacts']}, {r['seconds'] * 1e3:.2f} ms"
+            )
         print(f"wrote {args.out}/demo.png and {args.out}/demo.json")
         return 0
     except ValueError as exc:

@@ -29,8 +29,12 @@ def run(out_dir="results/demo") -> dict:
     block = Block.from_dimensions(width=0.5, height=2.0)
     pulse = SinePulse(amplitude=1.5 * G * np.tan(block.slenderness), period=0.6)
     summary = {
-        "block": {"half_diagonal": block.half_diagonal, "slenderness": block.slenderness,
-                  "restitution": block.restitution, "p": block.frequency_parameter},
+        "block": {
+            "half_diagonal": block.half_diagonal,
+            "slenderness": block.slenderness,
+            "restitution": block.restitution,
+            "p": block.frequency_parameter,
+        },
         "pulse": {"shape": "sine", "amplitude": pulse.amplitude, "period": pulse.period},
         "results": {},
     }
@@ -44,7 +48,9 @@ def run(out_dir="results/demo") -> dict:
         ax.plot(res.t, res.theta / block.slenderness, label=f"{method} ({elapsed * 1e3:.2f} ms)")
     ax.set_xlabel("t [s]")
     ax.set_ylabel(r"$\theta / \alpha$")
-    ax.set_title("Housner block 0.5 m x 2 m under a sine pulse, a_g = 1.5 g tan(alpha), T_p = 0.6 s")
+    ax.set_title(
+        "Housner block 0.5 m x 2 m under a sine pulse, a_g = 1.5 g tan(alpha), T_p = 0.6 s"
+    )
     ax.axhline(0.0, color="k", lw=0.5)
     ax.legend()
     fig.tight_layout()

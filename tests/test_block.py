@@ -10,8 +10,9 @@ from rockstudy.constants import G
 
 def test_frequency_parameter_is_sqrt_3g_over_4R():
     for R in (0.1, 1.0, 7.3):
-        assert rs.Block(R, 0.2).frequency_parameter == pytest.approx(math.sqrt(3 * G / (4 * R)),
-                                                                     rel=1e-15)
+        assert rs.Block(R, 0.2).frequency_parameter == pytest.approx(
+            math.sqrt(3 * G / (4 * R)), rel=1e-15
+        )
 
 
 def test_housner_restitution_by_momentum_balance():

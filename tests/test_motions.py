@@ -19,7 +19,9 @@ from rockstudy.motions import (
 def test_sine_pulse_definition():
     p = SinePulse(amplitude=3.0, period=0.8, cycles=2)
     t = np.linspace(0, 1.6, 101)
-    np.testing.assert_allclose(p.ground_acceleration(t), 3.0 * np.sin(2 * np.pi * t / 0.8), atol=1e-14)
+    np.testing.assert_allclose(
+        p.ground_acceleration(t), 3.0 * np.sin(2 * np.pi * t / 0.8), atol=1e-14
+    )
     assert p.duration == pytest.approx(1.6)
     assert p.ground_acceleration(1.7) == 0.0 and p.ground_acceleration(-0.1) == 0.0
     assert p.peak == 3.0
@@ -47,10 +49,15 @@ def test_ricker_starts_below_1e6_and_peaks_at_center():
     np.testing.assert_allclose(r.ground_acceleration(t), 4.0 * (1 - 2 * x) * np.exp(-x), atol=1e-13)
 
 
-@pytest.mark.parametrize("bad", [{"amplitude": 0.0, "period": 1.0},
-                                 {"amplitude": float("nan"), "period": 1.0},
-                                 {"amplitude": 1.0, "period": -1.0},
-                                 {"amplitude": 1.0, "period": 1.0, "cycles": 0}])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        {"amplitude": 0.0, "period": 1.0},
+        {"amplitude": float("nan"), "period": 1.0},
+        {"amplitude": 1.0, "period": -1.0},
+        {"amplitude": 1.0, "period": 1.0, "cycles": 0},
+    ],
+)
 def test_bad_pulse_input(bad):
     field = next(k for k, v in bad.items() if not (isinstance(v, float) and v == 1.0))
     with pytest.raises(ValueError, match=field):
@@ -85,7 +92,9 @@ def test_two_column_reader_el_centro(records_dir):
 
 def test_record_interpolates_linearly():
     rec = Record([0.0, 2.0, -2.0], dt=0.5)
-    np.testing.assert_allclose(rec.ground_acceleration([0.25, 0.5, 0.75, 1.0]), [1.0, 2.0, 0.0, -2.0])
+    np.testing.assert_allclose(
+        rec.ground_acceleration([0.25, 0.5, 0.75, 1.0]), [1.0, 2.0, 0.0, -2.0]
+    )
     assert rec.ground_acceleration(1.2) == 0.0
 
 
@@ -124,8 +133,16 @@ def test_stochastic_spectrum_follows_kanai_tajimi():
     from scipy.signal import welch
 
     wg, zg = 4 * math.pi, 0.4
-    rec = stochastic_record(peak=1.0, duration=2000.0, dt=0.01, ground_frequency=wg,
-                            ground_damping=zg, rise=0.5, plateau_end=2000.0, seed=1)
+    rec = stochastic_record(
+        peak=1.0,
+        duration=2000.0,
+        dt=0.01,
+        ground_frequency=wg,
+        ground_damping=zg,
+        rise=0.5,
+        plateau_end=2000.0,
+        seed=1,
+    )
     f, psd = welch(rec.acceleration, fs=100.0, nperseg=512)
     w2 = (2 * np.pi * f) ** 2
     kt = (wg**4 + 4 * zg**2 * wg**2 * w2) / ((wg**2 - w2) ** 2 + 4 * zg**2 * wg**2 * w2)

@@ -7,12 +7,12 @@ the erratum 1/a for 1/alpha).
 """
 
 from .sine import (
+    d0_star,
     first_impact_time_after_pulse,
     impact_velocity_after_pulse,
     max_rotation,
     pulse_end_time,
     sine_constants,
-    d0_star,
 )
 
 __all__ = [

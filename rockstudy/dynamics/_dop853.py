@@ -33,25 +33,62 @@ def make_dop853_step(rhs):
 
     @njit(cache=True)
     def step(args, t, y0, y1, f0, h, kx, kv):
-        kx[0] = y1
-        kv[0] = f0
-        for i in range(1, _NS):
-            sx = 0.0
-            sv = 0.0
-            for j in range(i):
-                a = _A[i][j]
-                if a != 0.0:
-                    sx += a * kx[j]
-                    sv += a * kv[j]
-            vi = y1 + h * sv
-            kx[i] = vi
-            kv[i] = rhs(t + _C[i] * h, y0 + h * sx, vi, args)
-        sx = 0.0
-        sv = 0.0
-        for j in range(_NS):
-            sx += _B[j] * kx[j]
-            sv += _B[j] * kv[j]
-        return y0 + h * sx, y1 + h * sv
+        # unrolled over the non-zero entries of the tableau, indexed by literals
+        # fmt: off
+        x0 = y1
+        v0 = f0
+        dx = (_A[1][0] * x0)
+        x1 = y1 + h * (_A[1][0] * v0)
+        v1 = rhs(t + _C[1] * h, y0 + h * dx, x1, args)
+        dx = (_A[2][0] * x0 + _A[2][1] * x1)
+        x2 = y1 + h * (_A[2][0] * v0 + _A[2][1] * v1)
+        v2 = rhs(t + _C[2] * h, y0 + h * dx, x2, args)
+        dx = (_A[3][0] * x0 + _A[3][2] * x2)
+        x3 = y1 + h * (_A[3][0] * v0 + _A[3][2] * v2)
+        v3 = rhs(t + _C[3] * h, y0 + h * dx, x3, args)
+        dx = (_A[4][0] * x0 + _A[4][2] * x2 + _A[4][3] * x3)
+        x4 = y1 + h * (_A[4][0] * v0 + _A[4][2] * v2 + _A[4][3] * v3)
+        v4 = rhs(t + _C[4] * h, y0 + h * dx, x4, args)
+        dx = (_A[5][0] * x0 + _A[5][3] * x3 + _A[5][4] * x4)
+        x5 = y1 + h * (_A[5][0] * v0 + _A[5][3] * v3 + _A[5][4] * v4)
+        v5 = rhs(t + _C[5] * h, y0 + h * dx, x5, args)
+        dx = (_A[6][0] * x0 + _A[6][3] * x3 + _A[6][4] * x4 + _A[6][5] * x5)
+        x6 = y1 + h * (_A[6][0] * v0 + _A[6][3] * v3 + _A[6][4] * v4 + _A[6][5] * v5)
+        v6 = rhs(t + _C[6] * h, y0 + h * dx, x6, args)
+        dx = (_A[7][0] * x0 + _A[7][3] * x3 + _A[7][4] * x4 + _A[7][5] * x5 + _A[7][6] * x6)
+        x7 = y1 + h * (_A[7][0] * v0 + _A[7][3] * v3 + _A[7][4] * v4 + _A[7][5] * v5
+            + _A[7][6] * v6)
+        v7 = rhs(t + _C[7] * h, y0 + h * dx, x7, args)
+        dx = (_A[8][0] * x0 + _A[8][3] * x3 + _A[8][4] * x4 + _A[8][5] * x5 + _A[8][6] * x6
+            + _A[8][7] * x7)
+        x8 = y1 + h * (_A[8][0] * v0 + _A[8][3] * v3 + _A[8][4] * v4 + _A[8][5] * v5
+            + _A[8][6] * v6 + _A[8][7] * v7)
+        v8 = rhs(t + _C[8] * h, y0 + h * dx, x8, args)
+        dx = (_A[9][0] * x0 + _A[9][3] * x3 + _A[9][4] * x4 + _A[9][5] * x5 + _A[9][6] * x6
+            + _A[9][7] * x7 + _A[9][8] * x8)
+        x9 = y1 + h * (_A[9][0] * v0 + _A[9][3] * v3 + _A[9][4] * v4 + _A[9][5] * v5
+            + _A[9][6] * v6 + _A[9][7] * v7 + _A[9][8] * v8)
+        v9 = rhs(t + _C[9] * h, y0 + h * dx, x9, args)
+        dx = (_A[10][0] * x0 + _A[10][3] * x3 + _A[10][4] * x4 + _A[10][5] * x5 + _A[10][6] * x6
+            + _A[10][7] * x7 + _A[10][8] * x8 + _A[10][9] * x9)
+        x10 = y1 + h * (_A[10][0] * v0 + _A[10][3] * v3 + _A[10][4] * v4 + _A[10][5] * v5
+            + _A[10][6] * v6 + _A[10][7] * v7 + _A[10][8] * v8 + _A[10][9] * v9)
+        v10 = rhs(t + _C[10] * h, y0 + h * dx, x10, args)
+        dx = (_A[11][0] * x0 + _A[11][3] * x3 + _A[11][4] * x4 + _A[11][5] * x5 + _A[11][6] * x6
+            + _A[11][7] * x7 + _A[11][8] * x8 + _A[11][9] * x9 + _A[11][10] * x10)
+        x11 = y1 + h * (_A[11][0] * v0 + _A[11][3] * v3 + _A[11][4] * v4 + _A[11][5] * v5
+            + _A[11][6] * v6 + _A[11][7] * v7 + _A[11][8] * v8 + _A[11][9] * v9 + _A[11][10] * v10)
+        v11 = rhs(t + _C[11] * h, y0 + h * dx, x11, args)
+        kx[0], kx[1], kx[2], kx[3], kx[4], kx[5] = x0, x1, x2, x3, x4, x5
+        kx[6], kx[7], kx[8], kx[9], kx[10], kx[11] = x6, x7, x8, x9, x10, x11
+        kv[0], kv[1], kv[2], kv[3], kv[4], kv[5] = v0, v1, v2, v3, v4, v5
+        kv[6], kv[7], kv[8], kv[9], kv[10], kv[11] = v6, v7, v8, v9, v10, v11
+        dx = (_B[0] * x0 + _B[5] * x5 + _B[6] * x6 + _B[7] * x7 + _B[8] * x8 + _B[9] * x9
+            + _B[10] * x10 + _B[11] * x11)
+        dv = (_B[0] * v0 + _B[5] * v5 + _B[6] * v6 + _B[7] * v7 + _B[8] * v8 + _B[9] * v9
+            + _B[10] * v10 + _B[11] * v11)
+        # fmt: on
+        return y0 + h * dx, y1 + h * dv
 
     return step
 
@@ -77,19 +114,19 @@ def dop853_error(kx, kv, h, sc_x, sc_v):
 
 @njit(cache=True, inline="always")
 def hermite5(s, h, y0, d0, a0, y1, d1, a1):
-    """Quintic Hermite value and derivative at s in [0, 1] of a step of length h.
+    """Quintic Hermite interpolant of a step of length h at s in [0, 1].
 
     y, d, a are the value, first and second time derivatives at the two ends.
-    Returns (y(s), dy/dt(s)).
+    Returns (y(s), dy/dt(s), d2y/dt2(s)).
     """
     s2 = s * s
     s3 = s2 * s
     s4 = s3 * s
     s5 = s4 * s
+    # basis functions (value), their s-derivatives and second s-derivatives
     h00 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5
     h10 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5
     h20 = 0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5
-    h01 = 10.0 * s3 - 15.0 * s4 + 6.0 * s5
     h11 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5
     h21 = 0.5 * s3 - s4 + 0.5 * s5
     g00 = -30.0 * s2 + 60.0 * s3 - 30.0 * s4
@@ -97,7 +134,14 @@ def hermite5(s, h, y0, d0, a0, y1, d1, a1):
     g20 = s - 4.5 * s2 + 6.0 * s3 - 2.5 * s4
     g11 = -12.0 * s2 + 28.0 * s3 - 15.0 * s4
     g21 = 1.5 * s2 - 4.0 * s3 + 2.5 * s4
+    q00 = -60.0 * s + 180.0 * s2 - 120.0 * s3
+    q10 = -36.0 * s + 96.0 * s2 - 60.0 * s3
+    q20 = 1.0 - 9.0 * s + 18.0 * s2 - 10.0 * s3
+    q11 = -24.0 * s + 84.0 * s2 - 60.0 * s3
+    q21 = 3.0 * s - 12.0 * s2 + 10.0 * s3
+    dy = y0 - y1
     hh = h * h
-    val = h00 * y0 + h10 * h * d0 + h20 * hh * a0 + h01 * y1 + h11 * h * d1 + h21 * hh * a1
-    der = (g00 * (y0 - y1)) / h + g10 * d0 + g20 * h * a0 + g11 * d1 + g21 * h * a1
-    return val, der
+    val = y1 + h00 * dy + h10 * h * d0 + h20 * hh * a0 + h11 * h * d1 + h21 * hh * a1
+    der = g00 * dy / h + g10 * d0 + g20 * h * a0 + g11 * d1 + g21 * h * a1
+    acc = q00 * dy / hh + q10 * d0 / h + q20 * a0 + q11 * d1 / h + q21 * a1
+    return val, der, acc

@@ -238,23 +238,26 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         rocking = False
         if t >= dur:
             break
-        code, tau, th, v, s, max_u, n_imp = _trig_phase(alpha, eta, q, W, ph, tau_ex, p * t,
-                                                        th, v, s, max_u, n_imp, rec)
+        code, tau, th, v, s, max_u, n_imp = _trig_phase(
+            alpha, eta, q, W, ph, tau_ex, p * t, th, v, s, max_u, n_imp, rec
+        )
         if code == PH_OVER:
             return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
         if code == PH_END:
             break
         t = tau / p
     if use_map:
-        over, peak, n_post = free_rocking_map(s * th, s * v * p, p, alpha, eta, MODEL_LINEAR,
-                                              REST_FRACTION * p * alpha)
+        over, peak, n_post = free_rocking_map(
+            s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
+        )
         if not over:
             return STATUS_OK, max(max_u, peak), False, n_imp + n_post, np.nan
         if rec.shape[0] == 0:
             tau_f, n_more = _free_fall_time(s * th, s * v, alpha, eta)
             return STATUS_OK, FALL_ROTATION, True, n_imp + n_more, dur + tau_f / p
-    code, tau, th, v, s, max_u, n_imp = _trig_phase(alpha, eta, 0.0, 1.0, 0.0, p * t_tail,
-                                                    tau_ex, th, v, s, max_u, n_imp, rec)
+    code, tau, th, v, s, max_u, n_imp = _trig_phase(
+        alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, max_u, n_imp, rec
+    )
     if code == PH_OVER:
         return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
     return STATUS_OK, max_u, False, n_imp, np.nan

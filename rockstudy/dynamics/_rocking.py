@@ -63,7 +63,7 @@ _step = make_dop853_step(_rhs)
 
 @njit(cache=True)
 def uplift_threshold(alpha, model):
-    """|u_g''| above which a block at rest starts rocking: g tan(alpha), or g alpha if linearized."""
+    """|u_g''| at which a block at rest starts rocking: g tan(alpha); g alpha if linearized."""
     return G * alpha if model == MODEL_LINEAR else G * math.tan(alpha)
 
 
@@ -148,89 +148,119 @@ def next_uplift(kind, mp, times, samples, thr, t0):
 def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
     """Root in [lo, hi] (unit step time) of the Hermite value (deriv=False) or derivative.
 
-    Finds where sgn * (q(s) - target) changes from >= 0 at lo to < 0 at hi, by safeguarded
-    Newton steps on the bracket.
+    Finds where sgn * (q(s) - target) changes from >= 0 at lo to < 0 at hi, by Newton steps
+    safeguarded by bisection of the bracket, to 1e-14 of the step.
     """
     s = 0.5 * (lo + hi)
-    for _ in range(60):
-        v, dv = hermite5(s, h, y0, d0, a0, y1, d1, a1)
-        if deriv:
-            q = dv
-            # derivative of dv in s, by a central difference of the exact quartic
-            e = 1e-6
-            dq = (hermite5(s + e, h, y0, d0, a0, y1, d1, a1)[1]
-                  - hermite5(s - e, h, y0, d0, a0, y1, d1, a1)[1]) / (2 * e)
-        else:
-            q = v
-            dq = dv * h
-        f = sgn * (q - target)
-        if f >= 0.0:
+    for _ in range(100):
+        v, dv, av = hermite5(s, h, y0, d0, a0, y1, d1, a1)
+        q, dq = (dv, av * h) if deriv else (v, dv * h)
+        f = q - target
+        if sgn * f >= 0.0:
             lo = s
         else:
             hi = s
-        sn = s - (q - target) / dq if dq != 0.0 else 0.5 * (lo + hi)
+        sn = s - f / dq if dq != 0.0 else 0.5 * (lo + hi)
         if not lo < sn < hi:
             sn = 0.5 * (lo + hi)
-        if abs(sn - s) < 1e-15:
+        if abs(sn - s) <= 1e-14 or hi - lo <= 1e-14:
             return sn
         s = sn
-        if hi - lo < 1e-15:
-            break
-    return 0.5 * (lo + hi)
+    return s
 
 
-@njit(cache=True, inline="always")
-def _push(hist, nh, t, th, om):
+# Per-scene work arrays: the rocking state ...
+T, TH, OM, SIDE, H = 0, 1, 2, 3, 4
+# ... and the running tallies (counts are stored as floats)
+MAXU, NIMP, WORK, NH, NI = 0, 1, 2, 3, 4
+
+
+@njit(cache=True)
+def _push(hist, ta, t, th, om):
     """Append a history row if there is room; always count it, so overflow is detectable."""
-    if nh < hist.shape[0]:
-        hist[nh, 0] = t
-        hist[nh, 1] = th
-        hist[nh, 2] = om
-    return nh + 1
+    n = int(ta[NH])
+    if n < hist.shape[0]:
+        hist[n, 0] = t
+        hist[n, 1] = th
+        hist[n, 2] = om
+    ta[NH] = n + 1
 
 
 @njit(cache=True)
-def _record_step(hist, nh, t, h, th, om, f0, th1, om1, f1):
-    """Append the Hermite interpolant at 1/4, 1/2, 3/4 of an accepted step and its end."""
+def _record_step(hist, ta, args, t, h, th, om, f0, th1, om1, kx, kv):
+    """Append states at 1/4, 1/2 and 3/4 of an accepted step, each by a DOP853 step from its
+    start (as accurate as the step itself), and the end of the step."""
     for j in range(1, 4):
-        x, v = hermite5(0.25 * j, h, th, om, f0, th1, om1, f1)
-        nh = _push(hist, nh, t + 0.25 * j * h, x, v)
-    return _push(hist, nh, t + h, th1, om1)
+        x, v = _step(args, t, th, om, f0, 0.25 * j * h, kx, kv)
+        _push(hist, ta, t + 0.25 * j * h, x, v)
+    _push(hist, ta, t + h, th1, om1)
 
 
 @njit(cache=True)
-def _peak(args, t, th, om, f0, dt, kx, kv):
-    """s * theta at the peak near t + dt: a true DOP853 step there, then one Newton step on
-    theta_dot = 0 (theta_peak = theta - theta_dot^2 / (2 theta_ddot))."""
-    s = args[2]
+def _true_state(args, t, th, om, f0, dt, kx, kv):
+    """State and theta_ddot at t + dt by one DOP853 step from t (dt within an accepted step)."""
     th_s, om_s = _step(args, t, th, om, f0, dt, kx, kv)
-    f_s = _rhs(t + dt, th_s, om_s, args)
-    if f_s == 0.0:
-        return s * th_s
-    return s * (th_s - 0.5 * om_s * om_s / f_s)
+    return th_s, om_s, _rhs(t + dt, th_s, om_s, args)
 
 
 @njit(cache=True)
-def _phase(p, alpha, eta, model, kind, mp, times, samples, thr, omega_rest, rtol, t, th, om, s,
-           t_stop, h, max_u, n_imp, hist, nh, imps, ni, max_steps):
-    """Integrate rocking from (t, th, om) on side s until rest, overturning or t_stop.
+def _step_events(s, h, th, om, f0, th1, om1, f1):
+    """Impact and peak of u = s theta inside an accepted step, in unit step time.
 
-    Returns (code, t, th, om, s, h, max_u, n_imp, nh, ni).
+    Returns (s_imp, s_pk): the first root of theta (2.0 if none) and the peak of u before it
+    (-1.0 if none), located on the quintic Hermite interpolant.
     """
+    u1 = s * th1
+    v0 = s * om
+    s_imp = 2.0
+    if u1 < 0.0:
+        s_imp = _root_hermite(0.0, s, False, h, th, om, f0, th1, om1, f1, 0.0, 1.0)
+    elif v0 < 0.0 and s * om1 > 0.0:
+        s_tr = _root_hermite(0.0, -s, True, h, th, om, f0, th1, om1, f1, 0.0, 1.0)
+        if s * hermite5(s_tr, h, th, om, f0, th1, om1, f1)[0] < 0.0:
+            s_imp = _root_hermite(0.0, s, False, h, th, om, f0, th1, om1, f1, 0.0, s_tr)
+    else:
+        # a short hop (up, down through zero, up again) can hide inside one long step
+        for j in range(1, 4):
+            if s * hermite5(0.25 * j, h, th, om, f0, th1, om1, f1)[0] < 0.0:
+                lo = 0.25 * (j - 1)
+                s_imp = _root_hermite(0.0, s, False, h, th, om, f0, th1, om1, f1, lo, 0.25 * j)
+                break
+    s_end = min(s_imp, 1.0)
+    s_pk = -1.0
+    if v0 >= 0.0 and s * hermite5(s_end, h, th, om, f0, th1, om1, f1)[1] <= 0.0:
+        s_pk = _root_hermite(0.0, s, True, h, th, om, f0, th1, om1, f1, 0.0, s_end)
+    return s_imp, s_pk
+
+
+@njit(cache=True)
+def _phase(blk, mot, log, st, ta, t_stop):
+    """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
+
+    blk = (p, alpha, eta, model, thr, omega_rest, tol, max_steps), mot = (kind, mp, times,
+    samples), log = (hist, imps) (empty arrays: no history). ``st`` and the tallies ``ta``
+    are updated in place. Returns PH_END, PH_REST, PH_OVER or PH_FAIL.
+    """
+    p, alpha, eta, model, thr, omega_rest, tol, max_steps = blk
+    kind, mp, times, samples = mot
+    hist, imps = log
     rec = hist.shape[0] > 0
+    t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
     dur = mp[3]
-    tol = TOL_SAFETY * rtol
     kx = np.empty(13)
     kv = np.empty(13)
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
     f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k))
     steps = 0
+    code = PH_END
     while t < t_stop:
         steps += 1
+        ta[WORK] += 1
         if steps > max_steps:
-            return PH_FAIL, t, th, om, s, h, max_u, n_imp, nh, ni
+            code = PH_FAIL
+            break
         t_next = t_stop
-        if kind == KIND_RECORD and t < dur:
+        if kind == KIND_RECORD and t < dur:  # end steps on record samples (kinks in u_g'')
             k = segment_index(times, t, k)
             t_next = min(t_next, times[k + 1])
         last = h >= t_next - t
@@ -244,82 +274,67 @@ def _phase(p, alpha, eta, model, kind, mp, times, samples, thr, omega_rest, rtol
         sc_x = tol * (ATOL_FRACTION * alpha + max(abs(th), abs(th1)))
         sc_v = tol * (ATOL_FRACTION * p * alpha + max(abs(om), abs(om1)))
         err = dop853_error(kx, kv, hs, sc_x, sc_v)
-        if not err <= 1.0:
+        if not err <= 1.0:  # rejected (or NaN)
             h = hs * max(0.2, 0.9 * err ** (-0.125)) if err == err else 0.2 * hs
             continue
         fac = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-0.125))
         h = max(h, hs * fac) if last else hs * fac
 
-        # ---- events on [t, t1], in the coordinates u = s*theta, v = s*theta_dot ----
-        u1 = s * th1
-        v0 = s * om
-        v1 = s * om1
-        s_imp = 2.0
-        if u1 < 0.0:
-            s_imp = _root_hermite(0.0, s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0)
-        elif v0 < 0.0 and v1 > 0.0:
-            s_tr = _root_hermite(0.0, -s, True, hs, th, om, f0, th1, om1, f1, 0.0, 1.0)
-            u_tr = s * hermite5(s_tr, hs, th, om, f0, th1, om1, f1)[0]
-            if u_tr < 0.0:
-                s_imp = _root_hermite(0.0, s, False, hs, th, om, f0, th1, om1, f1, 0.0, s_tr)
-        else:
-            # a short hop (up, down through zero, up again) can hide inside one long step
-            for j in range(1, 4):
-                if s * hermite5(0.25 * j, hs, th, om, f0, th1, om1, f1)[0] < 0.0:
-                    s_imp = _root_hermite(0.0, s, False, hs, th, om, f0, th1, om1, f1,
-                                          0.25 * (j - 1), 0.25 * j)
-                    break
-        s_end = min(s_imp, 1.0)
-        if v0 >= 0.0 and s * hermite5(s_end, hs, th, om, f0, th1, om1, f1)[1] <= 0.0:
-            s_pk = _root_hermite(0.0, s, True, hs, th, om, f0, th1, om1, f1, 0.0, s_end)
-            max_u = max(max_u, _peak(args, t, th, om, f0, s_pk * hs, kx, kv))
-        if s_imp > 1.0 and u1 >= FALL_ROTATION:
-            s_ot = _root_hermite(FALL_ROTATION, -1.0, False, hs, s * th, v0, s * f0, u1, v1,
-                                 s * f1, 0.0, 1.0)
-            t_ot = t + s_ot * hs
+        s_imp, s_pk = _step_events(s, hs, th, om, f0, th1, om1, f1)
+        if s_pk >= 0.0:  # peak: theta_peak = theta - theta_dot^2 / (2 theta_ddot), one Newton
+            ta[WORK] += 1
+            x, v, a = _true_state(args, t, th, om, f0, s_pk * hs, kx, kv)
+            ta[MAXU] = max(ta[MAXU], s * (x - 0.5 * v * v / a) if a != 0.0 else s * x)
+        if s_imp > 1.0 and s * th1 >= FALL_ROTATION:
+            s_ot = _root_hermite(
+                s * FALL_ROTATION, -s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0
+            )
+            om = hermite5(s_ot, hs, th, om, f0, th1, om1, f1)[1]
+            t = t + s_ot * hs
+            th = s * FALL_ROTATION
+            ta[MAXU] = FALL_ROTATION
             if rec:
-                v_ot = s * hermite5(s_ot, hs, s * th, v0, s * f0, u1, v1, s * f1)[1]
-                nh = _push(hist, nh, t_ot, s * FALL_ROTATION, v_ot)
-            return PH_OVER, t_ot, s * FALL_ROTATION, om1, s, h, FALL_ROTATION, n_imp, nh, ni
+                _push(hist, ta, t, th, om)
+            code = PH_OVER
+            break
         if s_imp > 1.0:
-            max_u = max(max_u, u1)
+            ta[MAXU] = max(ta[MAXU], s * th1)
             if rec:
-                nh = _record_step(hist, nh, t, hs, th, om, f0, th1, om1, f1)
+                _record_step(hist, ta, args, t, hs, th, om, f0, th1, om1, kx, kv)
             t, th, om, f0 = t1, th1, om1, f1
             continue
 
-        # ---- impact: locate on the interpolant, then one Newton step on a true RK step ----
-        hi_ = s_imp * hs
-        th_s, om_s = _step(args, t, th, om, f0, hi_, kx, kv)
-        f_s = _rhs(t + hi_, th_s, om_s, args)
-        dl = -th_s / om_s if om_s != 0.0 else 0.0
-        t_imp = t + hi_ + dl
-        om_imp = om_s + f_s * dl
-        om_post = eta * om_imp
-        n_imp += 1
-        if rec:
-            if ni < imps.shape[0]:
-                imps[ni] = t_imp
-            ni += 1
-            nh = _push(hist, nh, t_imp, 0.0, om_imp)
-            nh = _push(hist, nh, t_imp, 0.0, om_post)
-        t = t_imp
+        # impact: located on the interpolant, then one Newton step on a true RK step
+        ta[WORK] += 1
+        x, v, a = _true_state(args, t, th, om, f0, s_imp * hs, kx, kv)
+        dl = -x / v if v != 0.0 else 0.0
+        t = t + s_imp * hs + dl
+        om_pre = v + a * dl
+        om = eta * om_pre  # eq. (2.3) of [000], once per impact
         th = 0.0
-        if abs(om_post) < omega_rest:
-            if kind == KIND_RECORD:
-                k = segment_index(times, min(t, dur), k)
-            a = ground_acceleration(kind, mp, times, samples, t, k)
-            if abs(a) < thr:
-                return PH_REST, t, 0.0, 0.0, s, h, max_u, n_imp, nh, ni
-            s = -1.0 if a > 0.0 else 1.0
+        ta[NIMP] += 1
+        if rec:
+            n = int(ta[NI])
+            if n < imps.shape[0]:
+                imps[n] = t
+            ta[NI] = n + 1
+            _push(hist, ta, t, 0.0, om_pre)
+            _push(hist, ta, t, 0.0, om)
+        if kind == KIND_RECORD:
+            k = segment_index(times, min(t, dur), k)
+        if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
+            a_g = ground_acceleration(kind, mp, times, samples, t, k)
+            if abs(a_g) < thr:
+                om = 0.0
+                code = PH_REST
+                break
+            s = -1.0 if a_g > 0.0 else 1.0
             om = 0.0
         else:
             s = -s
-            om = om_post
-        if kind == KIND_RECORD:
-            k = segment_index(times, t, k)
         f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k))
-    return PH_END, t, th, om, s, h, max_u, n_imp, nh, ni
+    st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
+    return code
 
 
 @njit(cache=True, inline="always")
@@ -369,75 +384,56 @@ def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
 
 
 @njit(cache=True)
-def scene(p, alpha, eta, model, kind, mp, times, samples, rtol, use_map, t_tail, hist, imps,
-          max_steps, th_init=0.0, om_init=0.0):
-    """Rock one block through one motion, from rest or from (th_init, om_init) at t = 0.
+def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=0.0, om0=0.0):
+    """Rock one block through one motion, from rest or from (th0, om0) at t = 0.
 
+    mot = (kind, mp, times, samples); log = (hist, imps), empty arrays for no history.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
-    impact times recorded).
+    impact times recorded, DOP853 steps).
     """
+    kind, mp, times, samples = mot
     thr = uplift_threshold(alpha, model)
     omega_rest = REST_FRACTION * p * alpha
-    dur = mp[3]
+    blk = (p, alpha, eta, model, thr, omega_rest, TOL_SAFETY * rtol, max_steps)
+    hist = log[0]
     rec = hist.shape[0] > 0
-    t = 0.0
-    th = 0.0
-    om = 0.0
-    s = 1.0
-    h = 0.01 / p
-    max_u = 0.0
-    n_imp = 0
-    nh = 0
-    ni = 0
-    t_ot = np.nan
-    at_rest = th_init == 0.0 and om_init == 0.0
-    if not at_rest:
-        th = th_init
-        om = om_init
-        max_u = abs(th_init)
-        s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
+    dur = mp[3]
+    at_rest = th0 == 0.0 and om0 == 0.0
+    st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
+    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0])
     if rec:
-        nh = _push(hist, nh, 0.0, th, om)
-    while t < dur:
+        _push(hist, ta, 0.0, th0, om0)
+    code = PH_END
+    while st[T] < dur:
         if at_rest:
-            t_up = next_uplift(kind, mp, times, samples, thr, t)
+            t_up = next_uplift(kind, mp, times, samples, thr, st[T])
             if t_up >= dur:
-                t = dur
                 break
             k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
-            a = ground_acceleration(kind, mp, times, samples, t_up, k)
-            s = -1.0 if a > 0.0 else 1.0
-            t = t_up
-            th = 0.0
-            om = 0.0
+            a_g = ground_acceleration(kind, mp, times, samples, t_up, k)
+            st[T], st[TH], st[OM], st[SIDE] = t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0
             at_rest = False
             if rec:
-                nh = _push(hist, nh, t, 0.0, 0.0)
-        code, t, th, om, s, h, max_u, n_imp, nh, ni = _phase(
-            p, alpha, eta, model, kind, mp, times, samples, thr, omega_rest, rtol, t, th, om, s,
-            dur, h, max_u, n_imp, hist, nh, imps, ni, max_steps)
-        if code == PH_REST:
-            at_rest = True
-        elif code == PH_OVER:
-            return STATUS_OK, FALL_ROTATION, True, n_imp, t, nh, ni
-        elif code == PH_FAIL:
-            return STATUS_MAX_STEPS, max_u, False, n_imp, np.nan, nh, ni
+                _push(hist, ta, t_up, 0.0, 0.0)
+        code = _phase(blk, mot, log, st, ta, dur)
+        if code != PH_END and code != PH_REST:
+            break
+        at_rest = code == PH_REST
     if at_rest:
         if rec:
-            nh = _push(hist, nh, dur, 0.0, 0.0)
-        return STATUS_OK, max_u, False, n_imp, t_ot, nh, ni
-    if use_map:
-        over, peak, n_post = free_rocking_map(s * th, s * om, p, alpha, eta, model, omega_rest)
-        if not over:
-            return STATUS_OK, max(max_u, peak), False, n_imp + n_post, t_ot, nh, ni
-    code, t, th, om, s, h, max_u, n_imp, nh, ni = _phase(
-        p, alpha, eta, model, kind, mp, times, samples, thr, omega_rest, rtol, t, th, om, s,
-        t_tail, h, max_u, n_imp, hist, nh, imps, ni, max_steps)
-    if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, n_imp, t, nh, ni
-    if code == PH_FAIL:
-        return STATUS_MAX_STEPS, max_u, False, n_imp, np.nan, nh, ni
-    return STATUS_OK, max_u, False, n_imp, t_ot, nh, ni
+            _push(hist, ta, dur, 0.0, 0.0)
+    elif code == PH_END:
+        u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
+        over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
+        if use_map and not over:
+            ta[MAXU] = max(ta[MAXU], peak)
+            ta[NIMP] += n_post
+        else:  # integrate the free rocking: for the history, or to time the overturning
+            code = _phase(blk, mot, log, st, ta, t_tail)
+    status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
+    over = code == PH_OVER
+    t_ot = st[T] if over else np.nan
+    return (status, ta[MAXU], over, int(ta[NIMP]), t_ot, int(ta[NH]), int(ta[NI]), int(ta[WORK]))
 
 
 @njit(cache=True, parallel=True)
@@ -449,14 +445,25 @@ def scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps)
     over = np.empty(n, np.bool_)
     n_imp = np.empty(n, np.int64)
     t_ot = np.empty(n)
-    no_hist = np.empty((0, 3))
-    no_imps = np.empty(0)
+    work = np.empty(n, np.int64)
+    no_log = (np.empty((0, 3)), np.empty(0))
     for i in prange(n):
-        r = scene(p[i], alpha[i], eta[i], model, kind, mp[i], times, samples, rtol, True,
-                  np.inf, no_hist, no_imps, max_steps)
+        r = scene(
+            p[i],
+            alpha[i],
+            eta[i],
+            model,
+            (kind, mp[i], times, samples),
+            rtol,
+            True,
+            np.inf,
+            no_log,
+            max_steps,
+        )
         status[i] = r[0]
         max_rot[i] = r[1]
         over[i] = r[2]
         n_imp[i] = r[3]
         t_ot[i] = r[4]
-    return status, max_rot, over, n_imp, t_ot
+        work[i] = r[7]
+    return status, max_rot, over, n_imp, t_ot, work

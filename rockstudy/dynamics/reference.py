@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
-from ._rocking import MODEL_LINEAR, REST_FRACTION
+from ._rocking import MODEL_LINEAR, REST_FRACTION, free_rocking_map
 
 
 def _scalar_acceleration(motion: Motion):
@@ -40,7 +40,7 @@ def _uplift_time(acc, thr, t0, dur, grid):
     if abs(acc(t0)) >= thr:
         return t0
     pts = np.concatenate([[t0], grid[grid > t0], [dur]])
-    for lo, hi in zip(pts[:-1], pts[1:]):
+    for lo, hi in zip(pts[:-1], pts[1:], strict=True):
         if abs(acc(hi)) >= thr:
             if hi <= lo:
                 return hi
@@ -48,8 +48,19 @@ def _uplift_time(acc, thr, t0, dur, grid):
     return math.inf
 
 
-def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integrator="DOP853",
-                       t_max=None, initial_state=(0.0, 0.0), max_impacts=20000):
+def simulate_reference(
+    p,
+    alpha,
+    eta,
+    motion: Motion,
+    model=0,
+    rtol=1e-12,
+    integrator="DOP853",
+    t_max=None,
+    initial_state=(0.0, 0.0),
+    free_map=False,
+    max_impacts=20000,
+):
     """Integrate one scene with ``solve_ivp`` and events.
 
     Parameters
@@ -67,6 +78,10 @@ def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integ
         End of the free-rocking tail [s]; by default until rest or overturning.
     initial_state : (float, float)
         theta [rad] and theta_dot [rad/s] at t = 0; (0, 0) starts at rest.
+    free_map : bool
+        After the motion ends, use the closed-form free-rocking map of the kernels instead of
+        integrating (integrating on only if the block overturns). This is the scipy path with
+        the same algorithm as the kernels, for a like-for-like timing.
 
     Returns
     -------
@@ -80,9 +95,9 @@ def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integ
     t_end = math.inf if t_max is None else float(t_max)
     atol = [rtol * alpha, rtol * p * alpha]
     if isinstance(motion, Record):
-        grid = np.asarray(motion.time)
+        grid = breaks = np.asarray(motion.time)
     else:
-        grid = np.linspace(0.0, dur, 4097)
+        grid, breaks = np.linspace(0.0, dur, 4097), None
 
     def rhs(t, y, s):
         a = acc(t) / G
@@ -96,6 +111,7 @@ def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integ
     max_u = abs(th)
     t = 0.0
     at_rest = th == 0.0 and om == 0.0
+    mapped = False
     s = math.copysign(1.0, th if th != 0.0 else om)
     while True:
         if at_rest:
@@ -106,7 +122,16 @@ def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integ
             s = -1.0 if acc(t) > 0 else 1.0
             at_rest = False
             ts.append(t), ths.append(0.0), oms.append(0.0)
-        stop = dur if t < dur else min(t_end, t + 100.0 / p)
+        if t >= dur and free_map and not mapped:
+            mapped = True
+            over, peak, n_post = free_rocking_map(s * th, s * om, p, alpha, eta, model, omega_rest)
+            if not over:
+                impacts.extend([math.nan] * n_post)
+                return _pack(ts, ths, oms, max(max_u, peak), False, impacts, math.nan)
+        if t < dur:  # records: stop at every sample, where u_g'' has a kink
+            stop = dur if breaks is None else breaks[np.searchsorted(breaks, t, side="right")]
+        else:
+            stop = min(t_end, t + 100.0 / p)
         if t >= stop:
             break
 
@@ -122,15 +147,26 @@ def simulate_reference(p, alpha, eta, motion: Motion, model=0, rtol=1e-12, integ
         impact.terminal, impact.direction = True, -1
         fall.terminal, fall.direction = True, 1
         peak.direction = -1
-        sol = solve_ivp(rhs, (t, stop), [th, om], method=integrator, args=(s,), rtol=rtol,
-                        atol=atol, events=(impact, fall, peak))
+        sol = solve_ivp(
+            rhs,
+            (t, stop),
+            [th, om],
+            method=integrator,
+            args=(s,),
+            rtol=rtol,
+            atol=atol,
+            events=(impact, fall, peak),
+        )
         if sol.status < 0:
             raise RuntimeError(f"solve_ivp failed: {sol.message}")
-        ts.extend(sol.t[1:]), ths.extend(sol.y[0, 1:]), oms.extend(sol.y[1, 1:])
+        end = -1 if sol.status == 1 else None  # the event row is added below, exactly
+        ts.extend(sol.t[1:end]), ths.extend(sol.y[0, 1:end]), oms.extend(sol.y[1, 1:end])
         if sol.y_events[2].size:
             max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
         if sol.t_events[1].size:
-            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, float(sol.t_events[1][0]))
+            t_ot = float(sol.t_events[1][0])
+            ts.append(t_ot), ths.append(s * FALL_ROTATION), oms.append(sol.y_events[1][0, 1])
+            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, t_ot)
         if sol.t_events[0].size:
             t = float(sol.t_events[0][0])
             om_pre = float(sol.y_events[0][0, 1])

@@ -23,8 +23,11 @@ def rocking_parameters(structure) -> tuple[float, float, float]:
     if hasattr(structure, "equivalent_block"):
         structure = structure.equivalent_block()
     try:
-        return (float(structure.frequency_parameter), float(structure.slenderness),
-                float(structure.restitution))
+        return (
+            float(structure.frequency_parameter),
+            float(structure.slenderness),
+            float(structure.restitution),
+        )
     except AttributeError:
         raise TypeError(
             "structure must be a rockstudy Block or provide equivalent_block(); "
@@ -39,16 +42,36 @@ def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     while True:
         hist = np.empty((cap, 3))
         imps = np.empty(cap)
-        status, max_rot, over, n_imp, t_ot, nh, ni = _rocking.scene(
-            p, alpha, eta, model, kind, mp, times, samples, rtol, False, t_tail, hist, imps,
-            max_steps, x0[0], x0[1])
+        status, max_rot, over, n_imp, t_ot, nh, ni, work = _rocking.scene(
+            p,
+            alpha,
+            eta,
+            model,
+            (kind, mp, times, samples),
+            rtol,
+            False,
+            t_tail,
+            (hist, imps),
+            max_steps,
+            x0[0],
+            x0[1],
+        )
         if nh <= cap and ni <= cap:
             break
         cap *= 4
     if status == _rocking.STATUS_MAX_STEPS:
         raise RuntimeError(f"{method}: more than max_steps={max_steps} steps in one phase")
-    return RockingResult(hist[:nh, 0].copy(), hist[:nh, 1].copy(), hist[:nh, 2].copy(),
-                         float(max_rot), bool(over), imps[:ni].copy(), float(t_ot), method)
+    return RockingResult(
+        hist[:nh, 0].copy(),
+        hist[:nh, 1].copy(),
+        hist[:nh, 2].copy(),
+        float(max_rot),
+        bool(over),
+        imps[:ni].copy(),
+        float(t_ot),
+        method,
+        {"dop853_steps": int(work)},
+    )
 
 
 def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
@@ -60,14 +83,24 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
     cap = 1024
     while True:
         rec = np.zeros((cap, 7))
-        status, max_rot, over, n_imp, t_ot = _linear.trig_scene(p, alpha, eta, mp, False,
-                                                                t_tail, rec, x0[0], x0[1])
+        status, max_rot, over, n_imp, t_ot = _linear.trig_scene(
+            p, alpha, eta, mp, False, t_tail, rec, x0[0], x0[1]
+        )
         if rec[0, 0] < cap - 1:
             break
         cap *= 4
     t, th, om, impacts = _linear.phase_history(rec, p, alpha, mp[1], mp[2], x0)
-    return RockingResult(t, th, om, float(max_rot), bool(over), impacts, float(t_ot), method,
-                         {"solver": "exact piecewise (eq. 3.4 of [000])"})
+    return RockingResult(
+        t,
+        th,
+        om,
+        float(max_rot),
+        bool(over),
+        impacts,
+        float(t_ot),
+        method,
+        {"solver": "exact piecewise (eq. 3.4 of [000])"},
+    )
 
 
 def _tail_end(p, eta, motion, t_max):
@@ -80,10 +113,19 @@ def _tail_end(p, eta, motion, t_max):
 
 
 def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
-    r = simulate_reference(p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max,
-                           initial_state=x0)
-    return RockingResult(r["t"], r["theta"], r["theta_dot"], r["max_rotation"], r["overturned"],
-                         r["impact_times"], r["overturn_time"], method)
+    r = simulate_reference(
+        p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max, initial_state=x0
+    )
+    return RockingResult(
+        r["t"],
+        r["theta"],
+        r["theta_dot"],
+        r["max_rotation"],
+        r["overturned"],
+        r["impact_times"],
+        r["overturn_time"],
+        method,
+    )
 
 
 _METHODS = {
@@ -94,9 +136,16 @@ _METHODS = {
 }
 
 
-def simulate(structure, motion: Motion, method: Method = "nonlinear", rtol: float = 1e-8,
-             t_max: float | None = None, initial_rotation: float = 0.0,
-             initial_velocity: float = 0.0, max_steps: int = 10_000_000) -> RockingResult:
+def simulate(
+    structure,
+    motion: Motion,
+    method: Method = "nonlinear",
+    rtol: float = 1e-8,
+    t_max: float | None = None,
+    initial_rotation: float = 0.0,
+    initial_velocity: float = 0.0,
+    max_steps: int = 10_000_000,
+) -> RockingResult:
     """Rock a structure through a ground motion.
 
     Parameters
@@ -134,8 +183,9 @@ def simulate(structure, motion: Motion, method: Method = "nonlinear", rtol: floa
     rtol = _validate.in_open_interval("rtol", rtol, 0.0, 1.0, "(0, 1)")
     if t_max is not None:
         t_max = _validate.positive("t_max", t_max)
-    th0 = _validate.in_open_interval("initial_rotation", initial_rotation, -FALL_ROTATION,
-                                     FALL_ROTATION, "(-pi/2, pi/2) rad")
+    th0 = _validate.in_open_interval(
+        "initial_rotation", initial_rotation, -FALL_ROTATION, FALL_ROTATION, "(-pi/2, pi/2) rad"
+    )
     om0 = float(initial_velocity)
     if not math.isfinite(om0):
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")

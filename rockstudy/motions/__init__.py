@@ -7,6 +7,7 @@ from .stochastic import envelope_jennings, kanai_tajimi_filter, stochastic_recor
 
 __all__ = [
     "Motion",
+    "PULSES",
     "SinePulse",
     "CosinePulse",
     "HalfSinePulse",

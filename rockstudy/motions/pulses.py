@@ -57,8 +57,7 @@ class _TrigPulse(Motion):
         return abs(self.amplitude)
 
     def kernel_spec(self):
-        kind, rows = pulse_kernel_rows(_NAMES[type(self)], self.amplitude, self.period,
-                                       self.cycles)
+        kind, rows = pulse_kernel_rows(_NAMES[type(self)], self.amplitude, self.period, self.cycles)
         return kind, rows[0], _EMPTY, _EMPTY
 
 
@@ -156,8 +155,12 @@ class RickerWavelet(Motion):
         return kind, rows[0], _EMPTY, _EMPTY
 
 
-_NAMES = {SinePulse: "sine", CosinePulse: "cosine", HalfSinePulse: "half-sine",
-          RickerWavelet: "ricker"}
+_NAMES = {
+    SinePulse: "sine",
+    CosinePulse: "cosine",
+    HalfSinePulse: "half-sine",
+    RickerWavelet: "ricker",
+}
 PULSES = {name: cls for cls, name in _NAMES.items()}
 
 
@@ -171,8 +174,9 @@ def pulse_kernel_rows(pulse: str, amplitude, period, cycles=1):
         a_g [m/s^2], T_p [s] and the number of cycles (sine and cosine), broadcast together.
         They are not validated here; the public constructors and the batch entry point do.
     """
-    amp, per, cyc = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
-                                          for x in (amplitude, period, cycles)))
+    amp, per, cyc = np.broadcast_arrays(
+        *(np.atleast_1d(np.asarray(x, dtype=float)) for x in (amplitude, period, cycles))
+    )
     rows = np.empty(amp.shape + (4,))
     rows[:, 0] = amp
     if pulse == "ricker":

@@ -139,5 +139,7 @@ class Record(Motion):
             text = text.replace(",", " ")
         data = np.loadtxt(text.splitlines(), comments="#", delimiter=delimiter, ndmin=2)
         if data.shape[1] != 2:
-            raise ValueError(f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}")
+            raise ValueError(
+                f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}"
+            )
         return cls(data[:, 1] * factor, time=data[:, 0], name=path.stem)

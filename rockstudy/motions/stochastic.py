@@ -94,6 +94,8 @@ def stochastic_record(
     n = int(round(duration / dt)) + 1
     noise = rng.standard_normal(n)
     b, a = kanai_tajimi_filter(ground_frequency, ground_damping, dt)
-    acc = signal.lfilter(b, a, noise) * envelope_jennings(dt * np.arange(n), rise, plateau_end, decay)
+    acc = signal.lfilter(b, a, noise) * envelope_jennings(
+        dt * np.arange(n), rise, plateau_end, decay
+    )
     acc *= peak / np.max(np.abs(acc))
     return Record(acc, dt=dt, name=f"kanai-tajimi(seed={seed})")

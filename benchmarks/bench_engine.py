@@ -1,0 +1,176 @@
+"""Engine benchmark (issue 2): speed and accuracy of the rocking solvers on one scene set.
+
+One run times, on the same random set of sine-pulse scenes:
+  - the scipy path: solve_ivp DOP853 with events at rtol 1e-8, integrating the free rocking
+    after the pulse ("scipy full"), and with the kernels' closed-form map instead ("scipy+map",
+    the like-for-like comparison);
+  - the numba nonlinear kernel at rtol 1e-8 (batch entry point, one thread = one core);
+  - the exact linear solver (batch entry point, one thread).
+Errors are measured against solve_ivp DOP853 at rtol 1e-12. Prints a table and writes
+benchmarks/results/engine.json.
+
+    python benchmarks/bench_engine.py [--scenes 1000] [--scipy-scenes 1000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import rockstudy as rs
+from rockstudy.constants import G
+from rockstudy.dynamics.batch import simulate_batch
+from rockstudy.dynamics.reference import simulate_reference
+
+OUT = Path(__file__).parent / "results"
+
+
+def scene_set(n, seed=20261121):
+    rng = np.random.default_rng(seed)
+    R = rng.uniform(0.3, 5.0, n)
+    alpha = rng.uniform(0.05, 0.4, n)
+    ratio = rng.uniform(1.05, 5.0, n)  # a_g / (g tan alpha): rocking and overturning
+    amp = ratio * G * np.tan(alpha) * rng.choice([-1.0, 1.0], n)
+    period = rng.uniform(0.1, 2.0, n)
+    return R, alpha, amp, period
+
+
+def timed(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return out, float(np.median(times))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scenes", type=int, default=1000)
+    ap.add_argument(
+        "--scipy-scenes", type=int, default=1000, help="scenes timed through scipy (the slow part)"
+    )
+    args = ap.parse_args()
+    n = args.scenes
+    R, alpha, amp, period = scene_set(n)
+    p = np.sqrt(3 * G / (4 * R))
+    eta = 1 - 1.5 * np.sin(alpha) ** 2
+    numba.set_num_threads(1)
+    kw = dict(half_diagonal=R, slenderness=alpha, pulse="sine", amplitude=amp, period=period)
+
+    # warm up (compile), then time: median of repeats
+    simulate_batch(**{k: v[:2] if isinstance(v, np.ndarray) else v for k, v in kw.items()})
+    simulate_batch(
+        method="linear", **{k: v[:2] if isinstance(v, np.ndarray) else v for k, v in kw.items()}
+    )
+    ker, t_ker = timed(lambda: simulate_batch(rtol=1e-8, **kw), 5)
+    lin_reps = max(5, int(2e5 // n))
+    lin, t_lin = timed(lambda: simulate_batch(method="linear", **kw), lin_reps)
+
+    # reference, rtol 1e-12, full integration
+    print(f"reference: {n} scenes through solve_ivp DOP853 at rtol 1e-12 ...", flush=True)
+    ref = [
+        simulate_reference(
+            p[i], alpha[i], eta[i], rs.motions.SinePulse(amp[i], period[i]), rtol=1e-12
+        )
+        for i in range(n)
+    ]
+    ref_max = np.array([r["max_rotation"] for r in ref])
+    ref_over = np.array([r["overturned"] for r in ref])
+
+    # scipy timings at rtol 1e-8
+    m = min(args.scipy_scenes, n)
+    sc_times = {"full": [], "map": []}
+    sc_max = np.empty(m)
+    for i in range(m):
+        pulse = rs.motions.SinePulse(amp[i], period[i])
+        for key, fm in (("full", False), ("map", True)):
+            t0 = time.perf_counter()
+            r = simulate_reference(p[i], alpha[i], eta[i], pulse, rtol=1e-8, free_map=fm)
+            sc_times[key].append(time.perf_counter() - t0)
+            if fm:
+                sc_max[i] = r["max_rotation"]
+
+    # kernel impact times (single-scene path, rtol 1e-8) against the reference
+    imp_err = []
+    for i in range(n):
+        res = rs.simulate(
+            rs.Block(R[i], alpha[i]), rs.motions.SinePulse(amp[i], period[i]), rtol=1e-8
+        )
+        k = min(10, ref[i]["impact_times"].size, res.n_impacts)
+        if k:
+            imp_err.append(np.max(np.abs(res.impact_times[:k] - ref[i]["impact_times"][:k])))
+    imp_err = np.array(imp_err)
+
+    survived = ~ref_over & (ref_max > 0)
+    rel = np.abs(ker["max_rotation"][survived] / ref_max[survived] - 1)
+    disagree = np.flatnonzero(ker["overturned"] != ref_over)
+    near_boundary = 0
+    for i in disagree:  # is the scene within 1e-4 (relative amplitude) of the boundary?
+        outs = {
+            simulate_reference(
+                p[i], alpha[i], eta[i], rs.motions.SinePulse(amp[i] * f, period[i]), rtol=1e-12
+            )["overturned"]
+            for f in (1 - 1e-4, 1 + 1e-4)
+        }
+        near_boundary += len(outs) == 2
+
+    lin_ref_over = None  # the linear solver is exact; its check is in the test suite
+    rate = {
+        "scipy_full": m / float(np.sum(sc_times["full"])),
+        "scipy_map": m / float(np.sum(sc_times["map"])),
+        "nonlinear_kernel": n / t_ker,
+        "linear_exact": n / t_lin,
+    }
+    result = {
+        "scenes": n,
+        "scipy_scenes": m,
+        "machine": platform.processor() or platform.machine(),
+        "scenes_per_second_per_core": rate,
+        "ratio_kernel_vs_scipy_full": rate["nonlinear_kernel"] / rate["scipy_full"],
+        "ratio_kernel_vs_scipy_map": rate["nonlinear_kernel"] / rate["scipy_map"],
+        "ratio_linear_vs_scipy_map": rate["linear_exact"] / rate["scipy_map"],
+        "kernel_max_rotation_rel_error": {
+            "max": float(rel.max()),
+            "p99": float(np.quantile(rel, 0.99)),
+            "median": float(np.median(rel)),
+        },
+        "scipy_1e-8_max_rotation_rel_error_max": float(
+            np.max(np.abs(sc_max[survived[:m]] / ref_max[:m][survived[:m]] - 1))
+        ),
+        "kernel_first10_impact_time_abs_error": {
+            "max": float(imp_err.max()),
+            "median": float(np.median(imp_err)),
+        },
+        "overturn_disagreements": int(disagree.size),
+        "overturn_disagreements_within_1e-4_of_boundary": int(near_boundary),
+        "overturned_share": float(ref_over.mean()),
+        "status_nonzero": int(np.count_nonzero(ker["status"])),
+        "linear_reference": lin_ref_over,
+    }
+    OUT.mkdir(exist_ok=True)
+    (OUT / "engine.json").write_text(json.dumps(result, indent=2))
+    print(f"{'path':22s} {'scenes/s/core':>14s} {'vs scipy full':>14s} {'vs scipy+map':>13s}")
+    for key, v in rate.items():
+        print(f"{key:22s} {v:14.1f} {v / rate['scipy_full']:14.1f} {v / rate['scipy_map']:13.1f}")
+    e = result["kernel_max_rotation_rel_error"]
+    print(
+        f"kernel max-rotation rel. error vs rtol 1e-12: max {e['max']:.2e}, "
+        f"p99 {e['p99']:.2e}, median {e['median']:.2e}"
+    )
+    print(f"kernel first-10 impact times: max abs error {imp_err.max():.2e} s")
+    print(
+        f"overturning: {disagree.size} disagreements, {near_boundary} of them within 1e-4 "
+        f"of the boundary; {ref_over.mean():.0%} of scenes overturn"
+    )
+    print(f"wrote {OUT / 'engine.json'}")
+
+
+if __name__ == "__main__":
+    main()
