@@ -5,10 +5,20 @@ the single-ODE formulation (Prieto & Lourenco 2005), dynamically equivalent stru
 (DeJong & Dimitrakopoulos 2014), and parametric studies on top.
 """
 
-from . import motions, structures
-from .dynamics import RockingResult, simulate
+from . import closedform, motions, similarity, structures
+from .dynamics import RockingResult, simulate, simulate_batch
 from .structures import Block
 
 __version__ = "0.1.0"
 
-__all__ = ["Block", "RockingResult", "motions", "simulate", "structures", "__version__"]
+__all__ = [
+    "Block",
+    "RockingResult",
+    "closedform",
+    "motions",
+    "similarity",
+    "simulate",
+    "simulate_batch",
+    "structures",
+    "__version__",
+]

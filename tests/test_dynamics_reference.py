@@ -133,13 +133,18 @@ def test_linear_exact_matches_linear_kernel_in_batch():
     eta = 1 - 1.5 * np.sin(alpha) ** 2
     for shape in ("sine", "cosine", "half-sine"):
         kind, mp = pulse_kernel_rows(shape, amp, period)
-        exact = _linear.trig_batch(p, alpha, eta, mp)
+        exact = _linear.trig_batch(p, alpha, eta, mp).T
         rk = _rocking.scene_batch(
             p, alpha, eta, _rocking.MODEL_LINEAR, kind, mp, np.zeros(2), np.zeros(2), 1e-11, 10**6
-        )
-        np.testing.assert_array_equal(exact[2], rk[2])
-        survived = ~exact[2]
-        err = np.abs(rk[1] - exact[1])[survived]
-        assert np.all(err <= 1e-6 * exact[1][survived] + 1e-9 * alpha[survived]), err.max()
-        over = exact[2]
-        np.testing.assert_allclose(rk[4][over], exact[4][over], rtol=0, atol=1e-8)
+        ).T
+        col = {name: i for i, name in enumerate(_rocking.BATCH_COLUMNS)}
+        over = exact[col["overturned"]] == 1.0
+        np.testing.assert_array_equal(over, rk[col["overturned"]] == 1.0)
+        m_ex, m_rk = exact[col["max_rotation"]], rk[col["max_rotation"]]
+        err = np.abs(m_rk - m_ex)[~over]
+        assert np.all(err <= 1e-6 * m_ex[~over] + 1e-9 * alpha[~over]), err.max()
+        t_ex, t_rk = exact[col["overturn_time"]], rk[col["overturn_time"]]
+        np.testing.assert_allclose(t_rk[over], t_ex[over], rtol=0, atol=1e-8)
+        f_ex, f_rk = exact[col["first_impact_time"]], rk[col["first_impact_time"]]
+        np.testing.assert_array_equal(np.isnan(f_ex), np.isnan(f_rk))
+        np.testing.assert_allclose(f_rk, f_ex, rtol=0, atol=1e-8)

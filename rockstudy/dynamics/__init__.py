@@ -1,7 +1,8 @@
 """Rocking solvers: event-driven numba kernels, the exact linearized solution, the scipy
 reference, and the batch entry point used by studies."""
 
+from .batch import simulate_batch
 from .result import RockingResult
 from .simulate import simulate
 
-__all__ = ["RockingResult", "simulate"]
+__all__ = ["RockingResult", "simulate", "simulate_batch"]

@@ -95,13 +95,24 @@ def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
     rec[0, 0] = n + 1
 
 
+# running tallies of a scene: max |theta|, impacts, tau of the first impact
+_MAXU, _NIMP, _FIRST = 0, 1, 2
+
+
 @njit(cache=True)
-def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, max_u, n_imp, rec):
+def _impact_tally(ta, tau):
+    if ta[_NIMP] == 0:
+        ta[_FIRST] = tau
+    ta[_NIMP] += 1
+
+
+@njit(cache=True)
+def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
     """Rock (exactly) from tau0 until rest, overturning or tau_ex (end of pulse or of history).
 
-    theta and v = d theta / d tau are in rad; q = 0 gives free rocking. ``rec`` is a phase log
-    (see :func:`_log_phase`; shape (0, 7) to skip logging). Returns
-    (code, tau, theta, v, s, max_u, n_imp).
+    theta and v = d theta / d tau are in rad; q = 0 gives free rocking. ``ta`` holds the
+    tallies (updated in place); ``rec`` is a phase log (see :func:`_log_phase`; shape (0, 7) to
+    skip logging). Returns (code, tau, theta, v, s).
     """
     c = q / (1.0 + W * W)
     d = min(0.5, 0.25 * math.pi / W)
@@ -131,15 +142,16 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, max_u, n_imp, re
             end = s_imp if s_imp >= 0.0 else sb
             if va >= 0.0 and _u(1, A, B, c, W, x0, alpha, s, end) <= 0.0:
                 s_pk = _root(1, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, end)
-                max_u = max(max_u, _u(0, A, B, c, W, x0, alpha, s, s_pk))
+                ta[_MAXU] = max(ta[_MAXU], _u(0, A, B, c, W, x0, alpha, s, s_pk))
             if s_imp >= 0.0:
                 break
             if ub >= FALL_ROTATION:
                 s_ot = _root(0, FALL_ROTATION, -1.0, A, B, c, W, x0, alpha, s, sa, sb)
                 if log:
                     _log_phase(rec, tau0, tau0 + s_ot, A, B, s, q, 0.0)
-                return PH_OVER, tau0 + s_ot, s * FALL_ROTATION, 0.0, s, FALL_ROTATION, n_imp
-            max_u = max(max_u, ub)
+                ta[_MAXU] = FALL_ROTATION
+                return PH_OVER, tau0 + s_ot, s * FALL_ROTATION, 0.0, s
+            ta[_MAXU] = max(ta[_MAXU], ub)
             sa = sb
             va = vb
         if s_imp < 0.0:
@@ -147,18 +159,17 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, max_u, n_imp, re
             v_e = _u(1, A, B, c, W, x0, alpha, s, sig_end)
             if log:
                 _log_phase(rec, tau0, tau_ex, A, B, s, q, 0.0)
-            return PH_END, tau_ex, s * u_e, s * v_e, s, max_u, n_imp
+            return PH_END, tau_ex, s * u_e, s * v_e, s
         if log:
             _log_phase(rec, tau0, tau0 + s_imp, A, B, s, q, 1.0)
-        v_pre = s * _u(1, A, B, c, W, x0, alpha, s, s_imp)
-        n_imp += 1
-        v_post = eta * v_pre
+        v_post = eta * s * _u(1, A, B, c, W, x0, alpha, s, s_imp)
         tau0 += s_imp
+        _impact_tally(ta, tau0)
         th0 = 0.0
         if abs(v_post) < rest_v:
             qa = q * math.sin(W * tau0 + ph)
             if abs(qa) < alpha:
-                return PH_REST, tau0, 0.0, 0.0, s, max_u, n_imp
+                return PH_REST, tau0, 0.0, 0.0, s
             s = -1.0 if qa > 0.0 else 1.0
             v0 = 0.0
         else:
@@ -186,24 +197,35 @@ def _first_root_above_one(a2, a1, a0):
 
 
 @njit(cache=True)
-def _free_fall_time(u, v, alpha, eta):
-    """tau from (u, v) until |theta| = pi/2 in free linearized rocking; (tau, impacts on the way).
+def _free_next_event(u, v, alpha):
+    """Free linearized rocking from (u, v): sigma to the next impact and to the fall, and the
+    speed at that impact. u(sigma) = alpha + A e^-sigma + B e^sigma (eq. 3.5 of [000]), so both
+    are roots of quadratics in x = e^sigma."""
+    B = 0.5 * (u - alpha + v)
+    A = 0.5 * (u - alpha - v)
+    x_imp = _first_root_above_one(B, alpha, A) if v < 0.0 or u < alpha else np.inf
+    x_ot = _first_root_above_one(B, -(FALL_ROTATION - alpha), A)
+    v_imp = abs(B * x_imp - A / x_imp) if x_imp < np.inf else 0.0
+    return math.log(x_imp), math.log(x_ot), v_imp
 
-    u(sigma) = alpha + A e^-sigma + B e^sigma (eq. 3.5 of [000]); impacts and the fall are
-    roots of quadratics in x = e^sigma.
-    """
-    tau = 0.0
-    for n in range(2):
-        B = 0.5 * (u - alpha + v)
-        A = 0.5 * (u - alpha - v)
-        x_imp = _first_root_above_one(B, alpha, A) if v < 0.0 or u < alpha else np.inf
-        x_ot = _first_root_above_one(B, -(FALL_ROTATION - alpha), A)
-        if x_ot <= x_imp:
-            return tau + math.log(x_ot), n
-        tau += math.log(x_imp)
+
+@njit(cache=True)
+def _free_after_pulse(u, v, alpha, eta, tau, ta, over):
+    """Tally the free rocking after the pulse: the first impact (if none yet) and, for a block
+    that overturns, the impacts on the way and the tau of the fall (else NaN)."""
+    for _ in range(3):
+        s_imp, s_ot, v_imp = _free_next_event(u, v, alpha)
+        if over and s_ot <= s_imp:
+            return tau + s_ot
+        if s_imp == np.inf:
+            return np.nan
+        _impact_tally(ta, tau + s_imp)
+        if not over:
+            return np.nan
+        tau += s_imp
         u = 0.0
-        v = eta * abs(B * x_imp - A / x_imp)
-    return np.nan, 2
+        v = eta * v_imp
+    return np.nan
 
 
 @njit(cache=True)
@@ -212,25 +234,26 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
 
     With ``use_map`` the free rocking after the pulse is mapped, otherwise it is followed in
     closed form until rest, overturning or ``t_tail`` [s]. ``rec`` is the phase log of
-    :func:`_trig_phase`. Returns (status, max rotation, overturned, impacts, overturning time).
+    :func:`_trig_phase`. Returns (status, max rotation, overturned, impacts, overturning time
+    [s], first impact time [s]).
     """
     a_g, w, ph, dur = mp[0], mp[1], mp[2], mp[3]
     q = a_g / G
     W = w / p
     tau_ex = p * dur
     thr = G * alpha
+    ta = np.array([abs(th_init), 0.0, np.nan])
     t = 0.0
-    max_u = abs(th_init)
-    n_imp = 0
     rocking = th_init != 0.0 or om_init != 0.0
     th = th_init
     v = om_init / p
     s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
+    code = PH_END
     while True:
         if not rocking:
             t_up = _uplift_trig(mp, thr, t)
             if t_up >= dur:
-                return STATUS_OK, max_u, False, n_imp, np.nan
+                return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
             s = -1.0 if a_g * math.sin(w * t_up + ph) > 0.0 else 1.0
             t = t_up
             th = 0.0
@@ -238,49 +261,40 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         rocking = False
         if t >= dur:
             break
-        code, tau, th, v, s, max_u, n_imp = _trig_phase(
-            alpha, eta, q, W, ph, tau_ex, p * t, th, v, s, max_u, n_imp, rec
-        )
-        if code == PH_OVER:
-            return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
-        if code == PH_END:
+        code, tau, th, v, s = _trig_phase(alpha, eta, q, W, ph, tau_ex, p * t, th, v, s, ta, rec)
+        if code != PH_REST:
             break
         t = tau / p
-    if use_map:
-        over, peak, n_post = free_rocking_map(
-            s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
-        )
-        if not over:
-            return STATUS_OK, max(max_u, peak), False, n_imp + n_post, np.nan
-        if rec.shape[0] == 0:
-            tau_f, n_more = _free_fall_time(s * th, s * v, alpha, eta)
-            return STATUS_OK, FALL_ROTATION, True, n_imp + n_more, dur + tau_f / p
-    code, tau, th, v, s, max_u, n_imp = _trig_phase(
-        alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, max_u, n_imp, rec
-    )
+    if code == PH_END:
+        if use_map:
+            over, peak, n_post = free_rocking_map(
+                s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
+            )
+            n_before = ta[_NIMP]
+            tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, ta, over)
+            if not over:
+                ta[_MAXU] = max(ta[_MAXU], peak)
+                ta[_NIMP] = n_before + n_post
+            code = PH_OVER if over else PH_END
+        else:
+            code, tau, th, v, s = _trig_phase(
+                alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, ta, rec
+            )
     if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p
-    return STATUS_OK, max_u, False, n_imp, np.nan
+        return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p
+    return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
 
 
 @njit(cache=True, parallel=True)
 def trig_batch(p, alpha, eta, mp):
-    """:func:`trig_scene` over rows, in parallel."""
-    n = p.shape[0]
-    status = np.empty(n, np.int8)
-    max_rot = np.empty(n)
-    over = np.empty(n, np.bool_)
-    n_imp = np.empty(n, np.int64)
-    t_ot = np.empty(n)
+    """:func:`trig_scene` over rows, in parallel; an (n, 7) array of ``BATCH_COLUMNS``."""
+    out = np.empty((p.shape[0], 7))
     no_log = np.empty((0, 7))
-    for i in prange(n):
+    for i in prange(p.shape[0]):
         r = trig_scene(p[i], alpha[i], eta[i], mp[i], True, np.inf, no_log)
-        status[i] = r[0]
-        max_rot[i] = r[1]
-        over[i] = r[2]
-        n_imp[i] = r[3]
-        t_ot[i] = r[4]
-    return status, max_rot, over, n_imp, t_ot
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
+        out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
+    return out
 
 
 def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40):

@@ -31,6 +31,7 @@ PH_END = 0
 PH_REST = 1
 PH_OVER = 2
 PH_FAIL = 3
+PH_IMPACT = 4
 
 STATUS_OK = 0
 STATUS_MAX_STEPS = 1
@@ -172,7 +173,7 @@ def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
 # Per-scene work arrays: the rocking state ...
 T, TH, OM, SIDE, H = 0, 1, 2, 3, 4
 # ... and the running tallies (counts are stored as floats)
-MAXU, NIMP, WORK, NH, NI = 0, 1, 2, 3, 4
+MAXU, NIMP, WORK, NH, NI, FIRST = 0, 1, 2, 3, 4, 5
 
 
 @njit(cache=True)
@@ -234,12 +235,13 @@ def _step_events(s, h, th, om, f0, th1, om1, f1):
 
 
 @njit(cache=True)
-def _phase(blk, mot, log, st, ta, t_stop):
+def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
     blk = (p, alpha, eta, model, thr, omega_rest, tol, max_steps), mot = (kind, mp, times,
     samples), log = (hist, imps) (empty arrays: no history). ``st`` and the tallies ``ta``
-    are updated in place. Returns PH_END, PH_REST, PH_OVER or PH_FAIL.
+    are updated in place. Returns PH_END, PH_REST, PH_OVER or PH_FAIL; or PH_IMPACT once the
+    impact count reaches ``stop_at_impacts`` (the state is then just after that impact).
     """
     p, alpha, eta, model, thr, omega_rest, tol, max_steps = blk
     kind, mp, times, samples = mot
@@ -312,6 +314,8 @@ def _phase(blk, mot, log, st, ta, t_stop):
         om_pre = v + a * dl
         om = eta * om_pre  # eq. (2.3) of [000], once per impact
         th = 0.0
+        if ta[NIMP] == 0:
+            ta[FIRST] = t
         ta[NIMP] += 1
         if rec:
             n = int(ta[NI])
@@ -332,6 +336,9 @@ def _phase(blk, mot, log, st, ta, t_stop):
             om = 0.0
         else:
             s = -s
+        if ta[NIMP] == stop_at_impacts:
+            code = PH_IMPACT
+            break
         f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k))
     st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
     return code
@@ -389,7 +396,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=
 
     mot = (kind, mp, times, samples); log = (hist, imps), empty arrays for no history.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
-    impact times recorded, DOP853 steps).
+    impact times recorded, DOP853 steps, first impact time).
     """
     kind, mp, times, samples = mot
     thr = uplift_threshold(alpha, model)
@@ -400,7 +407,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=
     dur = mp[3]
     at_rest = th0 == 0.0 and om0 == 0.0
     st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
-    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0])
+    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan])
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END
@@ -419,10 +426,13 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=
         if code != PH_END and code != PH_REST:
             break
         at_rest = code == PH_REST
+    if use_map and code == PH_END and not at_rest and ta[NIMP] == 0:
+        code = _phase(blk, mot, log, st, ta, t_tail, 1)  # integrate on to time the first impact
+        at_rest = code == PH_REST
     if at_rest:
         if rec:
             _push(hist, ta, dur, 0.0, 0.0)
-    elif code == PH_END:
+    elif code == PH_END or code == PH_IMPACT:
         u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
         over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
         if use_map and not over:
@@ -433,37 +443,33 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=
     status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
     over = code == PH_OVER
     t_ot = st[T] if over else np.nan
-    return (status, ta[MAXU], over, int(ta[NIMP]), t_ot, int(ta[NH]), int(ta[NI]), int(ta[WORK]))
+    nh, ni = int(ta[NH]), int(ta[NI])
+    return status, ta[MAXU], over, int(ta[NIMP]), t_ot, nh, ni, int(ta[WORK]), ta[FIRST]
+
+
+#: Columns of the batch output array.
+BATCH_COLUMNS = (
+    "status",
+    "max_rotation",
+    "overturned",
+    "n_impacts",
+    "overturn_time",
+    "steps",
+    "first_impact_time",
+)
 
 
 @njit(cache=True, parallel=True)
 def scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps):
-    """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel."""
-    n = p.shape[0]
-    status = np.empty(n, np.int8)
-    max_rot = np.empty(n)
-    over = np.empty(n, np.bool_)
-    n_imp = np.empty(n, np.int64)
-    t_ot = np.empty(n)
-    work = np.empty(n, np.int64)
+    """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel.
+
+    Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
+    """
+    out = np.empty((p.shape[0], 7))
     no_log = (np.empty((0, 3)), np.empty(0))
-    for i in prange(n):
-        r = scene(
-            p[i],
-            alpha[i],
-            eta[i],
-            model,
-            (kind, mp[i], times, samples),
-            rtol,
-            True,
-            np.inf,
-            no_log,
-            max_steps,
-        )
-        status[i] = r[0]
-        max_rot[i] = r[1]
-        over[i] = r[2]
-        n_imp[i] = r[3]
-        t_ot[i] = r[4]
-        work[i] = r[7]
-    return status, max_rot, over, n_imp, t_ot, work
+    for i in prange(p.shape[0]):
+        mot = (kind, mp[i], times, samples)
+        r = scene(p[i], alpha[i], eta[i], model, mot, rtol, True, np.inf, no_log, max_steps)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
+        out[i, 4], out[i, 5], out[i, 6] = r[4], r[7], r[8]
+    return out

@@ -13,13 +13,14 @@ import numpy as np
 from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import PULSES, pulse_kernel_rows
-from ..structures.block import frequency_parameter, restitution_housner
+from ..structures.block import frequency_parameter as _p_of_R
+from ..structures.block import restitution_housner
 from . import _linear, _rocking
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
 _MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR}
 
-OUTPUTS = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status", "steps")
+OUTPUTS = _rocking.BATCH_COLUMNS
 
 
 def _column(name, values, n, low=None, high=None, low_open=True, high_open=True):
@@ -53,7 +54,7 @@ def _pulse_params(pulse, amplitude, period, cycles, n):
 def simulate_batch(
     *,
     half_diagonal=None,
-    frequency_parameter_=None,
+    frequency_parameter=None,
     slenderness,
     restitution=None,
     pulse: PulseName = "sine",
@@ -74,7 +75,7 @@ def simulate_batch(
     Parameters
     ----------
     half_diagonal : array_like, optional
-        R [m] > 0; or give ``frequency_parameter_`` p [rad/s] directly (equivalent blocks).
+        R [m] > 0; or give ``frequency_parameter`` p [rad/s] directly (equivalent blocks).
     slenderness : array_like
         alpha [rad] in (0, pi/2).
     restitution : array_like, optional
@@ -95,8 +96,9 @@ def simulate_batch(
     -------
     dict of ndarrays
         ``max_rotation`` [rad] (pi/2 if overturned), ``overturned`` (bool), ``n_impacts``
-        (until rest), ``overturn_time`` [s] (NaN if it survived), ``status`` (0 ok,
-        1 step limit reached), ``steps`` (DOP853 steps taken; 0 for the exact solver).
+        (until rest), ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s]
+        (NaN if none), ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
+        taken; 0 for the exact solver).
     """
     try:
         model = _MODELS[method]
@@ -104,13 +106,13 @@ def simulate_batch(
         raise ValueError(f"method must be one of {sorted(_MODELS)}, got {method!r}") from None
     if not 0.0 < rtol < 1.0:
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
-    if (half_diagonal is None) == (frequency_parameter_ is None):
-        raise ValueError("give exactly one of half_diagonal or frequency_parameter_")
+    if (half_diagonal is None) == (frequency_parameter is None):
+        raise ValueError("give exactly one of half_diagonal or frequency_parameter")
     shapes = [
         np.shape(x)
         for x in (
             half_diagonal,
-            frequency_parameter_,
+            frequency_parameter,
             slenderness,
             restitution,
             amplitude,
@@ -125,9 +127,9 @@ def simulate_batch(
     alpha = _column("slenderness", slenderness, n, 0.0, np.pi / 2)
     if half_diagonal is not None:
         R = _column("half_diagonal", half_diagonal, n, 0.0)
-        p = np.vectorize(frequency_parameter)(R)
+        p = np.vectorize(_p_of_R)(R)
     else:
-        p = _column("frequency_parameter_", frequency_parameter_, n, 0.0)
+        p = _column("frequency_parameter", frequency_parameter, n, 0.0)
     if restitution is None:
         eta = np.vectorize(restitution_housner)(alpha)
     else:
@@ -142,17 +144,11 @@ def simulate_batch(
     p = np.ascontiguousarray(p, dtype=float)
     eta = np.ascontiguousarray(eta, dtype=float)
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
-        status, max_rot, over, n_imp, t_ot = _linear.trig_batch(p, alpha, eta, mp)
-        work = np.zeros(n, np.int64)
+        out = _linear.trig_batch(p, alpha, eta, mp)
     else:
-        status, max_rot, over, n_imp, t_ot, work = _rocking.scene_batch(
-            p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps
-        )
-    return {
-        "max_rotation": max_rot,
-        "overturned": over,
-        "n_impacts": n_imp,
-        "overturn_time": t_ot,
-        "status": status,
-        "steps": work,
-    }
+        out = _rocking.scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps)
+    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
+    for name in ("status", "n_impacts", "steps"):
+        cols[name] = cols[name].astype(np.int64)
+    cols["overturned"] = cols["overturned"].astype(bool)
+    return cols

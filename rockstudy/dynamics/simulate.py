@@ -11,28 +11,12 @@ from .. import _validate
 from ..constants import FALL_ROTATION
 from ..motions import Motion
 from ..motions import _kernels as mk
+from ..structures.block import block_parameters
 from . import _linear, _rocking
 from .reference import simulate_reference
 from .result import RockingResult
 
 Method = Literal["nonlinear", "linear", "scipy", "scipy-linear"]
-
-
-def rocking_parameters(structure) -> tuple[float, float, float]:
-    """(p [rad/s], alpha [rad], eta [-]) of a block, or of a structure's equivalent block."""
-    if hasattr(structure, "equivalent_block"):
-        structure = structure.equivalent_block()
-    try:
-        return (
-            float(structure.frequency_parameter),
-            float(structure.slenderness),
-            float(structure.restitution),
-        )
-    except AttributeError:
-        raise TypeError(
-            "structure must be a rockstudy Block or provide equivalent_block(); "
-            f"got {type(structure).__name__}"
-        ) from None
 
 
 def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
@@ -42,7 +26,7 @@ def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     while True:
         hist = np.empty((cap, 3))
         imps = np.empty(cap)
-        status, max_rot, over, n_imp, t_ot, nh, ni, work = _rocking.scene(
+        status, max_rot, over, n_imp, t_ot, nh, ni, work, _ = _rocking.scene(
             p,
             alpha,
             eta,
@@ -83,7 +67,7 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
     cap = 1024
     while True:
         rec = np.zeros((cap, 7))
-        status, max_rot, over, n_imp, t_ot = _linear.trig_scene(
+        status, max_rot, over, n_imp, t_ot, _ = _linear.trig_scene(
             p, alpha, eta, mp, False, t_tail, rec, x0[0], x0[1]
         )
         if rec[0, 0] < cap - 1:
@@ -189,5 +173,5 @@ def simulate(
     om0 = float(initial_velocity)
     if not math.isfinite(om0):
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
-    p, alpha, eta = rocking_parameters(structure)
+    p, alpha, eta = block_parameters(structure)
     return runner(p, alpha, eta, motion, model, rtol, t_max, int(max_steps), method, (th0, om0))

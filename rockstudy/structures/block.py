@@ -109,3 +109,20 @@ class Block:
     def uplift_acceleration(self) -> float:
         """Ground acceleration that starts rocking, g tan(alpha) [m/s^2], section 2 of [000]."""
         return G * math.tan(self.slenderness)
+
+
+def block_parameters(structure) -> tuple[float, float, float]:
+    """(p [rad/s], alpha [rad], eta [-]) of a block, or of a structure's equivalent block."""
+    if hasattr(structure, "equivalent_block"):
+        structure = structure.equivalent_block()
+    try:
+        return (
+            float(structure.frequency_parameter),
+            float(structure.slenderness),
+            float(structure.restitution),
+        )
+    except AttributeError:
+        raise TypeError(
+            "structure must be a rockstudy Block or provide equivalent_block(); "
+            f"got {type(structure).__name__}"
+        ) from None
