@@ -182,7 +182,7 @@ def test_overturning_time_eq_25_of_003():
 
         reach.terminal = True
         sol = solve_ivp(
-            lambda t, y: [y[1], p * p * (y[0] - ALPHA + q)],
+            lambda t, y, q=q: [y[1], p * p * (y[0] - ALPHA + q)],
             (0, 100),
             [0, 0],
             events=reach,
