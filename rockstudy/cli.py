@@ -58,10 +58,18 @@ def main(argv=None) -> int:
     sim.add_argument("--json", action="store_true", help="print the summary as JSON")
     demo = sub.add_parser("demo", help="the demo job: a plot and a JSON summary")
     demo.add_argument("--out", default="results/demo")
+    figs = sub.add_parser("figures", help="recompute the figures of paper 000 as PNGs")
+    figs.add_argument("--out", default="results/figures")
     args = parser.parse_args(argv)
     try:
         if args.command == "simulate":
             return _simulate(args)
+        if args.command == "figures":
+            from .figures import make_all
+
+            for path in make_all(args.out):
+                print(f"wrote {path}")
+            return 0
         from .demo import run
 
         s = run(args.out)

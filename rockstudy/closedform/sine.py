@@ -372,14 +372,15 @@ def max_rotation(a, omega, eta):
     r"""Peak rotation after the first impact, theta_max / alpha, eq. (4.13) of [000].
 
     Exact when the first impact follows the pulse (above the curve 3.31); NaN where the block
-    overturns after that impact.
+    overturns after that impact, or where D0* > 1 (it does not come back to an impact).
 
     .. math:: \theta_m / \alpha = 1 - \sqrt{1 - \eta^2 (1 - D_0^*)}
     """
     if not a > 1.0:
         return np.nan
-    x = 1.0 - eta * eta * (1.0 - _d0(a, omega))
-    return 1.0 - math.sqrt(x) if x > 0.0 else np.nan
+    d0 = _d0(a, omega)
+    x = 1.0 - eta * eta * (1.0 - d0)
+    return 1.0 - math.sqrt(x) if x > 0.0 and d0 <= 1.0 else np.nan
 
 
 @vectorize(_F3, cache=True)

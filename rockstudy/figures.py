@@ -1,0 +1,297 @@
+"""Paper [000]'s figures, recomputed: ``rockstudy figures --out DIR`` (or ``make figures``).
+
+Every figure is computed from the solvers and the closed forms when the command runs; nothing
+is read from stored numbers.
+
+- ``fig04_overturning.png``: overturning plots in (omega, a) for several eta: the classifier's
+  modes, the closed-form boundaries (3.10), (3.18), (3.20)-(3.21), (3.30), (3.31), and the
+  points where the exact linear solver disagrees.
+- ``fig06_collapse.png``: two different blocks under one-cosine pulses with equal groups,
+  in dimensional terms and collapsed in (4.11).
+- ``fig08_spectra.png``: rocking spectra theta_max g / a_g against omega, linear solver (solid)
+  and (4.13) (dashed), eta from 0.80 to 0.96.
+- ``fig10_nonslender_overturning.png``: overturning boundaries of non-slender blocks
+  (nonlinear) in the (5.3) groups for several alpha.
+- ``fig11_nonslender_histories.png``: non-slender responses in (4.11) and in (6.1) groups.
+- ``fig13_nonslender_spectra.png``: nonlinear spectra in (6.1) groups for several alpha.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from . import closedform as cf
+from . import similarity as sim
+from .constants import G
+from .dynamics import simulate, simulate_batch
+from .structures import Block
+
+_MODE_COLORS = ["#dddddd", "#9ecae1", "#c7e9c0", "#fdae6b", "#e6550d"]
+
+
+def _plot_roots(ax, w, roots, **kw):
+    """Plot each root column as a curve, broken where it jumps between branches."""
+    for k in range(roots.shape[1]):
+        y = roots[:, k].copy()
+        y[1:][np.abs(np.diff(y)) > 0.05 * np.nanmax(np.abs(y), initial=1.0)] = np.nan
+        ax.plot(w, y, **kw)
+        kw.pop("label", None)
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _linear_modes(a, omega, eta):
+    R = 3 * G / 4  # p = 1
+    out = simulate_batch(
+        half_diagonal=R,
+        slenderness=0.05,
+        restitution=eta,
+        pulse="sine",
+        amplitude=a * G * 0.05,
+        period=2 * np.pi / omega,
+        method="linear",
+    )
+    end = 2 * np.pi / omega
+    return np.where(
+        out["max_rotation"] == 0,
+        0,
+        np.where(
+            out["overturned"],
+            np.where(out["n_impacts"] == 0, 4, 3),
+            np.where(out["first_impact_time"] <= end, 1, 2),
+        ),
+    )
+
+
+def fig04(path, etas=(0.7, 0.8, 0.9, 1.0)):
+    """Overturning plots of [000] Fig. 4."""
+    plt = _plt()
+    from matplotlib.colors import ListedColormap
+
+    w = np.linspace(0.3, 10, 240)
+    a = np.linspace(1.0, 10, 240)
+    W, A = np.meshgrid(w, a)
+    fig, axes = plt.subplots(1, len(etas), figsize=(4.2 * len(etas), 4.2), sharey=True)
+    styles = {
+        "2": ("k", "-"),
+        "1.2": ("C3", "-"),
+        "1.1": ("C0", "-"),
+        "1.1-approx": ("C0", "--"),
+        "limit": ("0.3", ":"),
+    }
+    for ax, eta in zip(axes, etas, strict=True):
+        modes = cf.overturning_mode_code(A, W, eta)
+        ax.pcolormesh(
+            W, A, modes, cmap=ListedColormap(_MODE_COLORS), vmin=-0.5, vmax=4.5, shading="auto"
+        )
+        for case, (color, ls) in styles.items():
+            roots = cf.overturning_boundary(w, eta, case, a_max=10.5)
+            _plot_roots(ax, w, roots, color=color, ls=ls, lw=1.2, label=f"({case})")
+        sub = (slice(None, None, 6), slice(None, None, 6))
+        sim_modes = _linear_modes(A[sub].ravel(), W[sub].ravel(), eta).reshape(A[sub].shape)
+        bad = sim_modes != modes[sub]
+        ax.plot(W[sub][bad], A[sub][bad], "x", color="m", ms=4, label="linear solver disagrees")
+        ax.set_title(f"eta = {eta:g}")
+        ax.set_xlabel(r"$\omega_g / p$")
+        ax.set_ylim(1, 10)
+    axes[0].set_ylabel(r"$a_g / (g\alpha)$")
+    axes[-1].legend(fontsize=7, loc="upper right")
+    fig.suptitle(
+        "Overturning of the linearized block under a sine pulse: modes "
+        + ", ".join(f"{i}={m}" for i, m in enumerate(cf.MODES)),
+        fontsize=8,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig06(path):
+    """Two blocks, one master curve: [000] Figs. 5-6 (one-cosine pulses, eta = 0.85)."""
+    plt = _plt()
+    b1 = Block(1.0, 0.10, restitution=0.85)
+    p1 = sim.pulse_for(b1, omega=4.0, ratio=0.5, law="4.11", shape="cosine")
+    b2 = Block(3.2, 0.04, restitution=0.85)
+    g = sim.groups(b1, p1)
+    p2 = sim.pulse_for(b2, omega=g["omega"], ratio=g["inverse_a"], law="4.11", shape="cosine")
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
+    for blk, pulse, ls in ((b1, p1, "-"), (b2, p2, "--")):
+        res = simulate(blk, pulse, method="linear", t_max=12.0 / blk.frequency_parameter)
+        label = f"R = {blk.half_diagonal:g} m, alpha = {blk.slenderness:g}"
+        ax1.plot(res.t, res.theta, ls, label=label)
+        tau, y = sim.to_groups(res.t, res.theta, blk, pulse, "4.11")
+        ax2.plot(tau, y, ls, label=label)
+    ax1.set(xlabel="t [s]", ylabel=r"$\theta$ [rad]", title="dimensional")
+    ax2.set(
+        xlabel=r"$\tau = p t$",
+        ylabel=r"$\theta g / a_g$",
+        title=r"groups (4.11): $\omega_g/p$ = 4, $g\alpha/a_g$ = 0.5",
+    )
+    ax1.legend(fontsize=8)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig08(path, ratios=(0.2, 0.4, 0.6), etas=(0.80, 0.84, 0.88, 0.92, 0.96)):
+    """Rocking spectra of [000] Fig. 8: linear solver against (4.13)."""
+    plt = _plt()
+    w = np.geomspace(0.5, 15, 300)
+    fig, axes = plt.subplots(1, len(ratios), figsize=(4.2 * len(ratios), 3.8))
+    R = 3 * G / 4
+    for ax, ratio in zip(axes, ratios, strict=True):
+        a = 1.0 / ratio
+        for k, eta in enumerate(etas):
+            out = simulate_batch(
+                half_diagonal=R,
+                slenderness=0.05,
+                restitution=eta,
+                pulse="sine",
+                amplitude=a * G * 0.05,
+                period=2 * np.pi / w,
+                method="linear",
+            )
+            y = np.where(out["overturned"], np.nan, out["max_rotation"] / 0.05 / a)
+            ax.plot(w, y, color=f"C{k}", label=f"eta = {eta:.2f}")
+            ax.plot(w, cf.max_rotation(a, w, eta) / a, "--", color=f"C{k}", lw=0.9)
+        ax.set(
+            xlabel=r"$\omega_g/p$",
+            ylabel=r"$\theta_{max} g / a_g$",
+            title=rf"$g\alpha/a_g$ = {ratio:g} (solid: solver, dashed: 4.13)",
+        )
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _nonlinear_overturn(alpha, w, ratio, eta=0.85):
+    """Overturned (bool) of a nonlinear block (p = 1) over (ratio, omega) in (5.3) groups."""
+    R = 3 * G / 4
+    Wg, Rg = np.meshgrid(w, ratio)
+    out = simulate_batch(
+        half_diagonal=R,
+        slenderness=alpha,
+        restitution=eta,
+        pulse="sine",
+        amplitude=(G * np.tan(alpha) / Rg).ravel(),
+        period=(2 * np.pi / Wg).ravel(),
+        rtol=1e-8,
+    )
+    return Wg, Rg, out["overturned"].reshape(Wg.shape)
+
+
+def fig10(path, alphas_deg=(2, 5, 10, 15, 20)):
+    """Overturning of non-slender blocks in (5.3) groups, [000] Fig. 10 (eta = 0.85)."""
+    plt = _plt()
+    w = np.linspace(0.5, 10, 120)
+    ratio = np.linspace(0.08, 0.99, 120)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for k, deg in enumerate(alphas_deg):
+        Wg, Rg, over = _nonlinear_overturn(np.radians(deg), w, ratio)
+        ax.contour(Wg, Rg, over.astype(float), levels=[0.5], colors=[f"C{k}"])
+        ax.plot([], [], color=f"C{k}", label=f"alpha = {deg} deg (nonlinear)")
+    for case in ("2", "1.2", "1.1"):
+        roots = cf.overturning_boundary(w, 0.85, case, a_max=13)
+        _plot_roots(ax, w, 1.0 / roots, color="k", ls=":", lw=1)
+    ax.plot([], [], "k:", label="closed form (slender limit)")
+    ax.set(
+        xlabel=r"$\omega_g/p$",
+        ylabel=r"$g\tan\alpha / a_g$",
+        ylim=(0.08, 1.0),
+        title="overturning boundaries, eta = 0.85 (overturns below the curves)",
+    )
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig11(path, alphas=(0.15, 0.2, 0.25, 0.3), ratio=0.75, omega=4.0, eta=0.85):
+    """Non-slender responses in (4.11) and (6.1) groups, [000] Figs. 11-12."""
+    plt = _plt()
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8), sharex=True)
+    for k, alpha in enumerate(alphas):
+        blk = Block(1.0, alpha, restitution=eta)
+        pulse = sim.pulse_for(blk, omega=omega, ratio=ratio, law="6.1")
+        res = simulate(blk, pulse, t_max=14.0 / blk.frequency_parameter)
+        tau, y411 = sim.to_groups(res.t, res.theta, blk, pulse, "4.11")
+        _, y61 = sim.to_groups(res.t, res.theta, blk, pulse, "6.1")
+        ax1.plot(tau, y411, color=f"C{k}", label=f"alpha = {alpha:g}")
+        ax2.plot(tau, y61, color=f"C{k}", label=f"alpha = {alpha:g}")
+    ax1.set(xlabel=r"$\tau$", ylabel=r"$\theta g / a_g$", title="(4.11): not self-similar")
+    ax2.set(
+        xlabel=r"$\tau$",
+        ylabel=r"$\theta g / (a_g \cos\alpha)$",
+        title="(6.1): practically self-similar",
+    )
+    ax1.legend(fontsize=8)
+    fig.suptitle(
+        rf"nonlinear, $g\tan\alpha/a_g$ = {ratio:g}, $\omega_g/p$ = {omega:g}, "
+        f"eta = {eta:g}",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig13(path, alphas=(0.1, 0.2, 0.3), ratios=(0.5, 0.75), eta=0.85):
+    """Nonlinear spectra in (6.1) groups for different slenderness, [000] Fig. 13."""
+    plt = _plt()
+    w = np.geomspace(0.5, 15, 200)
+    R = 3 * G / 4
+    fig, axes = plt.subplots(1, len(ratios), figsize=(5 * len(ratios), 3.8))
+    for ax, ratio in zip(axes, ratios, strict=True):
+        for k, alpha in enumerate(alphas):
+            a_g = G * np.tan(alpha) / ratio
+            out = simulate_batch(
+                half_diagonal=R,
+                slenderness=alpha,
+                restitution=eta,
+                pulse="sine",
+                amplitude=a_g,
+                period=2 * np.pi / w,
+            )
+            y = np.where(out["overturned"], np.nan, out["max_rotation"] * G / (a_g * np.cos(alpha)))
+            ax.plot(w, y, color=f"C{k}", label=f"alpha = {alpha:g}")
+        ax.set(
+            xlabel=r"$\omega_g/p$",
+            ylabel=r"$\theta_{max} g / (a_g\cos\alpha)$",
+            title=rf"$g\tan\alpha/a_g$ = {ratio:g}, eta = {eta:g}",
+        )
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+FIGURES = {
+    "fig04_overturning.png": fig04,
+    "fig06_collapse.png": fig06,
+    "fig08_spectra.png": fig08,
+    "fig10_nonslender_overturning.png": fig10,
+    "fig11_nonslender_histories.png": fig11,
+    "fig13_nonslender_spectra.png": fig13,
+}
+
+
+def make_all(out_dir="results/figures") -> list[Path]:
+    """Compute and write every figure into ``out_dir``; returns the paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, fn in FIGURES.items():
+        fn(out / name)
+        paths.append(out / name)
+    return paths
