@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 
 def _simulate(args) -> int:
@@ -37,6 +38,48 @@ def _simulate(args) -> int:
     return 0
 
 
+def _run(args) -> int:
+    from .study import load_study, run_study
+
+    study = load_study(args.study)
+    report = run_study(
+        study,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        scheduler_file=args.scheduler_file,
+        resume=args.resume,
+        base_dir=Path(args.study).resolve().parent,
+        progress=not args.quiet,
+    )
+    print(
+        f"{study.name}: {report.samples} samples in {report.chunks_total} chunks; computed "
+        f"{len(report.chunks_computed)} chunks in {report.seconds:.1f} s; "
+        f"{report.failed_samples} failed samples"
+    )
+    print(
+        f"cube: {report.path} (xarray.open_zarr)" + (f", {report.netcdf}" if report.netcdf else "")
+    )
+    return 0
+
+
+def _validate(args) -> int:
+    from .study import StudyError, load_study
+
+    status = 0
+    for path in args.study:
+        try:
+            study = load_study(path)
+            print(
+                f"{path}: ok ({study.sampler.kind}, {len(study.parameters())} distributed "
+                f"parameters, sha256 {study.sha256()[:12]})"
+            )
+        except StudyError as exc:
+            print(exc, file=sys.stderr)
+            status = 2
+    return status
+
+
 def main(argv=None) -> int:
     """Entry point of the ``rockstudy`` command."""
     parser = argparse.ArgumentParser(prog="rockstudy", description=__doc__)
@@ -60,10 +103,31 @@ def main(argv=None) -> int:
     demo.add_argument("--out", default="results/demo")
     figs = sub.add_parser("figures", help="recompute the figures of paper 000 as PNGs")
     figs.add_argument("--out", default="results/figures")
+    run = sub.add_parser("run", help="run a study file into a zarr cube")
+    run.add_argument("study")
+    run.add_argument("--out", required=True, help="the zarr store to write (PATH.nc too)")
+    where = run.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="local cluster size (default 2)")
+    where.add_argument("--scheduler", help="address of a running dask scheduler")
+    where.add_argument("--scheduler-file", help="scheduler file of a running dask cluster")
+    run.add_argument("--resume", action="store_true", help="compute only pending chunks")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    val = sub.add_parser("validate", help="check study files, naming every problem")
+    val.add_argument("study", nargs="+")
+    sch = sub.add_parser("schema", help="print the JSON schema of study files")
     args = parser.parse_args(argv)
     try:
         if args.command == "simulate":
             return _simulate(args)
+        if args.command == "run":
+            return _run(args)
+        if args.command == "validate":
+            return _validate(args)
+        if args.command == "schema":
+            from .study import json_schema
+
+            print(json.dumps(json_schema(), indent=2))
+            return 0
         if args.command == "figures":
             from .figures import make_all
 
@@ -80,7 +144,7 @@ def main(argv=None) -> int:
             )
         print(f"wrote {args.out}/demo.png and {args.out}/demo.json")
         return 0
-    except ValueError as exc:
+    except (ValueError, FileExistsError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

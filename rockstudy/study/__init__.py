@@ -1,0 +1,23 @@
+"""The study layer: declarative TOML studies, samplers, dask execution and zarr result cubes.
+
+Imports run one way: ``study`` uses the physics packages, never the reverse.
+"""
+
+from .runner import RunReport, run_study
+from .sampling import make_design, salib_problem
+from .spec import Study, StudyError, json_schema, load_study, validate_text
+from .store import export_netcdf, open_result
+
+__all__ = [
+    "RunReport",
+    "Study",
+    "StudyError",
+    "export_netcdf",
+    "json_schema",
+    "load_study",
+    "make_design",
+    "open_result",
+    "run_study",
+    "salib_problem",
+    "validate_text",
+]

@@ -1,0 +1,178 @@
+"""Evaluate a chunk of design rows: the function each dask task runs.
+
+It takes plain numpy columns and the normalised study, calls the batch entry point of the
+engine, and returns the requested outputs with a per-sample status (1 ok, 2 failed) and error
+message. A row whose kernel fails (step limit, or an exception isolated by re-running the rows
+one by one) is recorded as failed; overturning is an outcome, not a failure.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..constants import G
+from ..dynamics.batch import simulate_batch
+from ..motions import Record, stochastic_record
+from .spec import Study
+
+STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
+ERROR_WIDTH = 120
+
+#: Outputs: (long_name, units, dtype, fill value for failed rows)
+OUTPUTS = {
+    "max_rotation": ("max |theta| (pi/2 if overturned)", "rad", "f8", np.nan),
+    "max_rotation_ratio": ("max |theta| / theta_cr", "1", "f8", np.nan),
+    "overturned": ("overturned (1) or survived (0); -1 if failed", "1", "i1", -1),
+    "n_impacts": ("impacts until rest; -1 if failed", "1", "i8", -1),
+    "overturn_time": ("time at which |theta| reached pi/2 (NaN if it survived)", "s", "f8", np.nan),
+    "first_impact_time": ("time of the first impact (NaN if none)", "s", "f8", np.nan),
+    "steps": ("DOP853 steps taken (0 for the exact linear solver)", "1", "i8", -1),
+}
+
+
+def resolve_file(name: str, base_dir) -> Path:
+    """A record path as written in a study: absolute, relative to the working directory, or
+    relative to the study file's directory."""
+    path = Path(name)
+    if path.is_absolute() or path.exists():
+        return path
+    if base_dir is not None and (Path(base_dir) / path).exists():
+        return Path(base_dir) / path
+    raise FileNotFoundError(f"motion.files: {name!r} not found (from {Path.cwd()} or {base_dir})")
+
+
+@lru_cache(maxsize=32)
+def _load_record(path: str, units: str) -> Record:
+    if path.lower().endswith(".at2"):
+        return Record.from_at2(path)
+    return Record.from_csv(path, units=units)
+
+
+def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
+    """Engine outputs for the rows ``idx`` of the chunk columns (may raise)."""
+    mo = study.motion
+    common = dict(
+        frequency_parameter=cols["frequency_parameter"][idx],
+        slenderness=cols["critical_rotation"][idx],
+        restitution=cols["restitution"][idx],
+        method=study.run.method,
+        rtol=study.run.rtol,
+        max_steps=study.run.max_steps,
+    )
+    if mo.kind == "pulse":
+        return simulate_batch(
+            pulse=mo.shape,
+            amplitude=cols["amplitude"][idx],
+            period=cols["period"][idx],
+            cycles=mo.cycles,
+            **common,
+        )
+    uplift = G * np.tan(cols["critical_rotation"][idx])
+    if mo.kind == "record":
+        out = {}
+        rec_idx = cols["record"][idx]
+        for r in np.unique(rec_idx):
+            sel = rec_idx == r
+            rec = _load_record(str(resolve_file(mo.files[r], base_dir)), mo.units)
+            scale = (
+                cols["scale"][idx][sel]
+                if "scale" in cols
+                else cols["pga_ratio"][idx][sel] * uplift[sel] / rec.peak
+            )
+            part = simulate_batch(
+                record=rec,
+                scale=scale,
+                **{k: (v[sel] if isinstance(v, np.ndarray) else v) for k, v in common.items()},
+            )
+            for k, v in part.items():
+                out.setdefault(k, np.empty(idx.size, v.dtype))[sel] = v
+        return out
+    out = {}
+    for j, i in enumerate(idx):  # stochastic: one seeded record per sample
+        seed = np.random.SeedSequence(study.seed, spawn_key=(2, int(cols["sample"][i])))
+        rec = stochastic_record(
+            peak=cols["pga_ratio"][i] * uplift[j],
+            duration=mo.duration,
+            dt=mo.dt,
+            ground_frequency=mo.ground_frequency,
+            ground_damping=mo.ground_damping,
+            seed=seed,
+        )
+        part = simulate_batch(
+            record=rec,
+            **{k: (v[j : j + 1] if isinstance(v, np.ndarray) else v) for k, v in common.items()},
+        )
+        for k, v in part.items():
+            out.setdefault(k, np.empty(idx.size, v.dtype))[j] = v[0]
+    return out
+
+
+def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
+    """Outputs, ``status`` and ``error`` for one chunk of design columns.
+
+    Parameters
+    ----------
+    study_json : str
+        The normalised study (:meth:`Study.normalized`).
+    cols : dict of ndarray
+        Design columns of the chunk (``sample``, ``frequency_parameter``,
+        ``critical_rotation``, ``restitution`` and the motion's columns).
+    """
+    import numba
+
+    numba.set_num_threads(1)  # one task per core: no nested threading
+    study = Study.model_validate(json.loads(study_json))
+    n = cols["sample"].size
+    wanted = study.run.outputs
+    result = {name: np.full(n, OUTPUTS[name][3], dtype=OUTPUTS[name][2]) for name in wanted}
+    status = np.full(n, STATUS_OK, dtype=np.int8)
+    error = np.full(n, "", dtype=f"<U{ERROR_WIDTH}")
+    try:
+        raw = _run_rows(study, cols, np.arange(n), base_dir)
+        failed = np.zeros(n, bool)
+    except Exception:  # isolate the failing rows, keep the others
+        raw, failed = _rows_one_by_one(study, cols, base_dir, error)
+    kernel_failed = (raw["status"] != 0) & ~failed
+    error[kernel_failed] = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
+    failed |= kernel_failed
+    status[failed] = STATUS_FAILED
+    ok = ~failed
+    for name in wanted:
+        if name == "max_rotation_ratio":
+            values = raw["max_rotation"] / cols["critical_rotation"]
+        else:
+            values = raw[name]
+        result[name][ok] = values[ok].astype(OUTPUTS[name][2])
+    result["status"] = status
+    result["error"] = error
+    return result
+
+
+def _rows_one_by_one(study, cols, base_dir, error):
+    n = cols["sample"].size
+    raw = {
+        k: np.zeros(n)
+        for k in (
+            "max_rotation",
+            "overturned",
+            "n_impacts",
+            "overturn_time",
+            "first_impact_time",
+            "steps",
+            "status",
+        )
+    }
+    failed = np.zeros(n, bool)
+    for i in range(n):
+        try:
+            one = _run_rows(study, cols, np.array([i]), base_dir)
+            for k in raw:
+                raw[k][i] = one[k][0]
+        except Exception as exc:  # recorded per sample, never aborts the run
+            failed[i] = True
+            error[i] = f"{type(exc).__name__}: {exc}"[:ERROR_WIDTH]
+    return raw, failed

@@ -1,0 +1,174 @@
+"""The design of a study: its input rows, derived rocking parameters and dimensionless groups.
+
+Uniform numbers come from one root ``numpy.random.SeedSequence`` (Monte Carlo), a scrambled
+Latin hypercube or scrambled Sobol' points in SALib's Saltelli layout, and are mapped through
+each distribution's inverse CDF. The whole design is made before anything runs, so results do
+not depend on chunking or on the number of workers.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+from scipy.stats import qmc
+
+from ..constants import G
+from .spec import Study
+
+#: CF-style attributes of every design variable.
+VARIABLES = {
+    "half_diagonal": ("half-diagonal R of the block", "m"),
+    "slenderness": ("slenderness alpha (critical rotation theta_cr)", "rad"),
+    "restitution": ("coefficient of restitution eta", "1"),
+    "frequency_parameter": ("frequency parameter p", "rad s-1"),
+    "critical_rotation": ("critical rotation theta_cr of the equivalent block", "rad"),
+    "amplitude": ("pulse amplitude a_g (signed)", "m s-2"),
+    "amplitude_ratio": ("a_g / (g tan alpha)", "1"),
+    "period": ("pulse period T_p", "s"),
+    "frequency_ratio": ("omega_g / p", "1"),
+    "scale": ("factor on the record", "1"),
+    "pga_ratio": ("peak ground acceleration / (g tan alpha)", "1"),
+    "record": ("index of the record in the study's files", "1"),
+    "omega": ("omega_g / p, eq. (3.6) of [000]", "1"),
+    "a": ("a_g / (g alpha), eq. (3.6) of [000]", "1"),
+    "inverse_a": ("g alpha / a_g, eq. (4.11) of [000]", "1"),
+    "uplift_ratio": ("g tan(alpha) / a_g, eqs. (5.3), (6.1) of [000]", "1"),
+    "cos_alpha": ("cos(alpha), eq. (5.3) of [000]", "1"),
+}
+
+
+def salib_problem(study: Study) -> dict:
+    """The SALib problem of a study: its distributed parameters on the unit hypercube."""
+    names = list(study.parameters())
+    return {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
+
+
+def unit_samples(study: Study) -> np.ndarray:
+    """Points in [0, 1)^D of the study's sampler (rows = samples)."""
+    d = len(study.parameters())
+    s = study.sampler
+    root = np.random.SeedSequence(study.seed)
+    if s.kind == "monte_carlo":
+        return np.random.default_rng(root).random((s.n, d))
+    if s.kind == "lhs":
+        return qmc.LatinHypercube(d=d, seed=np.random.default_rng(root)).random(s.n)
+    if s.kind == "sobol":
+        from SALib.sample import sobol
+
+        x = sobol.sample(
+            salib_problem(study),
+            s.n,
+            calc_second_order=s.second_order,
+            scramble=True,
+            seed=study.seed,
+        )
+        return np.clip(x, 0.0, np.nextafter(1.0, 0.0))
+    raise ValueError(f"unit samples do not apply to sampler {s.kind!r}")
+
+
+def _inputs(study: Study) -> tuple[dict, dict]:
+    """Columns of the distributed parameters, and the grid axes (grid sampler only)."""
+    params = study.parameters()
+    if study.sampler.kind == "grid":
+        axes = {name: dist.points() for name, dist in params.items()}
+        mesh = np.meshgrid(*axes.values(), indexing="ij")
+        return {name: m.ravel() for name, m in zip(axes, mesh, strict=True)}, axes
+    u = unit_samples(study)
+    return {
+        name: np.asarray(dist.ppf(u[:, j]), dtype=float)
+        for j, (name, dist) in enumerate(params.items())
+    }, {}
+
+
+def _value(cols, spec, name, n):
+    """A parameter's column: sampled, or the fixed number broadcast."""
+    if name in cols:
+        return cols[name]
+    return np.full(n, float(getattr(spec, name)))
+
+
+def make_design(study: Study) -> xr.Dataset:
+    """All inputs of a study on the ``sample`` dimension, with the derived rocking parameters
+    (p, alpha, eta), the motion in SI units and the dimensionless groups of [000].
+
+    For grid studies the grid axes are kept as coordinates ``<name>_grid`` and the attribute
+    ``grid_dims`` lists them, so :func:`rockstudy.study.store.open_result` can unstack.
+    """
+    cols, axes = _inputs(study)
+    n = len(next(iter(cols.values())))
+    st, mo = study.structure, study.motion
+    data = {}
+    if st.kind == "equivalent_block":
+        p = _value(cols, st, "frequency_parameter", n)
+        alpha = _value(cols, st, "critical_rotation", n)
+        eta = _value(cols, st, "restitution", n)
+        data.update(frequency_parameter=p, critical_rotation=alpha, restitution=eta)
+    else:
+        R = _value(cols, st, "half_diagonal", n)
+        alpha0 = _value(cols, st, "slenderness", n)
+        p = np.sqrt(3.0 * G / (4.0 * R))
+        alpha = alpha0
+        if st.kind == "rocking_wall":  # eq. (23) of [003]: p_wall = sqrt(2) p, theta_cr = 2 alpha
+            p = math.sqrt(2.0) * p
+            alpha = 2.0 * alpha0
+        eta = (
+            1.0 - 1.5 * np.sin(alpha0) ** 2
+            if st.restitution == "housner"
+            else _value(cols, st, "restitution", n)
+        )
+        data.update(
+            half_diagonal=R,
+            slenderness=alpha0,
+            restitution=eta,
+            frequency_parameter=p,
+            critical_rotation=alpha,
+        )
+    uplift = G * np.tan(alpha)
+    if mo.kind == "pulse":
+        ratio = (
+            _value(cols, mo, "amplitude_ratio", n)
+            if mo.amplitude is None
+            else _value(cols, mo, "amplitude", n) / uplift
+        )
+        amp = mo.direction * ratio * uplift
+        period = (
+            _value(cols, mo, "period", n)
+            if mo.frequency_ratio is None
+            else 2.0 * np.pi / (_value(cols, mo, "frequency_ratio", n) * p)
+        )
+        data.update(
+            amplitude=amp,
+            amplitude_ratio=ratio,
+            period=period,
+            frequency_ratio=2.0 * np.pi / (period * p),
+        )
+        a_g = np.abs(amp)
+        data.update(
+            omega=2.0 * np.pi / (period * p),
+            a=a_g / (G * alpha),
+            inverse_a=G * alpha / a_g,
+            uplift_ratio=uplift / a_g,
+        )
+    elif mo.kind == "record":
+        rng = np.random.default_rng(np.random.SeedSequence([study.seed, 1]))
+        data["record"] = rng.integers(0, len(mo.files), n).astype(np.int64)
+        if mo.scale is not None:
+            data["scale"] = _value(cols, mo, "scale", n)
+        else:
+            data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
+    else:
+        data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
+    data["cos_alpha"] = np.cos(alpha)
+    ds = xr.Dataset(
+        {k: ("sample", np.asarray(v)) for k, v in data.items()}, coords={"sample": np.arange(n)}
+    )
+    for name, values in axes.items():
+        ds.coords[f"{name}_grid"] = (f"{name}_grid", values)
+    ds.attrs["grid_dims"] = list(axes)
+    for name, var in ds.data_vars.items():
+        long_name, units = VARIABLES[name]
+        var.attrs.update(long_name=long_name, units=units)
+    ds["sample"].attrs.update(long_name="sample index", units="1")
+    return ds
