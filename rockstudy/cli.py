@@ -114,7 +114,7 @@ def main(argv=None) -> int:
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     val = sub.add_parser("validate", help="check study files, naming every problem")
     val.add_argument("study", nargs="+")
-    sch = sub.add_parser("schema", help="print the JSON schema of study files")
+    sub.add_parser("schema", help="print the JSON schema of study files")
     args = parser.parse_args(argv)
     try:
         if args.command == "simulate":

@@ -8,7 +8,7 @@ negative.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -209,6 +209,6 @@ class Grid(_Dist):
 
 
 Distribution = Annotated[
-    Union[Uniform, LogUniform, Normal, TruncNormal, LogNormal, Triangular, Choice, Grid],
+    Uniform | LogUniform | Normal | TruncNormal | LogNormal | Triangular | Choice | Grid,
     Field(discriminator="dist"),
 ]

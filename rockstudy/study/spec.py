@@ -38,13 +38,13 @@ import json
 import math
 import tomllib
 from pathlib import Path
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .distributions import Distribution
 
-Param = Union[float, Distribution]
+Param = float | Distribution
 
 
 class _Model(BaseModel):
@@ -228,8 +228,8 @@ class RunSpec(_Model):
         return self
 
 
-Structure = Annotated[Union[BlockSpec, WallSpec, EquivalentBlockSpec], Field(discriminator="kind")]
-MotionSpec = Annotated[Union[PulseSpec, RecordSpec, StochasticSpec], Field(discriminator="kind")]
+Structure = Annotated[BlockSpec | WallSpec | EquivalentBlockSpec, Field(discriminator="kind")]
+MotionSpec = Annotated[PulseSpec | RecordSpec | StochasticSpec, Field(discriminator="kind")]
 
 
 class Study(_Model):

@@ -51,15 +51,23 @@ def chunk_bounds(n: int, size: int) -> list[tuple[int, int]]:
 
 def create_store(path, design: xr.Dataset, study: Study) -> None:
     """Write the template cube: design, outputs at their fill values, status pending."""
+    import dask
+    import dask.array as da
+
     n = design.sizes["sample"]
+    size = min(study.chunk_size, n)
     ds = design.copy()
+
+    def lazy(fill, dtype):  # written chunk by chunk: the template never sits in memory
+        return ("sample", da.full(n, fill, dtype=dtype, chunks=size))
+
     for name in study.run.outputs:
         long_name, units, dtype, fill = OUTPUTS[name]
-        ds[name] = ("sample", np.full(n, fill, dtype=dtype))
+        ds[name] = lazy(fill, dtype)
         ds[name].attrs.update(long_name=long_name, units=units)
-    ds["status"] = ("sample", np.zeros(n, np.int8))
+    ds["status"] = lazy(STATUS_PENDING, np.int8)
     ds["status"].attrs.update(long_name="0 pending, 1 ok, 2 failed", units="1")
-    ds["error"] = ("sample", np.full(n, "", dtype=f"<U{ERROR_WIDTH}"))
+    ds["error"] = lazy("", f"<U{ERROR_WIDTH}")
     ds["error"].attrs.update(long_name="error message of a failed sample", units="1")
     ds.attrs.update(
         study=study.normalized(),
@@ -71,11 +79,10 @@ def create_store(path, design: xr.Dataset, study: Study) -> None:
         Conventions="CF-1.8",
     )
     chunks = {
-        name: {"chunks": (min(study.chunk_size, n),)}
-        for name, var in ds.data_vars.items()
-        if var.dims == ("sample",)
+        name: {"chunks": (size,)} for name, var in ds.data_vars.items() if var.dims == ("sample",)
     }
-    ds.to_zarr(Path(path), mode="w-", encoding=chunks, **_FORMAT)
+    with dask.config.set(scheduler="threads"):  # here, never on a cluster's workers
+        ds.to_zarr(Path(path), mode="w-", encoding=chunks, **_FORMAT)
 
 
 def write_chunk(path, start: int, stop: int, result: dict) -> None:
@@ -120,18 +127,21 @@ def _unstack_grid(ds, dims):
     shape = [ds.sizes[f"{d}_grid"] for d in dims]
     out = {}
     for name, var in ds.data_vars.items():
-        if var.dims == ("sample",):
+        if var.dims == ("sample",) and name not in dims:
             out[name] = (tuple(dims), var.values.reshape(shape), var.attrs)
     coords = {d: ds[f"{d}_grid"].values for d in dims}
     return xr.Dataset(out, coords=coords, attrs=ds.attrs)
 
 
 def export_netcdf(path, out_path) -> Path:
-    """Write the finished cube as netCDF (scipy backend) beside the zarr store."""
-    ds = xr.open_zarr(Path(path), consolidated=True).load()
+    """Write the finished cube as netCDF (scipy backend) beside the zarr store, streamed."""
+    import dask
+
+    ds = xr.open_zarr(Path(path), consolidated=True)  # lazy: written chunk by chunk
     ds.attrs["grid_dims"] = json.dumps(ds.attrs.get("grid_dims", []))
-    for name in list(ds.data_vars):
-        if ds[name].dtype == np.int64:
+    for name in list(ds.variables):
+        if ds[name].dtype == np.int64:  # netCDF3 has no 64-bit integers
             ds[name] = ds[name].astype(np.int32)
-    ds.to_netcdf(Path(out_path), engine="scipy")
+    with dask.config.set(scheduler="threads"):
+        ds.to_netcdf(Path(out_path), engine="scipy")
     return Path(out_path)
