@@ -15,6 +15,8 @@ $(STAMP): pyproject.toml
 setup: $(STAMP)
 
 demo: $(STAMP)
+	rm -rf results/quickstart.zarr results/quickstart.nc
+	$(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr
 	$(BIN)/rockstudy demo --out results/demo
 
 test: $(STAMP)
@@ -23,6 +25,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_engine.py
 	$(BIN)/python benchmarks/bench_closedform.py
+	$(BIN)/python benchmarks/bench_study.py
 
 figures: $(STAMP)
 	$(BIN)/rockstudy figures --out results/figures

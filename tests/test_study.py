@@ -211,7 +211,7 @@ def test_failed_samples_are_recorded(tmp_path):
     failed = ds.status.values == 2
     assert report.failed_samples == failed.sum() > 0
     assert (ds.status.values == 1).sum() > 0  # blocks that never uplift need no step
-    assert all("max_steps=3" in e for e in ds.error.values[failed])
+    assert all(b"max_steps=3" in e for e in ds.error.values[failed])
     assert np.all(np.isnan(ds.max_rotation.values[failed]))
 
 

@@ -163,11 +163,12 @@ def _execute(client, todo, columns, study_json, base_dir, out, report, bar):
         futures[fut] = (a, b)
         return fut
 
+    writer = store.ChunkWriter(out)
     seq = as_completed([submit(*pending.pop(0)) for _ in range(min(in_flight, len(pending)))])
     for fut in seq:
         a, b = futures.pop(fut)
         result = fut.result()
-        store.write_chunk(out, a, b, result)
+        writer.write(a, b, result)
         report.chunks_computed.append((a, b))
         bar.step()
         if pending:

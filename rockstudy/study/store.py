@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .evaluate import ERROR_WIDTH, OUTPUTS, STATUS_PENDING
+from .evaluate import ERROR_DTYPE, OUTPUTS, STATUS_PENDING
 from .spec import Study
 
 _FORMAT = {"zarr_format": 2, "consolidated": True}
@@ -67,7 +67,7 @@ def create_store(path, design: xr.Dataset, study: Study) -> None:
         ds[name].attrs.update(long_name=long_name, units=units)
     ds["status"] = lazy(STATUS_PENDING, np.int8)
     ds["status"].attrs.update(long_name="0 pending, 1 ok, 2 failed", units="1")
-    ds["error"] = lazy("", f"<U{ERROR_WIDTH}")
+    ds["error"] = lazy(b"", ERROR_DTYPE)
     ds["error"].attrs.update(long_name="error message of a failed sample", units="1")
     ds.attrs.update(
         study=study.normalized(),
@@ -85,14 +85,28 @@ def create_store(path, design: xr.Dataset, study: Study) -> None:
         ds.to_zarr(Path(path), mode="w-", encoding=chunks, **_FORMAT)
 
 
+class ChunkWriter:
+    """Writes finished chunks straight into the zarr arrays of a cube, ``status`` last.
+
+    The arrays were created by :func:`create_store` with the study's chunks, so each chunk
+    write touches its own zarr chunks only.
+    """
+
+    def __init__(self, path):
+        import zarr
+
+        self.group = zarr.open_group(str(path), mode="r+", zarr_format=2)
+
+    def write(self, start: int, stop: int, result: dict) -> None:
+        for name, values in result.items():
+            if name != "status":
+                self.group[name][start:stop] = values
+        self.group["status"][start:stop] = result["status"]
+
+
 def write_chunk(path, start: int, stop: int, result: dict) -> None:
     """Write one finished chunk: every output, then ``status`` (last)."""
-    region = {"sample": slice(start, stop)}
-    body = xr.Dataset({k: ("sample", v) for k, v in result.items() if k != "status"})
-    body.to_zarr(Path(path), region=region, **_FORMAT)
-    xr.Dataset({"status": ("sample", result["status"])}).to_zarr(
-        Path(path), region=region, **_FORMAT
-    )
+    ChunkWriter(path).write(start, stop, result)
 
 
 def read_status(path) -> np.ndarray:
