@@ -103,17 +103,18 @@ def run_study(
     design = make_design(study)
     n = design.sizes["sample"]
     bounds = store.chunk_bounds(n, study.chunk_size)
-    if out.exists():
-        if not resume:
-            raise FileExistsError(f"{out} exists: pass resume=True (--resume) or a new path")
-        import xarray as xr
-
-        attrs = xr.open_zarr(out, consolidated=True).attrs
-        if attrs.get("study_sha256") != study.sha256():
+    template = None
+    if out.exists() and not resume:
+        raise FileExistsError(f"{out} exists: pass resume=True (--resume) or a new path")
+    if out.exists() and store.template_complete(out):
+        if store.study_sha256(out) != study.sha256():
             raise ValueError(f"{out} holds a different study (sha256 mismatch); cannot resume")
         todo = store.pending_chunks(out, study.chunk_size)
-    else:
-        store.create_store(out, design, study)
+    else:  # new, or killed while its template was written: nothing finished yet
+
+        def template():
+            store.create_store(out, design, study, overwrite=True)
+
         todo = bounds
     report = RunReport(out, n, len(bounds))
     cols_names = [name for name, v in design.data_vars.items() if v.dims == ("sample",)]
@@ -127,7 +128,9 @@ def run_study(
     bar = _Progress(len(todo), progress)
     try:
         if todo:
-            _execute(client, todo, columns, study_json, base_dir, out, report, bar)
+            _execute(client, todo, columns, study_json, base_dir, out, report, bar, template)
+        elif template is not None:
+            template()
     finally:
         if own and client is not None:
             client.close()
@@ -141,7 +144,8 @@ def run_study(
     return report
 
 
-def _execute(client, todo, columns, study_json, base_dir, out, report, bar):
+def _execute(client, todo, columns, study_json, base_dir, out, report, bar, template):
+    """Submit the chunks, write the template while the first ones run, then write results."""
     from distributed import as_completed
 
     n_workers = max(1, len(client.nthreads()))
@@ -163,8 +167,11 @@ def _execute(client, todo, columns, study_json, base_dir, out, report, bar):
         futures[fut] = (a, b)
         return fut
 
+    first = [submit(*pending.pop(0)) for _ in range(min(in_flight, len(pending)))]
+    if template is not None:
+        template()
     writer = store.ChunkWriter(out)
-    seq = as_completed([submit(*pending.pop(0)) for _ in range(min(in_flight, len(pending)))])
+    seq = as_completed(first)
     for fut in seq:
         a, b = futures.pop(fut)
         result = fut.result()

@@ -49,8 +49,12 @@ def chunk_bounds(n: int, size: int) -> list[tuple[int, int]]:
     return [(i, min(i + size, n)) for i in range(0, n, size)]
 
 
-def create_store(path, design: xr.Dataset, study: Study) -> None:
-    """Write the template cube: design, outputs at their fill values, status pending."""
+def create_store(path, design: xr.Dataset, study: Study, overwrite: bool = False) -> None:
+    """Write the template cube: design, outputs at their fill values, status pending.
+
+    The attribute ``template_complete`` is set last: a store without it was interrupted before
+    any result was written, and is rebuilt (``overwrite``) rather than resumed.
+    """
     import dask
     import dask.array as da
 
@@ -82,7 +86,24 @@ def create_store(path, design: xr.Dataset, study: Study) -> None:
         name: {"chunks": (size,)} for name, var in ds.data_vars.items() if var.dims == ("sample",)
     }
     with dask.config.set(scheduler="threads"):  # here, never on a cluster's workers
-        ds.to_zarr(Path(path), mode="w-", encoding=chunks, **_FORMAT)
+        ds.to_zarr(Path(path), mode="w" if overwrite else "w-", encoding=chunks, **_FORMAT)
+    import zarr
+
+    zarr.open_group(str(path), mode="r+", zarr_format=2).attrs["template_complete"] = 1
+    zarr.consolidate_metadata(str(path), zarr_format=2)
+
+
+def template_complete(path) -> bool:
+    """Whether a store's template was fully written."""
+    try:
+        return bool(xr.open_zarr(Path(path), consolidated=True).attrs.get("template_complete"))
+    except Exception:
+        return False
+
+
+def study_sha256(path) -> str | None:
+    """The sha256 of the study a store holds."""
+    return xr.open_zarr(Path(path), consolidated=True).attrs.get("study_sha256")
 
 
 class ChunkWriter:
