@@ -1,5 +1,28 @@
-"""Rocking structures reduced to the parameters the solvers need."""
+"""Rocking structures reduced to the parameters the solvers need (paper [003])."""
 
 from .block import Block, block_parameters, frequency_parameter, restitution_housner
+from .equivalent import (
+    Arch,
+    ConicalShell,
+    PointMassStrut,
+    RockingWall,
+    SymmetricFrame,
+    restitution_symmetric_body,
+)
+from .mechanism import EquivalentBlock, Mechanism, RockingParameters
 
-__all__ = ["Block", "block_parameters", "frequency_parameter", "restitution_housner"]
+__all__ = [
+    "Arch",
+    "Block",
+    "ConicalShell",
+    "EquivalentBlock",
+    "Mechanism",
+    "PointMassStrut",
+    "RockingParameters",
+    "RockingWall",
+    "SymmetricFrame",
+    "block_parameters",
+    "frequency_parameter",
+    "restitution_housner",
+    "restitution_symmetric_body",
+]
