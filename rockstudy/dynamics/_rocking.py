@@ -26,6 +26,11 @@ from ._dop853 import dop853_error, hermite5, make_dop853_step
 
 MODEL_NONLINEAR = 0
 MODEL_LINEAR = 1
+MODEL_TABLE = 2  # a mechanism, eq. (8) of [003], from tabulated I, G, B (structures/mechanism)
+
+#: Columns of a mechanism table, on a uniform grid of the amplitude phi in [0, fall].
+TAB_PHI, TAB_I, TAB_DI, TAB_G, TAB_DG, TAB_B, TAB_DB, TAB_V, TAB_DV = range(9)
+NO_TABLE = np.empty((0, 9))
 
 PH_END = 0
 PH_REST = 1
@@ -48,11 +53,45 @@ ATOL_FRACTION = 1e-3
 NEVER_AT_REST = 2**31 - 1
 
 
+@njit(cache=True, inline="always")
+def _hermite3(u, tab, col, dcol):
+    """Cubic Hermite value and derivative of table column ``col`` (derivative ``dcol``) at u."""
+    n = tab.shape[0]
+    dphi = tab[1, TAB_PHI] - tab[0, TAB_PHI]
+    i = min(max(int(u / dphi), 0), n - 2)
+    x = (u - tab[i, TAB_PHI]) / dphi
+    y0, y1 = tab[i, col], tab[i + 1, col]
+    d0, d1 = tab[i, dcol] * dphi, tab[i + 1, dcol] * dphi
+    x2 = x * x
+    x3 = x2 * x
+    val = (
+        (2 * x3 - 3 * x2 + 1) * y0
+        + (x3 - 2 * x2 + x) * d0
+        + (-2 * x3 + 3 * x2) * y1
+        + (x3 - x2) * d1
+    )
+    der = ((6 * x2 - 6 * x) * (y0 - y1) + (3 * x2 - 4 * x + 1) * d0 + (3 * x2 - 2 * x) * d1) / dphi
+    return val, der
+
+
+@njit(cache=True)
+def _mechanism_accel(u, v, a_g, tab):
+    """u'' of a mechanism from eq. (8) of [003]: I u'' + I'/2 u'^2 - G g = -B a_g."""
+    inertia, d_inertia = _hermite3(u, tab, TAB_I, TAB_DI)
+    g_nl = _hermite3(u, tab, TAB_G, TAB_DG)[0]
+    b_nl = _hermite3(u, tab, TAB_B, TAB_DB)[0]
+    return (g_nl * G - 0.5 * d_inertia * v * v - b_nl * a_g) / inertia
+
+
 @njit(cache=True)
 def _rhs(t, th, om, args):
-    """theta_ddot on side s: eq. (2.2) of [000] (nonlinear) or eq. (3.1) (linearized)."""
-    p, alpha, s, model, kind, mp, times, samples, k = args
-    a = ground_acceleration(kind, mp, times, samples, t, k) / G
+    """theta_ddot on side s: eq. (2.2) of [000] (nonlinear), eq. (3.1) (linearized) or a
+    tabulated mechanism, eq. (8) of [003], in the amplitude u = s theta."""
+    p, alpha, s, model, kind, mp, times, samples, k, tab = args
+    a_g = ground_acceleration(kind, mp, times, samples, t, k)
+    if model == MODEL_TABLE:
+        return s * _mechanism_accel(s * th, s * om, s * a_g, tab)
+    a = a_g / G
     if model == MODEL_LINEAR:
         return p * p * (th - alpha * s - a)
     x = alpha * s - th
@@ -238,12 +277,13 @@ def _step_events(s, h, th, om, f0, th1, om1, f1):
 def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
-    blk = (p, alpha, eta, model, thr, omega_rest, tol, max_steps), mot = (kind, mp, times,
-    samples), log = (hist, imps) (empty arrays: no history). ``st`` and the tallies ``ta``
-    are updated in place. Returns PH_END, PH_REST, PH_OVER or PH_FAIL; or PH_IMPACT once the
-    impact count reaches ``stop_at_impacts`` (the state is then just after that impact).
+    blk = (p, alpha, eta, model, thr, omega_rest, tol, max_steps, fall, tab),
+    mot = (kind, mp, times, samples), log = (hist, imps) (empty arrays: no history).
+    ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
+    or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
+    then just after that impact).
     """
-    p, alpha, eta, model, thr, omega_rest, tol, max_steps = blk
+    p, alpha, eta, model, thr, omega_rest, tol, max_steps, fall, tab = blk
     kind, mp, times, samples = mot
     hist, imps = log
     rec = hist.shape[0] > 0
@@ -252,7 +292,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     kx = np.empty(13)
     kv = np.empty(13)
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
-    f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k))
+    f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k, tab))
     steps = 0
     code = PH_END
     while t < t_stop:
@@ -267,7 +307,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             t_next = min(t_next, times[k + 1])
         last = h >= t_next - t
         hs = t_next - t if last else h
-        args = (p, alpha, s, model, kind, mp, times, samples, k)
+        args = (p, alpha, s, model, kind, mp, times, samples, k, tab)
         th1, om1 = _step(args, t, th, om, f0, hs, kx, kv)
         t1 = t_next if last else t + hs
         f1 = _rhs(t1, th1, om1, args)
@@ -287,14 +327,12 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             ta[WORK] += 1
             x, v, a = _true_state(args, t, th, om, f0, s_pk * hs, kx, kv)
             ta[MAXU] = max(ta[MAXU], s * (x - 0.5 * v * v / a) if a != 0.0 else s * x)
-        if s_imp > 1.0 and s * th1 >= FALL_ROTATION:
-            s_ot = _root_hermite(
-                s * FALL_ROTATION, -s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0
-            )
+        if s_imp > 1.0 and s * th1 >= fall:
+            s_ot = _root_hermite(s * fall, -s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0)
             om = hermite5(s_ot, hs, th, om, f0, th1, om1, f1)[1]
             t = t + s_ot * hs
-            th = s * FALL_ROTATION
-            ta[MAXU] = FALL_ROTATION
+            th = s * fall
+            ta[MAXU] = fall
             if rec:
                 _push(hist, ta, t, th, om)
             code = PH_OVER
@@ -339,7 +377,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if ta[NIMP] == stop_at_impacts:
             code = PH_IMPACT
             break
-        f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k))
+        f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k, tab))
     st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
     return code
 
@@ -391,17 +429,65 @@ def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
 
 
 @njit(cache=True)
-def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=0.0, om0=0.0):
-    """Rock one block through one motion, from rest or from (th0, om0) at t = 0.
+def _potential_level(level, lo, hi, tab):
+    """u in [lo, hi] where V(u) = level, V increasing there (bisection on the table)."""
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if _hermite3(mid, tab, TAB_V, TAB_DV)[0] < level:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
 
-    mot = (kind, mp, times, samples); log = (hist, imps), empty arrays for no history.
+
+@njit(cache=True)
+def _free_map_table(u, v, phi_cr, eta, tab, omega_rest):
+    """:func:`free_rocking_map` for a tabulated mechanism: E = I(u) v^2 / 2 + g V(u), with the
+    speed at the pivot multiplied by eta at each impact. Returns (overturns, peak, impacts)."""
+    i0 = tab[0, TAB_I]
+    v_rest = tab[0, TAB_V]
+    barrier = _hermite3(phi_cr, tab, TAB_V, TAB_DV)[0]
+    e = 0.5 * _hermite3(u, tab, TAB_I, TAB_DI)[0] * v * v / G + _hermite3(u, tab, TAB_V, TAB_DV)[0]
+    peak = u
+    if e >= barrier:
+        if (u < phi_cr and v > 0.0) or (u >= phi_cr and v >= 0.0):
+            return True, tab[-1, TAB_PHI], 0
+    elif u > phi_cr:
+        return True, tab[-1, TAB_PHI], 0
+    elif v > 0.0:
+        peak = _potential_level(e, u, phi_cr, tab)
+    w = math.sqrt(max(2.0 * G * (e - v_rest) / i0, 0.0))  # speed at the first impact
+    if w < omega_rest:
+        return False, peak, 0
+    w1 = eta * w
+    e1 = 0.5 * i0 * w1 * w1 / G + v_rest
+    if e1 >= barrier:
+        return True, tab[-1, TAB_PHI], 1
+    peak = max(peak, _potential_level(e1, 0.0, phi_cr, tab))
+    if w1 < omega_rest:
+        return False, peak, 1
+    if eta >= 1.0:
+        return False, peak, NEVER_AT_REST
+    return False, peak, 2 + int(math.floor(math.log(omega_rest / w1) / math.log(eta)))
+
+
+@njit(cache=True)
+def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0, om0, fall, tab):
+    """Rock one block (or tabulated mechanism) through one motion, from rest or (th0, om0).
+
+    mot = (kind, mp, times, samples); log = (hist, imps), empty arrays for no history. For
+    MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
+    table and ``fall`` the amplitude at which it is taken to have collapsed.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
     impact times recorded, DOP853 steps, first impact time).
     """
     kind, mp, times, samples = mot
-    thr = uplift_threshold(alpha, model)
+    if model == MODEL_TABLE:
+        thr = -G * tab[0, TAB_G] / tab[0, TAB_B]  # g lambda, eq. (10) of [003]
+    else:
+        thr = uplift_threshold(alpha, model)
     omega_rest = REST_FRACTION * p * alpha
-    blk = (p, alpha, eta, model, thr, omega_rest, TOL_SAFETY * rtol, max_steps)
+    blk = (p, alpha, eta, model, thr, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
     hist = log[0]
     rec = hist.shape[0] > 0
     dur = mp[3]
@@ -434,7 +520,10 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0=
             _push(hist, ta, dur, 0.0, 0.0)
     elif code == PH_END or code == PH_IMPACT:
         u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
-        over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
+        if model == MODEL_TABLE:
+            over, peak, n_post = _free_map_table(u, v, alpha, eta, tab, omega_rest)
+        else:
+            over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
         if use_map and not over:
             ta[MAXU] = max(ta[MAXU], peak)
             ta[NIMP] += n_post
@@ -469,7 +558,22 @@ def scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps)
     no_log = (np.empty((0, 3)), np.empty(0))
     for i in prange(p.shape[0]):
         mot = (kind, mp[i], times, samples)
-        r = scene(p[i], alpha[i], eta[i], model, mot, rtol, True, np.inf, no_log, max_steps)
+        r = scene(
+            p[i],
+            alpha[i],
+            eta[i],
+            model,
+            mot,
+            rtol,
+            True,
+            np.inf,
+            no_log,
+            max_steps,
+            0.0,
+            0.0,
+            FALL_ROTATION,
+            NO_TABLE,
+        )
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
         out[i, 4], out[i, 5], out[i, 6] = r[4], r[7], r[8]
     return out

@@ -16,10 +16,23 @@ from . import _linear, _rocking
 from .reference import simulate_reference
 from .result import RockingResult
 
-Method = Literal["nonlinear", "linear", "scipy", "scipy-linear"]
+Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism"]
 
 
-def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+def _kernel(
+    p,
+    alpha,
+    eta,
+    motion,
+    model,
+    rtol,
+    t_max,
+    max_steps,
+    method,
+    x0,
+    fall=FALL_ROTATION,
+    tab=_rocking.NO_TABLE,
+):
     kind, mp, times, samples = motion.kernel_spec()
     t_tail = _tail_end(p, eta, motion, t_max)
     cap = 4096
@@ -39,6 +52,8 @@ def _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
             max_steps,
             x0[0],
             x0[1],
+            fall,
+            tab,
         )
         if nh <= cap and ni <= cap:
             break
@@ -117,6 +132,7 @@ _METHODS = {
     "linear": (_linear_exact, _rocking.MODEL_LINEAR),
     "scipy": (_scipy, _rocking.MODEL_NONLINEAR),
     "scipy-linear": (_scipy, _rocking.MODEL_LINEAR),
+    "mechanism": (None, _rocking.MODEL_TABLE),
 }
 
 
@@ -143,6 +159,9 @@ def simulate(
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
         trigonometric pulses, the same kernel otherwise.
         ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
+        For a structure with a ``mechanism()`` (a wall, an arch, a frame), ``"nonlinear"``
+        (or ``"mechanism"``) integrates the full mechanism, eq. (8) of [003]; the other
+        methods run its equivalent block (kappa_1).
     rtol : float
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
     t_max : float, optional
@@ -173,5 +192,33 @@ def simulate(
     om0 = float(initial_velocity)
     if not math.isfinite(om0):
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
+    if hasattr(structure, "mechanism") and method in ("nonlinear", "mechanism"):
+        return _mechanism(structure, motion, rtol, t_max, int(max_steps), (th0, om0))
     p, alpha, eta = block_parameters(structure)
     return runner(p, alpha, eta, motion, model, rtol, t_max, int(max_steps), method, (th0, om0))
+
+
+def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
+    """The full mechanism, eq. (8) of [003], through the tabulated kernel."""
+    from .mechanism import structure_table
+
+    params = structure.rocking_parameters()
+    if not params.restitution > 0:
+        raise ValueError(f"{type(structure).__name__} needs a restitution (in (0, 1]) to rock")
+    tab, fall = structure_table(structure)
+    result = _kernel(
+        params.frequency_parameter,
+        params.critical_rotation,
+        params.restitution,
+        motion,
+        _rocking.MODEL_TABLE,
+        rtol,
+        t_max,
+        max_steps,
+        "mechanism",
+        x0,
+        fall,
+        tab,
+    )
+    result.info["fall_rotation"] = fall
+    return result
