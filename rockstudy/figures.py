@@ -14,10 +14,15 @@ is read from stored numbers.
   (nonlinear) in the (5.3) groups for several alpha.
 - ``fig11_nonslender_histories.png``: non-slender responses in (4.11) and in (6.1) groups.
 - ``fig13_nonslender_spectra.png``: nonlinear spectra in (6.1) groups for several alpha.
+
+and of paper [003]: ``fig003_03_wall_errors.png`` (the rocking wall's equivalent block: period,
+overturning-time and uplift errors) and ``fig003_10_arch*.png`` (the arch's rocking parameters,
+and its errors for two inclusion angles).
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -295,3 +300,78 @@ def make_all(out_dir="results/figures") -> list[Path]:
         fn(out / name)
         paths.append(out / name)
     return paths
+
+
+def _error_panels(path, ds, xname, xlabel, title):
+    """Period, overturning-time (kappa_1, kappa_2) and uplift errors against one parameter."""
+    plt = _plt()
+    fig, axes = plt.subplots(1, 4, figsize=(17, 3.8))
+    x = ds[xname].values
+    for j, r in enumerate(ds.amplitude.values):
+        axes[0].plot(x, ds.period_ratio.values[:, j], "o-", ms=3, label=f"phi/phi_cr = {r:g}")
+    for ax, var, k in (
+        (axes[1], "overturn_time_ratio_kappa1", "kappa_1"),
+        (axes[2], "overturn_time_ratio_kappa2", "kappa_2"),
+    ):
+        for j, r in enumerate(ds.acceleration.values):
+            ax.plot(x, ds[var].values[:, j], "o-", ms=3, label=f"u_g''/(g lambda) = {r:g}")
+        ax.set(xlabel=xlabel, ylabel="t_over,blockeq / t_over,mech", title=f"overturning, {k}")
+    axes[3].plot(x, ds.uplift_ratio.values, "ko-", ms=3)
+    axes[3].set(xlabel=xlabel, ylabel="lambda_lin / lambda", title="uplift")
+    axes[0].set(xlabel=xlabel, ylabel="T_blockeq / T_mech", title="free-rocking period")
+    axes[0].legend(fontsize=7)
+    axes[1].legend(fontsize=7)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def fig003_wall(path):
+    """[003] Fig. 3: the rocking wall's equivalent block, errors against slenderness."""
+    from .structures import RockingWall
+    from .structures.errors import error_map
+
+    alphas = np.linspace(0.03, 0.35, 12)
+    ds = error_map([RockingWall(1.0, a) for a in alphas], {"slenderness": alphas})
+    _error_panels(path, ds, "slenderness", "alpha [rad]", "rocking wall (slider-crank)")
+
+
+def fig003_arch(path):
+    """[003] Figs. 10-13: the arch's equivalent block, errors against the thickness ratio for a
+    semicircular arch (beta = pi) and for beta = 2.4 rad."""
+    from .structures import Arch
+    from .structures.errors import error_map
+
+    plt = _plt()
+    ratios = np.linspace(0.12, 0.22, 8)
+    paths = []
+    for beta in (math.pi, 2.4):
+        ds = error_map([Arch(beta, t * 5.0, 5.0) for t in ratios], {"thickness_ratio": ratios})
+        sub = Path(str(path).replace(".png", f"_beta{beta:.2f}.png"))
+        _error_panels(
+            sub, ds, "thickness_ratio", "t_a / r_a", f"arch, inclusion angle {beta:.3f} rad"
+        )
+        paths.append(sub)
+    # the summary figure: the arch's rocking parameters (Fig. 10)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    for beta in (2.0, 2.4, 2.8, math.pi):
+        rps = [Arch(beta, t * 5.0, 5.0).rocking_parameters() for t in ratios]
+        axes[0].plot(
+            ratios,
+            [r.frequency_parameter * math.sqrt(5.0 / G) for r in rps],
+            label=f"beta = {beta:.2f}",
+        )
+        axes[1].plot(ratios, [r.critical_rotation for r in rps])
+        axes[2].plot(ratios, [r.uplift for r in rps])
+    axes[0].set(xlabel="t_a / r_a", ylabel="p sqrt(r_a / g)")
+    axes[1].set(xlabel="t_a / r_a", ylabel="phi_cr [rad]")
+    axes[2].set(xlabel="t_a / r_a", ylabel="lambda")
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+FIGURES["fig003_03_wall_errors.png"] = fig003_wall
+FIGURES["fig003_10_arch.png"] = fig003_arch

@@ -250,3 +250,40 @@ def test_equivalent_blocks_run_through_simulate():
     assert not full.overturned and full.n_impacts > 0
     with pytest.raises(ValueError, match="restitution"):
         rs.simulate(RockingWall(1.0, 0.1), pulse)
+
+
+def test_error_map_against_simulations():
+    """The map's free-rocking period of an exact block equivalent (point mass strut) equals the
+    nonlinear kernel's; its block period is the linear solver's; its overturning time is
+    solve_ivp's on eq. (8)."""
+    from scipy.integrate import solve_ivp
+
+    from rockstudy.structures.errors import error_map
+
+    strut = PointMassStrut(1.0, 0.2)
+    ds = error_map([strut], {"slenderness": [0.2]}, amplitude=(0.5,), acceleration=(2.0,))
+    rp = strut.rocking_parameters()
+    blk = rs.structures.EquivalentBlock(rp.frequency_parameter, 0.2, 1.0)
+    nl = rs.simulate(blk, rs.motions.NoMotion(), initial_rotation=0.1, rtol=1e-11, t_max=3.0)
+    lin = rs.simulate(blk, rs.motions.NoMotion(), method="linear", initial_rotation=0.1,
+                      t_max=3.0)
+    assert float(ds.period_ratio[0, 0]) == pytest.approx(
+        lin.impact_times[0] / nl.impact_times[0], rel=1e-7)
+    # overturning time: integrate eq. (8) from rest under 2 g lambda until phi_cr
+    mech = strut.mechanism()
+    a = -2.0 * rp.uplift * G
+
+    def rhs(t, y):
+        tt = mech.terms(np.array([y[0]]))
+        return [y[1], (tt["G"][0] * G - tt["J"][0] * y[1] ** 2 - tt["B"][0] * a) / tt["I"][0]]
+
+    def reach(t, y):
+        return y[0] - rp.critical_rotation
+
+    reach.terminal = True
+    sol = solve_ivp(rhs, (0, 50), [0.0, 0.0], events=reach, rtol=1e-11, atol=1e-13)
+    t_block = rs.closedform.overturning_time_constant_acceleration(
+        rp.frequency_parameter, 2.0, rp.uplift / rp.uplift_linearized)
+    assert float(ds.overturn_time_ratio_kappa1[0, 0]) == pytest.approx(
+        t_block / sol.t_events[0][0], rel=1e-6)
+    assert float(ds.uplift_ratio[0]) == pytest.approx(0.2 / math.tan(0.2), rel=1e-12)

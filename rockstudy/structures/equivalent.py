@@ -304,35 +304,39 @@ class Arch(_Symmetric):
         return lam, ok
 
     def _search(self):
-        """Least lambda over admissible hinge sets: all sets of 4 of 25 joints, then three
-        levels of local refinement (each a 7^4 grid at a third of the previous spacing)."""
+        """Least lambda over admissible hinge sets: all sets of 4 of 25 joints for both face
+        patterns, then three levels of local refinement of the best (each a 7^4 grid at a third
+        of the previous spacing)."""
         beta = self.inclusion_angle
         grid = np.linspace(-beta / 2, beta / 2, 25)
-        first = np.array(list(combinations(range(grid.size), 4))).T
+        psi = grid[np.array(list(combinations(range(grid.size), 4))).T]
         best = None
         for faces in ((1, -1, 1, -1), (-1, 1, -1, 1)):
-            faces = np.array(faces)
-            psi, h, cand = grid[first], grid[1] - grid[0], None
-            for _level in range(4):
-                with np.errstate(all="ignore"):
-                    lam, ok = self._evaluate(psi, faces)
-                lam = np.where(ok & np.isfinite(lam), lam, np.inf)
-                j = int(np.argmin(lam))
-                if not np.isfinite(lam[j]):
-                    break
-                cand = (float(lam[j]), psi[:, j].copy())
-                h /= 3
-                local = [
-                    np.clip(cand[1][i] + h * np.arange(-3, 4), -beta / 2, beta / 2)
-                    for i in range(4)
-                ]
-                psi = np.array([m.ravel() for m in np.meshgrid(*local, indexing="ij")])
-                psi = psi[:, np.all(np.diff(psi, axis=0) > 0, axis=0)]
+            cand = self._best(psi, np.array(faces))
             if cand is not None and (best is None or cand[0] < best[0]):
-                best = (cand[0], cand[1], faces)
+                best = (*cand, np.array(faces))
         if best is None:
             raise ValueError("no admissible four-hinge mechanism: check the arch geometry")
+        h = grid[1] - grid[0]
+        for _level in range(3):
+            h /= 3
+            local = [
+                np.clip(best[1][i] + h * np.arange(-3, 4), -beta / 2, beta / 2) for i in range(4)
+            ]
+            psi = np.array([m.ravel() for m in np.meshgrid(*local, indexing="ij")])
+            psi = psi[:, np.all(np.diff(psi, axis=0) > 0, axis=0)]
+            cand = self._best(psi, best[2])
+            if cand is not None and cand[0] <= best[0]:
+                best = (*cand, best[2])
         return {"uplift": best[0], "angles": best[1], "faces": best[2]}
+
+    def _best(self, psi, faces):
+        """(lambda, hinge angles) of the admissible candidate of least lambda, or None."""
+        with np.errstate(all="ignore"):
+            lam, ok = self._evaluate(psi, faces)
+        lam = np.where(ok & np.isfinite(lam), lam, np.inf)
+        j = int(np.argmin(lam))
+        return (float(lam[j]), psi[:, j].copy()) if np.isfinite(lam[j]) else None
 
     @property
     def hinges(self) -> dict:

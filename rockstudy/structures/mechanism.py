@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..constants import G
 from ._jet import Jet
@@ -126,7 +125,8 @@ class Mechanism:
     phi_max: float = math.pi / 2
 
     def terms(self, phi) -> dict:
-        """I_nl, J_nl, G_nl, B_nl of eq. (8) and V / g, with their phi-derivatives, at phi."""
+        """I_nl, J_nl, G_nl, B_nl of eq. (8), V / g = sum m y_G and X = sum m x_G, with
+        phi-derivatives, at phi."""
         xs, ys, betas = self.pose(Jet.variable(phi))
         inertia = 0.0
         inertia_d = 0.0
@@ -135,12 +135,14 @@ class Mechanism:
         v = 0.0
         v_d = 0.0
         v_dd = 0.0
+        x_sum = 0.0
         for m, ig, x, y, beta in zip(self.masses, self.inertias, xs, ys, betas, strict=True):
             inertia = inertia + m * (x.d1**2 + y.d1**2) + ig * beta.d1**2
             inertia_d = inertia_d + 2 * m * (x.d1 * x.d2 + y.d1 * y.d2) + 2 * ig * beta.d1 * beta.d2
             b = b - m * x.d1
             b_d = b_d - m * x.d2
             v = v + m * y.value
+            x_sum = x_sum + m * x.value
             v_d = v_d + m * y.d1
             v_dd = v_dd + m * y.d2
         return {
@@ -152,6 +154,7 @@ class Mechanism:
             "B": b,
             "dB": b_d,
             "V": v,
+            "X": x_sum,
         }
 
     def critical_rotation(self) -> float:
@@ -163,14 +166,22 @@ class Mechanism:
             raise ValueError("the mechanism is not stable at rest (G_nl(0+) >= 0)")
         if sign.size == 0:
             raise ValueError("no unstable equilibrium within the kinematic range")
-        i = sign[0]
-        return brentq(
-            lambda x: float(self.terms(np.array([x]))["G"][0]),
-            grid[i],
-            grid[i + 1],
-            xtol=1e-15,
-            rtol=4 * np.finfo(float).eps,
-        )
+        lo, hi = grid[sign[0]], grid[sign[0] + 1]
+        x = 0.5 * (lo + hi)
+        for _ in range(50):  # Newton on G with its exact derivative, kept in the bracket
+            t = self.terms(np.array([x]))
+            gx, dg = float(t["G"][0]), float(t["dG"][0])
+            if gx < 0:
+                lo = x
+            else:
+                hi = x
+            xn = x - gx / dg if dg != 0 else 0.5 * (lo + hi)
+            if not lo < xn < hi:
+                xn = 0.5 * (lo + hi)
+            if abs(xn - x) <= 1e-15 * max(1.0, x):
+                return xn
+            x = xn
+        return x
 
     def rocking_parameters(self, restitution: float) -> RockingParameters:
         """The rocking parameters of this direction (eqs. 9-20 of [003])."""
