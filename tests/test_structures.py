@@ -265,10 +265,10 @@ def test_error_map_against_simulations():
     rp = strut.rocking_parameters()
     blk = rs.structures.EquivalentBlock(rp.frequency_parameter, 0.2, 1.0)
     nl = rs.simulate(blk, rs.motions.NoMotion(), initial_rotation=0.1, rtol=1e-11, t_max=3.0)
-    lin = rs.simulate(blk, rs.motions.NoMotion(), method="linear", initial_rotation=0.1,
-                      t_max=3.0)
+    lin = rs.simulate(blk, rs.motions.NoMotion(), method="linear", initial_rotation=0.1, t_max=3.0)
     assert float(ds.period_ratio[0, 0]) == pytest.approx(
-        lin.impact_times[0] / nl.impact_times[0], rel=1e-7)
+        lin.impact_times[0] / nl.impact_times[0], rel=1e-7
+    )
     # overturning time: integrate eq. (8) from rest under 2 g lambda until phi_cr
     mech = strut.mechanism()
     a = -2.0 * rp.uplift * G
@@ -283,7 +283,49 @@ def test_error_map_against_simulations():
     reach.terminal = True
     sol = solve_ivp(rhs, (0, 50), [0.0, 0.0], events=reach, rtol=1e-11, atol=1e-13)
     t_block = rs.closedform.overturning_time_constant_acceleration(
-        rp.frequency_parameter, 2.0, rp.uplift / rp.uplift_linearized)
+        rp.frequency_parameter, 2.0, rp.uplift / rp.uplift_linearized
+    )
     assert float(ds.overturn_time_ratio_kappa1[0, 0]) == pytest.approx(
-        t_block / sol.t_events[0][0], rel=1e-6)
+        t_block / sol.t_events[0][0], rel=1e-6
+    )
     assert float(ds.uplift_ratio[0]) == pytest.approx(0.2 / math.tan(0.2), rel=1e-12)
+
+
+def test_asymmetric_frame_reduces_to_symmetric_frame():
+    from rockstudy.structures import AsymmetricFrame
+
+    b, H, L, h = 0.3, 2.0, 6.0, 0.25
+    m_col, m_beam = 1.0, 1.5
+    asym = AsymmetricFrame(b, H, H, L, h, m_col, m_beam, m_col)
+    sym = SymmetricFrame(math.hypot(b, H), math.atan2(b, H), m_beam / (2 * m_col))
+    ref = sym.rocking_parameters()
+    for rp in asym.rocking_parameters():
+        assert rp.frequency_parameter == pytest.approx(ref.frequency_parameter, rel=1e-10)
+        assert rp.critical_rotation == pytest.approx(ref.critical_rotation, rel=1e-10)
+        assert rp.uplift == pytest.approx(ref.uplift, rel=1e-10)
+        assert rp.kappa1 == pytest.approx(ref.kappa1, rel=1e-10)
+
+
+def test_asymmetric_frame_uplift_eq_33():
+    """lambda_p, lambda_n of the generic four-bar mechanism against eq. (33) by virtual work."""
+    from rockstudy.structures import AsymmetricFrame
+
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        b = rng.uniform(0.15, 0.4)
+        H = rng.uniform(1.5, 3.0)
+        frame = AsymmetricFrame(
+            b,
+            H,
+            H * rng.uniform(0.5, 0.95),
+            rng.uniform(4, 10),
+            rng.uniform(0.1, 0.5),
+            *rng.uniform(0.5, 3.0, 3),
+        )
+        pos, neg = frame.rocking_parameters()
+        lp, ln = frame.uplift_closed_form()
+        assert pos.uplift == pytest.approx(lp, rel=1e-12)
+        assert neg.uplift == pytest.approx(ln, rel=1e-12)
+        assert pos.uplift != pytest.approx(neg.uplift, rel=1e-3)  # asymmetric
+    with pytest.raises(ValueError, match="beam_length"):
+        AsymmetricFrame(0.5, 2.0, 1.5, 1.5, 0.2)

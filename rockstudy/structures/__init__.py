@@ -3,6 +3,7 @@
 from .block import Block, block_parameters, frequency_parameter, restitution_housner
 from .equivalent import (
     Arch,
+    AsymmetricFrame,
     ConicalShell,
     PointMassStrut,
     RockingWall,
@@ -13,6 +14,7 @@ from .mechanism import EquivalentBlock, Mechanism, RockingParameters
 
 __all__ = [
     "Arch",
+    "AsymmetricFrame",
     "Block",
     "ConicalShell",
     "EquivalentBlock",

@@ -220,6 +220,38 @@ def _four_bar(A, B0, C0, D, phi):
     return (bx, by), (cx, cy), beta2, beta3
 
 
+def four_bar_mechanism(A, B0, C0, D, bodies, phi_max=math.pi / 4) -> Mechanism:
+    """A four-bar rocking mechanism (ground pivots A and D; blocks AB, BC, CD).
+
+    ``bodies`` lists (mass, centre of mass at rest, inertia about it) of AB, BC and CD. The
+    generalized coordinate is the rotation of AB in the sense that raises the centre of mass
+    (rocking, not falling, V' > 0), and x is mirrored if needed so that the structure leans
+    towards -x as phi grows (B_nl > 0: a ground acceleration towards -x lifts it).
+    """
+
+    def pose(phi, sense, mirror):
+        (bx, by), _, beta2, beta3 = _four_bar(A, B0, C0, D, phi * sense)
+        xs, ys = [], []
+        for (_, (gx, gy), _), base, moved, beta in zip(
+            bodies,
+            (A, B0, D),
+            ((A[0], A[1]), (bx, by), (D[0], D[1])),
+            (phi * sense, beta2, beta3),
+            strict=True,
+        ):
+            rx, ry = _rotate(gx - base[0], gy - base[1], beta)
+            xs.append(mirror * (rx + moved[0]))
+            ys.append(ry + moved[1])
+        return xs, ys, [phi * sense, beta2, beta3]
+
+    masses = tuple(float(b[0]) for b in bodies)
+    inertias = tuple(float(b[2]) for b in bodies)
+    t0 = Mechanism(masses, inertias, lambda phi: pose(phi, 1.0, 1.0)).terms(np.array([0.0]))
+    sense = 1.0 if t0["G"][0] < 0 else -1.0  # G = -V'/g < 0: the rotation lifts the mass
+    mirror = 1.0 if sense * t0["B"][0] > 0 else -1.0
+    return Mechanism(masses, inertias, lambda phi: pose(phi, sense, mirror), phi_max=phi_max)
+
+
 @dataclass(frozen=True)
 class Arch(_Symmetric):
     """A circular masonry arch rocking as a four-hinge (three-block) mechanism, sec. 5.2 of [003].
@@ -347,30 +379,124 @@ class Arch(_Symmetric):
     def mechanism(self):
         psi, faces = self._hinges["angles"], self._hinges["faces"]
         r, t = self.radius, self.thickness
-        pts = [np.array(self._point(psi[i], faces[i])) for i in range(4)]
-        A, B0, C0, D = pts
+        hinges = [np.array(self._point(psi[i], faces[i])) for i in range(4)]
         secs = [_sector(r, t, psi[k], psi[k + 1]) for k in range(3)]
-        x_sum = None
+        bodies = [(a, (gx, gy), j) for a, gx, gy, j in secs]
+        return four_bar_mechanism(*hinges, bodies, phi_max=math.pi / 4)
 
-        def pose(phi):
-            nonlocal x_sum
-            (bx, by), _, beta2, beta3 = _four_bar(A, B0, C0, D, phi * sense)
-            xs, ys = [], []
-            for k, (pivot, beta) in enumerate(((A, phi * sense), ((bx, by), beta2), (D, beta3))):
-                _, gx, gy, _ = secs[k]
-                base = B0 if k == 1 else pivot
-                rx, ry = _rotate(gx - base[0], gy - base[1], beta)
-                X = rx + (bx if k == 1 else pivot[0])
-                Y = ry + (by if k == 1 else pivot[1])
-                xs.append(-X)  # mirrored: the arch leans towards -x as phi grows
-                ys.append(Y)
-            return xs, ys, [phi * sense, beta2, beta3]
 
-        # the sense of AB's rotation in which the lateral load does positive work
-        sense = 1.0
-        probe = Mechanism(tuple(s[0] for s in secs), tuple(s[3] for s in secs), pose)
-        if probe.terms(np.array([0.0]))["B"][0] < 0:
-            sense = -1.0
-        return Mechanism(
-            tuple(s[0] for s in secs), tuple(s[3] for s in secs), pose, phi_max=math.pi / 4
+@dataclass(frozen=True)
+class AsymmetricFrame:
+    """Two rocking columns of different heights under a rigid beam (a four-bar linkage,
+    sec. 5.1 of [003]); the mechanism differs with the direction of rocking.
+
+    Geometry (our reading of Fig. 4, whose image was not transcribed): both columns are
+    2b wide; the left column AB is 2H high on the ground, the right column CD is 2H1 high
+    standing on ground raised by 2(H - H1), so the tops are level; the beam, 2h deep, spans
+    the outer faces over the length L and rests on the column tops. Each column rocks about
+    a base corner and the beam about the diagonally opposite top corner.
+
+    Parameters
+    ----------
+    half_width : float
+        b [m].
+    height, height_right : float
+        H and H1 [m], the half-heights of the left and right columns.
+    beam_length, beam_half_depth : float
+        L and h [m].
+    mass_left, mass_beam, mass_right : float
+        m_AB, m_BC, m_CD [kg] (or any consistent unit).
+    restitution : float, optional
+        eta (no derivation is offered for the asymmetric frame).
+    """
+
+    half_width: float
+    height: float
+    height_right: float
+    beam_length: float
+    beam_half_depth: float
+    mass_left: float = 1.0
+    mass_beam: float = 1.0
+    mass_right: float = 1.0
+    restitution: float | None = None
+
+    def __post_init__(self):
+        for name in (
+            "half_width",
+            "height",
+            "height_right",
+            "beam_length",
+            "beam_half_depth",
+            "mass_left",
+            "mass_beam",
+            "mass_right",
+        ):
+            _validate.positive(name, getattr(self, name))
+        if self.beam_length <= 4 * self.half_width:
+            raise ValueError("beam_length must exceed the two column widths, 4 * half_width")
+        if self.restitution is not None:
+            _validate.restitution(self.restitution)
+
+    def mechanism(self, direction: int = 1) -> Mechanism:
+        """The mechanism for rocking towards +x (direction 1) or -x (direction -1)."""
+        if direction not in (1, -1):
+            raise ValueError(f"direction must be 1 or -1, got {direction!r}")
+        b, H, H1, L, h = (
+            self.half_width,
+            self.height,
+            self.height_right,
+            self.beam_length,
+            self.beam_half_depth,
         )
+        base_r = 2 * (H - H1)
+        # towards -x the columns turn about their left base corners, the beam about the right
+        # top corners; towards +x, mirror the corners
+        if direction == -1:
+            A, B0 = np.array([0.0, 0.0]), np.array([2 * b, 2 * H])
+            D, C0 = np.array([L - 2 * b, base_r]), np.array([L, 2 * H])
+        else:
+            A, B0 = np.array([2 * b, 0.0]), np.array([0.0, 2 * H])
+            D, C0 = np.array([L, base_r]), np.array([L - 2 * b, 2 * H])
+        m1, m2, m3 = self.mass_left, self.mass_beam, self.mass_right
+        bodies = [
+            (m1, (b, H), m1 * (b * b + H * H) / 3),
+            (m2, (L / 2, 2 * H + h), m2 * (L * L + 4 * h * h) / 12),
+            (m3, (L - b, base_r + H1), m3 * (b * b + H1 * H1) / 3),
+        ]
+        return four_bar_mechanism(A, B0, C0, D, bodies, phi_max=math.pi / 4)
+
+    def rocking_parameters(self) -> tuple[RockingParameters, RockingParameters]:
+        """(positive, negative): the rocking parameters of each direction (eqs. 26-38)."""
+        eta = np.nan if self.restitution is None else self.restitution
+        return (
+            self.mechanism(1).rocking_parameters(eta),
+            self.mechanism(-1).rocking_parameters(eta),
+        )
+
+    def uplift_closed_form(self) -> tuple[float, float]:
+        """lambda_p, lambda_n by virtual work at rest, eq. (33) of [003] in the form consistent
+        with (36) (the transcription's +- placement is not: at H1 = H it must give tan alpha):
+
+        .. math::
+            \\lambda = \\frac{b}{H}
+            \\frac{m_{AB} + [1 + H/H_1 \\mp \\frac{2b}{L'}(1 - H/H_1)] m_{BC} + (H/H_1) m_{CD}}
+                 {m_{AB} + 2[1 \\pm \\frac{b h}{L' H}(1 - H/H_1)] m_{BC} + m_{CD}}
+
+        with L' = L - 2b the distance between the beam's two top hinges, upper signs for
+        rocking towards +x.
+        """
+        b, H, H1, L, h = (
+            self.half_width,
+            self.height,
+            self.height_right,
+            self.beam_length,
+            self.beam_half_depth,
+        )
+        m1, m2, m3 = self.mass_left, self.mass_beam, self.mass_right
+        lp = L - 2 * b
+        out = []
+        for sign in (1, -1):
+            num = m1 + (1 + H / H1 - sign * 2 * b / lp * (1 - H / H1)) * m2 + H / H1 * m3
+            den = m1 + 2 * (1 + sign * b * h / (lp * H) * (1 - H / H1)) * m2 + m3
+            out.append(b / H * num / den)
+        return tuple(out)

@@ -194,9 +194,9 @@ class Mechanism:
             raise ValueError("the equilibrium at phi_cr is not unstable (G_eq <= 0)")
         return RockingParameters(
             frequency_parameter=math.sqrt(G * g_eq / i_eq),
-            critical_rotation=phi_cr,
+            critical_rotation=float(phi_cr),
             uplift=uplift,
-            uplift_linearized=g_eq * phi_cr / b_eq,
+            uplift_linearized=float(g_eq * phi_cr / b_eq),
             restitution=float(restitution),
             scale=b_eq / g_eq,
         )
