@@ -18,7 +18,7 @@ from numba import njit
 
 from rockstudy.constants import FALL_ROTATION, G
 from rockstudy.dynamics import _rocking
-from rockstudy.dynamics.mechanism import mechanism_table
+from rockstudy.dynamics.mechanism import structure_table
 from rockstudy.motions.pulses import pulse_kernel_rows
 from rockstudy.structures import Arch, RockingWall, SymmetricFrame
 
@@ -53,7 +53,7 @@ def _run(p, alpha, eta, model, kind, mp, fall, tab):
 
 def per_scene(structure, n=2000, repeat=5):
     rp = structure.rocking_parameters()
-    tab, fall = mechanism_table(structure.mechanism())
+    tab, fall = structure_table(structure)
     rng = np.random.default_rng(0)
     amp = rng.uniform(1.05, 4.0, n) * G * rp.uplift
     kind, mp = pulse_kernel_rows("sine", amp, rng.uniform(0.2, 2.0, n))

@@ -17,7 +17,6 @@ from numba import njit, prange
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import (
     KIND_RECORD,
-    KIND_RICKER,
     KIND_TRIG,
     ground_acceleration,
     segment_index,
@@ -30,7 +29,7 @@ MODEL_TABLE = 2  # a mechanism, eq. (8) of [003], from tabulated I, G, B (struct
 
 #: Columns of a mechanism table, on a uniform grid of the amplitude phi in [0, fall].
 TAB_PHI, TAB_I, TAB_DI, TAB_G, TAB_DG, TAB_B, TAB_DB, TAB_V, TAB_DV = range(9)
-NO_TABLE = np.empty((0, 9))
+NO_TABLE = np.empty((2, 0, 9))  # [direction + (0), direction - (1)], node, column
 
 PH_END = 0
 PH_REST = 1
@@ -90,7 +89,7 @@ def _rhs(t, th, om, args):
     p, alpha, s, model, kind, mp, times, samples, k, tab = args
     a_g = ground_acceleration(kind, mp, times, samples, t, k)
     if model == MODEL_TABLE:
-        return s * _mechanism_accel(s * th, s * om, s * a_g, tab)
+        return s * _mechanism_accel(s * th, s * om, s * a_g, tab[0] if s > 0.0 else tab[1])
     a = a_g / G
     if model == MODEL_LINEAR:
         return p * p * (th - alpha * s - a)
@@ -126,22 +125,30 @@ def _uplift_trig(mp, thr, t0):
     return t if t <= dur else np.inf
 
 
+@njit(cache=True, inline="always")
+def _excess(a, thr_p, thr_n):
+    """By how much u_g'' = a exceeds the uplift threshold of the side it pushes towards:
+    a > 0 lifts onto the negative pivot (threshold thr_n), a < 0 onto the positive (thr_p)."""
+    return a - thr_n if a > 0.0 else -a - thr_p
+
+
 @njit(cache=True)
-def _uplift_ricker(kind, mp, times, samples, thr, t0):
-    """First t >= t0 with |u_g''| >= thr, by a scan at T_p/256 and bisection to round-off."""
+def _uplift_scan(kind, mp, times, samples, thr_p, thr_n, t0):
+    """First t >= t0 with a non-negative excess, by a scan at T_p/256 and bisection."""
     dur = mp[3]
-    dt = 1.0 / (256.0 * mp[1])
+    dt = (2.0 * math.pi / mp[1] if kind == KIND_TRIG else 1.0 / mp[1]) / 256.0
     lo = t0
-    if abs(ground_acceleration(kind, mp, times, samples, lo, 0)) >= thr:
+    if _excess(ground_acceleration(kind, mp, times, samples, lo, 0), thr_p, thr_n) >= 0.0:
         return lo
     while lo < dur:
         hi = min(lo + dt, dur)
-        if abs(ground_acceleration(kind, mp, times, samples, hi, 0)) >= thr:
+        if _excess(ground_acceleration(kind, mp, times, samples, hi, 0), thr_p, thr_n) >= 0.0:
             for _ in range(200):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                if abs(ground_acceleration(kind, mp, times, samples, mid, 0)) >= thr:
+                a = ground_acceleration(kind, mp, times, samples, mid, 0)
+                if _excess(a, thr_p, thr_n) >= 0.0:
                     hi = mid
                 else:
                     lo = mid
@@ -151,21 +158,21 @@ def _uplift_ricker(kind, mp, times, samples, thr, t0):
 
 
 @njit(cache=True)
-def _uplift_record(mp, times, samples, thr, t0):
-    """First t >= t0 with |u_g''| >= thr on the piecewise-linear record, or inf."""
+def _uplift_record(mp, times, samples, thr_p, thr_n, t0):
+    """First t >= t0 with a non-negative excess on the piecewise-linear record, or inf."""
     n = times.shape[0]
     if t0 > times[n - 1]:
         return np.inf
     k = segment_index(times, t0, 0)
     a0 = ground_acceleration(KIND_RECORD, mp, times, samples, t0, k)
-    if abs(a0) >= thr:
+    if _excess(a0, thr_p, thr_n) >= 0.0:
         return t0
     ta = t0
     while k < n - 1:
         tb = times[k + 1]
         b = mp[0] * samples[k + 1]
-        if abs(b) >= thr:
-            target = thr if b > 0 else -thr
+        if _excess(b, thr_p, thr_n) >= 0.0:
+            target = thr_n if b > 0 else -thr_p
             return ta + (target - a0) / (b - a0) * (tb - ta)
         ta, a0 = tb, b
         k += 1
@@ -173,15 +180,16 @@ def _uplift_record(mp, times, samples, thr, t0):
 
 
 @njit(cache=True)
-def next_uplift(kind, mp, times, samples, thr, t0):
-    """First time >= t0 at which the ground acceleration reaches the uplift threshold thr."""
+def next_uplift(kind, mp, times, samples, thr_p, thr_n, t0):
+    """First time >= t0 at which the ground acceleration reaches the uplift threshold of the
+    side it pushes towards (thr_p onto the positive pivot, thr_n onto the negative)."""
     if t0 > mp[3]:
         return np.inf
-    if kind == KIND_TRIG:
-        return _uplift_trig(mp, thr, t0)
-    if kind == KIND_RICKER:
-        return _uplift_ricker(kind, mp, times, samples, thr, t0)
-    return _uplift_record(mp, times, samples, thr, t0)
+    if kind == KIND_RECORD:
+        return _uplift_record(mp, times, samples, thr_p, thr_n, t0)
+    if kind == KIND_TRIG and thr_p == thr_n:
+        return _uplift_trig(mp, thr_p, t0)
+    return _uplift_scan(kind, mp, times, samples, thr_p, thr_n, t0)
 
 
 @njit(cache=True)
@@ -277,13 +285,13 @@ def _step_events(s, h, th, om, f0, th1, om1, f1):
 def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
-    blk = (p, alpha, eta, model, thr, omega_rest, tol, max_steps, fall, tab),
+    blk = (p, alpha, eta, model, thr_p, thr_n, omega_rest, tol, max_steps, fall, tab),
     mot = (kind, mp, times, samples), log = (hist, imps) (empty arrays: no history).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact).
     """
-    p, alpha, eta, model, thr, omega_rest, tol, max_steps, fall, tab = blk
+    p, alpha, eta, model, thr_p, thr_n, omega_rest, tol, max_steps, fall, tab = blk
     kind, mp, times, samples = mot
     hist, imps = log
     rec = hist.shape[0] > 0
@@ -366,7 +374,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             k = segment_index(times, min(t, dur), k)
         if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
             a_g = ground_acceleration(kind, mp, times, samples, t, k)
-            if abs(a_g) < thr:
+            if _excess(a_g, thr_p, thr_n) < 0.0:
                 om = 0.0
                 code = PH_REST
                 break
@@ -441,29 +449,48 @@ def _potential_level(level, lo, hi, tab):
 
 
 @njit(cache=True)
-def _free_map_table(u, v, phi_cr, eta, tab, omega_rest):
-    """:func:`free_rocking_map` for a tabulated mechanism: E = I(u) v^2 / 2 + g V(u), with the
-    speed at the pivot multiplied by eta at each impact. Returns (overturns, peak, impacts)."""
-    i0 = tab[0, TAB_I]
-    v_rest = tab[0, TAB_V]
+def _critical(tab):
+    """phi_cr of a table: where G changes sign (bisection on the Hermite interpolant)."""
+    g = tab[:, TAB_G]
+    i = 0
+    while i < g.shape[0] - 1 and g[i + 1] < 0.0:
+        i += 1
+    lo, hi = tab[i, TAB_PHI], tab[min(i + 1, g.shape[0] - 1), TAB_PHI]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if _hermite3(mid, tab, TAB_G, TAB_DG)[0] < 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def _free_map_table(u, v, eta, tab, other, omega_rest):
+    """:func:`free_rocking_map` for a tabulated mechanism: E = I(u) v^2 / 2 + g V(u) on this
+    side's table, the other side's after an impact; the speed at the pivot is multiplied by
+    eta at each impact. Returns (overturns, peak, impacts)."""
+    fall = tab[-1, TAB_PHI]
+    phi_cr = _critical(tab)
     barrier = _hermite3(phi_cr, tab, TAB_V, TAB_DV)[0]
     e = 0.5 * _hermite3(u, tab, TAB_I, TAB_DI)[0] * v * v / G + _hermite3(u, tab, TAB_V, TAB_DV)[0]
     peak = u
     if e >= barrier:
         if (u < phi_cr and v > 0.0) or (u >= phi_cr and v >= 0.0):
-            return True, tab[-1, TAB_PHI], 0
+            return True, fall, 0
     elif u > phi_cr:
-        return True, tab[-1, TAB_PHI], 0
+        return True, fall, 0
     elif v > 0.0:
         peak = _potential_level(e, u, phi_cr, tab)
-    w = math.sqrt(max(2.0 * G * (e - v_rest) / i0, 0.0))  # speed at the first impact
+    w = math.sqrt(max(2.0 * G * (e - tab[0, TAB_V]) / tab[0, TAB_I], 0.0))  # impact speed
     if w < omega_rest:
         return False, peak, 0
     w1 = eta * w
-    e1 = 0.5 * i0 * w1 * w1 / G + v_rest
-    if e1 >= barrier:
-        return True, tab[-1, TAB_PHI], 1
-    peak = max(peak, _potential_level(e1, 0.0, phi_cr, tab))
+    e1 = 0.5 * other[0, TAB_I] * w1 * w1 / G + other[0, TAB_V]
+    phi_cr1 = _critical(other)
+    if e1 >= _hermite3(phi_cr1, other, TAB_V, TAB_DV)[0]:
+        return True, fall, 1
+    peak = max(peak, _potential_level(e1, 0.0, phi_cr1, other))
     if w1 < omega_rest:
         return False, peak, 1
     if eta >= 1.0:
@@ -482,12 +509,13 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     impact times recorded, DOP853 steps, first impact time).
     """
     kind, mp, times, samples = mot
-    if model == MODEL_TABLE:
-        thr = -G * tab[0, TAB_G] / tab[0, TAB_B]  # g lambda, eq. (10) of [003]
+    if model == MODEL_TABLE:  # g lambda of each direction, eq. (10) of [003]
+        thr_p = -G * tab[0, 0, TAB_G] / tab[0, 0, TAB_B]
+        thr_n = -G * tab[1, 0, TAB_G] / tab[1, 0, TAB_B]
     else:
-        thr = uplift_threshold(alpha, model)
+        thr_p = thr_n = uplift_threshold(alpha, model)
     omega_rest = REST_FRACTION * p * alpha
-    blk = (p, alpha, eta, model, thr, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
+    blk = (p, alpha, eta, model, thr_p, thr_n, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
     hist = log[0]
     rec = hist.shape[0] > 0
     dur = mp[3]
@@ -499,7 +527,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     code = PH_END
     while st[T] < dur:
         if at_rest:
-            t_up = next_uplift(kind, mp, times, samples, thr, st[T])
+            t_up = next_uplift(kind, mp, times, samples, thr_p, thr_n, st[T])
             if t_up >= dur:
                 break
             k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
@@ -521,7 +549,8 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     elif code == PH_END or code == PH_IMPACT:
         u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
         if model == MODEL_TABLE:
-            over, peak, n_post = _free_map_table(u, v, alpha, eta, tab, omega_rest)
+            side = 0 if st[SIDE] > 0.0 else 1
+            over, peak, n_post = _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
         else:
             over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
         if use_map and not over:

@@ -20,8 +20,16 @@ from . import _rocking
 
 @lru_cache(maxsize=64)
 def structure_table(structure, n: int = 4001):
-    """:func:`mechanism_table` of a (hashable, immutable) structure, computed once."""
-    return mechanism_table(structure.mechanism(), n)
+    """The kernel's tables of a (hashable, immutable) structure, computed once: an array of
+    shape (2, n, 9) for rocking towards +x and -x, and the collapse amplitude."""
+    try:
+        mechs = (structure.mechanism(1), structure.mechanism(-1))
+    except TypeError:  # a symmetric structure: one mechanism for both directions
+        mechs = (structure.mechanism(),) * 2
+    tabs = [mechanism_table(m, n) for m in mechs]
+    fall = min(t[1] for t in tabs)
+    tabs = [mechanism_table(m, n, fall) for m in mechs] if tabs[0][1] != tabs[1][1] else tabs
+    return np.ascontiguousarray(np.stack([t[0] for t in tabs])), fall
 
 
 def mechanism_table(mechanism, n: int = 4001, phi_fall: float | None = None):

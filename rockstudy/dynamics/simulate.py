@@ -203,6 +203,8 @@ def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
     from .mechanism import structure_table
 
     params = structure.rocking_parameters()
+    if isinstance(params, tuple):  # (positive, negative) of an asymmetric structure
+        params = params[0]
     if not params.restitution > 0:
         raise ValueError(f"{type(structure).__name__} needs a restitution (in (0, 1]) to rock")
     tab, fall = structure_table(structure)

@@ -473,6 +473,27 @@ class AsymmetricFrame:
             self.mechanism(-1).rocking_parameters(eta),
         )
 
+    def equivalent_block(self, kappa="kappa1"):
+        """One equivalent block for both directions: the two directions' rocking parameters
+        averaged, as [003] sec. 6.2 suggests for frames of small asymmetry."""
+        pos, neg = self.rocking_parameters()
+        if not pos.restitution > 0:
+            raise ValueError("AsymmetricFrame needs a restitution (in (0, 1]) to rock")
+        mean = RockingParameters(
+            *[
+                0.5 * (getattr(pos, f) + getattr(neg, f))
+                for f in (
+                    "frequency_parameter",
+                    "critical_rotation",
+                    "uplift",
+                    "uplift_linearized",
+                    "restitution",
+                    "scale",
+                )
+            ]
+        )
+        return mean.equivalent_block(kappa)
+
     def uplift_closed_form(self) -> tuple[float, float]:
         """lambda_p, lambda_n by virtual work at rest, eq. (33) of [003] in the form consistent
         with (36) (the transcription's +- placement is not: at H1 = H it must give tan alpha):
