@@ -431,3 +431,40 @@ def fig003_14(path):
 
 
 FIGURES["fig003_14_frame_record.png"] = fig003_14
+
+
+def fig003_frame(path):
+    """[003] Figs. 5-8: the asymmetric frame's equivalent block in each direction, against the
+    height ratio H1 / H."""
+    from .structures import AsymmetricFrame
+    from .structures.errors import Direction, error_map
+
+    ratios = np.linspace(0.6, 1.0, 9)
+    frames = [AsymmetricFrame(0.3, 2.0, 2.0 * r, 6.0, 0.25, 1.0, 1.5, 1.0) for r in ratios]
+    for d, name in ((1, "p"), (-1, "n")):
+        ds = error_map([Direction(f, d) for f in frames], {"height_ratio": ratios})
+        sub = Path(str(path).replace(".png", f"_{name}.png"))
+        _error_panels(
+            sub,
+            ds,
+            "height_ratio",
+            "H1 / H",
+            f"asymmetric frame, rocking {'+x' if d == 1 else '-x'} ({name})",
+        )
+    plt = _plt()
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    for d, name in ((0, "p"), (1, "n")):
+        rps = [f.rocking_parameters()[d] for f in frames]
+        axes[0].plot(ratios, [r.frequency_parameter for r in rps], "o-", label=name)
+        axes[1].plot(ratios, [r.critical_rotation / math.atan2(0.3, 2.0) for r in rps], "o-")
+        axes[2].plot(ratios, [r.uplift for r in rps], "o-")
+    axes[0].set(xlabel="H1 / H", ylabel="p [rad/s]")
+    axes[1].set(xlabel="H1 / H", ylabel="phi_cr / alpha")
+    axes[2].set(xlabel="H1 / H", ylabel="lambda")
+    axes[0].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+FIGURES["fig003_05_frame.png"] = fig003_frame

@@ -137,3 +137,18 @@ def error_map(
     ds["amplitude"].attrs.update(long_name="phi / phi_cr", units="1")
     ds["acceleration"].attrs.update(long_name="u_g'' / (g lambda)", units="1")
     return ds
+
+
+class Direction:
+    """One rocking direction of an asymmetric structure, seen as a symmetric one (for
+    :func:`error_map`): direction 1 rocks towards +x, -1 towards -x."""
+
+    def __init__(self, structure, direction: int):
+        self.structure, self.direction = structure, direction
+
+    def mechanism(self):
+        return self.structure.mechanism(self.direction)
+
+    def rocking_parameters(self):
+        pos, neg = self.structure.rocking_parameters()
+        return pos if self.direction == 1 else neg

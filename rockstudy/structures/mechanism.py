@@ -160,7 +160,8 @@ class Mechanism:
     def critical_rotation(self) -> float:
         """phi_cr: the first root of V' in (0, phi_max), eq. (9) of [003]."""
         grid = np.linspace(0.0, self.phi_max, 2001)[1:]
-        g = self.terms(grid)["G"]
+        with np.errstate(invalid="ignore"):  # a linkage may lock before phi_max: NaN there
+            g = self.terms(grid)["G"]
         sign = np.flatnonzero(np.diff(np.sign(g)) != 0)
         if g[0] >= 0:
             raise ValueError("the mechanism is not stable at rest (G_nl(0+) >= 0)")
