@@ -1,0 +1,294 @@
+"""Analyses of result cubes: Sobol' indices, fragility curves, and the collapse of responses
+onto the dimensionless groups of [000].
+
+Each function takes an ``xarray.Dataset`` (a cube from :func:`rockstudy.study.run_study`, or
+any dataset on a ``sample`` dimension) and returns pandas or xarray objects.
+
+Failed samples (``status`` 2) follow an explicit policy: ``"error"`` (refuse), ``"drop"``
+(drop them; for Sobol' the whole Saltelli block of each failed base sample) or ``"impute"``
+(replace the output by the mean of the successful samples). Overturning is an outcome, not a
+failure.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+from scipy import optimize, stats
+from scipy.spatial import cKDTree
+
+from .spec import Study
+
+FailedPolicy = Literal["error", "drop", "impute"]
+
+
+def study_of(ds: xr.Dataset) -> Study:
+    """The study a cube was made from (its ``study`` attribute)."""
+    return Study.model_validate(json.loads(ds.attrs["study"]))
+
+
+def _values(ds, output, failed: FailedPolicy):
+    y = np.asarray(ds[output].values, dtype=float)
+    bad = (ds["status"].values == 2) if "status" in ds else np.zeros(y.size, bool)
+    bad |= ~np.isfinite(y)
+    if bad.any():
+        if failed == "error":
+            raise ValueError(
+                f"{int(bad.sum())} failed samples in {output!r}; choose failed='drop' or 'impute'"
+            )
+        if failed == "impute":
+            y = np.where(bad, np.mean(y[~bad]), y)
+    return y, bad
+
+
+def sobol_indices(
+    ds: xr.Dataset,
+    output: str,
+    names=None,
+    second_order: bool | None = None,
+    failed: FailedPolicy = "error",
+    num_resamples: int = 1000,
+    conf_level: float = 0.95,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """First-order and total Sobol' indices of ``output`` with bootstrap confidence intervals.
+
+    The cube must hold a Saltelli design (a ``sobol`` study), whose distributed parameters are
+    the inputs; ``names`` overrides them (e.g. for datasets made outside a study), in the order
+    of the design's columns.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index: input names; columns ``S1``, ``S1_conf``, ``ST``, ``ST_conf``.
+    """
+    from SALib.analyze import sobol
+
+    if names is None:
+        study = study_of(ds)
+        if study.sampler.kind != "sobol":
+            raise ValueError("Sobol' indices need a sobol study (Saltelli design)")
+        names = list(study.parameters())
+        second_order = study.sampler.second_order if second_order is None else second_order
+    second_order = bool(second_order)
+    d = len(names)
+    block = 2 * d + 2 if second_order else d + 2
+    y, bad = _values(ds, output, failed)
+    if y.size % block:
+        raise ValueError(f"{y.size} samples is not a whole number of Saltelli blocks of {block}")
+    if failed == "drop" and bad.any():
+        keep = ~bad.reshape(-1, block).any(axis=1)
+        y = y.reshape(-1, block)[keep].ravel()
+    problem = {"num_vars": d, "names": list(names), "bounds": [[0.0, 1.0]] * d}
+    res = sobol.analyze(
+        problem,
+        y,
+        calc_second_order=second_order,
+        num_resamples=num_resamples,
+        conf_level=conf_level,
+        seed=seed,
+    )
+    return pd.DataFrame(
+        {k: res[k] for k in ("S1", "S1_conf", "ST", "ST_conf")},
+        index=pd.Index(list(names), name="input"),
+    )
+
+
+def sobol_convergence(
+    ds: xr.Dataset, output: str, names=None, second_order=None, failed: FailedPolicy = "error", **kw
+) -> pd.DataFrame:
+    """Sobol' indices on nested prefixes N = 2^k of the base samples (a convergence table).
+
+    Returns a frame with a (N, input) index and the columns of :func:`sobol_indices`.
+    """
+    if names is None:
+        study = study_of(ds)
+        names = list(study.parameters())
+        second_order = study.sampler.second_order if second_order is None else second_order
+    block = 2 * len(names) + 2 if second_order else len(names) + 2
+    n_base = ds.sizes["sample"] // block
+    frames = []
+    k = 4
+    while 2**k <= n_base:
+        sub = ds.isel(sample=slice(0, 2**k * block))
+        t = sobol_indices(sub, output, names, second_order, failed, **kw)
+        t.insert(0, "N", 2**k)
+        frames.append(t.reset_index())
+        k += 1
+    return pd.concat(frames).set_index(["N", "input"])
+
+
+def first_order_given_data(
+    ds: xr.Dataset, output: str, variables, failed: FailedPolicy = "drop", seed: int = 0
+) -> pd.DataFrame:
+    """First-order indices of ``output`` on any variables of the cube (e.g. the dimensionless
+    groups, which are not the sampler's inputs), by SALib's RBD-FAST on the given data."""
+    from SALib.analyze import rbd_fast
+
+    y, bad = _values(ds, output, failed)
+    x = np.column_stack([np.asarray(ds[v].values, float) for v in variables])
+    keep = ~bad & np.all(np.isfinite(x), axis=1)
+    x, y = x[keep], y[keep]
+    problem = {
+        "num_vars": len(variables),
+        "names": list(variables),
+        "bounds": [[float(c.min()), float(c.max())] for c in x.T],
+    }
+    res = rbd_fast.analyze(problem, x, y, seed=seed)
+    return pd.DataFrame(
+        {"S1": res["S1"], "S1_conf": res["S1_conf"]},
+        index=pd.Index(list(variables), name="variable"),
+    )
+
+
+# ------------------------------------------------------------------------------ fragility
+
+
+def _fit_lognormal(im, y):
+    """Maximum-likelihood (theta, beta) of P = Phi(ln(im / theta) / beta)."""
+    x = np.log(im)
+
+    def nll(q):
+        z = (x - q[0]) / np.exp(q[1])
+        return -np.sum(y * stats.norm.logcdf(z) + (1 - y) * stats.norm.logsf(z))
+
+    start = np.array([np.median(x), np.log(max(np.std(x), 0.1))])
+    res = optimize.minimize(
+        nll, start, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000}
+    )
+    return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+
+
+def fragility(
+    ds: xr.Dataset,
+    intensity: str,
+    outcome: str = "overturned",
+    by=None,
+    bins=None,
+    n_boot: int = 200,
+    conf_level: float = 0.9,
+    seed: int = 0,
+    failed: FailedPolicy = "drop",
+) -> pd.DataFrame:
+    """Lognormal fragility curves P(outcome | intensity) fitted by maximum likelihood.
+
+    Parameters
+    ----------
+    intensity : str
+        The intensity measure variable (e.g. ``pga_ratio``, ``amplitude``).
+    outcome : str
+        A 0/1 variable (default ``overturned``).
+    by : str, optional
+        Fit one curve per group of this variable; with ``bins`` (edges) for continuous ones.
+    n_boot : int
+        Bootstrap resamples for the confidence intervals of theta and beta.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per group: ``theta`` (median capacity), ``beta`` (log-standard deviation),
+        their bootstrap intervals, and the number of samples.
+    """
+    y, bad = _values(ds, outcome, failed)
+    im = np.asarray(ds[intensity].values, float)
+    keep = ~bad & np.isfinite(im) & (im > 0)
+    groups = {"all": keep}
+    if by is not None:
+        g = np.asarray(ds[by].values)
+        if bins is not None:
+            idx = np.digitize(g, bins)
+            groups = {
+                f"{bins[i - 1]:g}-{bins[i]:g}": keep & (idx == i) for i in range(1, len(bins))
+            }
+        else:
+            groups = {v: keep & (g == v) for v in np.unique(g[keep])}
+    rng = np.random.default_rng(seed)
+    rows = []
+    lo_q, hi_q = 50 * (1 - conf_level), 50 * (1 + conf_level)
+    for name, sel in groups.items():
+        x, z = im[sel], y[sel]
+        if z.size < 10 or z.min() == z.max():
+            continue
+        theta, beta = _fit_lognormal(x, z)
+        boot = np.array(
+            [
+                _fit_lognormal(x[i], z[i])
+                for i in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
+            ]
+        )
+        rows.append(
+            {
+                by or "group": name,
+                "theta": theta,
+                "beta": beta,
+                "theta_lo": np.percentile(boot[:, 0], lo_q),
+                "theta_hi": np.percentile(boot[:, 0], hi_q),
+                "beta_lo": np.percentile(boot[:, 1], lo_q),
+                "beta_hi": np.percentile(boot[:, 1], hi_q),
+                "n": int(z.size),
+            }
+        )
+    return pd.DataFrame(rows).set_index(by or "group")
+
+
+def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:
+    """Evaluate fitted fragility curves (and their theta bands) at intensities ``im``."""
+    im = np.asarray(im, float)
+    p = {
+        k: np.array([stats.norm.cdf(np.log(im / r[t]) / r["beta"]) for _, r in table.iterrows()])
+        for k, t in (("probability", "theta"), ("lower", "theta_hi"), ("upper", "theta_lo"))
+    }
+    coords = {"group": table.index.astype(str).values, "intensity": im}
+    return xr.Dataset({k: (("group", "intensity"), v) for k, v in p.items()}, coords=coords)
+
+
+# ------------------------------------------------------------------------------ collapse
+
+
+def collapse_metric(
+    ds: xr.Dataset, response: str, groups, decimals: int = 10, failed: FailedPolicy = "drop"
+) -> float:
+    """Share of the response variance that lies within sets of samples sharing the same groups.
+
+    Samples are grouped by their (rounded) values of ``groups``; the metric is the within-set
+    sum of squares over the total. It is 0 for a perfectly self-similar response and ~1 when
+    the groups explain nothing. The design must repeat each group point (``replicates``).
+    """
+    y, bad = _values(ds, response, failed)
+    keys = np.column_stack([np.round(np.asarray(ds[g].values, float), decimals) for g in groups])[
+        ~bad
+    ]
+    y = y[~bad]
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    means = np.bincount(inverse, weights=y) / np.bincount(inverse)
+    within = np.sum((y - means[inverse]) ** 2)
+    total = np.sum((y - y.mean()) ** 2)
+    return float(within / total) if total > 0 else 0.0
+
+
+def unexplained_share(
+    ds: xr.Dataset,
+    response: str,
+    groups,
+    k: int = 10,
+    failed: FailedPolicy = "drop",
+    log_groups: bool = True,
+) -> float:
+    """Cross-check on any random design: the share of the response variance left unexplained
+    by a smooth fit over the groups (the mean of the k nearest neighbours in standardised,
+    optionally logarithmic, group coordinates, leaving each sample out)."""
+    y, bad = _values(ds, response, failed)
+    x = np.column_stack([np.asarray(ds[g].values, float) for g in groups])
+    keep = ~bad & np.all(np.isfinite(x), axis=1)
+    x, y = x[keep], y[keep]
+    if log_groups and np.all(x > 0):
+        x = np.log(x)
+    x = (x - x.mean(axis=0)) / np.where(x.std(axis=0) > 0, x.std(axis=0), 1.0)
+    _, idx = cKDTree(x).query(x, k=k + 1)
+    fit = y[idx[:, 1:]].mean(axis=1)
+    return float(np.sum((y - fit) ** 2) / np.sum((y - y.mean()) ** 2))
