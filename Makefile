@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup demo test bench figures lint clean
+.PHONY: setup debian demo test bench figures lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -14,18 +14,28 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
+# Debian packages the tests need: headless Chromium renders the HTML reports
+debian:
+	@command -v chromium >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    apt-get update -qq && apt-get install -y -qq --no-install-recommends chromium; \
+	  else echo "please install Debian's chromium (needed by tests/test_report.py)"; exit 1; fi; }
+
 demo: $(STAMP)
 	rm -rf results/quickstart.zarr results/quickstart.nc
 	$(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr
+	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report
 	$(BIN)/rockstudy demo --out results/demo
 
-test: $(STAMP)
+test: $(STAMP) debian
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_engine.py
 	$(BIN)/python benchmarks/bench_closedform.py
 	$(BIN)/python benchmarks/bench_study.py
+	$(BIN)/python benchmarks/bench_structures.py
+	$(BIN)/python benchmarks/bench_report.py
 
 figures: $(STAMP)
 	$(BIN)/rockstudy figures --out results/figures

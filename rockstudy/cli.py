@@ -115,6 +115,9 @@ def main(argv=None) -> int:
     val = sub.add_parser("validate", help="check study files, naming every problem")
     val.add_argument("study", nargs="+")
     sub.add_parser("schema", help="print the JSON schema of study files")
+    rep = sub.add_parser("report", help="an HTML report (figures, CSV tables) of a result cube")
+    rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
+    rep.add_argument("--out", help="directory (default: RESULT_report)")
     args = parser.parse_args(argv)
     try:
         if args.command == "simulate":
@@ -123,6 +126,11 @@ def main(argv=None) -> int:
             return _run(args)
         if args.command == "validate":
             return _validate(args)
+        if args.command == "report":
+            from .study.report import make_report
+
+            print(f"wrote {make_report(args.result, args.out)}")
+            return 0
         if args.command == "schema":
             from .study import json_schema
 

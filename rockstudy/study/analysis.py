@@ -148,18 +148,22 @@ def first_order_given_data(
 # ------------------------------------------------------------------------------ fragility
 
 
-def _fit_lognormal(im, y):
-    """Maximum-likelihood (theta, beta) of P = Phi(ln(im / theta) / beta)."""
+def _fit_lognormal(im, y, start=None):
+    """Maximum-likelihood (theta, beta) of P = Phi(ln(im / theta) / beta), by BFGS on
+    (ln theta, ln beta) with the exact gradient of the Bernoulli log-likelihood."""
     x = np.log(im)
 
     def nll(q):
-        z = (x - q[0]) / np.exp(q[1])
-        return -np.sum(y * stats.norm.logcdf(z) + (1 - y) * stats.norm.logsf(z))
+        beta = np.exp(np.clip(q[1], -12.0, 6.0))
+        z = (x - q[0]) / beta
+        lp, lq, ld = stats.norm.logcdf(z), stats.norm.logsf(z), stats.norm.logpdf(z)
+        r = y * np.exp(ld - lp) - (1 - y) * np.exp(ld - lq)  # d loglik / dz (Mills ratios)
+        grad = np.array([np.sum(r) / beta, np.sum(r * z)])
+        return -np.sum(y * lp + (1 - y) * lq), grad
 
-    start = np.array([np.median(x), np.log(max(np.std(x), 0.1))])
-    res = optimize.minimize(
-        nll, start, method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000}
-    )
+    if start is None:
+        start = np.array([np.median(x), np.log(max(np.std(x), 0.1))])
+    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
     return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
 
@@ -214,10 +218,11 @@ def fragility(
         if z.size < 10 or z.min() == z.max():
             continue
         theta, beta = _fit_lognormal(x, z)
+        start = np.log([theta, beta])
         boot = np.array(
             [
-                _fit_lognormal(x[i], z[i])
-                for i in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
+                _fit_lognormal(x[k], z[k], start)
+                for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
             ]
         )
         rows.append(

@@ -26,6 +26,7 @@ VARIABLES = {
     "critical_rotation": ("critical rotation theta_cr of the equivalent block", "rad"),
     "amplitude": ("pulse amplitude a_g (signed)", "m s-2"),
     "amplitude_ratio": ("a_g / (g tan alpha)", "1"),
+    "amplitude_a": ("a = a_g / (g alpha), eq. (3.6) of [000]", "1"),
     "period": ("pulse period T_p", "s"),
     "frequency_ratio": ("omega_g / p", "1"),
     "scale": ("factor on the record", "1"),
@@ -36,6 +37,7 @@ VARIABLES = {
     "inverse_a": ("g alpha / a_g, eq. (4.11) of [000]", "1"),
     "uplift_ratio": ("g tan(alpha) / a_g, eqs. (5.3), (6.1) of [000]", "1"),
     "cos_alpha": ("cos(alpha), eq. (5.3) of [000]", "1"),
+    "group_point": ("index of the group point (replicated designs)", "1"),
 }
 
 
@@ -76,6 +78,13 @@ def _inputs(study: Study) -> tuple[dict, dict]:
         mesh = np.meshgrid(*axes.values(), indexing="ij")
         return {name: m.ravel() for name, m in zip(axes, mesh, strict=True)}, axes
     u = unit_samples(study)
+    reps = study.sampler.replicates
+    if reps > 1:  # group points first, then dimensional realizations of each
+        groups = study.group_parameters()
+        u = np.repeat(u, reps, axis=0)
+        dims = [j for j, name in enumerate(params) if name not in groups]
+        rng = np.random.default_rng(np.random.SeedSequence([study.seed, 3]))
+        u[:, dims] = rng.random((u.shape[0], len(dims)))
     return {
         name: np.asarray(dist.ppf(u[:, j]), dtype=float)
         for j, (name, dist) in enumerate(params.items())
@@ -98,6 +107,9 @@ def make_design(study: Study) -> xr.Dataset:
     """
     cols, axes = _inputs(study)
     n = len(next(iter(cols.values())))
+    if study.sampler.replicates > 1:
+        reps = study.sampler.replicates
+        cols["group_point"] = np.repeat(np.arange(n // reps), reps)
     st, mo = study.structure, study.motion
     data = {}
     if st.kind == "equivalent_block":
@@ -127,11 +139,13 @@ def make_design(study: Study) -> xr.Dataset:
         )
     uplift = G * np.tan(alpha)
     if mo.kind == "pulse":
-        ratio = (
-            _value(cols, mo, "amplitude_ratio", n)
-            if mo.amplitude is None
-            else _value(cols, mo, "amplitude", n) / uplift
-        )
+        if mo.amplitude is not None:
+            ratio = _value(cols, mo, "amplitude", n) / uplift
+        elif mo.amplitude_a is not None:
+            data["amplitude_a"] = _value(cols, mo, "amplitude_a", n)
+            ratio = data["amplitude_a"] * G * alpha / uplift
+        else:
+            ratio = _value(cols, mo, "amplitude_ratio", n)
         amp = mo.direction * ratio * uplift
         period = (
             _value(cols, mo, "period", n)
@@ -161,6 +175,8 @@ def make_design(study: Study) -> xr.Dataset:
     else:
         data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
     data["cos_alpha"] = np.cos(alpha)
+    if "group_point" in cols:
+        data["group_point"] = cols["group_point"]
     ds = xr.Dataset(
         {k: ("sample", np.asarray(v)) for k, v in data.items()}, coords={"sample": np.arange(n)}
     )

@@ -120,26 +120,32 @@ def _within(name, value, low, high, label):
 
 
 class PulseSpec(_Model):
-    """An analytic pulse. Give the amplitude either in m/s^2 (``amplitude``) or as a multiple
-    of the uplift acceleration g tan(alpha) (``amplitude_ratio``), and the period either in
-    seconds (``period``) or as omega_g / p (``frequency_ratio``)."""
+    """An analytic pulse. Give the amplitude in m/s^2 (``amplitude``), as a multiple of the
+    uplift acceleration g tan(alpha) (``amplitude_ratio``, the groups of eqs. 5.3 and 6.1 of
+    [000]) or of g alpha (``amplitude_a``, a of eq. 3.6: the groups of 4.10 and 4.11), and the
+    period in seconds (``period``) or as omega_g / p (``frequency_ratio``)."""
 
     kind: Literal["pulse"]
     shape: Literal["sine", "cosine", "half-sine", "ricker"] = "sine"
     cycles: int = Field(default=1, ge=1)
     amplitude: Param | None = None
     amplitude_ratio: Param | None = None
+    amplitude_a: Param | None = None
     period: Param | None = None
     frequency_ratio: Param | None = None
     direction: Literal[1, -1] = 1
 
     @model_validator(mode="after")
     def _one_of_each(self):
-        if (self.amplitude is None) == (self.amplitude_ratio is None):
-            raise ValueError("give exactly one of amplitude [m/s^2] or amplitude_ratio")
+        given = [x is not None for x in (self.amplitude, self.amplitude_ratio, self.amplitude_a)]
+        if sum(given) != 1:
+            raise ValueError(
+                "give exactly one of amplitude [m/s^2], amplitude_ratio "
+                "(a_g / (g tan alpha)) or amplitude_a (a_g / (g alpha))"
+            )
         if (self.period is None) == (self.frequency_ratio is None):
             raise ValueError("give exactly one of period [s] or frequency_ratio")
-        for name in ("amplitude", "amplitude_ratio", "period", "frequency_ratio"):
+        for name in ("amplitude", "amplitude_ratio", "amplitude_a", "period", "frequency_ratio"):
             _check_positive(name, getattr(self, name))
         if self.cycles != 1 and self.shape not in ("sine", "cosine"):
             raise ValueError(f"cycles applies to sine and cosine pulses, not {self.shape}")
@@ -187,6 +193,7 @@ class SamplerSpec(_Model):
     kind: Literal["monte_carlo", "lhs", "sobol", "grid"]
     n: int | None = Field(default=None, ge=1)
     second_order: bool = False
+    replicates: int = Field(default=1, ge=1)
 
     @model_validator(mode="after")
     def _n(self):
@@ -199,6 +206,8 @@ class SamplerSpec(_Model):
             raise ValueError(f"sobol needs n = 2^k, got {self.n}")
         if self.second_order and self.kind != "sobol":
             raise ValueError("second_order applies to the sobol sampler only")
+        if self.replicates > 1 and self.kind not in ("monte_carlo", "lhs"):
+            raise ValueError("replicates applies to the monte_carlo and lhs samplers")
         return self
 
 
@@ -257,7 +266,25 @@ class Study(_Model):
             raise ValueError(f"{grid_params} use dist = 'grid', which needs sampler.kind = 'grid'")
         if self.sampler.kind == "sobol" and len(self.parameters()) < 2:
             raise ValueError("sobol needs at least two distributed parameters")
+        if self.sampler.replicates > 1:
+            mo, st = self.motion, self.structure
+            if mo.kind != "pulse" or mo.amplitude is not None or mo.period is not None:
+                raise ValueError(
+                    "replicates need a pulse given by its groups: amplitude_ratio "
+                    "or amplitude_a, and frequency_ratio"
+                )
+            if st.kind != "block" or st.restitution == "housner":
+                raise ValueError(
+                    "replicates need a block with a given restitution (Housner's "
+                    "depends on alpha, which would change the groups)"
+                )
         return self
+
+    def group_parameters(self) -> list[str]:
+        """Distributed parameters that are dimensionless groups (held fixed across the
+        replicates of a group point): the pulse's ratios and the restitution."""
+        names = ("amplitude_ratio", "amplitude_a", "frequency_ratio", "restitution")
+        return [n for n in self.parameters() if n in names]
 
     def parameters(self) -> dict[str, Distribution]:
         """The distributed parameters, in design order (structure, then motion)."""
