@@ -16,7 +16,7 @@ from . import _linear, _rocking
 from .reference import simulate_reference
 from .result import RockingResult
 
-Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism"]
+Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex"]
 
 
 def _kernel(
@@ -111,6 +111,23 @@ def _tail_end(p, eta, motion, t_max):
     return math.inf
 
 
+def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l=1e-4):
+    from .complex import simulate_complex
+
+    r = simulate_complex(p, alpha, eta, motion, l=l, rtol=rtol, t_end=t_max, x0=x0)
+    return RockingResult(
+        r["t"],
+        r["theta"],
+        r["theta_dot"],
+        r["max_rotation"],
+        r["overturned"],
+        r["impact_times"],
+        r["overturn_time"],
+        method,
+        {"l": l, "rk45_steps": r["steps"]},
+    )
+
+
 def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     r = simulate_reference(
         p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max, initial_state=x0
@@ -133,6 +150,7 @@ _METHODS = {
     "scipy": (_scipy, _rocking.MODEL_NONLINEAR),
     "scipy-linear": (_scipy, _rocking.MODEL_LINEAR),
     "mechanism": (None, _rocking.MODEL_TABLE),
+    "complex": (_complex, None),
 }
 
 
@@ -145,6 +163,7 @@ def simulate(
     initial_rotation: float = 0.0,
     initial_velocity: float = 0.0,
     max_steps: int = 10_000_000,
+    l: float = 1e-4,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -162,6 +181,8 @@ def simulate(
         For a structure with a ``mechanism()`` (a wall, an arch, a frame), ``"nonlinear"``
         (or ``"mechanism"``) integrates the full mechanism, eq. (8) of [003]; the other
         methods run its equivalent block (kappa_1).
+        ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
+        (Housner's model as l -> 0; steps below l / 10 make it slow).
     rtol : float
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
     t_max : float, optional
@@ -172,6 +193,8 @@ def simulate(
         block starts at rest. Use with :class:`rockstudy.motions.NoMotion` for free rocking.
     max_steps : int
         Safety cap on the integrator steps in one rocking phase.
+    l : float
+        The complex formulation's l (method ``"complex"`` only), in (0, 0.1).
 
     Returns
     -------
@@ -195,6 +218,10 @@ def simulate(
     if hasattr(structure, "mechanism") and method in ("nonlinear", "mechanism"):
         return _mechanism(structure, motion, rtol, t_max, int(max_steps), (th0, om0))
     p, alpha, eta = block_parameters(structure)
+    if method == "complex":
+        return _complex(
+            p, alpha, eta, motion, None, rtol, t_max, int(max_steps), method, (th0, om0), l
+        )
     return runner(p, alpha, eta, motion, model, rtol, t_max, int(max_steps), method, (th0, om0))
 
 

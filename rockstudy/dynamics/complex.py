@@ -1,0 +1,198 @@
+"""The single-ODE "complex" formulation of rocking (Prieto & Lourenco 2005, paper [001]).
+
+The rotation is the real part of x = chi e^{i psi}; rocking becomes a central-force motion
+with a small angular momentum l = chi^2 psi_dot, impacts are fast half-turns of psi near the
+origin, and restitution mu is a Dirac-like damping force. In dimensionless time t = p tau,
+eqs. (31)-(37) of [001] with the errata of DESIGN.md (l^2 / chi^3, l / chi^2, 2 ln(mu) chi_2 l
+/ (pi chi_1^2)) read
+
+    chi'' = l^2 / chi^3 - sin(alpha - alpha chi) / alpha + 2 ln(mu) chi' l / (pi chi^2)
+            + F(t) cos(psi) cos(alpha - alpha chi),        psi' = l / chi^2,
+
+with F = -u_g''(t / p) / (g alpha) for any ground motion (beta cos(omega t) in [001]). theta =
+alpha chi cos(psi). It converges to Housner's model only as l -> 0 and needs steps below l
+(here an adaptive Dormand-Prince 5(4) with h <= l / 10, as [001] recommends), so it is costly:
+the work-precision chart of the project shows by how much. chi never goes below chi_c of eq.
+(40), sin(alpha - alpha chi_c) chi_c^3 = alpha l^2 (about l^(2/3), eq. 41).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.integrate import RK45
+from scipy.optimize import brentq
+
+from ..constants import FALL_ROTATION, G
+from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+
+_A = tuple(tuple(float(x) for x in row) for row in RK45.A)
+_B = tuple(float(x) for x in RK45.B)
+_C = tuple(float(x) for x in RK45.C)
+_E = tuple(float(x) for x in RK45.E)
+
+
+def chi_c(alpha: float, l: float) -> float:
+    """The lower bound of chi, eq. (40) of [001]: sin(alpha - alpha chi) chi^3 = alpha l^2."""
+    # the smallest root: sin(alpha - alpha chi) chi^3 rises from 0 to its maximum below 1/2
+    return brentq(
+        lambda c: math.sin(alpha - alpha * c) * c**3 - alpha * l * l,
+        1e-300,
+        0.5,
+        xtol=1e-300,
+        rtol=1e-15,
+    )
+
+
+@njit(cache=True)
+def _rhs(t, y, out, p, alpha, lnmu, l, kind, mp, times, samples, seg):
+    chi, v, psi = y[0], y[1], y[2]
+    tau = t / p
+    if kind == KIND_RECORD and tau <= mp[3]:
+        seg[0] = segment_index(times, tau, seg[0])
+    f = -ground_acceleration(kind, mp, times, samples, tau, seg[0]) / (G * alpha)
+    c = math.cos(alpha - alpha * chi)
+    out[0] = v
+    out[1] = (
+        l * l / chi**3
+        - math.sin(alpha - alpha * chi) / alpha
+        + 2.0 * lnmu * v * l / (math.pi * chi * chi)
+        + f * math.cos(psi) * c
+    )
+    out[2] = l / (chi * chi)
+
+
+@njit(cache=True)
+def _integrate(
+    p, alpha, lnmu, l, kind, mp, times, samples, y0, t_end, rtol, h_max, hist, max_steps
+):
+    """Dormand-Prince 5(4) on (chi, chi', psi) from y0 to t_end; every accepted step is logged
+    in ``hist`` (t, chi, chi', psi) while there is room. Returns (rows, steps, status)."""
+    y = y0.copy()
+    k = np.zeros((7, 3))
+    ytmp = np.empty(3)
+    ynew = np.empty(3)
+    seg = np.zeros(1, np.int64)
+    t = 0.0
+    h = h_max
+    nh = 0
+    steps = 0
+    fall = FALL_ROTATION / alpha
+    _rhs(t, y, k[0], p, alpha, lnmu, l, kind, mp, times, samples, seg)
+    while t < t_end:
+        steps += 1
+        if steps > max_steps:
+            return nh, steps, 1
+        hs = min(h, t_end - t)
+        for i in range(1, 6):  # six stages; the seventh is f at the new point (FSAL)
+            for m in range(3):
+                acc = 0.0
+                for j in range(i):
+                    acc += _A[i][j] * k[j, m]
+                ytmp[m] = y[m] + hs * acc
+            _rhs(t + _C[i] * hs, ytmp, k[i], p, alpha, lnmu, l, kind, mp, times, samples, seg)
+        err = 0.0
+        for m in range(3):
+            acc = 0.0
+            for j in range(6):
+                acc += _B[j] * k[j, m]
+            ynew[m] = y[m] + hs * acc
+        _rhs(t + hs, ynew, k[6], p, alpha, lnmu, l, kind, mp, times, samples, seg)
+        for m in range(3):
+            e = 0.0
+            for j in range(7):
+                e += _E[j] * k[j, m]
+            scale = rtol * (1e-3 + max(abs(y[m]), abs(ynew[m])))
+            err = max(err, abs(hs * e) / scale)
+        if not err <= 1.0 or ynew[0] <= 0.0:
+            h = hs * 0.25 if not err == err or ynew[0] <= 0.0 else hs * max(0.2, 0.9 * err**-0.2)
+            continue
+        t += hs
+        y[:] = ynew
+        k[0, :] = k[6, :]
+        h = min(h_max, hs * (5.0 if err == 0.0 else min(5.0, 0.9 * err**-0.2)))
+        if nh < hist.shape[0]:
+            hist[nh, 0] = t
+            hist[nh, 1] = y[0]
+            hist[nh, 2] = y[1]
+            hist[nh, 3] = y[2]
+            nh += 1
+        if y[0] >= fall:
+            return nh, steps, 2
+    return nh, steps, 0
+
+
+def simulate_complex(
+    p, alpha, eta, motion, l=1e-4, rtol=1e-8, t_end=None, x0=(0.0, 0.0), max_steps=50_000_000
+):
+    """Integrate the complex formulation; returns a dict of the RockingResult fields.
+
+    Parameters
+    ----------
+    p, alpha, eta : float
+        Frequency parameter [rad/s], slenderness [rad], restitution (mu of [001]).
+    l : float
+        The dimensionless angular momentum; the model tends to Housner's as l -> 0.
+    t_end : float, optional
+        End of the history [s] (default: the motion plus 10 / p).
+    x0 : (float, float)
+        theta [rad] and theta_dot [rad/s] at t = 0; from rest the block starts at chi_c.
+    """
+    if not 0 < l < 0.1:
+        raise ValueError(f"l must lie in (0, 0.1), got {l!r}")
+    kind, mp, times, samples = motion.kernel_spec()
+    th0, om0 = x0
+    chi0 = max(abs(th0) / alpha, chi_c(alpha, l))
+    psi0 = 0.0 if th0 >= 0 else math.pi
+    a0 = motion.ground_acceleration(0.0)
+    if th0 == 0.0 and om0 == 0.0 and a0 > 0:  # lean the way the first push of the ground goes
+        psi0 = math.pi
+    v0 = om0 / (p * alpha) * (1.0 if th0 >= 0 else -1.0)
+    y0 = np.array([chi0, v0, psi0])
+    t_phys = (motion.duration + 10.0 / p) if t_end is None else t_end
+    cap = 200_000
+    while True:
+        hist = np.empty((cap, 4))
+        nh, steps, status = _integrate(
+            p,
+            alpha,
+            math.log(eta),
+            l,
+            kind,
+            mp,
+            times,
+            samples,
+            y0,
+            p * t_phys,
+            rtol,
+            l / 10.0,
+            hist,
+            max_steps,
+        )
+        if nh < cap or status != 0:
+            break
+        cap *= 4
+    if status == 1:
+        raise RuntimeError(f"complex: more than max_steps={max_steps} steps")
+    t = hist[:nh, 0] / p
+    chi, dchi, psi = hist[:nh, 1], hist[:nh, 2], hist[:nh, 3]
+    theta = alpha * chi * np.cos(psi)
+    dpsi = l / chi**2
+    theta_dot = p * alpha * (dchi * np.cos(psi) - chi * np.sin(psi) * dpsi)
+    # impacts: psi passes an odd multiple of pi/2 (the real part changes sign)
+    turns = np.floor((psi - math.pi / 2) / math.pi)
+    jumps = np.flatnonzero(np.diff(turns) != 0)
+    impacts = t[jumps]
+    over = status == 2
+    return {
+        "t": t,
+        "theta": theta,
+        "theta_dot": theta_dot,
+        "max_rotation": FALL_ROTATION if over else float(np.max(np.abs(theta), initial=0)),
+        "overturned": over,
+        "impact_times": impacts,
+        "overturn_time": float(t[-1]) if over else math.nan,
+        "steps": int(steps),
+    }
