@@ -55,26 +55,9 @@ def _plt():
 
 
 def _linear_modes(a, omega, eta):
-    R = 3 * G / 4  # p = 1
-    out = simulate_batch(
-        half_diagonal=R,
-        slenderness=0.05,
-        restitution=eta,
-        pulse="sine",
-        amplitude=a * G * 0.05,
-        period=2 * np.pi / omega,
-        method="linear",
-    )
-    end = 2 * np.pi / omega
-    return np.where(
-        out["max_rotation"] == 0,
-        0,
-        np.where(
-            out["overturned"],
-            np.where(out["n_impacts"] == 0, 4, 3),
-            np.where(out["first_impact_time"] <= end, 1, 2),
-        ),
-    )
+    from .closedform.validity import linear_outcomes
+
+    return linear_outcomes(a, omega, eta)[0]
 
 
 def fig04(path, etas=(0.7, 0.8, 0.9, 1.0)):
@@ -152,20 +135,13 @@ def fig08(path, ratios=(0.2, 0.4, 0.6), etas=(0.80, 0.84, 0.88, 0.92, 0.96)):
     """Rocking spectra of [000] Fig. 8: linear solver against (4.13)."""
     plt = _plt()
     w = np.geomspace(0.5, 15, 300)
+    from .closedform.validity import linear_outcomes
+
     fig, axes = plt.subplots(1, len(ratios), figsize=(4.2 * len(ratios), 3.8))
-    R = 3 * G / 4
     for ax, ratio in zip(axes, ratios, strict=True):
         a = 1.0 / ratio
         for k, eta in enumerate(etas):
-            out = simulate_batch(
-                half_diagonal=R,
-                slenderness=0.05,
-                restitution=eta,
-                pulse="sine",
-                amplitude=a * G * 0.05,
-                period=2 * np.pi / w,
-                method="linear",
-            )
+            out = linear_outcomes(a, w, eta)[1]
             y = np.where(out["overturned"], np.nan, out["max_rotation"] / 0.05 / a)
             ax.plot(w, y, color=f"C{k}", label=f"eta = {eta:.2f}")
             ax.plot(w, cf.max_rotation(a, w, eta) / a, "--", color=f"C{k}", lw=0.9)

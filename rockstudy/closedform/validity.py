@@ -31,6 +31,7 @@ from ..dynamics.batch import simulate_batch
 from . import sine
 
 _P = 1.0  # the map is in (a, omega): any p will do; p = 1 makes t = tau
+_LIN_ALPHA = 0.05  # the linear model is scale-free in (a, omega, eta): any alpha will do
 _R = 3.0 * G / (4.0 * _P * _P)
 
 
@@ -45,6 +46,24 @@ def _modes(out, period):
             np.where(out["first_impact_time"] <= period, sine.SAFE_DURING, sine.SAFE_AFTER),
         ),
     ).astype(np.int8)
+
+
+def linear_outcomes(a, omega, eta):
+    """The exact linear solver on the sine pulses of (a, omega, eta) (any p: here p = 1), and
+    the mode of each (an index of cf.MODES). Returns (modes, batch outputs)."""
+    a, omega, eta = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (a, omega, eta)))
+    period = 2.0 * np.pi / (omega * _P)
+    out = simulate_batch(
+        half_diagonal=_R,
+        slenderness=lin_alpha,
+        restitution=eta.ravel(),
+        pulse="sine",
+        amplitude=(a * G * lin_alpha).ravel(),
+        period=period.ravel(),
+        method="linear",
+    )
+    out = {k: v.reshape(a.shape) for k, v in out.items()}
+    return _modes(out, period), out
 
 
 def validity_map(
@@ -82,18 +101,7 @@ def validity_map(
     t_up = np.arcsin(1.0 / A) / (W * _P)
     dims = ("eta", "omega", "a")
 
-    lin_alpha = 0.05  # the linear model is scale-free in (a, omega, eta)
-    lin = simulate_batch(
-        half_diagonal=_R,
-        slenderness=lin_alpha,
-        restitution=E.ravel(),
-        pulse="sine",
-        amplitude=(A * G * lin_alpha).ravel(),
-        period=period.ravel(),
-        method="linear",
-    )
-    lin = {k: v.reshape(shape) for k, v in lin.items()}
-    mode_lin = _modes(lin, period)
+    mode_lin, lin = linear_outcomes(A, W, E)
     tau_lin = _P * (lin["first_impact_time"] - t_up)
 
     mode_cf = sine.overturning_mode_code(A, W, E)
@@ -103,7 +111,7 @@ def validity_map(
     during = sine.limit_residual(A, W) >= 0.0
     tau_cf = np.where(during, tau_i1, tau_i2)
     th_cf = sine.max_rotation(A, W, E)
-    th_lin = np.where(lin["overturned"], np.nan, lin["max_rotation"] / lin_alpha)
+    th_lin = np.where(lin["overturned"], np.nan, lin["max_rotation"] / _LIN_ALPHA)
 
     ds = xr.Dataset(
         {

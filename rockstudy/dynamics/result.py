@@ -45,6 +45,21 @@ class RockingResult:
         """Number of impacts (until rest, overturning or the end of the history)."""
         return int(self.impact_times.size)
 
+    @classmethod
+    def from_dict(cls, r: dict, method: str, info: dict | None = None) -> RockingResult:
+        """From the dict of a solver (keys: the field names)."""
+        return cls(
+            r["t"],
+            r["theta"],
+            r["theta_dot"],
+            r["max_rotation"],
+            r["overturned"],
+            r["impact_times"],
+            r["overturn_time"],
+            method,
+            info or {},
+        )
+
     def summary(self) -> dict:
         """The scalar outcomes as a JSON-ready dict."""
         return {

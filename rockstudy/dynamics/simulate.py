@@ -115,33 +115,14 @@ def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l
     from .complex import simulate_complex
 
     r = simulate_complex(p, alpha, eta, motion, l=l, rtol=rtol, t_end=t_max, x0=x0)
-    return RockingResult(
-        r["t"],
-        r["theta"],
-        r["theta_dot"],
-        r["max_rotation"],
-        r["overturned"],
-        r["impact_times"],
-        r["overturn_time"],
-        method,
-        {"l": l, "rk45_steps": r["steps"]},
-    )
+    return RockingResult.from_dict(r, method, {"l": l, "rk45_steps": r["steps"]})
 
 
 def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     r = simulate_reference(
         p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max, initial_state=x0
     )
-    return RockingResult(
-        r["t"],
-        r["theta"],
-        r["theta_dot"],
-        r["max_rotation"],
-        r["overturned"],
-        r["impact_times"],
-        r["overturn_time"],
-        method,
-    )
+    return RockingResult.from_dict(r, method)
 
 
 _METHODS = {

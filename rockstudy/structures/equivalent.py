@@ -437,17 +437,21 @@ class AsymmetricFrame:
         if self.restitution is not None:
             _validate.restitution(self.restitution)
 
-    def mechanism(self, direction: int = 1) -> Mechanism:
-        """The mechanism for rocking towards +x (direction 1) or -x (direction -1)."""
-        if direction not in (1, -1):
-            raise ValueError(f"direction must be 1 or -1, got {direction!r}")
-        b, H, H1, L, h = (
+    @property
+    def _dims(self):
+        return (
             self.half_width,
             self.height,
             self.height_right,
             self.beam_length,
             self.beam_half_depth,
         )
+
+    def mechanism(self, direction: int = 1) -> Mechanism:
+        """The mechanism for rocking towards +x (direction 1) or -x (direction -1)."""
+        if direction not in (1, -1):
+            raise ValueError(f"direction must be 1 or -1, got {direction!r}")
+        b, H, H1, L, h = self._dims
         base_r = 2 * (H - H1)
         # towards -x the columns turn about their left base corners, the beam about the right
         # top corners; towards +x, mirror the corners
@@ -506,13 +510,7 @@ class AsymmetricFrame:
         with L' = L - 2b the distance between the beam's two top hinges, upper signs for
         rocking towards +x.
         """
-        b, H, H1, L, h = (
-            self.half_width,
-            self.height,
-            self.height_right,
-            self.beam_length,
-            self.beam_half_depth,
-        )
+        b, H, H1, L, h = self._dims
         m1, m2, m3 = self.mass_left, self.mass_beam, self.mass_right
         lp = L - 2 * b
         out = []
