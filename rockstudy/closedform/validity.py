@@ -55,10 +55,10 @@ def linear_outcomes(a, omega, eta):
     period = 2.0 * np.pi / (omega * _P)
     out = simulate_batch(
         half_diagonal=_R,
-        slenderness=lin_alpha,
+        slenderness=_LIN_ALPHA,
         restitution=eta.ravel(),
         pulse="sine",
-        amplitude=(a * G * lin_alpha).ravel(),
+        amplitude=(a * G * _LIN_ALPHA).ravel(),
         period=period.ravel(),
         method="linear",
     )
