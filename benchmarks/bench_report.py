@@ -39,14 +39,22 @@ def main():
         make_report(tmp / "sobol.zarr", tmp / "sobol_report")
         result["report_57344_sobol_seconds"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        for name in ("self_similarity", "self_similarity_nonlinear", "self_similarity_61"):
+        for name in (
+            "self_similarity",
+            "self_similarity_nonlinear",
+            "self_similarity_61",
+            "self_similarity_fragility",
+        ):
             cube = tmp / f"{name}.zarr"
             run_study(
                 load_study(ROOT / "studies" / f"{name}.toml"), cube, workers=2, progress=False
             )
             make_report(cube, tmp / f"{name}_report")
-            table = pd.read_csv(tmp / f"{name}_report" / "collapse.csv", index_col=0)
-            result[f"{name}_collapse"] = table.to_dict(orient="index")
+            for part in ("collapse", "fragility"):
+                path = tmp / f"{name}_report" / f"{part}.csv"
+                if path.exists():
+                    table = pd.read_csv(path, index_col=0)
+                    result[f"{name}_{part}"] = table.to_dict(orient="records")
         result["flagship_end_to_end_seconds"] = time.perf_counter() - t0
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
