@@ -388,3 +388,25 @@ def test_asymmetric_frame_dynamics():
     up = rs.simulate(asym, pulse)
     down = rs.simulate(asym, rs.motions.SinePulse(-pulse.amplitude, 0.7))
     assert up.max_rotation != pytest.approx(down.max_rotation, rel=1e-3)
+
+
+def test_asymmetric_frame_free_rocking_period_each_direction():
+    from rockstudy.structures import AsymmetricFrame
+
+    frame = AsymmetricFrame(0.3, 2.0, 1.5, 6.0, 0.25, 1.0, 1.5, 1.0, restitution=1.0)
+    for direction, params in zip((1, -1), frame.rocking_parameters(), strict=True):
+        mech = frame.mechanism(direction)
+        phi0 = 0.5 * params.critical_rotation
+        v0 = float(mech.terms(np.array([phi0]))["V"][0])
+
+        def smooth(phi, mech=mech, phi0=phi0, v0=v0):
+            t = mech.terms(np.array([phi]))
+            d = phi0 - phi
+            slope = (v0 - t["V"][0]) / d if d > 1e-12 else -t["G"][0]
+            return math.sqrt(t["I"][0] / (2 * G * slope))
+
+        quarter = quad(smooth, 0.0, phi0, weight="alg", wvar=(0.0, -0.5), epsrel=1e-11)[0]
+        res = rs.simulate(
+            frame, rs.motions.NoMotion(), initial_rotation=direction * phi0, rtol=1e-11, t_max=2.0
+        )
+        assert res.impact_times[0] == pytest.approx(quarter, rel=1e-7)
