@@ -1,11 +1,13 @@
 """The complex formulation of paper [001] against Housner's model."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
 import rockstudy as rs
+from rockstudy.dynamics import ComplexFromRestWarning
 from rockstudy.dynamics.complex import chi_c
 
 
@@ -51,6 +53,25 @@ def test_forced_complex_close_to_housner():
     blk = rs.Block(1.0, 0.15, restitution=0.9)
     pulse = rs.motions.SinePulse(2.0 * 9.81 * math.tan(0.15), 0.8)
     ref = rs.simulate(blk, pulse, rtol=1e-10)
-    res = rs.simulate(blk, pulse, method="complex", l=1e-4)
+    with pytest.warns(ComplexFromRestWarning):
+        res = rs.simulate(blk, pulse, method="complex", l=1e-4)
     assert res.overturned == ref.overturned
     assert res.max_rotation == pytest.approx(ref.max_rotation, rel=0.02)
+
+
+def test_complex_from_rest_is_flagged():
+    """Documented failure: from rest the departure is set by the spin at chi_c, not by
+    Housner's uplift. Here Housner overturns (one impact, then the fall) while the complex
+    formulation keeps rocking at every l: the warning must fire, and only from rest."""
+    blk = rs.Block(1.0, 0.25)
+    pulse = rs.motions.SinePulse(6.0, 0.5)
+    assert rs.simulate(blk, pulse, t_max=4.5).overturned
+    with pytest.warns(ComplexFromRestWarning, match="from rest"):
+        res = rs.simulate(blk, pulse, method="complex", l=1e-2, t_max=4.5)
+    assert not res.overturned  # the failure the warning reports is real
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ComplexFromRestWarning)
+        # displaced start, and a motion below uplift (a_g < g tan alpha): no warning
+        rs.simulate(blk, pulse, method="complex", l=1e-2, t_max=1.0, initial_rotation=0.05)
+        weak = rs.motions.SinePulse(0.9 * 9.81 * math.tan(0.25), 0.5)
+        rs.simulate(blk, weak, method="complex", l=1e-2, t_max=1.0)

@@ -2,7 +2,8 @@
 reference, and the batch entry point used by studies."""
 
 from .batch import simulate_batch
+from .complex import ComplexFromRestWarning
 from .result import RockingResult
 from .simulate import simulate
 
-__all__ = ["RockingResult", "simulate", "simulate_batch"]
+__all__ = ["ComplexFromRestWarning", "RockingResult", "simulate", "simulate_batch"]
