@@ -36,6 +36,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_study.py
 	$(BIN)/python benchmarks/bench_structures.py
 	$(BIN)/python benchmarks/bench_report.py
+	$(BIN)/python -W ignore benchmarks/bench_work_precision.py
 
 figures: $(STAMP)
 	$(BIN)/rockstudy figures --out results/figures

@@ -1,0 +1,360 @@
+"""Work-precision benchmark (issue 6): error against CPU time for every rocking method.
+
+One run evaluates a fixed set of scenes (slender and non-slender blocks; sine, cosine, half-sine
+and Ricker pulses; the El Centro NS record scaled to several intensities) over a common window
+(the motion plus 3 s), with every method:
+
+  - the numba nonlinear kernel (``simulate``) at rtol 1e-4 ... 1e-10;
+  - scipy's RK45, DOP853 and LSODA with events (the reference path) at rtol 1e-4 ... 1e-10;
+  - a fixed-step semi-implicit Euler with an impact on the sign change of theta, the scheme users
+    often write, at dt = 1e-2 ... 1e-5 s;
+  - the linearized model (exact piecewise solver for pulses, the kernel on eq. 3.1 otherwise);
+  - the complex formulation of [001] at l = 1e-2 ... 1e-5 (on a subset when l is small: its
+    steps are below l / 10).
+
+The reference is solve_ivp DOP853 at rtol 1e-12. Error measures: max-rotation relative error
+(scenes where neither overturns), first-impact-time error, and the overturning disagreement
+rate. Prints a table and writes benchmarks/results/work_precision.{json,png}.
+
+    python benchmarks/bench_work_precision.py [--scenes 200] [--complex-subset 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import time
+import warnings
+from pathlib import Path
+
+import matplotlib
+import numba
+import numpy as np
+from numba import njit
+
+import rockstudy as rs
+from rockstudy.constants import FALL_ROTATION, G
+from rockstudy.dynamics import ComplexFromRestWarning, simulate_batch
+from rockstudy.dynamics.reference import simulate_reference
+from rockstudy.structures.block import block_parameters
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+OUT = Path(__file__).parent / "results"
+RECORD = Path(__file__).resolve().parents[2] / "shared" / "records" / "elcentro_NS.dat"
+TOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+SCIPY_TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+STEPS = (1e-2, 1e-3, 1e-4, 1e-5)
+LS = (1e-2, 1e-3, 1e-4, 1e-5)
+
+
+def scene_set(n, seed=6):
+    """(block, motion, t_end, batch spec) for n scenes; every fifth one runs the record."""
+    rng = np.random.default_rng(seed)
+    rec = rs.motions.Record.from_csv(RECORD, units="g")
+    rec = rs.motions.Record(rec.acceleration[:601], dt=0.02, name="El Centro NS, first 12 s")
+    makers = [
+        (rs.motions.SinePulse, "sine"),
+        (rs.motions.CosinePulse, "cosine"),
+        (rs.motions.HalfSinePulse, "half-sine"),
+        (rs.motions.RickerWavelet, "ricker"),
+    ]
+    scenes = []
+    for i in range(n):
+        alpha = rng.uniform(0.05, 0.25) if i % 2 == 0 else rng.uniform(0.3, 0.6)
+        block = rs.Block(half_diagonal=rng.uniform(0.3, 3.0), slenderness=alpha)
+        ratio = rng.uniform(1.05, 4.0)  # peak over the uplift level g tan(alpha)
+        sign = rng.choice([-1.0, 1.0])
+        if i % 5 == 4:
+            factor = sign * ratio * G * math.tan(alpha) / rec.peak
+            motion, spec = rec.scaled(factor), {"record": rec, "scale": factor}
+        else:
+            cls, name = makers[(i - i // 5) % 4]
+            amp, period = sign * ratio * G * math.tan(alpha), rng.uniform(0.2, 1.5)
+            motion, spec = cls(amp, period), {"pulse": name, "amplitude": amp, "period": period}
+        scenes.append((block, motion, motion.duration + 3.0, spec))
+    return scenes
+
+
+def batch_kernel(scenes, rtol):
+    """The batch entry point on every scene, one call per pulse shape and one for the record.
+    Returns the per-scene outputs and the CPU time per scene."""
+    groups = {}
+    for i, (_, _, _, spec) in enumerate(scenes):
+        groups.setdefault(spec.get("pulse", "record"), []).append(i)
+    out = [None] * len(scenes)
+    cpu = 0.0
+    for key, idx in groups.items():
+        blocks = [scenes[i][0] for i in idx]
+        specs = [scenes[i][3] for i in idx]
+        kw = {
+            "half_diagonal": np.array([b.half_diagonal for b in blocks]),
+            "slenderness": np.array([b.slenderness for b in blocks]),
+            "rtol": rtol,
+        }
+        if key == "record":
+            kw |= {"record": specs[0]["record"], "scale": np.array([s["scale"] for s in specs])}
+        else:
+            kw |= {
+                "pulse": key,
+                "amplitude": np.array([s["amplitude"] for s in specs]),
+                "period": np.array([s["period"] for s in specs]),
+            }
+        simulate_batch(**{k: v[:1] if isinstance(v, np.ndarray) else v for k, v in kw.items()})
+        t0 = time.process_time()
+        r = simulate_batch(**kw)
+        cpu += time.process_time() - t0
+        for j, i in enumerate(idx):
+            out[i] = (r["max_rotation"][j], r["overturned"][j], r["first_impact_time"][j])
+    return out, cpu / len(scenes)
+
+
+@njit(cache=True)
+def _euler_scene(p, alpha, eta, acc, dt):
+    """Semi-implicit Euler on eq. (2.2) of [000], uplift when |a_g| > g tan(alpha), an impact
+    when theta changes sign (theta_dot *= eta), rest below 1e-4 p alpha after an impact.
+    Returns (max |theta|, overturned, first impact time)."""
+    th = 0.0
+    om = 0.0
+    s = 0.0
+    rest = True
+    thr = G * math.tan(alpha)
+    max_u = 0.0
+    first = math.nan
+    for k in range(acc.size):
+        a = acc[k] / G
+        if rest:
+            if abs(acc[k]) <= thr:
+                continue
+            rest = False
+            s = -1.0 if a > 0.0 else 1.0
+        x = alpha * s - th
+        om += dt * (-p * p * (math.sin(x) + a * math.cos(x)))
+        th_new = th + dt * om
+        if th_new * s < 0.0:  # crossed theta = 0: impact
+            om *= eta
+            s = -s
+            if math.isnan(first):
+                first = (k + 1) * dt
+            if abs(om) < 1e-4 * p * alpha:
+                th, om, rest = 0.0, 0.0, True
+                continue
+        th = th_new
+        max_u = max(max_u, abs(th))
+        if max_u >= FALL_ROTATION:
+            return FALL_ROTATION, True, first
+    return max_u, False, first
+
+
+def euler(block, motion, t_end, dt):
+    p, alpha, eta = block_parameters(block)
+    acc = np.asarray(motion.ground_acceleration(np.arange(0.0, t_end, dt)), dtype=float)
+    return _euler_scene(p, alpha, eta, acc, dt)
+
+
+def run_simulate(block, motion, t_end, **kw):
+    r = rs.simulate(block, motion, t_max=t_end, **kw)
+    first = r.impact_times[0] if r.n_impacts else math.nan
+    return r.max_rotation, r.overturned, first
+
+
+def run_scipy(block, motion, t_end, integrator, rtol):
+    p, alpha, eta = block_parameters(block)
+    r = simulate_reference(p, alpha, eta, motion, rtol=rtol, integrator=integrator, t_max=t_end)
+    imp = r["impact_times"]
+    return r["max_rotation"], r["overturned"], imp[0] if imp.size else math.nan
+
+
+def measure(name, family, fn, scenes, ref, idx=None):
+    """Time ``fn`` over the scenes (or the subset ``idx``) and compare with the reference."""
+    idx = np.arange(len(scenes)) if idx is None else np.asarray(idx)
+    out, errors = [], []
+    if isinstance(fn, tuple):  # precomputed (outputs, cpu per scene)
+        out, cpu = fn
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ComplexFromRestWarning)
+            fn(*scenes[idx[0]][:3])  # compile / warm up
+            t0 = time.process_time()
+            for i in idx:
+                try:
+                    out.append(fn(*scenes[i][:3]))
+                except (ValueError, RuntimeError) as exc:  # e.g. scipy's event search fails
+                    out.append((math.nan, False, math.nan))
+                    errors.append(f"scene {i}: {type(exc).__name__}: {exc}")
+        cpu = (time.process_time() - t0) / idx.size
+    ok = np.array([math.isfinite(o[0]) for o in out])
+    idx, out = idx[ok], [o for o, k in zip(out, ok, strict=True) if k]
+    mx = np.array([o[0] for o in out])
+    ov = np.array([bool(o[1]) for o in out])
+    t1 = np.array([o[2] for o in out])
+    r_mx, r_ov, r_t1 = ref[0][idx], ref[1][idx], ref[2][idx]
+    both_rock = ~ov & ~r_ov & (r_mx > 0)
+    rot = np.abs(mx[both_rock] - r_mx[both_rock]) / r_mx[both_rock]
+    both_imp = np.isfinite(t1) & np.isfinite(r_t1)
+    imp = np.abs(t1[both_imp] - r_t1[both_imp])
+    missed = int(np.sum(np.isfinite(r_t1) != np.isfinite(t1)))
+
+    def stats(e):
+        if e.size == 0:
+            return {"median": None, "p99": None, "max": None}
+        return {k: float(f(e)) for k, f in (("median", np.median), ("max", np.max))} | {
+            "p99": float(np.percentile(e, 99))
+        }
+
+    row = {
+        "method": name,
+        "family": family,
+        "scenes": int(idx.size),
+        "cpu_s_per_scene": cpu,
+        "max_rotation_rel_error": stats(rot),
+        "first_impact_error_s": stats(imp),
+        "first_impact_missed_or_spurious": missed,
+        "overturn_disagreement_rate": float(np.mean(ov != r_ov)),
+        "failed_runs": len(errors),
+        "failures": errors[:5],
+    }
+    r, i = row["max_rotation_rel_error"], row["first_impact_error_s"]
+    print(
+        f"{name:24s} {idx.size:5d} {cpu * 1e3:10.3f} {r['p99'] or math.nan:12.2e} "
+        f"{i['p99'] or math.nan:12.2e} {missed:6d} "
+        f"{row['overturn_disagreement_rate']:8.3f} {len(errors):5d}",
+        flush=True,
+    )
+    return row
+
+
+def plot(rows, path):
+    fig, axes = plt.subplots(1, 3, figsize=(16, 5.2))
+    keys = [
+        ("max_rotation_rel_error", "max-rotation relative error (p99)"),
+        ("first_impact_error_s", "first-impact-time error [s] (p99)"),
+    ]
+    families = sorted({r["family"] for r in rows}, key=[r["family"] for r in rows].index)
+    for ax, (key, title) in zip(axes[:2], keys, strict=True):
+        for fam in families:
+            sel = [r for r in rows if r["family"] == fam and r[key]["p99"] is not None]
+            if sel:
+                x = [r["cpu_s_per_scene"] for r in sel]
+                y = [max(r[key]["p99"], 1e-16) for r in sel]
+                ax.loglog(x, y, "o-", label=fam)
+        ax.set_xlabel("CPU time per scene [s]")
+        ax.set_title(title)
+        ax.grid(True, which="both", alpha=0.3)
+    for fam in families:
+        sel = [r for r in rows if r["family"] == fam]
+        x = [r["cpu_s_per_scene"] for r in sel]
+        ax = axes[2]
+        ax.semilogx(x, [100 * r["overturn_disagreement_rate"] for r in sel], "o-", label=fam)
+    axes[2].set_xlabel("CPU time per scene [s]")
+    axes[2].set_title("overturning disagreement [%]")
+    axes[2].grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("rockstudy work-precision: error vs CPU time (reference: DOP853 rtol 1e-12)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scenes", type=int, default=200)
+    ap.add_argument(
+        "--complex-subset", type=int, default=20, help="scenes for the complex form at l <= 1e-4"
+    )
+    args = ap.parse_args()
+    numba.set_num_threads(1)
+    scenes = scene_set(args.scenes)
+    print(f"reference: {len(scenes)} scenes, DOP853 rtol 1e-12 ...", flush=True)
+    ref_rows = [run_scipy(b, m, t, "DOP853", 1e-12) for b, m, t, _ in scenes]
+    ref = (
+        np.array([r[0] for r in ref_rows]),
+        np.array([bool(r[1]) for r in ref_rows]),
+        np.array([r[2] for r in ref_rows]),
+    )
+    print(f"{np.mean(ref[1]):.0%} of the scenes overturn; {np.mean(ref[0] == 0):.0%} stay at rest")
+    print(
+        f"{'method':24s} {'n':>5s} {'ms/scene':>10s} {'rot p99':>12s} {'t1 p99 [s]':>12s} "
+        f"{'miss':>6s} {'overt.':>8s} {'fail':>5s}"
+    )
+    rows = []
+    for rtol in TOLS:
+        rows.append(
+            measure(
+                f"kernel rtol={rtol:.0e}",
+                "nonlinear kernel, simulate()",
+                lambda b, m, t, r=rtol: run_simulate(b, m, t, rtol=r),
+                scenes,
+                ref,
+            )
+        )
+    for rtol in TOLS:
+        rows.append(
+            measure(
+                f"batch rtol={rtol:.0e}",
+                "nonlinear kernel, batch",
+                batch_kernel(scenes, rtol),
+                scenes,
+                ref,
+            )
+        )
+    for integrator in ("RK45", "DOP853", "LSODA"):
+        for rtol in SCIPY_TOLS:
+            rows.append(
+                measure(
+                    f"scipy {integrator} {rtol:.0e}",
+                    f"scipy {integrator}",
+                    lambda b, m, t, i=integrator, r=rtol: run_scipy(b, m, t, i, r),
+                    scenes,
+                    ref,
+                )
+            )
+    for dt in STEPS:
+        rows.append(
+            measure(
+                f"Euler dt={dt:.0e}",
+                "semi-implicit Euler",
+                lambda b, m, t, h=dt: euler(b, m, t, h),
+                scenes,
+                ref,
+            )
+        )
+    rows.append(
+        measure(
+            "linear",
+            "linearized (3.1)",
+            lambda b, m, t: run_simulate(b, m, t, method="linear"),
+            scenes,
+            ref,
+        )
+    )
+    rng = np.random.default_rng(1)
+    subset = np.sort(rng.choice(len(scenes), min(args.complex_subset, len(scenes)), False))
+    for ell in LS:
+        rows.append(
+            measure(
+                f"complex l={ell:.0e}",
+                "complex [001]",
+                lambda b, m, t, e=ell: run_simulate(b, m, t, method="complex", l=e),
+                scenes,
+                ref,
+                idx=None if ell > 1e-4 else subset[: args.complex_subset if ell > 1e-5 else 3],
+            )
+        )
+    OUT.mkdir(exist_ok=True)
+    doc = {
+        "machine": platform.processor() or platform.machine(),
+        "scenes": len(scenes),
+        "window": "motion duration + 3 s",
+        "reference": "solve_ivp DOP853 rtol 1e-12 with events",
+        "rows": rows,
+    }
+    (OUT / "work_precision.json").write_text(json.dumps(doc, indent=2))
+    plot(rows, OUT / "work_precision.png")
+    print(f"wrote {OUT / 'work_precision.json'} and work_precision.png")
+
+
+if __name__ == "__main__":
+    main()
