@@ -191,6 +191,20 @@ def test_arch_milankovitch_minimum_thickness():
         Arch(math.pi, 0.10, 1.0)
 
 
+def _quarter_period_by_quadrature(mech, phi0):
+    """Time from phi0 at rest to the impact: integral of sqrt(I / (2 g (V(phi0) - V))) over
+    (0, phi0) from the mechanism's exact terms (energy conservation, eq. 8 of [003])."""
+    v0 = float(mech.terms(np.array([phi0]))["V"][0])
+
+    def smooth(phi):  # sqrt(phi0 - phi) / speed: the 1/sqrt singularity goes to quad's weight
+        t = mech.terms(np.array([phi]))
+        d = phi0 - phi
+        slope = (v0 - t["V"][0]) / d if d > 1e-12 else -t["G"][0]
+        return math.sqrt(t["I"][0] / (2 * G * slope))
+
+    return quad(smooth, 0.0, phi0, weight="alg", wvar=(0.0, -0.5), epsrel=1e-11)[0]
+
+
 @pytest.mark.parametrize(
     "structure",
     [
@@ -205,17 +219,8 @@ def test_arch_milankovitch_minimum_thickness():
 def test_free_rocking_period_integration_vs_energy_quadrature(structure):
     """Quarter period from phi0 to the impact: the kernel on eq. (8) against
     integral of sqrt(I / (2 g (V(phi0) - V))) from the mechanism's exact terms."""
-    mech = structure.mechanism()
     phi0 = 0.6 * structure.rocking_parameters().critical_rotation
-    v0 = float(mech.terms(np.array([phi0]))["V"][0])
-
-    def smooth(phi):  # sqrt(phi0 - phi) / speed: the 1/sqrt singularity goes to quad's weight
-        t = mech.terms(np.array([phi]))
-        d = phi0 - phi
-        slope = (v0 - t["V"][0]) / d if d > 1e-12 else -t["G"][0]
-        return math.sqrt(t["I"][0] / (2 * G * slope))
-
-    quarter = quad(smooth, 0.0, phi0, weight="alg", wvar=(0.0, -0.5), epsrel=1e-11)[0]
+    quarter = _quarter_period_by_quadrature(structure.mechanism(), phi0)
     res = rs.simulate(
         structure, rs.motions.NoMotion(), initial_rotation=phi0, rtol=1e-11, t_max=2.0
     )
@@ -395,17 +400,8 @@ def test_asymmetric_frame_free_rocking_period_each_direction():
 
     frame = AsymmetricFrame(0.3, 2.0, 1.5, 6.0, 0.25, 1.0, 1.5, 1.0, restitution=1.0)
     for direction, params in zip((1, -1), frame.rocking_parameters(), strict=True):
-        mech = frame.mechanism(direction)
         phi0 = 0.5 * params.critical_rotation
-        v0 = float(mech.terms(np.array([phi0]))["V"][0])
-
-        def smooth(phi, mech=mech, phi0=phi0, v0=v0):
-            t = mech.terms(np.array([phi]))
-            d = phi0 - phi
-            slope = (v0 - t["V"][0]) / d if d > 1e-12 else -t["G"][0]
-            return math.sqrt(t["I"][0] / (2 * G * slope))
-
-        quarter = quad(smooth, 0.0, phi0, weight="alg", wvar=(0.0, -0.5), epsrel=1e-11)[0]
+        quarter = _quarter_period_by_quadrature(frame.mechanism(direction), phi0)
         res = rs.simulate(
             frame, rs.motions.NoMotion(), initial_rotation=direction * phi0, rtol=1e-11, t_max=2.0
         )

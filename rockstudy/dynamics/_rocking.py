@@ -403,6 +403,17 @@ def _cinv(y, model):
 
 
 @njit(cache=True)
+def _impacts_until_rest(w1, rest, eta):
+    """Impacts of a free-rocking sequence whose first impact left speed w1 (> 0): impact k
+    leaves w1 eta^(k-1) (eq. 2.3 of [000]); the first one below ``rest`` ends it."""
+    if w1 < rest:
+        return 1
+    if eta >= 1.0:
+        return NEVER_AT_REST
+    return 2 + int(math.floor(math.log(rest / w1) / math.log(eta)))
+
+
+@njit(cache=True)
 def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
     r"""Outcome of free rocking from rotation u = s theta and speed v = s theta_dot [rad, rad/s].
 
@@ -428,12 +439,7 @@ def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
     if _c(alpha, model) + 0.5 * w1 * w1 >= 1.0:
         return True, FALL_ROTATION, 1
     peak = max(peak, alpha - _cinv(_c(alpha, model) + 0.5 * w1 * w1, model))
-    if w1 < rest:
-        return False, peak, 1
-    if eta >= 1.0:
-        return False, peak, NEVER_AT_REST
-    # impact k has post-impact speed w eta^k; the first one below rest ends the sequence
-    return False, peak, 2 + int(math.floor(math.log(rest / w1) / math.log(eta)))
+    return False, peak, _impacts_until_rest(w1, rest, eta)
 
 
 @njit(cache=True)
@@ -491,11 +497,7 @@ def _free_map_table(u, v, eta, tab, other, omega_rest):
     if e1 >= _hermite3(phi_cr1, other, TAB_V, TAB_DV)[0]:
         return True, fall, 1
     peak = max(peak, _potential_level(e1, 0.0, phi_cr1, other))
-    if w1 < omega_rest:
-        return False, peak, 1
-    if eta >= 1.0:
-        return False, peak, NEVER_AT_REST
-    return False, peak, 2 + int(math.floor(math.log(omega_rest / w1) / math.log(eta)))
+    return False, peak, _impacts_until_rest(w1, omega_rest, eta)
 
 
 @njit(cache=True)
