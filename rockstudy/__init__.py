@@ -6,13 +6,25 @@ the single-ODE formulation (Prieto & Lourenco 2005), dynamically equivalent stru
 """
 
 from . import closedform, motions, similarity, structures
+from ._warnings import (
+    AccuracyWarning,
+    ClosedFormValidityWarning,
+    ComplexAccuracyWarning,
+    LinearizationWarning,
+    LooseToleranceWarning,
+)
 from .dynamics import RockingResult, simulate, simulate_batch
 from .structures import Block
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "AccuracyWarning",
     "Block",
+    "ClosedFormValidityWarning",
+    "ComplexAccuracyWarning",
+    "LinearizationWarning",
+    "LooseToleranceWarning",
     "RockingResult",
     "closedform",
     "motions",

@@ -144,7 +144,7 @@ def fig08(path, ratios=(0.2, 0.4, 0.6), etas=(0.80, 0.84, 0.88, 0.92, 0.96)):
             out = linear_outcomes(a, w, eta)[1]
             y = np.where(out["overturned"], np.nan, out["max_rotation"] / 0.05 / a)
             ax.plot(w, y, color=f"C{k}", label=f"eta = {eta:.2f}")
-            ax.plot(w, cf.max_rotation(a, w, eta) / a, "--", color=f"C{k}", lw=0.9)
+            ax.plot(w, cf.max_rotation(a, w, eta, check=False) / a, "--", color=f"C{k}", lw=0.9)
         ax.set(
             xlabel=r"$\omega_g/p$",
             ylabel=r"$\theta_{max} g / a_g$",

@@ -5,7 +5,8 @@ coefficient of restitution. Time tau = p t runs from the uplift, at the pulse ph
 psi = arcsin(1/a) (eq. 3.3 with the erratum 1/a). The block first rocks on the side opposite to
 the acceleration; rotations are in units of alpha and velocities in units of p alpha.
 
-Every public function is a numpy ufunc (numba ``vectorize``): it broadcasts over arrays and
+Every public function is a numpy ufunc (numba ``vectorize``; :func:`max_rotation` wraps one and
+warns outside the region where it is exact): it broadcasts over arrays and
 returns NaN where a <= 1 (no uplift), where a quantity does not exist (e.g. no impact), or where
 exp(p T_ex) overflows (omega below about 0.009).
 """
@@ -13,9 +14,12 @@ exp(p T_ex) overflows (omega below about 0.009).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 from numba import float64, int8, njit, vectorize
+
+from .._warnings import ClosedFormValidityWarning
 
 _F2 = [float64(float64, float64)]
 _F3 = [float64(float64, float64, float64)]
@@ -367,15 +371,42 @@ def overturning_mode(a, omega, eta):
     return np.asarray(MODES)[overturning_mode_code(a, omega, eta)]
 
 
-@vectorize(_F3, cache=True, target="parallel")
-def max_rotation(a, omega, eta):
+def max_rotation(a, omega, eta, *, check=True):
     r"""Peak rotation after the first impact, theta_max / alpha, eq. (4.13) of [000].
 
     Exact when the first impact follows the pulse (above the curve 3.31); NaN where the block
     overturns after that impact, or where D0* > 1 (it does not come back to an impact).
 
     .. math:: \theta_m / \alpha = 1 - \sqrt{1 - \eta^2 (1 - D_0^*)}
+
+    Parameters
+    ----------
+    a, omega, eta : array_like
+        a_g / (g alpha), omega_g / p and the restitution, broadcast together.
+    check : bool
+        Warn (:class:`rockstudy.ClosedFormValidityWarning`) when points lie below the (3.31)
+        curve, where the first impact comes during the pulse and (4.13) is an approximation
+        (median error 16 %, unbounded near the overturning boundaries; see
+        :mod:`rockstudy.closedform.validity`).
     """
+    out = _max_rotation(a, omega, eta)
+    if check:
+        during = np.broadcast_to(limit_residual(a, omega) > 0.0, np.shape(out))
+        n = int(np.count_nonzero(during & np.isfinite(out)))
+        if n:
+            warnings.warn(
+                f"eq. (4.13) at {n} of {np.size(out)} points below the (3.31) curve: the first "
+                "impact comes during the pulse, and (4.13) only approximates the max rotation "
+                "there (median error 16 %, unbounded near the overturning boundaries)",
+                ClosedFormValidityWarning,
+                stacklevel=2,
+            )
+    return out
+
+
+@vectorize(_F3, cache=True, target="parallel")
+def _max_rotation(a, omega, eta):
+    """eq. (4.13) of [000]; see :func:`max_rotation`."""
     if not a > 1.0:
         return np.nan
     d0 = _d0(a, omega)

@@ -110,7 +110,7 @@ def validity_map(
     tau_i2 = sine.first_impact_time_after_pulse(A, W)
     during = sine.limit_residual(A, W) >= 0.0
     tau_cf = np.where(during, tau_i1, tau_i2)
-    th_cf = sine.max_rotation(A, W, E)
+    th_cf = sine.max_rotation(A, W, E, check=False)
     th_lin = np.where(lin["overturned"], np.nan, lin["max_rotation"] / _LIN_ALPHA)
 
     ds = xr.Dataset(

@@ -46,6 +46,8 @@ REST_FRACTION = 1e-4
 #: Local error target as a fraction of rtol, so that global errors (peaks, impact times over
 #: tens of cycles) stay below rtol; calibrated against the scipy reference at rtol 1e-12.
 TOL_SAFETY = 0.1
+#: Shortest step (in units of 1/p) retried when an impact falls outside its step.
+MIN_STEP = 1e-9
 #: Absolute error scales of theta and theta_dot, as fractions of alpha and p*alpha.
 ATOL_FRACTION = 1e-3
 #: Impact count reported when eta = 1 (the block never comes to rest).
@@ -356,6 +358,11 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         ta[WORK] += 1
         x, v, a = _true_state(args, t, th, om, f0, s_imp * hs, kx, kv)
         dl = -x / v if v != 0.0 else 0.0
+        if not 0.0 <= s_imp * hs + dl <= hs:  # the interpolant misplaced it
+            if hs * p > MIN_STEP:
+                h = 0.25 * hs  # retry with a shorter step
+                continue
+            dl = min(max(s_imp * hs + dl, 0.0), hs) - s_imp * hs
         t = t + s_imp * hs + dl
         om_pre = v + a * dl
         om = eta * om_pre  # eq. (2.3) of [000], once per impact

@@ -10,17 +10,22 @@ from typing import Literal
 
 import numpy as np
 
+from ..constants import G
 from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import PULSES, pulse_kernel_rows
 from ..structures.block import frequency_parameter as _p_of_R
 from ..structures.block import restitution_housner
-from . import _linear, _rocking
+from . import _auto, _linear, _rocking
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
-_MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR}
+_MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR, "auto": None}
+_CODES = {
+    _rocking.MODEL_NONLINEAR: _auto.MODEL_NONLINEAR,
+    _rocking.MODEL_LINEAR: _auto.MODEL_LINEAR,
+}
 
-OUTPUTS = _rocking.BATCH_COLUMNS
+OUTPUTS = _rocking.BATCH_COLUMNS + ("model",)
 
 
 def _column(name, values, n, low=None, high=None, low_open=True, high_open=True):
@@ -63,7 +68,7 @@ def simulate_batch(
     cycles=1,
     record: Record | None = None,
     scale=1.0,
-    method: Literal["nonlinear", "linear"] = "nonlinear",
+    method: Literal["nonlinear", "linear", "auto"] = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = 1_000_000,
 ) -> dict:
@@ -86,11 +91,16 @@ def simulate_batch(
         Number of cycles of sine and cosine pulses.
     record : Record, optional
         Use this record instead of a pulse, multiplied row by row by ``scale``.
-    method : {"nonlinear", "linear"}
+    method : {"nonlinear", "linear", "auto"}
         Housner's eq. (2.2) or the linearized eq. (3.1) of [000]. The linear model under
-        trigonometric pulses uses the exact piecewise solution.
+        trigonometric pulses uses the exact piecewise solution. ``"auto"`` chooses row by row
+        the cheapest model whose error bound meets ``rtol``: rest where the ground never
+        reaches g tan(alpha) (exact), the exact linear solver where its tabulated
+        linearization error (one-cycle trigonometric pulses) is below ``rtol``, and the
+        nonlinear kernel at 0.05 ``rtol`` otherwise.
     rtol : float
-        Relative tolerance of the integrator.
+        Relative tolerance of the integrator; for ``"auto"``, the relative accuracy asked of
+        the max rotation (and the overturning decision).
 
     Returns
     -------
@@ -98,7 +108,8 @@ def simulate_batch(
         ``max_rotation`` [rad] (pi/2 if overturned), ``overturned`` (bool), ``n_impacts``
         (until rest), ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s]
         (NaN if none), ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
-        taken; 0 for the exact solver).
+        taken; 0 for the exact solver), ``model`` (0 rest without integration, 1 linear,
+        2 nonlinear: what each row ran).
     """
     try:
         model = _MODELS[method]
@@ -143,12 +154,56 @@ def simulate_batch(
         times = samples = np.zeros(2)
     p = np.ascontiguousarray(p, dtype=float)
     eta = np.ascontiguousarray(eta, dtype=float)
-    if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
-        out = _linear.trig_batch(p, alpha, eta, mp)
+    rows = (p, alpha, eta, kind, mp, times, samples)
+    if model is not None:
+        out = _run(rows, np.arange(n), model, rtol, max_steps)
+        codes = np.full(n, _CODES[model], np.int8)
     else:
-        out = _rocking.scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps)
+        out, codes = _auto_rows(rows, pulse if record is None else None, cycles, rtol, max_steps)
     cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
     for name in ("status", "n_impacts", "steps"):
         cols[name] = cols[name].astype(np.int64)
     cols["overturned"] = cols["overturned"].astype(bool)
+    cols["model"] = codes
     return cols
+
+
+def _run(rows, idx, model, rtol, max_steps):
+    """Outputs (n, 7) of the rows ``idx`` under one model."""
+    p, alpha, eta, kind, mp, times, samples = rows
+    args = (p[idx], alpha[idx], eta[idx])
+    if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
+        return _linear.trig_batch(*args, mp[idx])
+    return _rocking.scene_batch(*args, model, kind, mp[idx], times, samples, rtol, max_steps)
+
+
+def _auto_rows(rows, pulse, cycles, tolerance, max_steps):
+    """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`)."""
+    p, alpha, eta, kind, mp, times, samples = rows
+    n = p.size
+    peak = np.abs(mp[:, 0]) * (1.0 if pulse is not None else np.max(np.abs(samples)))
+    psi = peak / (G * np.tan(alpha))
+    codes = np.full(n, _auto.MODEL_NONLINEAR, np.int8)
+    codes[psi < 1.0] = _auto.MODEL_REST
+    if pulse is not None and kind == mk.KIND_TRIG:
+        one_cycle = np.broadcast_to(np.asarray(cycles), (n,)) == 1
+        omega = mp[:, 1] / p
+        bound = _auto.linearization_bound(pulse, eta, alpha, psi, omega)
+        codes[(codes == _auto.MODEL_NONLINEAR) & one_cycle & (bound <= tolerance)] = (
+            _auto.MODEL_LINEAR
+        )
+    out = np.zeros((n, len(_rocking.BATCH_COLUMNS)))
+    out[:, 4] = out[:, 6] = np.nan  # overturn and first impact times of a block at rest
+    for code, model, rtol in (
+        (_auto.MODEL_LINEAR, _rocking.MODEL_LINEAR, tolerance),
+        (_auto.MODEL_NONLINEAR, _rocking.MODEL_NONLINEAR, _auto.kernel_rtol(tolerance)),
+    ):
+        idx = np.flatnonzero(codes == code)
+        if idx.size:
+            out[idx] = _run(rows, idx, model, rtol, max_steps)
+    ratio = out[:, 1] / alpha
+    small = np.flatnonzero((codes == _auto.MODEL_NONLINEAR) & (ratio < _auto.SMALL_ROTATION))
+    for rtol in np.unique(_auto.kernel_rtol_small(tolerance, ratio[small])):
+        idx = small[_auto.kernel_rtol_small(tolerance, ratio[small]) == rtol]
+        out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps)
+    return out, codes

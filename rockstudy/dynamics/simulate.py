@@ -3,20 +3,26 @@
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Literal
 
 import numpy as np
 
 from .. import _validate
-from ..constants import FALL_ROTATION
+from .._warnings import LinearizationWarning
+from ..constants import FALL_ROTATION, G
 from ..motions import Motion
 from ..motions import _kernels as mk
+from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
-from . import _linear, _rocking
+from . import _auto, _linear, _rocking
 from .reference import simulate_reference
 from .result import RockingResult
 
-Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex"]
+#: simulate(method="linear") warns above this linearization error bound.
+LINEAR_WARN = 0.1
+
+Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"]
 
 
 def _kernel(
@@ -118,6 +124,68 @@ def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l
     return RockingResult.from_dict(r, method, {"l": l, "rk45_steps": r["steps"]})
 
 
+def _linearization_bound(p, alpha, eta, motion, x0):
+    """(psi, error bound of the linear model) for one scene; inf where none is tabulated."""
+    psi = motion.peak / (G * math.tan(alpha))
+    shape = {cls: name for name, cls in PULSES.items()}.get(type(motion))
+    if x0 != (0.0, 0.0) or shape is None or getattr(motion, "cycles", 1) != 1:
+        return psi, math.inf
+    omega = 2.0 * math.pi / (motion.period * p)
+    return psi, float(_auto.linearization_bound(shape, eta, alpha, psi, omega))
+
+
+def _warn_linearization(p, alpha, eta, motion, x0):
+    psi, bound = _linearization_bound(p, alpha, eta, motion, x0)
+    if psi < 1.0 and x0 == (0.0, 0.0):
+        return
+    if bound > LINEAR_WARN or (math.isinf(bound) and alpha > _auto.LINEAR_ALPHA_MAX):
+        what = "unknown for this scene" if math.isinf(bound) else f"up to {bound:.2g}"
+        warnings.warn(
+            f"linearized model (3.1) at alpha = {alpha:.3g} rad, a_g / (g tan alpha) = "
+            f"{psi:.3g}: its relative max-rotation error is {what} (it grows as alpha^2 and "
+            "near psi = 1 and the overturning boundaries); use method='nonlinear' or 'auto'",
+            LinearizationWarning,
+            stacklevel=4,
+        )
+
+
+def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+    """The cheapest model whose error bound meets ``rtol`` (see :mod:`._auto`)."""
+    psi, bound = _linearization_bound(p, alpha, eta, motion, x0)
+    if x0 == (0.0, 0.0) and psi < 1.0:
+        chosen, bound = _auto.MODEL_REST, 0.0
+    else:
+        chosen = _auto.MODEL_LINEAR if bound <= rtol else _auto.MODEL_NONLINEAR
+    info = {"model": _auto.MODEL_NAMES[chosen], "linearization_bound": bound}
+    if chosen == _auto.MODEL_LINEAR:
+        r = _linear_exact(
+            p, alpha, eta, motion, _rocking.MODEL_LINEAR, rtol, t_max, max_steps, method, x0
+        )
+    else:
+        k_rtol = _auto.kernel_rtol(rtol)
+        r = _kernel(
+            p, alpha, eta, motion, _rocking.MODEL_NONLINEAR, k_rtol, t_max, max_steps, method, x0
+        )
+        ratio = r.max_rotation / alpha
+        if 0.0 < ratio < _auto.SMALL_ROTATION:  # chattering: the absolute scale dominates
+            k_rtol = float(_auto.kernel_rtol_small(rtol, ratio))
+            r = _kernel(
+                p,
+                alpha,
+                eta,
+                motion,
+                _rocking.MODEL_NONLINEAR,
+                k_rtol,
+                t_max,
+                max_steps,
+                method,
+                x0,
+            )
+        info["rtol"] = k_rtol
+    r.info.update(info)
+    return r
+
+
 def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     r = simulate_reference(
         p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max, initial_state=x0
@@ -132,6 +200,7 @@ _METHODS = {
     "scipy-linear": (_scipy, _rocking.MODEL_LINEAR),
     "mechanism": (None, _rocking.MODEL_TABLE),
     "complex": (_complex, None),
+    "auto": (_auto_method, None),
 }
 
 
@@ -164,8 +233,14 @@ def simulate(
         methods run its equivalent block (kappa_1).
         ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
         (Housner's model as l -> 0; steps below l / 10 make it slow).
+        ``"auto"``: the cheapest model whose error bound meets ``rtol``: no integration
+        where the ground never reaches g tan(alpha), the exact linear solver where its
+        tabulated linearization error (one-cycle trigonometric pulses from rest) is below
+        ``rtol``, the nonlinear kernel at 0.05 ``rtol`` otherwise (tighter again for
+        responses below 0.1 alpha). ``result.info["model"]`` says which ran.
     rtol : float
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
+        For ``"auto"``: the relative accuracy asked of the max rotation.
     t_max : float, optional
         End of the history [s]. By default the free rocking after the motion is followed until
         the block comes to rest or overturns.
@@ -199,6 +274,8 @@ def simulate(
     if hasattr(structure, "mechanism") and method in ("nonlinear", "mechanism"):
         return _mechanism(structure, motion, rtol, t_max, int(max_steps), (th0, om0))
     p, alpha, eta = block_parameters(structure)
+    if method in ("linear", "scipy-linear"):
+        _warn_linearization(p, alpha, eta, motion, (th0, om0))
     if method == "complex":
         return _complex(
             p, alpha, eta, motion, None, rtol, t_max, int(max_steps), method, (th0, om0), l

@@ -32,6 +32,12 @@ OUTPUTS = {
     "overturn_time": ("time at which |theta| reached pi/2 (NaN if it survived)", "s", "f8", np.nan),
     "first_impact_time": ("time of the first impact (NaN if none)", "s", "f8", np.nan),
     "steps": ("DOP853 steps taken (0 for the exact linear solver)", "1", "i8", -1),
+    "model": (
+        "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear; -1 if failed",
+        "1",
+        "i1",
+        -1,
+    ),
 }
 
 
@@ -167,6 +173,7 @@ def _rows_one_by_one(study, cols, base_dir, error):
             "first_impact_time",
             "steps",
             "status",
+            "model",
         )
     }
     failed = np.zeros(n, bool)

@@ -219,14 +219,15 @@ Output = Literal[
     "overturn_time",
     "first_impact_time",
     "steps",
+    "model",
 ]
 
 
 class RunSpec(_Model):
     """The solver and what to keep."""
 
-    method: Literal["nonlinear", "linear"] = "nonlinear"
-    rtol: float = Field(default=1e-8, gt=0, lt=1)
+    method: Literal["nonlinear", "linear", "auto"] = "nonlinear"
+    rtol: float = Field(default=1e-8, gt=0, lt=1)  # for "auto": accuracy of the max rotation
     max_steps: int = Field(default=1_000_000, ge=1)
     outputs: list[Output] = Field(default=["max_rotation", "overturned"], min_length=1)
 

@@ -1,0 +1,25 @@
+"""Warning classes: a method is asked to work where its measured accuracy is poor (issue 6).
+
+All derive from :class:`AccuracyWarning`, so ``warnings.simplefilter("error", AccuracyWarning)``
+turns every one of them into an error.
+"""
+
+
+class AccuracyWarning(RuntimeWarning):
+    """A result is outside the range where the method was measured to be accurate."""
+
+
+class LinearizationWarning(AccuracyWarning):
+    """The linearized model (3.1) of [000] was run where its error bound is large or unknown."""
+
+
+class ClosedFormValidityWarning(AccuracyWarning):
+    """A closed form of [000] was evaluated outside the region where it is exact."""
+
+
+class ComplexAccuracyWarning(AccuracyWarning):
+    """The complex formulation of [001] was run at a large l."""
+
+
+class LooseToleranceWarning(AccuracyWarning):
+    """The nonlinear kernel was run at a tolerance looser than its measured reliable range."""
