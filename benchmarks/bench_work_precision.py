@@ -10,7 +10,13 @@ and Ricker pulses; the El Centro NS record scaled to several intensities) over a
     often write, at dt = 1e-2 ... 1e-5 s;
   - the linearized model (exact piecewise solver for pulses, the kernel on eq. 3.1 otherwise);
   - the complex formulation of [001] at l = 1e-2 ... 1e-5 (on a subset when l is small: its
-    steps are below l / 10).
+    steps are below l / 10);
+  - the closed form (4.13) of [000] with the mode classifier (3.10)-(3.31), on the sine pulses;
+  - the equivalent block (kappa_1) against the full mechanism, eq. (8) of [003], for a wall, a
+    frame and an arch (their own scenes; reference: the mechanism at rtol 1e-12);
+  - ``method="auto"`` at tolerances 1e-1 ... 1e-6, through simulate() and the batch entry
+    point, with the share of scenes within the tolerance and its cost against the cheapest
+    method that was adequate for each scene.
 
 The reference is solve_ivp DOP853 at rtol 1e-12. Error measures: max-rotation relative error
 (scenes where neither overturns), first-impact-time error, and the overturning disagreement
@@ -36,7 +42,8 @@ from numba import njit
 
 import rockstudy as rs
 from rockstudy.constants import FALL_ROTATION, G
-from rockstudy.dynamics import ComplexFromRestWarning, simulate_batch
+from rockstudy.dynamics import simulate_batch
+from rockstudy.dynamics.accuracy import relative_max_rotation_error
 from rockstudy.dynamics.reference import simulate_reference
 from rockstudy.structures.block import block_parameters
 
@@ -49,6 +56,8 @@ TOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 SCIPY_TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
 STEPS = (1e-2, 1e-3, 1e-4, 1e-5)
 LS = (1e-2, 1e-3, 1e-4, 1e-5)
+AUTO_TOLS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6)
+CANDIDATE_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 
 
 def scene_set(n, seed=6):
@@ -79,12 +88,13 @@ def scene_set(n, seed=6):
     return scenes
 
 
-def batch_kernel(scenes, rtol):
-    """The batch entry point on every scene, one call per pulse shape and one for the record.
-    Returns the per-scene outputs and the CPU time per scene."""
+def batch_kernel(scenes, rtol, method="nonlinear", subset=None):
+    """The batch entry point on every scene (or ``subset``), one call per pulse shape and one
+    for the record. Returns the per-scene outputs and the CPU time per scene."""
     groups = {}
     for i, (_, _, _, spec) in enumerate(scenes):
-        groups.setdefault(spec.get("pulse", "record"), []).append(i)
+        if subset is None or i in subset:
+            groups.setdefault(spec.get("pulse", "record"), []).append(i)
     out = [None] * len(scenes)
     cpu = 0.0
     for key, idx in groups.items():
@@ -94,6 +104,7 @@ def batch_kernel(scenes, rtol):
             "half_diagonal": np.array([b.half_diagonal for b in blocks]),
             "slenderness": np.array([b.slenderness for b in blocks]),
             "rtol": rtol,
+            "method": method,
         }
         if key == "record":
             kw |= {"record": specs[0]["record"], "scale": np.array([s["scale"] for s in specs])}
@@ -109,7 +120,8 @@ def batch_kernel(scenes, rtol):
         cpu += time.process_time() - t0
         for j, i in enumerate(idx):
             out[i] = (r["max_rotation"][j], r["overturned"][j], r["first_impact_time"][j])
-    return out, cpu / len(scenes)
+    n = sum(len(idx) for idx in groups.values())
+    return out, cpu / max(n, 1)
 
 
 @njit(cache=True)
@@ -176,7 +188,7 @@ def measure(name, family, fn, scenes, ref, idx=None):
         out, cpu = fn
     else:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ComplexFromRestWarning)
+            warnings.simplefilter("ignore", rs.AccuracyWarning)
             fn(*scenes[idx[0]][:3])  # compile / warm up
             t0 = time.process_time()
             for i in idx:
@@ -227,6 +239,167 @@ def measure(name, family, fn, scenes, ref, idx=None):
     return row
 
 
+def closed_form(scenes):
+    """(4.13) with the mode classifier on the sine-pulse scenes: (outputs, cpu per scene, idx).
+    The closed forms are those of the linearized block: a = a_g / (g alpha)."""
+    idx = [i for i, sc in enumerate(scenes) if sc[3].get("pulse") == "sine"]
+    pars = np.array([block_parameters(scenes[i][0]) for i in idx])
+    p, alpha, eta = pars.T
+    amp = np.array([abs(scenes[i][3]["amplitude"]) for i in idx])
+    a = amp / (G * alpha)
+    w = 2 * np.pi / (np.array([scenes[i][3]["period"] for i in idx]) * p)
+    rs.closedform.max_rotation(a[:1], w[:1], eta[:1], check=False)
+    t0 = time.process_time()
+    reps = 200
+    for _ in range(reps):
+        mode = rs.closedform.overturning_mode_code(a, w, eta)
+        th = rs.closedform.max_rotation(a, w, eta, check=False) * alpha
+    cpu = (time.process_time() - t0) / reps / len(idx)
+    over = (mode == rs.closedform.sine.OVER_IMPACT) | (mode == rs.closedform.sine.OVER_NO_IMPACT)
+    over |= (a > 1) & ~np.isfinite(th)
+    th = np.where(a > 1, th, 0.0)
+    out = [
+        (FALL_ROTATION if o else float(t), bool(o), math.nan) for o, t in zip(over, th, strict=True)
+    ]
+    return (out, cpu), idx
+
+
+def structure_rows(seed=3, n=40):
+    """The equivalent block (kappa_1) and the full mechanism at several tolerances, against
+    the mechanism at rtol 1e-12, for a wall, a frame and an arch."""
+    rows = []
+    structures = (
+        ("wall", rs.structures.RockingWall(1.0, 0.1, restitution=0.85)),
+        ("frame", rs.structures.SymmetricFrame(1.0, 0.15, 0.5)),
+        ("arch", rs.structures.Arch(math.pi, 0.75, 5.0, restitution=0.9)),
+    )
+    for name, st in structures:
+        rng = np.random.default_rng(seed)
+        rp = st.rocking_parameters()
+        eq = st.equivalent_block()
+        scenes = []
+        for i in range(n):
+            cls = (rs.motions.SinePulse, rs.motions.CosinePulse, rs.motions.HalfSinePulse)[i % 3]
+            amp = rng.choice([-1, 1]) * rng.uniform(1.05, 4.0) * G * rp.uplift
+            m = cls(amp, rng.uniform(0.2, 2.0))
+            scenes.append((st, m, m.duration + 3.0, {}))
+
+        def mech(s, m, t, r=1e-12):
+            res = rs.simulate(s, m, t_max=t, rtol=r)
+            return res.max_rotation, res.overturned, math.nan
+
+        def block(s, m, t, e=eq):
+            res = rs.simulate(e, m, t_max=t, rtol=1e-8)
+            return e.scale * res.max_rotation, res.overturned, math.nan
+
+        ref_rows = [mech(*sc[:3]) for sc in scenes]
+        ref = (
+            np.array([r[0] for r in ref_rows]),
+            np.array([r[1] for r in ref_rows]),
+            np.full(n, math.nan),
+        )
+        for rtol in (1e-4, 1e-6, 1e-8):
+            rows.append(
+                measure(
+                    f"{name} mechanism {rtol:.0e}",
+                    f"{name}: full mechanism (8) [003]",
+                    lambda s, m, t, r=rtol: mech(s, m, t, r),
+                    scenes,
+                    ref,
+                )
+            )
+        rows.append(
+            measure(f"{name} equivalent block", "equivalent block (kappa_1)", block, scenes, ref)
+        )
+    return rows
+
+
+def _time_each(fn, scenes, repeat=3):
+    """Outputs and the least of ``repeat`` wall times [s] of fn on each scene."""
+    outs, cost = [], []
+    for b, m, t, _ in scenes:
+        best = math.inf
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            out = fn(b, m, t)
+            best = min(best, time.perf_counter() - t0)
+        outs.append(out)
+        cost.append(best)
+    return outs, np.array(cost)
+
+
+def _rel_errors(outs, ref):
+    """Per-scene relative max-rotation error (inf on an overturning disagreement)."""
+    got = {
+        "max_rotation": np.array([o[0] for o in outs]),
+        "overturned": np.array([bool(o[1]) for o in outs]),
+    }
+    return relative_max_rotation_error(got, {"max_rotation": ref[0], "overturned": ref[1]})
+
+
+def auto_analysis(scenes, ref):
+    """method="auto" per tolerance: share of scenes within it, and its cost against the
+    cheapest adequate candidate (linear, or the kernel at rtol 1e-3 ... 1e-10) of each scene,
+    through simulate() (per scene) and through the batch entry point (the whole set)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rs.AccuracyWarning)
+        cands = {"linear": lambda b, m, t: run_simulate(b, m, t, method="linear")}
+        for r in CANDIDATE_RTOLS:
+            cands[f"kernel {r:.0e}"] = lambda b, m, t, r=r: run_simulate(b, m, t, rtol=r)
+        for fn in cands.values():
+            fn(*scenes[0][:3])
+        timed = {k: _time_each(fn, scenes) for k, fn in cands.items()}
+        errs = {k: _rel_errors(o, ref) for k, (o, _) in timed.items()}
+        rows = []
+        for tol in AUTO_TOLS:
+            fn = lambda b, m, t, r=tol: run_simulate(b, m, t, method="auto", rtol=r)  # noqa: E731
+            fn(*scenes[0][:3])
+            outs, cost = _time_each(fn, scenes)
+            err = _rel_errors(outs, ref)
+            cheapest = np.full(len(scenes), np.inf)
+            choice = np.full(len(scenes), "", dtype=object)
+            for k in cands:
+                ok = (errs[k] <= tol) & (timed[k][1] < cheapest)
+                cheapest[ok], choice[ok] = timed[k][1][ok], k
+            has = np.isfinite(cheapest)
+            ratio = cost[has] / cheapest[has]
+            b_out, b_cpu = batch_kernel(scenes, tol, method="auto")
+            b_err = _rel_errors(b_out, ref)
+            oracle_cpu = 0.0  # the per-scene cheapest adequate candidates, run in batches
+            for k in set(choice[has]):
+                sub = set(np.flatnonzero(choice == k))
+                method, r = ("linear", 1e-8) if k == "linear" else ("nonlinear", float(k[7:]))
+                oracle_cpu += batch_kernel(scenes, r, method=method, subset=sub)[1] * len(sub)
+            rows.append(
+                {
+                    "tolerance": tol,
+                    "within_tolerance_simulate": float(np.mean(err <= tol)),
+                    "within_tolerance_batch": float(np.mean(b_err <= tol)),
+                    "scenes_with_an_adequate_candidate": int(has.sum()),
+                    "cost_ratio_simulate_total": float(cost[has].sum() / cheapest[has].sum()),
+                    "cost_ratio_simulate_median": float(np.median(ratio)),
+                    "cost_ratio_simulate_p90": float(np.percentile(ratio, 90)),
+                    "share_within_2x_simulate": float(np.mean(ratio <= 2.0)),
+                    "cpu_s_per_scene_simulate": float(cost.mean()),
+                    "cpu_s_per_scene_batch": b_cpu,
+                    "cost_ratio_batch_total": b_cpu * len(scenes) / oracle_cpu,
+                    "cheapest_choices": {k: int(np.sum(choice == k)) for k in cands},
+                    "max_rotation_rel_error_p99_simulate": float(np.percentile(err, 99)),
+                }
+            )
+            r = rows[-1]
+            print(
+                f"auto tol={tol:.0e}: within tol {r['within_tolerance_simulate']:.3f} (simulate) "
+                f"{r['within_tolerance_batch']:.3f} (batch); cost / cheapest adequate: total "
+                f"{r['cost_ratio_simulate_total']:.2f}, "
+                f"median {r['cost_ratio_simulate_median']:.2f}, "
+                f"p90 {r['cost_ratio_simulate_p90']:.2f} (simulate), batch total "
+                f"{r['cost_ratio_batch_total']:.2f}",
+                flush=True,
+            )
+    return rows
+
+
 def plot(rows, path):
     fig, axes = plt.subplots(1, 3, figsize=(16, 5.2))
     keys = [
@@ -264,6 +437,7 @@ def main():
     ap.add_argument(
         "--complex-subset", type=int, default=20, help="scenes for the complex form at l <= 1e-4"
     )
+    ap.add_argument("--no-complex", action="store_true", help="skip the complex formulation")
     args = ap.parse_args()
     numba.set_num_threads(1)
     scenes = scene_set(args.scenes)
@@ -332,7 +506,7 @@ def main():
     )
     rng = np.random.default_rng(1)
     subset = np.sort(rng.choice(len(scenes), min(args.complex_subset, len(scenes)), False))
-    for ell in LS:
+    for ell in () if args.no_complex else LS:
         rows.append(
             measure(
                 f"complex l={ell:.0e}",
@@ -343,6 +517,22 @@ def main():
                 idx=None if ell > 1e-4 else subset[: args.complex_subset if ell > 1e-5 else 3],
             )
         )
+    cf_out, cf_idx = closed_form(scenes)
+    rows.append(
+        measure("closed form (4.13)", "closed form (4.13), sine", cf_out, scenes, ref, cf_idx)
+    )
+    rows.extend(structure_rows())
+    for tol in AUTO_TOLS:
+        rows.append(
+            measure(
+                f"auto batch tol={tol:.0e}",
+                "auto, batch",
+                batch_kernel(scenes, tol, method="auto"),
+                scenes,
+                ref,
+            )
+        )
+    auto = auto_analysis(scenes, ref)
     OUT.mkdir(exist_ok=True)
     doc = {
         "machine": platform.processor() or platform.machine(),
@@ -350,6 +540,7 @@ def main():
         "window": "motion duration + 3 s",
         "reference": "solve_ivp DOP853 rtol 1e-12 with events",
         "rows": rows,
+        "auto": auto,
     }
     (OUT / "work_precision.json").write_text(json.dumps(doc, indent=2))
     plot(rows, OUT / "work_precision.png")

@@ -100,10 +100,12 @@ def test_auto_avoids_chattering_error():
     assert np.mean(auto <= tol) >= 0.99
 
 
-def test_auto_in_simulate_follows_the_batch_choice():
+def test_auto_in_simulate_meets_the_tolerance():
+    """simulate(method="auto"): no integration below uplift, the kernel at 0.05 rtol otherwise
+    (the exact linear solver is dearer than the kernel when a history is built), within rtol of
+    Housner; simulate_batch takes the linear model for the slender block."""
     blk = rs.Block(half_diagonal=1.5, slenderness=0.05)
-    cases = [(0.8, "rest (no uplift)"), (3.0, "linear")]
-    for ratio, model in cases:
+    for ratio, model in [(0.8, "rest (no uplift)"), (3.0, "nonlinear")]:
         pulse = rs.motions.SinePulse(ratio * G * math.tan(0.05), 0.5)
         res = rs.simulate(blk, pulse, method="auto", rtol=1e-2)
         ref = rs.simulate(blk, pulse, rtol=1e-12)
@@ -111,10 +113,18 @@ def test_auto_in_simulate_follows_the_batch_choice():
         assert res.overturned == ref.overturned
         if ref.max_rotation > 0 and not ref.overturned:
             assert res.max_rotation == pytest.approx(ref.max_rotation, rel=1e-2)
+    batch = simulate_batch(
+        half_diagonal=1.5,
+        slenderness=0.05,
+        amplitude=3.0 * G * math.tan(0.05),
+        period=0.5,
+        method="auto",
+        rtol=1e-2,
+    )
+    assert batch["model"][0] == _auto.MODEL_LINEAR
     stocky = rs.Block(half_diagonal=1.5, slenderness=0.5)
     pulse = rs.motions.SinePulse(2.0 * G * math.tan(0.5), 0.5)
     res = rs.simulate(stocky, pulse, method="auto", rtol=1e-2)
-    assert res.info["model"] == "nonlinear"
     ref = rs.simulate(stocky, pulse, rtol=1e-12)
     assert res.max_rotation == pytest.approx(ref.max_rotation, rel=1e-2)
 

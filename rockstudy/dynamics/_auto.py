@@ -20,6 +20,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 TABLE = Path(__file__).resolve().parents[1] / "data" / "linearization_bound.npz"
 
@@ -43,7 +44,10 @@ MODEL_NAMES = {MODEL_REST: "rest (no uplift)", MODEL_LINEAR: "linear", MODEL_NON
 def bound_table() -> dict:
     """The stored table: ``K`` on cells (shape, eta, alpha, psi, omega) and the node axes."""
     with np.load(TABLE) as z:
-        return {k: z[k] for k in z.files}
+        tab = {k: z[k] for k in z.files}
+    tab["K"] = tab["K"].astype(float)
+    tab["shape_index"] = {str(s): i for i, s in enumerate(tab["shapes"])}
+    return tab
 
 
 def kernel_rtol(tolerance):
@@ -67,19 +71,35 @@ def kernel_rtol_small(tolerance, rotation_ratio):
     return 10.0 ** np.floor(np.log10(rtol))
 
 
+@njit(cache=True)
 def _cell(nodes, x):
     """Index of the cell [nodes[i], nodes[i + 1]] holding x, or -1 outside the nodes."""
-    i = np.searchsorted(nodes, x, side="right") - 1
-    inside = (x >= nodes[0]) & (x <= nodes[-1])
-    return np.where(inside, np.clip(i, 0, nodes.size - 2), -1)
+    if not nodes[0] <= x <= nodes[-1]:
+        return -1
+    return min(max(np.searchsorted(nodes, x, side="right") - 1, 0), nodes.size - 2)
 
 
+@njit(cache=True)
 def _bracket(nodes, x):
-    """The two nodes around x (the same node twice at or beyond the ends); -1 above."""
+    """The nodes around x (the first node twice at or below it); (-1, -1) above the last."""
+    if x <= nodes[0]:
+        return 0, 0
     hi = np.searchsorted(nodes, x, side="left")
-    lo = np.clip(hi - 1, 0, nodes.size - 1)
-    hi = np.where(hi >= nodes.size, -1, hi)
-    return np.where(x <= nodes[0], 0, lo), hi
+    return (-1, -1) if hi >= nodes.size else (hi - 1, hi)
+
+
+@njit(cache=True)
+def _lookup(K, eta_n, alpha_n, psi_n, omega_n, eta, alpha, psi, omega, out):
+    """Largest tabulated K over the cell of (psi, omega) and the nodes around eta and alpha."""
+    for i in range(eta.size):
+        ip, iw = _cell(psi_n, psi[i]), _cell(omega_n, omega[i])
+        e0, e1 = _bracket(eta_n, eta[i])
+        a0, a1 = _bracket(alpha_n, alpha[i])
+        if ip < 0 or iw < 0 or e1 < 0 or a1 < 0 or eta[i] < eta_n[0]:
+            out[i] = np.inf
+            continue
+        k = max(K[e0, a0, ip, iw], K[e0, a1, ip, iw], K[e1, a0, ip, iw], K[e1, a1, ip, iw])
+        out[i] = SAFETY * k * alpha[i] ** 2
 
 
 def linearization_bound(shape, restitution, slenderness, psi, omega):
@@ -99,22 +119,16 @@ def linearization_bound(shape, restitution, slenderness, psi, omega):
         (outside its range, or a cell where the models disagree on overturning).
     """
     tab = bound_table()
-    shapes = [str(s) for s in tab["shapes"]]
-    eta, alpha, psi, omega = np.broadcast_arrays(
+    args = np.broadcast_arrays(
         *(np.asarray(x, dtype=float) for x in (restitution, slenderness, psi, omega))
     )
-    if shape not in shapes:
-        return np.full(eta.shape, np.inf)
-    K = tab["K"][shapes.index(shape)]
-    ip, iw = _cell(tab["psi"], psi), _cell(tab["omega"], omega)
-    e0, e1 = _bracket(tab["eta"], eta)
-    a0, a1 = _bracket(tab["alpha"], alpha)
-    out = np.full(eta.shape, np.inf)
-    ok = (ip >= 0) & (iw >= 0) & (e1 >= 0) & (a1 >= 0) & (eta >= tab["eta"][0])
-    if ok.any():
-        i, j = ip[ok], iw[ok]
-        k = np.maximum.reduce([K[e, a, i, j] for e in (e0[ok], e1[ok]) for a in (a0[ok], a1[ok])])
-        out[ok] = SAFETY * k * alpha[ok] ** 2
+    out = np.full(args[0].shape, np.inf)
+    if shape in tab["shape_index"]:
+        flat = [np.ascontiguousarray(a).ravel() for a in args]
+        res = np.empty(flat[0].size)
+        K = tab["K"][tab["shape_index"][shape]]
+        _lookup(K, tab["eta"], tab["alpha"], tab["psi"], tab["omega"], *flat, res)
+        out = res.reshape(out.shape)
     return out
 
 
