@@ -95,7 +95,9 @@ def main(argv=None) -> int:
     sim.add_argument("--record", help="a PEER .AT2 file or a two-column (t [s], a [g]) file")
     sim.add_argument("--scale", type=float, default=1.0, help="factor on the record")
     sim.add_argument(
-        "--method", default="nonlinear", choices=["nonlinear", "linear", "scipy", "scipy-linear"]
+        "--method",
+        default="nonlinear",
+        choices=["nonlinear", "linear", "scipy", "scipy-linear", "complex", "auto"],
     )
     sim.add_argument("--rtol", type=float, default=1e-8)
     sim.add_argument("--json", action="store_true", help="print the summary as JSON")

@@ -210,3 +210,20 @@ def test_zeno_sequence_ends_at_the_closed_form_rest_time():
     t_inf = np.sum(2.0 / p * np.arctanh(w0 * eta ** np.arange(4000) / (p * alpha)))
     assert 0 < t_inf - res.impact_times[-1] < 2.0 / p * (rest / (p * alpha)) / (1 - eta)
     assert res.t[-1] == pytest.approx(res.impact_times[-1]) and res.theta[-1] == 0.0  # rest
+
+
+def test_loose_tolerance_warns_and_the_failure_is_real():
+    """Documented failure: above rtol 1e-3 the kernel gets overturning wrong on chattering
+    scenes just above uplift; it warns there, and not at 1e-3, where no decision is wrong."""
+    kw, _ = _random_pulses(1500, 9, psi=(1.0001, 1.15))
+    ref = simulate_batch(**kw, rtol=1e-12)
+    with pytest.warns(rs.LooseToleranceWarning, match="rtol = 0.1"):
+        loose = simulate_batch(**kw, rtol=1e-1)
+    assert np.mean(loose["overturned"] != ref["overturned"]) > 0.005
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", rs.AccuracyWarning)
+        fine = simulate_batch(**kw, rtol=1e-3)
+    np.testing.assert_array_equal(fine["overturned"], ref["overturned"])
+    blk = rs.Block(half_diagonal=1.0, slenderness=0.2)
+    with pytest.warns(rs.LooseToleranceWarning):
+        rs.simulate(blk, rs.motions.SinePulse(3.0, 0.5), rtol=1e-2)

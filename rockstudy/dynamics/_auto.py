@@ -16,11 +16,14 @@ disagree on overturning anywhere holds K = inf: the linear model is never used t
 from __future__ import annotations
 
 import math
+import warnings
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 from numba import njit
+
+from .._warnings import LooseToleranceWarning
 
 TABLE = Path(__file__).resolve().parents[1] / "data" / "linearization_bound.npz"
 
@@ -48,6 +51,19 @@ def bound_table() -> dict:
     tab["K"] = tab["K"].astype(float)
     tab["shape_index"] = {str(s): i for i, s in enumerate(tab["shapes"])}
     return tab
+
+
+def warn_loose_tolerance(rtol):
+    """Warn when the kernel runs above the tolerances measured in the failure maps."""
+    if rtol > KERNEL_RTOL_RANGE[1]:
+        warnings.warn(
+            f"rtol = {rtol:g} is looser than 1e-3, the loosest tolerance the nonlinear kernel "
+            "was measured reliable at: above it, chattering scenes just above uplift get the "
+            "overturning decision wrong (0.7 % of them at rtol 1e-2, 2.5 % at 1e-1; none at "
+            "1e-3); use method='auto' with rtol = the accuracy you need",
+            LooseToleranceWarning,
+            stacklevel=3,
+        )
 
 
 def kernel_rtol(tolerance):

@@ -117,6 +117,8 @@ def simulate_batch(
         raise ValueError(f"method must be one of {sorted(_MODELS)}, got {method!r}") from None
     if not 0.0 < rtol < 1.0:
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
+    if method == "nonlinear":
+        _auto.warn_loose_tolerance(rtol)
     if (half_diagonal is None) == (frequency_parameter is None):
         raise ValueError("give exactly one of half_diagonal or frequency_parameter")
     shapes = [

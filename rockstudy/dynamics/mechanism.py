@@ -19,6 +19,13 @@ from . import _rocking
 
 
 @lru_cache(maxsize=64)
+def structure_parameters(structure):
+    """``structure.rocking_parameters()`` of a (hashable, immutable) structure, computed once
+    (the critical-rotation search costs milliseconds)."""
+    return structure.rocking_parameters()
+
+
+@lru_cache(maxsize=64)
 def structure_table(structure, n: int = 4001):
     """The kernel's tables of a (hashable, immutable) structure, computed once: an array of
     shape (2, n, 9) for rocking towards +x and -x, and the collapse amplitude."""

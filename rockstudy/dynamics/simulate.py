@@ -259,6 +259,8 @@ def simulate(
     p, alpha, eta = block_parameters(structure)
     if method in ("linear", "scipy-linear"):
         _warn_linearization(p, alpha, eta, motion, (th0, om0))
+    if method in ("nonlinear", "mechanism"):
+        _auto.warn_loose_tolerance(rtol)
     if method == "complex":
         return _complex(
             p, alpha, eta, motion, None, rtol, t_max, int(max_steps), method, (th0, om0), l
@@ -268,9 +270,9 @@ def simulate(
 
 def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
     """The full mechanism, eq. (8) of [003], through the tabulated kernel."""
-    from .mechanism import structure_table
+    from .mechanism import structure_parameters, structure_table
 
-    params = structure.rocking_parameters()
+    params = structure_parameters(structure)
     if isinstance(params, tuple):  # (positive, negative) of an asymmetric structure
         params = params[0]
     if not params.restitution > 0:
