@@ -37,6 +37,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_structures.py
 	$(BIN)/python benchmarks/bench_report.py
 	$(BIN)/python -W ignore benchmarks/bench_work_precision.py
+	$(BIN)/python -W ignore benchmarks/bench_failure_maps.py
 
 figures: $(STAMP)
 	$(BIN)/rockstudy figures --out results/figures
