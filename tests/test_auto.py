@@ -136,11 +136,19 @@ def test_linear_warns_where_its_bound_is_large():
     with pytest.warns(rs.LinearizationWarning, match="alpha = 0.5"):
         lin = rs.simulate(stocky, pulse, method="linear")
     assert abs(lin.max_rotation / ref.max_rotation - 1) > 0.5  # the failure is real (72 %)
+    # inside the table, next to an overturning boundary: the bound is infinite
+    demo = rs.Block.from_dimensions(width=0.5, height=2.0)
+    pulse = rs.motions.SinePulse(1.5 * G * math.tan(demo.slenderness), 0.6)
+    ref = rs.simulate(demo, pulse, rtol=1e-12)
+    with pytest.warns(rs.LinearizationWarning, match="disagree on overturning"):
+        lin = rs.simulate(demo, pulse, method="linear")
+    assert abs(lin.max_rotation / ref.max_rotation - 1) > 0.05  # 10 %
     slender = rs.Block(half_diagonal=1.0, slenderness=0.05)
     pulse = rs.motions.SinePulse(3.0 * G * math.tan(0.05), 0.6)
     with warnings.catch_warnings():
         warnings.simplefilter("error", rs.AccuracyWarning)
         rs.simulate(slender, pulse, method="linear")
+        rs.simulate(slender, rs.motions.RickerWavelet(3.0 * G * 0.05, 0.6), method="linear")
 
 
 def test_complex_warns_at_large_l():

@@ -118,6 +118,17 @@ def _lookup(K, eta_n, alpha_n, psi_n, omega_n, eta, alpha, psi, omega, out):
         out[i] = SAFETY * k * alpha[i] ** 2
 
 
+def table_covers(restitution, slenderness, psi, omega):
+    """Whether (eta, alpha, psi, omega) lies inside the table's ranges (scalars)."""
+    tab = bound_table()
+    return bool(
+        tab["eta"][0] <= restitution <= tab["eta"][-1]
+        and slenderness <= tab["alpha"][-1]
+        and tab["psi"][0] <= psi <= tab["psi"][-1]
+        and tab["omega"][0] <= omega <= tab["omega"][-1]
+    )
+
+
 def linearization_bound(shape, restitution, slenderness, psi, omega):
     """Upper bound of the relative max-rotation error of the linear model (inf if none).
 

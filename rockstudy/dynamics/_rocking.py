@@ -534,7 +534,12 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END
+    phases = 0
     while st[T] < dur:
+        phases += 1
+        if phases > max_steps:  # a guard: every phase must move the state on
+            code = PH_FAIL
+            break
         if at_rest:
             t_up = next_uplift(kind, mp, times, samples, thr_p, thr_n, st[T])
             if t_up >= dur:

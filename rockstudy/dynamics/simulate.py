@@ -125,28 +125,39 @@ def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l
 
 
 def _linearization_bound(p, alpha, eta, motion, x0):
-    """(psi, error bound of the linear model) for one scene; inf where none is tabulated."""
+    """(psi, error bound of the linear model, whether the table covers the scene) for one
+    scene; the bound is inf where none is tabulated."""
     psi = motion.peak / (G * math.tan(alpha))
     shape = {cls: name for name, cls in PULSES.items()}.get(type(motion))
-    if x0 != (0.0, 0.0) or shape is None or getattr(motion, "cycles", 1) != 1:
-        return psi, math.inf
+    tabulated = shape in _auto.bound_table()["shape_index"]
+    if x0 != (0.0, 0.0) or not tabulated or getattr(motion, "cycles", 1) != 1:
+        return psi, math.inf, False
     omega = 2.0 * math.pi / (motion.period * p)
-    return psi, float(_auto.linearization_bound(shape, eta, alpha, psi, omega))
+    bound = float(_auto.linearization_bound(shape, eta, alpha, psi, omega))
+    return psi, bound, _auto.table_covers(eta, alpha, psi, omega)
 
 
 def _warn_linearization(p, alpha, eta, motion, x0):
-    psi, bound = _linearization_bound(p, alpha, eta, motion, x0)
+    psi, bound, covered = _linearization_bound(p, alpha, eta, motion, x0)
     if psi < 1.0 and x0 == (0.0, 0.0):
         return
-    if bound > LINEAR_WARN or (math.isinf(bound) and alpha > _auto.LINEAR_ALPHA_MAX):
-        what = "unknown for this scene" if math.isinf(bound) else f"up to {bound:.2g}"
-        warnings.warn(
-            f"linearized model (3.1) at alpha = {alpha:.3g} rad, a_g / (g tan alpha) = "
-            f"{psi:.3g}: its relative max-rotation error is {what} (it grows as alpha^2 and "
-            "near psi = 1 and the overturning boundaries); use method='nonlinear' or 'auto'",
-            LinearizationWarning,
-            stacklevel=4,
+    if covered and bound > LINEAR_WARN:
+        what = (
+            f"up to {bound:.2g}"
+            if math.isfinite(bound)
+            else "unbounded: the two models disagree on overturning near this scene"
         )
+    elif not covered and alpha > _auto.LINEAR_ALPHA_MAX:
+        what = "unknown here, and of order alpha^2 / 2 at best"
+    else:
+        return
+    warnings.warn(
+        f"linearized model (3.1) at alpha = {alpha:.3g} rad, a_g / (g tan alpha) = "
+        f"{psi:.3g}: its relative max-rotation error is {what} (it grows as alpha^2, near "
+        "psi = 1 and near the overturning boundaries); use method='nonlinear' or 'auto'",
+        LinearizationWarning,
+        stacklevel=4,
+    )
 
 
 def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
@@ -154,7 +165,7 @@ def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x
     history the exact linear solver is not cheaper than the kernel (it evaluates its phases on
     a dense grid in Python: 0.70 ms against 0.15-0.6 ms per work-precision scene), so here the
     choice is rest or the kernel; :func:`simulate_batch` also uses the linear model."""
-    psi, bound = _linearization_bound(p, alpha, eta, motion, x0)
+    psi, bound, _ = _linearization_bound(p, alpha, eta, motion, x0)
     rest = x0 == (0.0, 0.0) and psi < 1.0
     k_rtol = _auto.kernel_rtol(rtol)
     args = (p, alpha, eta, motion, _rocking.MODEL_NONLINEAR)
@@ -205,7 +216,7 @@ def simulate(
         The rocking block, described by p, alpha and eta.
     motion : Motion
         Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``.
-    method : {"nonlinear", "linear", "scipy", "scipy-linear"}
+    method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
         ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven DOP853 kernel.
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
         trigonometric pulses, the same kernel otherwise.
