@@ -176,6 +176,26 @@ def test_closed_form_warns_below_the_3_31_curve():
         rs.closedform.max_rotation(np.array([1.01, 3.0]), np.array([5.0, 6.0]), eta)
 
 
+def test_semi_analytical_forms_warn_outside_their_range():
+    """(3.29) holds near tau = 1 and (3.30) for 0.4 < omega < 4.2 (measured in
+    test_closedform.py and the validity map); outside, the calls say so."""
+    cf = rs.closedform
+    A, W = np.meshgrid(np.geomspace(1.01, 10, 40), np.geomspace(0.3, 12, 40), indexing="ij")
+    exact = cf.first_impact_time_during_pulse(A, W)
+    approx = cf.first_impact_time_during_pulse_approx(A, W, check=False)
+    inside = np.isfinite(approx) & (approx > 0.8) & (approx < 1.2)
+    outside = np.isfinite(approx) & ~inside & np.isfinite(exact)
+    assert np.max(np.abs(approx[outside] / exact[outside] - 1)) > 0.2  # the failure is real
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", rs.AccuracyWarning)
+        cf.first_impact_time_during_pulse_approx(A[inside], W[inside])
+        cf.case11_residual_approx(3.0, 2.0, 0.85)
+    with pytest.warns(rs.ClosedFormValidityWarning, match="3.29"):
+        cf.first_impact_time_during_pulse_approx(A[outside], W[outside])
+    with pytest.warns(rs.ClosedFormValidityWarning, match="3.30"):
+        cf.case11_residual_approx(3.0, 6.0, 0.85)
+
+
 def test_loose_tolerance_chattering_scene_terminates():
     """Regression: at rtol 1e-3 the interpolant placed an impact of a chattering scene far
     outside its step (a near-zero velocity in the Newton correction), time ran backwards and

@@ -68,7 +68,7 @@ def test_semi_analytical_impact_time_near_tau_1():
     the root of (3.21) where 0.8 < tau_i1 < 1.2 (and undefined for 1.2 % of those points)."""
     A, W = np.meshgrid(np.geomspace(1.001, 10, 200), np.geomspace(0.3, 12, 200), indexing="ij")
     exact = cf.first_impact_time_during_pulse(A, W)
-    approx = cf.first_impact_time_during_pulse_approx(A, W)
+    approx = cf.first_impact_time_during_pulse_approx(A, W, check=False)
     near = (exact > 0.8) & (exact < 1.2)
     assert near.sum() > 500
     ok = near & np.isfinite(approx)

@@ -285,16 +285,44 @@ def first_impact_time_during_pulse(a, omega):
     return _tau_i1(a, omega) if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
-def first_impact_time_during_pulse_approx(a, omega):
-    r"""Semi-analytical tau_i1 of eq. (3.29) of [000] (accurate for omega below about 5).
+def first_impact_time_during_pulse_approx(a, omega, *, check=True):
+    r"""Semi-analytical tau_i1 of eq. (3.29) of [000].
 
     .. math::
         \hat\tau_{i1} = \ln\frac{1 - a\sin(\omega+\psi)
             + \sqrt{[a\sin(\omega+\psi) - 1]^2 - (A_0^* + C_0^*\kappa)(B_0^* + C_0^*\lambda)}}
             {B_0^* + C_0^*\lambda}
+
+    It fits sin(omega tau + psi) around tau = 1 and is within 7 % of (3.21) only for
+    0.8 < tau < 1.2 (errors of order one elsewhere); ``check`` warns
+    (:class:`rockstudy.ClosedFormValidityWarning`) for results outside that range.
     """
+    out = _tau_i1_hat_ufunc(a, omega)
+    if check:
+        _warn_outside(
+            np.isfinite(out) & ((out <= 0.8) | (out >= 1.2)),
+            out,
+            "eq. (3.29) outside 0.8 < tau < 1.2, where it is within 7 % of (3.21); errors of "
+            "order one there",
+        )
+    return out
+
+
+@vectorize(_F2, cache=True)
+def _tau_i1_hat_ufunc(a, omega):
+    """eq. (3.29) of [000]; see :func:`first_impact_time_during_pulse_approx`."""
     return _tau_i1_hat(a, omega) if a > 1.0 else np.nan
+
+
+def _warn_outside(mask, out, what):
+    """Warn once for the points of ``out`` flagged by ``mask``."""
+    n = int(np.count_nonzero(mask))
+    if n:
+        warnings.warn(
+            f"{what}: {n} of {np.size(out)} points",
+            ClosedFormValidityWarning,
+            stacklevel=3,
+        )
 
 
 @vectorize(_F2, cache=True)
@@ -327,9 +355,26 @@ def case11_residual(a, omega, eta):
     return _case11_lhs(a, omega, eta, _tau_i1(a, omega))
 
 
+def case11_residual_approx(a, omega, eta, *, check=True):
+    """The same with the semi-analytical impact time (3.29), i.e. eq. (3.30) of [000].
+
+    Within 6.4 % of (3.20)-(3.21) for 0.4 < omega < 4.2; ``check`` warns
+    (:class:`rockstudy.ClosedFormValidityWarning`) for results outside that range.
+    """
+    out = _case11_approx_ufunc(a, omega, eta)
+    if check:
+        w = np.broadcast_to(omega, np.shape(out))
+        _warn_outside(
+            np.isfinite(out) & ((w <= 0.4) | (w >= 4.2)),
+            out,
+            "eq. (3.30) outside 0.4 < omega < 4.2, where it is within 6.4 % of (3.20)-(3.21)",
+        )
+    return out
+
+
 @vectorize(_F3, cache=True)
-def case11_residual_approx(a, omega, eta):
-    """The same with the semi-analytical impact time (3.29), i.e. eq. (3.30) of [000]."""
+def _case11_approx_ufunc(a, omega, eta):
+    """eq. (3.30) of [000]; see :func:`case11_residual_approx`."""
     if not a > 1.0:
         return np.nan
     return _case11_lhs(a, omega, eta, _tau_i1_hat(a, omega))
@@ -392,15 +437,13 @@ def max_rotation(a, omega, eta, *, check=True):
     out = _max_rotation(a, omega, eta)
     if check:
         during = np.broadcast_to(limit_residual(a, omega) > 0.0, np.shape(out))
-        n = int(np.count_nonzero(during & np.isfinite(out)))
-        if n:
-            warnings.warn(
-                f"eq. (4.13) at {n} of {np.size(out)} points below the (3.31) curve: the first "
-                "impact comes during the pulse, and (4.13) only approximates the max rotation "
-                "there (median error 16 %, unbounded near the overturning boundaries)",
-                ClosedFormValidityWarning,
-                stacklevel=2,
-            )
+        _warn_outside(
+            during & np.isfinite(out),
+            out,
+            "eq. (4.13) below the (3.31) curve: the first impact comes during the pulse, and "
+            "(4.13) only approximates the max rotation there (median error 16 %, unbounded "
+            "near the overturning boundaries)",
+        )
     return out
 
 

@@ -106,7 +106,7 @@ def validity_map(
 
     mode_cf = sine.overturning_mode_code(A, W, E)
     tau_i1 = sine.first_impact_time_during_pulse(A, W)
-    tau_i1_hat = sine.first_impact_time_during_pulse_approx(A, W)
+    tau_i1_hat = sine.first_impact_time_during_pulse_approx(A, W, check=False)
     tau_i2 = sine.first_impact_time_after_pulse(A, W)
     during = sine.limit_residual(A, W) >= 0.0
     tau_cf = np.where(during, tau_i1, tau_i2)
