@@ -34,7 +34,9 @@ import rockstudy as rs
 from rockstudy.closedform.validity import validity_map
 from rockstudy.constants import G
 from rockstudy.dynamics.accuracy import (
+    GRID_FREQUENCY,
     linearization_error_map,
+    pulse_grid_batch,
     relative_max_rotation_error,
     tolerance_error_map,
 )
@@ -48,21 +50,7 @@ from bench_work_precision import _euler_scene  # noqa: E402
 OUT = Path(__file__).parent / "results"
 PSI = np.geomspace(1.001, 20.0, 60)
 OMEGA = np.geomspace(0.1, 30.0, 60)
-P = 2.0
-
-
-def _grid_batch(psi, omega, alpha, eta, **kw):
-    Ps, W = np.meshgrid(psi, omega, indexing="ij")
-    out = rs.simulate_batch(
-        frequency_parameter=P,
-        slenderness=alpha,
-        restitution=eta,
-        pulse="sine",
-        amplitude=(Ps * G * math.tan(alpha)).ravel(),
-        period=(2 * np.pi / (W * P)).ravel(),
-        **kw,
-    )
-    return {k: v.reshape(Ps.shape) for k, v in out.items()}
+P = GRID_FREQUENCY
 
 
 def euler_map(ref, alpha=0.2, eta=0.9, dt_p=5e-2):
@@ -97,7 +85,7 @@ def _stats(err, mask):
 
 def complex_map(alpha=0.2, eta=0.9, ls=(1e-2, 1e-3), n=8):
     psi, omega = np.geomspace(1.1, 8.0, n), np.geomspace(0.5, 10.0, n)
-    ref = _grid_batch(psi, omega, alpha, eta, rtol=1e-11)
+    ref = pulse_grid_batch("sine", psi, omega, alpha, eta, rtol=1e-11)
     blk = rs.Block(half_diagonal=3 * G / (4 * P * P), slenderness=alpha, restitution=eta)
     errs = []
     for ell in ls:
@@ -137,12 +125,12 @@ def main():
     lin = linearization_error_map("sine", PSI, OMEGA, (0.05, 0.3), 0.9)
     tol = tolerance_error_map("sine", PSI, OMEGA, (0.2,), 0.9, (1e-3, 1e-6))
     chat_psi = np.geomspace(1.0001, 1.2, 60)
-    chat = _grid_batch(chat_psi, OMEGA, 0.2, 0.9, rtol=1e-12)
-    chat_loose = _grid_batch(chat_psi, OMEGA, 0.2, 0.9, rtol=1e-6)
-    chat_auto = _grid_batch(chat_psi, OMEGA, 0.2, 0.9, rtol=1e-6, method="auto")
+    chat = pulse_grid_batch("sine", chat_psi, OMEGA, 0.2, 0.9, rtol=1e-12)
+    chat_loose = pulse_grid_batch("sine", chat_psi, OMEGA, 0.2, 0.9, rtol=1e-6)
+    chat_auto = pulse_grid_batch("sine", chat_psi, OMEGA, 0.2, 0.9, rtol=1e-6, method="auto")
     chat_err = relative_max_rotation_error(chat_loose, chat)
     chat_auto_err = relative_max_rotation_error(chat_auto, chat)
-    ref02 = _grid_batch(PSI, OMEGA, 0.2, 0.9, rtol=1e-11)
+    ref02 = pulse_grid_batch("sine", PSI, OMEGA, 0.2, 0.9, rtol=1e-11)
     eul = euler_map(ref02)
     val = validity_map(a=np.geomspace(1.01, 20, 60), omega=OMEGA, eta=(0.9,), alpha=(0.05,))
     cpsi, comega, cerr, crock = complex_map()

@@ -10,6 +10,7 @@ from ._warnings import (
     AccuracyWarning,
     ClosedFormValidityWarning,
     ComplexAccuracyWarning,
+    ComplexFromRestWarning,
     LinearizationWarning,
     LooseToleranceWarning,
 )
@@ -23,6 +24,7 @@ __all__ = [
     "Block",
     "ClosedFormValidityWarning",
     "ComplexAccuracyWarning",
+    "ComplexFromRestWarning",
     "LinearizationWarning",
     "LooseToleranceWarning",
     "RockingResult",

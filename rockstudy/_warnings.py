@@ -21,5 +21,9 @@ class ComplexAccuracyWarning(AccuracyWarning):
     """The complex formulation of [001] was run at a large l."""
 
 
+class ComplexFromRestWarning(AccuracyWarning):
+    """The complex formulation was started from rest under a motion that lifts the block."""
+
+
 class LooseToleranceWarning(AccuracyWarning):
     """The nonlinear kernel was run at a tolerance looser than its measured reliable range."""

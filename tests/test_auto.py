@@ -73,7 +73,7 @@ def test_auto_meets_the_tolerance(tol):
     models = np.bincount(out["model"], minlength=3)
     assert np.all(models > 100)  # all three paths are exercised
     assert np.all(out["model"][psi < 1.0] == _auto.MODEL_REST)
-    assert np.all(out["model"][al > _auto.LINEAR_ALPHA_MAX] != _auto.MODEL_LINEAR)
+    assert np.all(out["model"][al > _auto.largest_slenderness()] != _auto.MODEL_LINEAR)
 
 
 def test_auto_rest_rows_equal_the_kernel():

@@ -15,7 +15,6 @@ disagree on overturning anywhere holds K = inf: the linear model is never used t
 
 from __future__ import annotations
 
-import math
 import warnings
 from functools import lru_cache
 from pathlib import Path
@@ -34,9 +33,6 @@ SAFETY = 2.0
 #: below 90 rtol at worst; ``auto`` runs it at this fraction of the accuracy asked for.
 KERNEL_RTOL_FRACTION = 0.05
 KERNEL_RTOL_RANGE = (1e-12, 1e-3)
-
-#: Largest slenderness in the table [rad]; beyond it the linear model is never chosen.
-LINEAR_ALPHA_MAX = 0.3
 
 #: Codes of the ``model`` output of :func:`rockstudy.simulate_batch`.
 MODEL_REST, MODEL_LINEAR, MODEL_NONLINEAR = 0, 1, 2
@@ -118,12 +114,17 @@ def _lookup(K, eta_n, alpha_n, psi_n, omega_n, eta, alpha, psi, omega, out):
         out[i] = SAFETY * k * alpha[i] ** 2
 
 
+def largest_slenderness():
+    """Largest alpha [rad] in the table; beyond it the linear model is never chosen."""
+    return float(bound_table()["alpha"][-1])
+
+
 def table_covers(restitution, slenderness, psi, omega):
     """Whether (eta, alpha, psi, omega) lies inside the table's ranges (scalars)."""
     tab = bound_table()
     return bool(
         tab["eta"][0] <= restitution <= tab["eta"][-1]
-        and slenderness <= tab["alpha"][-1]
+        and slenderness <= largest_slenderness()
         and tab["psi"][0] <= psi <= tab["psi"][-1]
         and tab["omega"][0] <= omega <= tab["omega"][-1]
     )
@@ -157,19 +158,3 @@ def linearization_bound(shape, restitution, slenderness, psi, omega):
         _lookup(K, tab["eta"], tab["alpha"], tab["psi"], tab["omega"], *flat, res)
         out = res.reshape(out.shape)
     return out
-
-
-def trig_uplifts(psi):
-    """Whether a one-cycle trigonometric pulse of peak ratio psi lifts the block: the ground
-    must exceed g tan(alpha), eq. (2.3) of [000]; below it the block stays at rest."""
-    return np.asarray(psi) > 1.0
-
-
-def peak_ratio(amplitude, slenderness, g):
-    """psi = |a_g| / (g tan alpha)."""
-    return np.abs(amplitude) / (g * np.tan(slenderness))
-
-
-def angular_frequency_ratio(period, frequency_parameter):
-    """omega = omega_g / p = 2 pi / (T_p p)."""
-    return 2.0 * math.pi / (np.asarray(period) * np.asarray(frequency_parameter))

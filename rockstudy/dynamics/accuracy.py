@@ -24,20 +24,21 @@ from ..constants import G
 from . import _auto
 from .batch import simulate_batch
 
-_P = 2.0  # the maps are in (psi, omega): any p will do
+GRID_FREQUENCY = 2.0  # p [rad/s] of the maps: they are in (psi, omega), any p will do
 REFERENCE_RTOL = 1e-11
 
 
-def _pulse_batch(shape, psi, omega, alpha, eta, method="nonlinear", rtol=REFERENCE_RTOL):
-    """The batch entry point on a (psi, omega) grid for one alpha and eta."""
+def pulse_grid_batch(shape, psi, omega, alpha, eta, method="nonlinear", rtol=REFERENCE_RTOL):
+    """:func:`simulate_batch` on a (psi, omega) grid of one-cycle pulses, for one alpha and
+    eta (p = 2 rad/s: the maps depend on p only through omega); outputs shaped (psi, omega)."""
     P, W = np.meshgrid(psi, omega, indexing="ij")
     out = simulate_batch(
-        frequency_parameter=_P,
+        frequency_parameter=GRID_FREQUENCY,
         slenderness=alpha,
         restitution=eta,
         pulse=shape,
         amplitude=(P * G * np.tan(alpha)).ravel(),
-        period=(2.0 * np.pi / (W * _P)).ravel(),
+        period=(2.0 * np.pi / (W * GRID_FREQUENCY)).ravel(),
         method=method,
         rtol=rtol,
     )
@@ -92,8 +93,8 @@ def linearization_error_map(
     over = np.empty(err.shape, bool)
     for i, e in enumerate(eta):
         for j, al in enumerate(alpha):
-            ref = _pulse_batch(shape, psi, omega, al, e, rtol=rtol)
-            lin = _pulse_batch(shape, psi, omega, al, e, method="linear")
+            ref = pulse_grid_batch(shape, psi, omega, al, e, rtol=rtol)
+            lin = pulse_grid_batch(shape, psi, omega, al, e, method="linear")
             err[i, j] = relative_max_rotation_error(lin, ref)
             over[i, j] = ref["overturned"]
     dims = ("eta", "alpha", "psi", "omega")
@@ -130,9 +131,9 @@ def tolerance_error_map(
     shape_ = (len(rtols), alpha.size, psi.size, omega.size)
     err, dn = np.empty(shape_), np.empty(shape_, np.int64)
     for j, al in enumerate(alpha):
-        ref = _pulse_batch(shape, psi, omega, al, eta)
+        ref = pulse_grid_batch(shape, psi, omega, al, eta)
         for i, rt in enumerate(rtols):
-            out = _pulse_batch(shape, psi, omega, al, eta, rtol=rt)
+            out = pulse_grid_batch(shape, psi, omega, al, eta, rtol=rt)
             err[i, j] = relative_max_rotation_error(out, ref)
             dn[i, j] = out["n_impacts"] - ref["n_impacts"]
     dims = ("rtol", "alpha", "psi", "omega")

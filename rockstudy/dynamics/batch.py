@@ -195,7 +195,8 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps):
             _auto.MODEL_LINEAR
         )
     out = np.zeros((n, len(_rocking.BATCH_COLUMNS)))
-    out[:, 4] = out[:, 6] = np.nan  # overturn and first impact times of a block at rest
+    for name in ("overturn_time", "first_impact_time"):  # NaN for a block at rest
+        out[:, _rocking.BATCH_COLUMNS.index(name)] = np.nan
     for code, model, rtol in (
         (_auto.MODEL_LINEAR, _rocking.MODEL_LINEAR, tolerance),
         (_auto.MODEL_NONLINEAR, _rocking.MODEL_NONLINEAR, _auto.kernel_rtol(tolerance)),
@@ -203,9 +204,10 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps):
         idx = np.flatnonzero(codes == code)
         if idx.size:
             out[idx] = _run(rows, idx, model, rtol, max_steps)
-    ratio = out[:, 1] / alpha
+    ratio = out[:, _rocking.BATCH_COLUMNS.index("max_rotation")] / alpha
     small = np.flatnonzero((codes == _auto.MODEL_NONLINEAR) & (ratio < _auto.SMALL_ROTATION))
-    for rtol in np.unique(_auto.kernel_rtol_small(tolerance, ratio[small])):
-        idx = small[_auto.kernel_rtol_small(tolerance, ratio[small]) == rtol]
+    rtols = _auto.kernel_rtol_small(tolerance, ratio[small])
+    for rtol in np.unique(rtols):
+        idx = small[rtols == rtol]
         out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps)
     return out, codes

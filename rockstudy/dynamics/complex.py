@@ -26,7 +26,7 @@ from numba import njit
 from scipy.integrate import RK45
 from scipy.optimize import brentq
 
-from .._warnings import AccuracyWarning, ComplexAccuracyWarning
+from .._warnings import ComplexAccuracyWarning, ComplexFromRestWarning
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
 
@@ -36,16 +36,12 @@ _C = tuple(float(x) for x in RK45.C)
 _E = tuple(float(x) for x in RK45.E)
 
 
-class ComplexFromRestWarning(AccuracyWarning):
-    """The complex formulation was started from rest under a motion that lifts the block."""
-
-
 #: Above this l the complex formulation's error exceeds about 1 % of alpha on [001]'s
 #: free-rocking case (tests/test_complex.py measures 0.161, 0.037 and 0.0056 alpha at
 #: l = 1e-2, 1e-3 and 1e-4).
 LARGE_L = 1e-4
 LARGE_L_WARNING = (
-    "method='complex' with l = {l:g} > 1e-4: on [001]'s free-rocking case the history error "
+    "method='complex' with l = {l:g} > {large:g}: on [001]'s free-rocking case the history error "
     "against Housner's model is 0.16 alpha at l = 1e-2, 0.037 alpha at 1e-3 and 0.0056 alpha "
     "at 1e-4 (order 0.6-0.8 in l); decrease l (the cost grows as 1/l)."
 )
@@ -178,7 +174,9 @@ def simulate_complex(
     if th0 == 0.0 and om0 == 0.0 and motion.peak >= G * math.tan(alpha):
         warnings.warn(FROM_REST_WARNING, ComplexFromRestWarning, stacklevel=4)
     if l > LARGE_L:
-        warnings.warn(LARGE_L_WARNING.format(l=l), ComplexAccuracyWarning, stacklevel=4)
+        warnings.warn(
+            LARGE_L_WARNING.format(l=l, large=LARGE_L), ComplexAccuracyWarning, stacklevel=4
+        )
     v0 = om0 / (p * alpha) * (1.0 if th0 >= 0 else -1.0)
     y0 = np.array([chi0, v0, psi0])
     t_phys = (motion.duration + 10.0 / p) if t_end is None else t_end

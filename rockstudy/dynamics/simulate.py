@@ -22,6 +22,8 @@ from .result import RockingResult
 #: simulate(method="linear") warns above this linearization error bound.
 LINEAR_WARN = 0.1
 
+_SHAPES = {cls: name for name, cls in PULSES.items()}  # pulse class -> shape name
+
 Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"]
 
 
@@ -128,7 +130,7 @@ def _linearization_bound(p, alpha, eta, motion, x0):
     """(psi, error bound of the linear model, whether the table covers the scene) for one
     scene; the bound is inf where none is tabulated."""
     psi = motion.peak / (G * math.tan(alpha))
-    shape = {cls: name for name, cls in PULSES.items()}.get(type(motion))
+    shape = _SHAPES.get(type(motion))
     tabulated = shape in _auto.bound_table()["shape_index"]
     if x0 != (0.0, 0.0) or not tabulated or getattr(motion, "cycles", 1) != 1:
         return psi, math.inf, False
@@ -147,7 +149,7 @@ def _warn_linearization(p, alpha, eta, motion, x0):
             if math.isfinite(bound)
             else "unbounded: the two models disagree on overturning near this scene"
         )
-    elif not covered and alpha > _auto.LINEAR_ALPHA_MAX:
+    elif not covered and alpha > _auto.largest_slenderness():
         what = "unknown here, and of order alpha^2 / 2 at best"
     else:
         return
@@ -265,13 +267,13 @@ def simulate(
     om0 = float(initial_velocity)
     if not math.isfinite(om0):
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
+    if method in ("nonlinear", "mechanism"):
+        _auto.warn_loose_tolerance(rtol)
     if hasattr(structure, "mechanism") and method in ("nonlinear", "mechanism"):
         return _mechanism(structure, motion, rtol, t_max, int(max_steps), (th0, om0))
     p, alpha, eta = block_parameters(structure)
     if method in ("linear", "scipy-linear"):
         _warn_linearization(p, alpha, eta, motion, (th0, om0))
-    if method in ("nonlinear", "mechanism"):
-        _auto.warn_loose_tolerance(rtol)
     if method == "complex":
         return _complex(
             p, alpha, eta, motion, None, rtol, t_max, int(max_steps), method, (th0, om0), l

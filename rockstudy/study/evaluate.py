@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..constants import G
+from ..dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ..dynamics.batch import simulate_batch
 from ..motions import Record, stochastic_record
 from .spec import Study
@@ -163,19 +164,7 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
 
 def _rows_one_by_one(study, cols, base_dir, error):
     n = cols["sample"].size
-    raw = {
-        k: np.zeros(n)
-        for k in (
-            "max_rotation",
-            "overturned",
-            "n_impacts",
-            "overturn_time",
-            "first_impact_time",
-            "steps",
-            "status",
-            "model",
-        )
-    }
+    raw = {k: np.zeros(n) for k in BATCH_OUTPUTS}
     failed = np.zeros(n, bool)
     for i in range(n):
         try:
