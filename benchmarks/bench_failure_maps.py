@@ -31,15 +31,15 @@ import matplotlib
 import numpy as np
 
 import rockstudy as rs
-from rockstudy.closedform.validity import validity_map
 from rockstudy.constants import G
-from rockstudy.dynamics.accuracy import (
+from rockstudy.verification.accuracy import (
     GRID_FREQUENCY,
     linearization_error_map,
     pulse_grid_batch,
     relative_max_rotation_error,
     tolerance_error_map,
 )
+from rockstudy.verification.validity import validity_map
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

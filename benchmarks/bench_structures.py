@@ -18,7 +18,7 @@ from numba import njit
 
 from rockstudy.constants import FALL_ROTATION, G
 from rockstudy.dynamics import _rocking
-from rockstudy.dynamics.mechanism import structure_table
+from rockstudy.dynamics._structure_tables import structure_table
 from rockstudy.motions.pulses import pulse_kernel_rows
 from rockstudy.structures import Arch, RockingWall, SymmetricFrame
 

@@ -43,9 +43,9 @@ from numba import njit
 import rockstudy as rs
 from rockstudy.constants import FALL_ROTATION, G
 from rockstudy.dynamics import simulate_batch
-from rockstudy.dynamics.accuracy import relative_max_rotation_error
 from rockstudy.dynamics.reference import simulate_reference
 from rockstudy.structures.block import block_parameters
+from rockstudy.verification.accuracy import relative_max_rotation_error
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

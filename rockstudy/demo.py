@@ -9,9 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import Block, LinearizationWarning, simulate
+from ._warnings import LinearizationWarning
 from .constants import G
+from .dynamics import simulate
 from .motions import SinePulse
+from .structures import Block
 
 
 def run(out_dir="results/demo") -> dict:

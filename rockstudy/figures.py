@@ -57,7 +57,7 @@ def _plt():
 
 
 def _linear_modes(a, omega, eta):
-    from .closedform.validity import linear_outcomes
+    from .verification.validity import linear_outcomes
 
     return linear_outcomes(a, omega, eta)[0]
 
@@ -137,7 +137,7 @@ def fig08(path, ratios=(0.2, 0.4, 0.6), etas=(0.80, 0.84, 0.88, 0.92, 0.96)):
     """Rocking spectra of [000] Fig. 8: linear solver against (4.13)."""
     plt = _plt()
     w = np.geomspace(0.5, 15, 300)
-    from .closedform.validity import linear_outcomes
+    from .verification.validity import linear_outcomes
 
     fig, axes = plt.subplots(1, len(ratios), figsize=(4.2 * len(ratios), 3.8))
     for ax, ratio in zip(axes, ratios, strict=True):
@@ -310,7 +310,7 @@ def _error_panels(path, ds, xname, xlabel, title):
 def fig003_wall(path):
     """[003] Fig. 3: the rocking wall's equivalent block, errors against slenderness."""
     from .structures import RockingWall
-    from .structures.errors import error_map
+    from .verification.equivalent_errors import error_map
 
     alphas = np.linspace(0.03, 0.35, 12)
     ds = error_map([RockingWall(1.0, a) for a in alphas], {"slenderness": alphas})
@@ -321,7 +321,7 @@ def fig003_arch(path):
     """[003] Figs. 10-13: the arch's equivalent block, errors against the thickness ratio for a
     semicircular arch (beta = pi) and for beta = 2.4 rad."""
     from .structures import Arch
-    from .structures.errors import error_map
+    from .verification.equivalent_errors import error_map
 
     plt = _plt()
     ratios = np.linspace(0.12, 0.22, 8)
@@ -417,7 +417,7 @@ def fig003_frame(path):
     """[003] Figs. 5-8: the asymmetric frame's equivalent block in each direction, against the
     height ratio H1 / H."""
     from .structures import AsymmetricFrame
-    from .structures.errors import Direction, error_map
+    from .verification.equivalent_errors import Direction, error_map
 
     ratios = np.linspace(0.6, 1.0, 9)
     frames = [AsymmetricFrame(0.3, 2.0, 2.0 * r, 6.0, 0.25, 1.0, 1.5, 1.0) for r in ratios]

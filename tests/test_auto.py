@@ -16,7 +16,7 @@ import pytest
 import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.dynamics import _auto, simulate_batch
-from rockstudy.dynamics.accuracy import linearization_error_map, relative_max_rotation_error
+from rockstudy.verification.accuracy import linearization_error_map, relative_max_rotation_error
 
 
 def _random_pulses(n, seed, psi=(0.8, 8.0), alpha=(0.01, 0.45), shape="sine"):

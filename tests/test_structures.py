@@ -263,7 +263,7 @@ def test_error_map_against_simulations():
     solve_ivp's on eq. (8)."""
     from scipy.integrate import solve_ivp
 
-    from rockstudy.structures.errors import error_map
+    from rockstudy.verification.equivalent_errors import error_map
 
     strut = PointMassStrut(1.0, 0.2)
     ds = error_map([strut], {"slenderness": [0.2]}, amplitude=(0.5,), acceleration=(2.0,))

@@ -400,8 +400,8 @@ def test_auto_study_meets_its_tolerance(tmp_path):
     the model that ran, and >= 99 % are within 1 % of Housner's max rotation (kernel at
     rtol 1e-12) with the same overturning decision."""
     from rockstudy import simulate_batch
-    from rockstudy.dynamics.accuracy import relative_max_rotation_error
     from rockstudy.study import open_result
+    from rockstudy.verification.accuracy import relative_max_rotation_error
 
     text = (ROOT / "studies" / "auto_method.toml").read_text().replace("n = 20000", "n = 2000")
     out = tmp_path / "auto.zarr"

@@ -5,8 +5,8 @@ import pytest
 
 import rockstudy as rs
 from rockstudy import closedform as cf
-from rockstudy.closedform.validity import validity_map
 from rockstudy.constants import G
+from rockstudy.verification.validity import validity_map
 
 
 @pytest.fixture(scope="module")

@@ -432,7 +432,7 @@ def max_rotation(a, omega, eta, *, check=True):
         Warn (:class:`rockstudy.ClosedFormValidityWarning`) when points lie below the (3.31)
         curve, where the first impact comes during the pulse and (4.13) is an approximation
         (median error 16 %, unbounded near the overturning boundaries; see
-        :mod:`rockstudy.closedform.validity`).
+        :mod:`rockstudy.verification.validity`).
     """
     out = _max_rotation(a, omega, eta)
     if check:

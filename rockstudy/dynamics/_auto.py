@@ -7,9 +7,9 @@ tan alpha - alpha). For a trigonometric pulse of one cycle it is therefore
     |theta_max,lin / theta_max - 1| <= K(shape, eta, psi, omega) alpha^2,
     psi = |a_g| / (g tan alpha),  omega = omega_g / p,
 
-with K measured on a grid by :func:`rockstudy.dynamics.accuracy.linearization_error_map` and
+with K measured on a grid by :func:`rockstudy.verification.accuracy.linearization_error_map` and
 stored as the largest value in each cell (``rockstudy/data/linearization_bound.npz``;
-regenerate with ``python -m rockstudy.dynamics.accuracy``). A cell where the two models
+regenerate with ``python -m rockstudy.verification.accuracy``). A cell where the two models
 disagree on overturning anywhere holds K = inf: the linear model is never used there.
 """
 

@@ -283,7 +283,7 @@ def simulate(
 
 def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
     """The full mechanism, eq. (8) of [003], through the tabulated kernel."""
-    from .mechanism import structure_parameters, structure_table
+    from ._structure_tables import structure_parameters, structure_table
 
     params = structure_parameters(structure)
     if isinstance(params, tuple):  # (positive, negative) of an asymmetric structure

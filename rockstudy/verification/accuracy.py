@@ -12,7 +12,8 @@ at rtol 1e-11 as the reference.
 - :func:`tolerance_error_map`: the kernel at loose tolerances (impacts gained or lost, max
   rotation, overturning).
 
-``python -m rockstudy.dynamics.accuracy`` regenerates ``rockstudy/data/linearization_bound.npz``.
+``python -m rockstudy.verification.accuracy`` regenerates
+``rockstudy/data/linearization_bound.npz``.
 """
 
 from __future__ import annotations
@@ -21,8 +22,8 @@ import numpy as np
 import xarray as xr
 
 from ..constants import G
-from . import _auto
-from .batch import simulate_batch
+from ..dynamics import _auto
+from ..dynamics.batch import simulate_batch
 
 GRID_FREQUENCY = 2.0  # p [rad/s] of the maps: they are in (psi, omega), any p will do
 REFERENCE_RTOL = 1e-11

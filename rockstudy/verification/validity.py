@@ -26,9 +26,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ..closedform import sine
 from ..constants import G
 from ..dynamics.batch import simulate_batch
-from . import sine
 
 _P = 1.0  # the map is in (a, omega): any p will do; p = 1 makes t = tau
 _LIN_ALPHA = 0.05  # the linear model is scale-free in (a, omega, eta): any alpha will do

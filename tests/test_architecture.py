@@ -1,0 +1,125 @@
+"""The import graph of the package runs one way (DESIGN.md, Layout).
+
+cli -> study -> verification -> (dynamics, closedform, similarity) -> structures -> motions
+-> constants. The test reads every module's imports (top level and inside functions) with
+``ast`` and checks that no package imports a package of a higher layer, and that the
+package-level graph has no cycle.
+"""
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "rockstudy"
+
+# Lower number = lower layer. A module may import only from its own package or lower layers.
+LAYER = {
+    "constants": 0,
+    "_validate": 0,
+    "_warnings": 0,
+    "data": 0,
+    "motions": 1,
+    "structures": 2,
+    "dynamics": 3,
+    "closedform": 3,
+    "similarity": 3,
+    "verification": 4,
+    "figures": 5,
+    "demo": 5,
+    "study": 5,
+    "cli": 6,
+    "__init__": 6,
+}
+# Physics packages of one layer must not import each other (no sideways loops).
+SIDEWAYS_FORBIDDEN = {"dynamics", "closedform", "similarity"}
+
+
+def _package_of(path: Path) -> str:
+    rel = path.relative_to(PACKAGE)
+    return rel.parts[0].removesuffix(".py")
+
+
+def _imported_packages(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text())
+    rel = path.relative_to(PACKAGE)
+    depth = len(rel.parts) - 1  # 0 for rockstudy/x.py, 1 for rockstudy/pkg/x.py
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == 0:
+                mod = node.module or ""
+                if mod.startswith("rockstudy."):
+                    out.add(mod.split(".")[1])
+                continue
+            up = node.level - 1  # levels above the module's own package
+            if up > depth:
+                continue
+            if up == depth:  # relative to rockstudy/
+                if node.module:
+                    out.add(node.module.split(".")[0])
+                else:  # `from . import name`: a submodule, or a name of rockstudy/__init__
+                    out.update(
+                        a.name if a.name in LAYER else "__init__" for a in node.names
+                    )
+            else:  # inside the module's own package
+                out.add(rel.parts[0])
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.startswith("rockstudy."):
+                    out.add(a.name.split(".")[1])
+    return out
+
+
+def _graph():
+    graph: dict[str, set[str]] = {}
+    for path in PACKAGE.rglob("*.py"):
+        pkg = _package_of(path)
+        graph.setdefault(pkg, set()).update(_imported_packages(path) - {pkg})
+    return graph
+
+
+def test_every_package_has_a_layer():
+    assert set(_graph()) <= set(LAYER), set(_graph()) - set(LAYER)
+
+
+def test_imports_run_downwards_only():
+    bad = []
+    for pkg, deps in _graph().items():
+        for dep in deps:
+            if LAYER[dep] > LAYER[pkg]:
+                bad.append(f"{pkg} imports {dep}")
+            elif dep in SIDEWAYS_FORBIDDEN and pkg in SIDEWAYS_FORBIDDEN and dep != pkg:
+                bad.append(f"{pkg} imports {dep} sideways")
+    assert not bad, bad
+
+
+def test_no_cycle():
+    graph = _graph()
+    state: dict[str, int] = {}
+
+    def visit(node, stack):
+        state[node] = 1
+        for dep in graph.get(node, ()):
+            if state.get(dep) == 1:
+                raise AssertionError(" -> ".join([*stack, node, dep]))
+            if dep not in state:
+                visit(dep, [*stack, node])
+        state[node] = 2
+
+    for node in graph:
+        if node not in state:
+            visit(node, [])
+
+
+def test_physics_never_imports_the_study_backends():
+    heavy = ("dask", "distributed", "SALib", "zarr", "netCDF4", "h5netcdf")
+    bad = []
+    for sub in ("motions", "structures", "dynamics", "closedform", "similarity.py"):
+        for path in (PACKAGE / sub).rglob("*.py") if sub != "similarity.py" else [PACKAGE / sub]:
+            for node in ast.walk(ast.parse(path.read_text())):
+                names = []
+                if isinstance(node, ast.Import):
+                    names = [a.name for a in node.names]
+                elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                    names = [node.module or ""]
+                bad += [f"{path.name}: {n}" for n in names if n.split(".")[0] in heavy]
+    assert not bad, bad
