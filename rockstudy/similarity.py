@@ -25,6 +25,7 @@ import numpy as np
 from . import _validate
 from .constants import G
 from .motions.pulses import PULSES, RickerWavelet
+from .motions.records import Record
 from .structures.block import Block, block_parameters
 
 Law = Literal["4.10", "4.11", "5.3", "6.1"]
@@ -189,3 +190,49 @@ def block_for(pulse, omega: float, ratio: float, law: Law = "4.11", restitution=
     if not 0.0 < alpha < math.pi / 2:
         raise ValueError(f"ratio gives a slenderness {alpha!r} outside (0, pi/2)")
     return Block(R, alpha, restitution)
+
+
+def uplift_acceleration(structure) -> float:
+    """Ground acceleration that starts rocking [m/s^2].
+
+    g tan(alpha) for a block (section 2 of [000]) or an equivalent block; g lambda for a
+    structure with rocking parameters (eq. 10 of [003]), the smaller of the two directions of
+    an asymmetric one.
+    """
+    if hasattr(structure, "rocking_parameters"):
+        params = structure.rocking_parameters()
+        params = params if isinstance(params, tuple) else (params,)
+        return G * min(float(q.uplift) for q in params)
+    return G * math.tan(_block(structure)[1])
+
+
+def record_groups(structure, record: Record) -> dict:
+    """The dimensionless intensities of a record for a structure: the record counterparts of
+    paper [000]'s (a, omega).
+
+    With a_up the uplift acceleration (:func:`uplift_acceleration`: g tan(alpha) for a block),
+    p the frequency parameter of the (equivalent) block, and the record's dominant velocity
+    pulse of period T_p and amplitude A (:meth:`rockstudy.motions.Record.pulse`):
+
+    - ``pga_ratio`` = PGA / a_up: rocking can start only if it exceeds 1;
+    - ``pgv_ratio`` = PGV p / a_up;
+    - ``pulse_frequency_ratio`` = omega_p / p = 2 pi / (T_p p), the omega_g / p of (3.6);
+    - ``pulse_amplitude_ratio`` = (2 pi A / T_p) / a_up: the pulse's acceleration amplitude
+      omega_p A (that of a harmonic of velocity amplitude A) over a_up, the a_g / (g tan alpha)
+      of (5.3). NaN when the record has no pulse (A = 0).
+
+    PGA and PGV are those of :meth:`rockstudy.motions.Record.intensity_measures`.
+    """
+    if not isinstance(record, Record):
+        raise TypeError(f"record must be a rockstudy Record, got {type(record).__name__}")
+    p = _block(structure)[0]
+    a_up = uplift_acceleration(structure)
+    im = record.intensity_measures()
+    pulse = record.pulse()
+    w_p = 2.0 * math.pi / pulse.period if pulse.amplitude > 0 else math.nan
+    return {
+        "pga_ratio": im["pga"] / a_up,
+        "pgv_ratio": im["pgv"] * p / a_up,
+        "pulse_frequency_ratio": w_p / p,
+        "pulse_amplitude_ratio": w_p * pulse.amplitude / a_up,
+    }

@@ -147,6 +147,10 @@ def simulate_batch(
         eta = np.vectorize(restitution_housner)(alpha)
     else:
         eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
+    if record is not None and getattr(record, "vertical", None) is not None:
+        raise NotImplementedError(
+            "record has a vertical component, which the solvers do not take yet"
+        )
     if record is not None:
         kind, p1, times, samples = record.kernel_spec()
         mp = np.tile(p1, (n, 1))

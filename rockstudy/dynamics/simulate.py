@@ -258,6 +258,11 @@ def simulate(
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}") from None
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
+    if getattr(motion, "vertical", None) is not None:
+        raise NotImplementedError(
+            "motion has a vertical component, which the solvers do not take yet; "
+            "simulate Record(motion.acceleration, time=motion.time) for the horizontal alone"
+        )
     rtol = _validate.in_open_interval("rtol", rtol, 0.0, 1.0, "(0, 1)")
     if t_max is not None:
         t_max = _validate.positive("t_max", t_max)

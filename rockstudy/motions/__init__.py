@@ -1,9 +1,12 @@
 """Ground motions: analytic pulses, sampled records and stochastic synthesis."""
 
 from .base import Motion
+from .mavroeidis import mp_pulse_acceleration, mp_pulse_velocity
+from .pulse_extraction import VelocityPulse
 from .pulses import PULSES, CosinePulse, HalfSinePulse, NoMotion, RickerWavelet, SinePulse
 from .records import Record
 from .stochastic import envelope_jennings, kanai_tajimi_filter, stochastic_record
+from .synthetic import synthetic_near_fault
 
 __all__ = [
     "Motion",
@@ -17,4 +20,8 @@ __all__ = [
     "stochastic_record",
     "envelope_jennings",
     "kanai_tajimi_filter",
+    "synthetic_near_fault",
+    "VelocityPulse",
+    "mp_pulse_velocity",
+    "mp_pulse_acceleration",
 ]

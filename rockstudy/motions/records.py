@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -10,8 +11,9 @@ import numpy as np
 
 from .. import _validate
 from ..constants import G
-from . import _kernels
+from . import _kernels, intensity
 from .base import Motion
+from .pulse_extraction import VelocityPulse, extract_pulse
 
 _UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
 
@@ -37,13 +39,20 @@ class Record(Motion):
         Strictly increasing sample times [s]; shifted so that the first sample is at t = 0.
     name : str
         A label for plots and results.
+    vertical : array_like, optional
+        Vertical ground acceleration [m/s^2], positive upwards, on the same samples.
+
+    Intensity measures (:meth:`intensity_measures`, :meth:`response_spectrum`, :meth:`pulse`) are
+    computed once and cached; the sample arrays are read-only for that reason.
     """
 
     acceleration: np.ndarray
     dt: float | None = None
     time: np.ndarray | None = None
     name: str = ""
+    vertical: np.ndarray | None = None
     _times: np.ndarray = field(init=False, repr=False)
+    _cache: dict = field(init=False, repr=False)
 
     def __post_init__(self):
         acc = _validate.finite_array("acceleration", self.acceleration)
@@ -70,10 +79,25 @@ class Record(Motion):
                 )
             times = times - times[0]
             dt = float(np.median(steps))
+        if self.vertical is not None:
+            vert = _validate.finite_array("vertical", self.vertical)
+            if vert.size != acc.size:
+                raise ValueError(
+                    f"vertical has {vert.size} samples but acceleration has {acc.size}; "
+                    "the vertical component must be given on the same samples"
+                )
+            vert = vert.copy()
+            vert.flags.writeable = False
+            object.__setattr__(self, "vertical", vert)
+        acc = acc.copy()
+        times = np.array(times, dtype=float)
+        acc.flags.writeable = False
+        times.flags.writeable = False
         object.__setattr__(self, "acceleration", acc)
         object.__setattr__(self, "dt", float(dt))
         object.__setattr__(self, "time", times)
         object.__setattr__(self, "_times", times)
+        object.__setattr__(self, "_cache", {})
 
     @property
     def duration(self) -> float:
@@ -84,19 +108,164 @@ class Record(Motion):
         return float(np.max(np.abs(self.acceleration)))
 
     def scaled(self, factor: float) -> Record:
-        """The same record with every sample multiplied by ``factor`` (negative mirrors)."""
-        return Record(self.acceleration * float(factor), time=self._times, name=self.name)
+        """The same record with every sample multiplied by ``factor`` (negative mirrors).
+
+        A vertical component is multiplied by ``|factor|``: mirroring the horizontal direction
+        does not turn the vertical upside down.
+        """
+        factor = float(factor)
+        if not math.isfinite(factor):
+            raise ValueError(f"factor must be a finite number, got {factor!r}")
+        vertical = None if self.vertical is None else self.vertical * abs(factor)
+        return Record(
+            self.acceleration * factor, time=self._times, name=self.name, vertical=vertical
+        )
+
+    def scaled_to(self, value: float, im: str = "pga", period=None, damping: float = 0.05):
+        """The record scaled so that its intensity measure ``im`` equals ``value``.
+
+        Parameters
+        ----------
+        value : float
+            Target, > 0, in the units of ``im`` (see :data:`rockstudy.motions.intensity.UNITS`).
+        im : str
+            A measure that scales with the record: ``pga``, ``pgv``, ``pgd``, ``cav``,
+            ``spectrum_intensity``, ``sa``, ``psv``, ``sd`` (linearly) or ``arias``
+            (quadratically).
+        period, damping
+            For the spectral measures: T [s] and zeta.
+        """
+        if im in ("significant_duration", "mean_period"):
+            raise ValueError(f"im={im!r} does not change with a scale factor; cannot scale to it")
+        value = _validate.positive("value", value)
+        current = self.intensity_measure(im, period=period, damping=damping)
+        if not (math.isfinite(current) and current > 0.0):
+            raise ValueError(
+                f"im={im!r}: the record {self.name!r} has {im} = {current!r}, "
+                f"so no scale factor reaches {value!r}"
+            )
+        ratio = value / current
+        return self.scaled(math.sqrt(ratio) if im == "arias" else ratio)
+
+    def _cached(self, key, compute):
+        if key not in self._cache:
+            self._cache[key] = compute()
+        return self._cache[key]
+
+    def _scalar_measures(self, damping: float) -> dict:
+        t, a = self._times, self.acceleration
+
+        def compute():
+            v = self._cached("velocity", lambda: intensity.ground_velocity(t, a))
+            d = self._cached("displacement", lambda: intensity.ground_displacement(t, a))
+            return {
+                "pga": self.peak,
+                "pgv": float(np.max(np.abs(v))),
+                "pgd": float(np.max(np.abs(d))),
+                "arias": intensity.arias_intensity(t, a),
+                "cav": intensity.cumulative_absolute_velocity(t, a),
+                "significant_duration": intensity.significant_duration(t, a),
+                "mean_period": intensity.mean_period(t, a),
+                "spectrum_intensity": intensity.spectrum_intensity(t, a, damping),
+            }
+
+        return self._cached(("scalars", damping), compute)
+
+    def _spectral_displacement(self, periods, damping: float) -> np.ndarray:
+        periods = intensity.check_periods(periods)
+        damping = intensity.check_damping(damping)
+        key = ("sd", periods.tobytes(), damping)
+        return self._cached(
+            key,
+            lambda: intensity.spectral_displacement(
+                self._times, self.acceleration, periods, damping
+            ),
+        )
+
+    def intensity_measures(self, periods=(), damping: float = 0.05) -> dict:
+        """The intensity measures of the (horizontal) record, with units.
+
+        Parameters
+        ----------
+        periods : array_like
+            Periods T [s] of the pseudo-spectral accelerations ``sa`` (may be empty).
+        damping : float
+            Damping ratio zeta in [0, 1) of ``sa`` and ``spectrum_intensity``.
+
+        Returns
+        -------
+        dict
+            ``pga`` [m/s^2], ``pgv`` [m/s], ``pgd`` [m], ``arias`` [m/s], ``cav`` [m/s],
+            ``significant_duration`` [s] (5-95 %), ``mean_period`` [s] (Rathje et al. 2004),
+            ``spectrum_intensity`` [m] (Housner 1952) and ``sa`` [m/s^2], an array over
+            ``periods``. See :mod:`rockstudy.motions.intensity` for definitions and the
+            baseline correction of velocity and displacement.
+        """
+        periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
+        damping = intensity.check_damping(damping)
+        out = dict(self._scalar_measures(damping))
+        w = 2.0 * np.pi / periods
+        out["sa"] = w * w * self._spectral_displacement(periods, damping) if periods.size else w
+        return out
+
+    def intensity_measure(self, im: str, period=None, damping: float = 0.05) -> float:
+        """One intensity measure by name (see :meth:`intensity_measures`; also ``psv``, ``sd``).
+
+        ``period`` [s] is required by ``sa``, ``psv`` and ``sd`` and refused by the others.
+        """
+        if im not in intensity.UNITS:
+            raise ValueError(f"im must be one of {sorted(intensity.UNITS)}, got {im!r}")
+        if im not in intensity.SPECTRAL:
+            if period is not None:
+                raise ValueError(f"period is only for {intensity.SPECTRAL}, not im={im!r}")
+            return self._scalar_measures(intensity.check_damping(damping))[im]
+        if period is None:
+            raise ValueError(f"im={im!r} needs a period [s]")
+        period = float(intensity.check_periods(period)[0])
+        sd = float(self._spectral_displacement([period], damping)[0])
+        return sd * (2.0 * np.pi / period) ** {"sd": 0, "psv": 1, "sa": 2}[im]
+
+    def response_spectrum(self, periods, damping: float = 0.05):
+        """Elastic response spectrum (Nigam & Jennings 1969) as an :class:`xarray.Dataset`.
+
+        ``sa`` [m/s^2] (pseudo-acceleration), ``psv`` [m/s] (pseudo-velocity) and ``sd`` [m]
+        on ``period`` [s]; the damping is in the attributes.
+        """
+        periods = intensity.check_periods(periods)
+        sd = self._spectral_displacement(periods, damping)
+        return intensity.response_spectrum_dataset(periods, sd, intensity.check_damping(damping))
+
+    def pulse(self) -> VelocityPulse:
+        """The dominant velocity pulse (Mavroeidis-Papageorgiou fit, Baker's indicator).
+
+        See :mod:`rockstudy.motions.pulse_extraction`.
+        """
+        return self._cached("pulse", lambda: extract_pulse(self._times, self.acceleration))
+
+    def _with_vertical(self, vertical: Record, path) -> Record:
+        """This record with the vertical component ``vertical`` read from ``path``."""
+        n, m = self.acceleration.size, vertical.acceleration.size
+        if n != m or not np.allclose(vertical._times, self._times, rtol=1e-9, atol=1e-12):
+            raise ValueError(
+                f"vertical: {path} has {m} samples at dt={vertical.dt!r} s but the horizontal "
+                f"record {self.name!r} has {n} at dt={self.dt!r} s; an H/V pair must share "
+                "its samples"
+            )
+        return Record(
+            self.acceleration, time=self._times, name=self.name, vertical=vertical.acceleration
+        )
 
     def kernel_spec(self):
         params = np.array([1.0, 0.0, 0.0, self.duration])
         return _kernels.KIND_RECORD, params, self._times, self.acceleration
 
     @classmethod
-    def from_at2(cls, path) -> Record:
+    def from_at2(cls, path, vertical=None) -> Record:
         """Read a PEER NGA ``.AT2`` file (acceleration in g), returned in m/s^2.
 
         Both header styles are read: ``NPTS= 2048, DT= .0066 SEC`` (with or without filter
-        information after it) and the older ``2048 0.0066 NPTS, DT``.
+        information after it) and the older ``2048 0.0066 NPTS, DT``. ``vertical`` is the path
+        of the vertical component's ``.AT2`` file, on the same samples.
         """
         path = Path(path)
         lines = path.read_text().splitlines()
@@ -116,10 +285,15 @@ class Record(Motion):
             raise ValueError(f"{path}: header says NPTS={npts} but {values.size} values follow")
         if "UNITS OF G" not in lines[2].upper():
             raise ValueError(f"{path}: line 3 must state 'UNITS OF G', got {lines[2].strip()!r}")
-        return cls(values * G, dt=dt, name=path.stem)
+        record = cls(values * G, dt=dt, name=path.stem)
+        return (
+            record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
+        )
 
     @classmethod
-    def from_csv(cls, path, units: str = "g", delimiter: str | None = None) -> Record:
+    def from_csv(
+        cls, path, units: str = "g", delimiter: str | None = None, vertical=None
+    ) -> Record:
         """Read a two-column text file of time [s] and acceleration in ``units``.
 
         Lines starting with ``#`` are skipped; columns may be separated by commas or blanks.
@@ -131,6 +305,8 @@ class Record(Motion):
             Units of the acceleration column.
         delimiter : str, optional
             Column separator; by default commas or white space.
+        vertical : path-like, optional
+            A file of the same format and samples holding the vertical component.
         """
         factor = _unit_factor(units)
         path = Path(path)
@@ -142,4 +318,7 @@ class Record(Motion):
             raise ValueError(
                 f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}"
             )
-        return cls(data[:, 1] * factor, time=data[:, 0], name=path.stem)
+        record = cls(data[:, 1] * factor, time=data[:, 0], name=path.stem)
+        if vertical is None:
+            return record
+        return record._with_vertical(cls.from_csv(vertical, units, delimiter), vertical)

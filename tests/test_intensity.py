@@ -1,0 +1,310 @@
+"""Intensity measures of records against independent oracles: scipy.signal.lsim (exact for a
+linearly interpolated input), closed forms for constant and harmonic inputs, and trapezoidal
+integrals (scipy.integrate)."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate, optimize, signal
+
+import rockstudy as rs
+from rockstudy.constants import G
+from rockstudy.motions import Record, SinePulse
+from rockstudy.motions.intensity import UNITS
+
+KEYS = {
+    "pga",
+    "pgv",
+    "pgd",
+    "arias",
+    "cav",
+    "significant_duration",
+    "mean_period",
+    "spectrum_intensity",
+    "sa",
+}
+
+
+def _random_record(n=1500, dt=0.01, seed=3):
+    rng = np.random.default_rng(seed)
+    return Record(rng.standard_normal(n), dt=dt, name="noise")
+
+
+def _oscillator(period, zeta):
+    w = 2 * math.pi / period
+    return signal.StateSpace([[0, 1], [-w * w, -2 * zeta * w]], [[0], [1]], [[1, 0]], [[0]])
+
+
+def _lsim_peak(record, period, zeta, refine):
+    """Peak |u| by lsim on a grid refined ``refine`` times (the input is linear on it), then
+    the free vibration after the record (zero input), also by lsim."""
+    t = record.time
+    tf = np.linspace(t[0], t[-1], (t.size - 1) * refine + 1)
+    sys = _oscillator(period, zeta)
+    _, y, x = signal.lsim(sys, -np.interp(tf, t, record.acceleration), tf)
+    tail = np.linspace(0.0, 1.5 * period, 3000 * refine // 10 + 1)
+    _, y2, _ = signal.lsim(sys, np.zeros(tail.size), tail, X0=x[-1])
+    sample_peak = float(np.max(np.abs(y[::refine])))
+    return max(np.max(np.abs(y)), np.max(np.abs(y2))), sample_peak
+
+
+@pytest.mark.parametrize("zeta", [0.0, 0.05, 0.2])
+@pytest.mark.parametrize(
+    "period, refine, rtol", [(0.05, 100, 2e-4), (0.3, 40, 1e-5), (1.0, 40, 1e-5), (4.0, 20, 1e-5)]
+)
+def test_spectral_displacement_matches_lsim(zeta, period, refine, rtol):
+    rec = _random_record(n=600)
+    sd = rec.response_spectrum([period], damping=zeta)["sd"].values[0]
+    ref, at_samples = _lsim_peak(rec, period, zeta, refine)
+    assert sd == pytest.approx(ref, rel=rtol)
+    assert sd >= at_samples * (1 - 1e-9)  # peaks between samples are not lost
+
+
+@pytest.mark.parametrize("zeta", [0.0, 0.05, 0.1])
+def test_constant_input_closed_form(zeta):
+    """A step a0 from rest: SD = a0 / omega^2 (1 + exp(-zeta pi / sqrt(1 - zeta^2)))."""
+    a0, period = 2.0, 1.0
+    rec = Record(np.full(6001, a0), dt=0.01)
+    w = 2 * math.pi / period
+    overshoot = math.exp(-zeta * math.pi / math.sqrt(1 - zeta * zeta))
+    sd = rec.response_spectrum([period], damping=zeta)["sd"].values[0]
+    assert sd == pytest.approx(a0 / w**2 * (1 + overshoot), rel=1e-9)
+
+
+def test_harmonic_input_closed_form():
+    """u'' + w^2 u = -A sin(W t) from rest: u = -A / (w^2 - W^2) (sin W t - W / w sin w t),
+    then free vibration of amplitude sqrt(u^2 + (v / w)^2) after the record."""
+    A, Tg, period = 3.0, 0.7, 1.1
+    W, w = 2 * math.pi / Tg, 2 * math.pi / period
+    dt = Tg / 2000
+    t = dt * np.arange(5 * 2000 + 1)  # five whole cycles
+    rec = Record(A * np.sin(W * t), dt=dt)
+    tt = np.linspace(0, t[-1], 2_000_001)
+    c = -A / (w * w - W * W)
+    u = c * (np.sin(W * tt) - W / w * np.sin(w * tt))
+    v_end = c * (W * math.cos(W * t[-1]) - W * math.cos(w * t[-1]))
+    expected = max(np.max(np.abs(u)), math.hypot(u[-1], v_end / w))
+    sd = rec.response_spectrum([period], damping=0.0)["sd"].values[0]
+    assert sd == pytest.approx(expected, rel=1e-5)
+
+
+def test_spectrum_dataset_and_pseudo_relations():
+    rec = _random_record()
+    periods = [0.1, 0.5, 2.0]
+    ds = rec.response_spectrum(periods, damping=0.05)
+    assert set(ds.data_vars) == {"sa", "psv", "sd"}
+    assert list(ds["period"].values) == periods
+    assert ds["sa"].attrs["units"] == "m/s^2" and ds["psv"].attrs["units"] == "m/s"
+    assert ds["sd"].attrs["units"] == "m" and ds["period"].attrs["units"] == "s"
+    w = 2 * np.pi / np.array(periods)
+    np.testing.assert_allclose(ds["sa"].values, w**2 * ds["sd"].values, rtol=1e-14)
+    np.testing.assert_allclose(ds["psv"].values, w * ds["sd"].values, rtol=1e-14)
+
+
+def test_short_period_sa_tends_to_pga():
+    """A rigid oscillator follows the ground: Sa(T -> 0) -> PGA (up to its lag 2 zeta a'/omega)."""
+    rec = _random_record(dt=0.02)
+    sa = rec.intensity_measures(periods=[1e-4])["sa"][0]
+    assert sa == pytest.approx(rec.peak, rel=1e-3)
+
+
+def test_sine_record_velocity_displacement_cav_closed_forms():
+    """Whole cycles of A sin(W t): v = A/W (1 - cos W t), d = A/W (t - sin(W t)/W), so
+    PGV = 2 A / W, PGD = A t_end / W, CAV = 4 A / W per cycle, Arias = pi A^2 t_end / (4 g)."""
+    A, Tg, cycles = 2.0, 0.5, 6
+    W = 2 * math.pi / Tg
+    dt = Tg / 4000
+    t = dt * np.arange(cycles * 4000 + 1)
+    im = Record(A * np.sin(W * t), dt=dt).intensity_measures()
+    assert set(im) == KEYS
+    assert im["pgv"] == pytest.approx(2 * A / W, rel=1e-6)
+    assert im["pgd"] == pytest.approx(A * t[-1] / W, rel=1e-6)
+    assert im["cav"] == pytest.approx(cycles * 4 * A / W, rel=1e-6)
+    assert im["arias"] == pytest.approx(math.pi * A * A * t[-1] / (4 * G), rel=1e-6)
+    # Husid curve of sin^2: H(t) = (t/2 - sin(2 W t)/(4 W)) / (t_end / 2)
+    husid = lambda s, q: (s / 2 - math.sin(2 * W * s) / (4 * W)) / (t[-1] / 2) - q  # noqa: E731
+    d595 = optimize.brentq(husid, 0, t[-1], args=(0.95,)) - optimize.brentq(
+        husid, 0, t[-1], args=(0.05,)
+    )
+    assert im["significant_duration"] == pytest.approx(d595, rel=1e-4)
+
+
+def test_pgv_and_arias_against_trapezoidal_integrals():
+    rec = _random_record()
+    t, a = rec.time, rec.acceleration
+    # the stated baseline correction: remove the constant that brings v(t_end) to zero
+    c = integrate.trapezoid(a, t) / t[-1]
+    v = integrate.cumulative_trapezoid(a - c, t, initial=0.0)
+    im = rec.intensity_measures()
+    assert im["pgv"] == pytest.approx(np.max(np.abs(v)), rel=1e-12)
+    # Arias of the linearly interpolated record: trapezoid on a 40x finer grid (O(h^2))
+    tf = np.linspace(0, t[-1], (t.size - 1) * 40 + 1)
+    arias = math.pi / (2 * G) * integrate.trapezoid(np.interp(tf, t, a) ** 2, tf)
+    assert im["arias"] == pytest.approx(arias, rel=1e-3)
+    cav = integrate.trapezoid(np.abs(np.interp(tf, t, a)), tf)
+    assert im["cav"] == pytest.approx(cav, rel=1e-3)
+
+
+def test_cav_exact_through_a_sign_change():
+    """A ramp from 1 to -1 over h: integral of |a| = h / 2."""
+    assert Record([1.0, -1.0], dt=0.4).intensity_measures()["cav"] == pytest.approx(0.2, rel=1e-15)
+
+
+def test_mean_period_of_a_sine():
+    f0 = 2.0
+    dt = 0.005
+    t = dt * np.arange(int(60 / dt) + 1)
+    tm = Record(np.sin(2 * math.pi * f0 * t), dt=dt).intensity_measures()["mean_period"]
+    assert tm == pytest.approx(1 / f0, rel=0.02)
+
+
+def test_spectrum_intensity_of_a_step():
+    """A step a0: PSV(T) = a0 T / (2 pi) (1 + overshoot), linear in T, so Housner's integral over
+    0.1-2.5 s is a0 (1 + overshoot) (2.5^2 - 0.1^2) / (4 pi)."""
+    a0, zeta = 1.5, 0.05
+    overshoot = math.exp(-zeta * math.pi / math.sqrt(1 - zeta * zeta))
+    si = Record(np.full(12001, a0), dt=0.005).intensity_measures(damping=zeta)["spectrum_intensity"]
+    assert si == pytest.approx(a0 * (1 + overshoot) * (2.5**2 - 0.1**2) / (4 * math.pi), rel=1e-9)
+
+
+def test_sa_of_sampled_sine_pulse_matches_lsim_and_is_cached():
+    pulse = SinePulse(3.0, 0.8)
+    dt = 0.002
+    t = dt * np.arange(int(pulse.duration / dt) + 1)
+    rec = Record(pulse.ground_acceleration(t), dt=dt)
+    periods = np.array([0.3, 0.8, 2.0])
+    sa = rec.intensity_measures(periods=periods)["sa"]
+    ref = [_lsim_peak(rec, T, 0.05, 20)[0] * (2 * np.pi / T) ** 2 for T in periods]
+    np.testing.assert_allclose(sa, ref, rtol=1e-5)
+    sa[:] = 0.0  # the caller's copy: the cache is not touched
+    np.testing.assert_allclose(rec.intensity_measures(periods=periods)["sa"], ref, rtol=1e-5)
+    assert rec.intensity_measure("sa", period=0.8) == pytest.approx(ref[1], rel=1e-5)
+
+
+def test_empty_periods_and_units_table():
+    im = _random_record().intensity_measures()
+    assert im["sa"].shape == (0,)
+    assert KEYS <= set(UNITS)
+
+
+def test_non_uniform_record_equals_uniform_one():
+    """The same samples given by dt or by (non-uniform-looking) times give the same IMs."""
+    rec = _random_record(n=800)
+    jitter = Record(rec.acceleration, time=rec.time + 1e-13 * np.arange(800) % 3)
+    a, b = rec.intensity_measures([0.5]), jitter.intensity_measures([0.5])
+    for key in KEYS:
+        np.testing.assert_allclose(a[key], b[key], rtol=1e-9)
+
+
+def test_scaled_to_targets():
+    rec = _random_record()
+    assert rec.scaled_to(2.0, im="pga").peak == pytest.approx(2.0, rel=1e-14)
+    assert rec.scaled_to(0.3, im="pgv").intensity_measures()["pgv"] == pytest.approx(0.3)
+    assert rec.scaled_to(0.7, im="arias").intensity_measures()["arias"] == pytest.approx(0.7)
+    scaled = rec.scaled_to(4.0, im="sa", period=0.5)
+    assert scaled.intensity_measure("sa", period=0.5) == pytest.approx(4.0, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "call, field",
+    [
+        (lambda r: r.intensity_measure("pgx"), "im"),
+        (lambda r: r.scaled_to(1.0, im="spectral_velocity"), "im"),
+        (lambda r: r.intensity_measures(periods=[0.5, -1.0]), "periods"),
+        (lambda r: r.intensity_measures(periods=[0.0]), "periods"),
+        (lambda r: r.response_spectrum([1.0], damping=1.0), "damping"),
+        (lambda r: r.intensity_measure("sa"), "period"),
+        (lambda r: r.intensity_measure("pga", period=1.0), "period"),
+        (lambda r: r.scaled_to(-1.0), "value"),
+        (lambda r: r.scaled_to(1.0, im="mean_period"), "mean_period"),
+        (lambda r: r.scaled(float("nan")), "factor"),
+    ],
+)
+def test_bad_input_names_the_field(call, field):
+    with pytest.raises(ValueError, match=field):
+        call(_random_record(n=50))
+
+
+def test_scale_target_out_of_reach():
+    still = Record(np.zeros(100), dt=0.01, name="still")
+    with pytest.raises(ValueError, match="im='pga'.*'still'"):
+        still.scaled_to(3.0, im="pga")
+
+
+# --- vertical component (data model) --------------------------------------------------------
+
+
+def _write_at2(path, values, dt):
+    lines = [
+        "PEER NGA STRONG MOTION DATABASE RECORD",
+        "test",
+        "ACCELERATION TIME SERIES IN UNITS OF G",
+    ]
+    lines.append(f"NPTS=   {len(values)}, DT=   {dt:.4f} SEC")
+    lines += [" ".join(f"{x:.7E}" for x in values[i : i + 5]) for i in range(0, len(values), 5)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_vertical_on_same_samples_and_scaled_consistently():
+    rec = Record([0.0, 1.0, -2.0, 0.5], dt=0.01, vertical=[0.1, -0.2, 0.3, 0.0])
+    mirrored = rec.scaled(-2.0)
+    np.testing.assert_array_equal(mirrored.acceleration, [0.0, -2.0, 4.0, -1.0])
+    np.testing.assert_array_equal(mirrored.vertical, [0.2, -0.4, 0.6, 0.0])
+    np.testing.assert_array_equal(mirrored.time, rec.time)
+    assert Record([1.0, 2.0], dt=0.1).vertical is None
+    with pytest.raises(ValueError, match="vertical"):
+        Record([0.0, 1.0, 2.0], dt=0.01, vertical=[0.0, 1.0])
+    with pytest.raises(ValueError, match="vertical"):
+        Record([0.0, 1.0], dt=0.01, vertical=[0.0, float("nan")])
+
+
+def test_at2_pair(tmp_path):
+    h, v = tmp_path / "h.AT2", tmp_path / "v.AT2"
+    _write_at2(h, [0.1, 0.2, -0.1, 0.0, 0.05, 0.0], 0.01)
+    _write_at2(v, [0.0, 0.05, 0.02, -0.01, 0.0, 0.0], 0.01)
+    rec = Record.from_at2(h, vertical=v)
+    np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.02, -0.01, 0.0, 0.0]) * G)
+    short, coarse = tmp_path / "short.AT2", tmp_path / "coarse.AT2"
+    _write_at2(short, [0.0, 0.05, 0.02], 0.01)
+    _write_at2(coarse, [0.0, 0.05, 0.02, -0.01, 0.0, 0.0], 0.02)
+    for bad in (short, coarse):
+        with pytest.raises(ValueError, match=f"vertical.*{bad.name}"):
+            Record.from_at2(h, vertical=bad)
+
+
+def test_csv_pair(tmp_path):
+    h, v, bad = tmp_path / "h.csv", tmp_path / "v.csv", tmp_path / "bad.csv"
+    h.write_text("0,0.1\n0.01,0.2\n0.02,-0.1\n")
+    v.write_text("0 0.0\n0.01 0.05\n0.02 0.01\n")
+    bad.write_text("0 0.0\n0.02 0.05\n0.04 0.01\n")
+    rec = Record.from_csv(h, vertical=v)
+    np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.01]) * G)
+    with pytest.raises(ValueError, match="vertical.*bad.csv"):
+        Record.from_csv(h, vertical=bad)
+
+
+def test_solvers_refuse_a_vertical_component_for_now():
+    rec = Record(np.full(200, 3.0), dt=0.01, vertical=np.full(200, 1.0))
+    with pytest.raises(NotImplementedError, match="vertical"):
+        rs.simulate(rs.Block(1.0, 0.2), rec)
+    with pytest.raises(NotImplementedError, match="vertical"):
+        rs.simulate_batch(half_diagonal=1.0, slenderness=0.2, record=rec)
+
+
+# --- the shared real records ----------------------------------------------------------------
+
+
+def test_shared_records_plausible(records_dir):
+    """Physical checks on real records: Sa at a tiny period is the PGA, durations and mean
+    periods lie within the record and the usual 0.1-2 s range. Prints the measures."""
+    files = sorted(records_dir.glob("*.AT2"))
+    recs = [Record.from_at2(f) for f in files] + [Record.from_csv(records_dir / "elcentro_NS.dat")]
+    for rec in recs:
+        im = rec.intensity_measures(periods=[1e-3, 1.0])
+        print(rec.name, {k: np.round(v, 4) for k, v in im.items()})
+        assert im["sa"][0] == pytest.approx(im["pga"], rel=2e-3)  # lag 2 zeta a'/omega
+        assert 0 < im["significant_duration"] < rec.duration
+        assert 0.1 < im["mean_period"] < 2.0
+    elcentro = recs[-1]
+    assert elcentro.peak / G == pytest.approx(0.349, abs=0.001)  # README of the records
