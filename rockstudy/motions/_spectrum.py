@@ -16,11 +16,11 @@ from numba import njit, prange
 
 
 @njit(cache=True)
-def step_coefficients(omega, zeta, h, out):
+def step_coefficients(omega, zeta, h):
     """The 8 coefficients of one exact step of length h (Nigam & Jennings 1969, eq. 20).
 
     u1 = A u0 + B v0 + C f0 + D f1 and v1 = A' u0 + B' v0 + C' f0 + D' f1 for a force per
-    unit mass f that is linear from f0 to f1 over the step; out = (A, B, C, D, A', B', C', D').
+    unit mass f that is linear from f0 to f1 over the step; returns (A, B, C, D, A', B', C', D').
     """
     wd = omega * math.sqrt(1.0 - zeta * zeta)
     r = zeta / math.sqrt(1.0 - zeta * zeta)
@@ -28,22 +28,23 @@ def step_coefficients(omega, zeta, h, out):
     s = math.sin(wd * h)
     c = math.cos(wd * h)
     k = omega * omega
-    out[0] = e * (r * s + c)
-    out[1] = e * s / wd
-    out[2] = (
+    q0 = e * (r * s + c)
+    q1 = e * s / wd
+    q2 = (
         2.0 * zeta / (omega * h)
         + e
         * (((1.0 - 2.0 * zeta * zeta) / (wd * h) - r) * s - (1.0 + 2.0 * zeta / (omega * h)) * c)
     ) / k
-    out[3] = (
+    q3 = (
         1.0
         - 2.0 * zeta / (omega * h)
         + e * ((2.0 * zeta * zeta - 1.0) / (wd * h) * s + 2.0 * zeta / (omega * h) * c)
     ) / k
-    out[4] = -e * omega / math.sqrt(1.0 - zeta * zeta) * s
-    out[5] = e * (c - r * s)
-    out[6] = (-1.0 / h + e * ((omega / math.sqrt(1.0 - zeta * zeta) + r / h) * s + c / h)) / k
-    out[7] = (1.0 - e * (r * s + c)) / (k * h)
+    q4 = -e * omega / math.sqrt(1.0 - zeta * zeta) * s
+    q5 = e * (c - r * s)
+    q6 = (-1.0 / h + e * ((omega / math.sqrt(1.0 - zeta * zeta) + r / h) * s + c / h)) / k
+    q7 = (1.0 - e * (r * s + c)) / (k * h)
+    return q0, q1, q2, q3, q4, q5, q6, q7
 
 
 @njit(cache=True)
@@ -55,32 +56,40 @@ def _advance(q, u, v, f0, f1):
 
 
 @njit(cache=True)
-def _peak_inside(omega, zeta, h, u, v, f0, f1, v1, q):
-    """|u| at the velocity zero inside a step (Illinois regula falsi on v over the step)."""
-    lo, hi, v_lo, v_hi = 0.0, h, v, v1
-    side = 0
-    tau = 0.5 * h
-    for _ in range(40):
-        tau = (lo * v_hi - hi * v_lo) / (v_hi - v_lo)
-        if not lo < tau < hi:
-            tau = 0.5 * (lo + hi)
-        step_coefficients(omega, zeta, tau, q)
-        ut, vt = _advance(q, u, v, f0, f0 + (f1 - f0) * tau / h)
-        if vt == 0.0 or hi - lo < 1e-12 * h:
-            return abs(ut)
-        if (vt > 0.0) == (v_lo > 0.0):
-            lo, v_lo = tau, vt
-            if side == -1:
-                v_hi *= 0.5
-            side = -1
+def _peak_inside(omega, zeta, h, u, v, f0, f1, v1):
+    """|u| at the velocity zero inside a step: safeguarded Newton on the exact v(tau).
+
+    Starts from the zero of the linear interpolation of v; v' = f - 2 zeta omega v - omega^2 u.
+    """
+    lo, hi = 0.0, h
+    tau = h * v / (v - v1)
+    ut = u
+    for _ in range(30):
+        f = f0 + (f1 - f0) * tau / h
+        ut, vt = _advance(step_coefficients(omega, zeta, tau), u, v, f0, f)
+        if (vt > 0.0) == (v > 0.0):
+            lo = tau
         else:
-            hi, v_hi = tau, vt
-            if side == 1:
-                v_lo *= 0.5
-            side = 1
-        if abs(vt) <= 1e-13 * (abs(v) + abs(v1)):
-            return abs(ut)
+            hi = tau
+        slope = f - 2.0 * zeta * omega * vt - omega * omega * ut
+        new = tau - vt / slope if slope != 0.0 else -1.0
+        if not lo < new < hi:
+            new = 0.5 * (lo + hi)
+        if abs(new - tau) <= 1e-12 * h:
+            break
+        tau = new
     return abs(ut)
+
+
+@njit(cache=True)
+def _may_peak_inside(omega, h, u, v, v1, peak):
+    """Whether the extremum inside a step could exceed ``peak``: its parabolic estimate
+    u + v tau / 2 (tau the zero of the linear v), with the excess allowed to be 2x off, and
+    always when omega h > 1.5 (the estimate is then poor)."""
+    if omega * h > 1.5:
+        return True
+    excess = 0.5 * abs(v) * h * v / (v - v1)
+    return abs(u) + 2.0 * excess > peak
 
 
 @njit(cache=True)
@@ -100,25 +109,22 @@ def _free_vibration_peak(omega, zeta, u, v):
 @njit(cache=True)
 def peak_displacement(omega, zeta, steps, acc):
     """Peak |u| [m] of one oscillator (omega [rad/s], zeta) under the record acc [m/s^2]."""
-    q = np.empty(8)
-    qs = np.empty(8)
-    h_prev = -1.0
+    h = steps[0]
+    q = step_coefficients(omega, zeta, h)
     u = 0.0
     v = 0.0
     peak = 0.0
+    f1 = -acc[0]
     for i in range(steps.shape[0]):
-        h = steps[i]
-        if h != h_prev:
-            step_coefficients(omega, zeta, h, q)
-            h_prev = h
-        f0 = -acc[i]
+        if steps[i] != h:
+            h = steps[i]
+            q = step_coefficients(omega, zeta, h)
+        f0 = f1
         f1 = -acc[i + 1]
         u1, v1 = _advance(q, u, v, f0, f1)
-        m = max(abs(u), abs(u1))
-        if m > peak:
-            peak = m
-        if v * v1 < 0.0 and m >= 0.5 * peak:
-            peak = max(peak, _peak_inside(omega, zeta, h, u, v, f0, f1, v1, qs))
+        peak = max(peak, abs(u1))
+        if v * v1 < 0.0 and _may_peak_inside(omega, h, u, v, v1, peak):
+            peak = max(peak, _peak_inside(omega, zeta, h, u, v, f0, f1, v1))
         u, v = u1, v1
     return max(peak, _free_vibration_peak(omega, zeta, u, v))
 
