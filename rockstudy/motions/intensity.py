@@ -55,6 +55,18 @@ def _steps(t):
     return h
 
 
+def uniform_samples(t, values):
+    """(grid, values on it, dt): the record on a uniform grid of its median step [s].
+
+    The samples themselves where the record is uniform; else the linear interpolation.
+    """
+    dt = float(np.median(np.diff(t)))
+    grid = t[0] + dt * np.arange(int(math.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
+    if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=1e-9 * dt):
+        return grid, values, dt
+    return grid, np.interp(grid, t, values), dt
+
+
 def baseline_offset(t, acc) -> float:
     """c [m/s^2]: the constant acceleration whose removal brings v(t_end) back to zero."""
     v_end = float(np.sum(0.5 * np.diff(t) * (acc[1:] + acc[:-1])))
@@ -134,11 +146,7 @@ def mean_period(t, acc) -> float:
     most 0.05 Hz. A record with a non-uniform step is resampled at its median step first.
     NaN if the band holds no energy.
     """
-    dt = float(np.median(np.diff(t)))
-    grid = t[0] + dt * np.arange(int(math.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
-    a = acc if grid.size == t.size and np.allclose(grid, t, rtol=0, atol=1e-9 * dt) else None
-    if a is None:
-        a = np.interp(grid, t, acc)
+    _, a, dt = uniform_samples(t, acc)
     nfft = 1 << int(math.ceil(math.log2(max(a.size, 1.0 / (MEAN_PERIOD_DF * dt)))))
     c2 = np.abs(np.fft.rfft(a, nfft)) ** 2
     f = np.fft.rfftfreq(nfft, dt)

@@ -15,7 +15,14 @@ Method
 
    where E is the cumulative squared velocity. Baker calls a record pulse-like above 0.85 (and
    with an early, strong pulse). His coefficients were fitted to wavelet-extracted pulses; here
-   they are applied to the fitted M-P pulse.
+   they are applied to the fitted M-P pulse, whose five free parameters capture more of the
+   velocity than one wavelet: a record whose velocity is one long, clean oscillation (e.g.
+   unprocessed noise dominated by its lowest frequencies) scores high.
+
+Why a fit rather than Baker's wavelet transform: it needs no wavelet library (Baker uses the
+Daubechies db4 wavelet of PyWavelets, outside this project's dependencies), and the M-P
+parameters (T_p, A, gamma, nu, t_0) are the ones that the synthetic records
+(:func:`rockstudy.motions.synthetic_near_fault`) and the record groups use.
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import fft, optimize
 
-from .intensity import ground_velocity
+from .intensity import ground_velocity, uniform_samples
 from .mavroeidis import mp_pulse_velocity
 
 #: Grid of the scan: number of periods and the values of gamma.
@@ -89,12 +96,6 @@ def baker_indicator(pgv_ratio: float, energy_ratio: float) -> float:
     """Baker's (2007) pulse indicator, eq. (1): 1 / (1 + exp(-23.3 + 14.6 PGV_r + 20.5 E_r))."""
     z = -23.3 + 14.6 * pgv_ratio + 20.5 * energy_ratio
     return 1.0 / (1.0 + math.exp(min(z, 700.0)))
-
-
-def _uniform(t, v):
-    dt = float(np.median(np.diff(t)))
-    grid = t[0] + dt * np.arange(int(math.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
-    return grid, np.interp(grid, t, v), dt
 
 
 def _block_means(grid, v, q):
@@ -162,7 +163,7 @@ def extract_pulse(t, acc) -> VelocityPulse:
     energy = float(v @ v)
     if energy == 0.0:
         return VelocityPulse(math.nan, 0.0, 0.0, math.nan, math.nan, 0.0, math.nan, 1.0, 1.0)
-    grid, vg, dt = _uniform(t, v)
+    grid, vg, dt = uniform_samples(t, v)
     _, period, gamma, center, amplitude, phase = _scan(grid, vg, dt)
     amplitude, period, gamma, phase, center = _refine(
         t, v, np.array([amplitude, period, gamma, phase, center])
