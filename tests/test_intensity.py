@@ -61,6 +61,20 @@ def test_spectral_displacement_matches_lsim(zeta, period, refine, rtol):
     assert sd >= at_samples * (1 - 1e-9)  # peaks between samples are not lost
 
 
+@pytest.mark.parametrize("period", [0.05, 0.5, 3.0])
+def test_non_uniform_steps_match_lsim(period):
+    """Sample times on multiples of 1 ms with random steps of 2-7 ms: lsim on the uniform 1/20 ms
+    grid that holds every sample (the input is linear on it) is exact."""
+    rng = np.random.default_rng(11)
+    ticks = np.concatenate(([0], np.cumsum(rng.integers(2, 8, 700))))
+    acc = rng.standard_normal(ticks.size)
+    rec = Record(acc, time=1e-3 * ticks)
+    sd = rec.response_spectrum([period], damping=0.05)["sd"].values[0]
+    fine = Record(np.interp(np.arange(ticks[-1] + 1), ticks, acc), dt=1e-3)
+    ref, _ = _lsim_peak(fine, period, 0.05, 20)
+    assert sd == pytest.approx(ref, rel=5e-5)
+
+
 @pytest.mark.parametrize("zeta", [0.0, 0.05, 0.1])
 def test_constant_input_closed_form(zeta):
     """A step a0 from rest: SD = a0 / omega^2 (1 + exp(-zeta pi / sqrt(1 - zeta^2)))."""

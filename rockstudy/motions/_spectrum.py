@@ -82,17 +82,6 @@ def _peak_inside(omega, zeta, h, u, v, f0, f1, v1):
 
 
 @njit(cache=True)
-def _may_peak_inside(omega, h, u, v, v1, peak):
-    """Whether the extremum inside a step could exceed ``peak``: its parabolic estimate
-    u + v tau / 2 (tau the zero of the linear v), with the excess allowed to be 2x off, and
-    always when omega h > 1.5 (the estimate is then poor)."""
-    if omega * h > 1.5:
-        return True
-    excess = 0.5 * abs(v) * h * v / (v - v1)
-    return abs(u) + 2.0 * excess > peak
-
-
-@njit(cache=True)
 def _free_vibration_peak(omega, zeta, u, v):
     """Largest |u| of the damped free vibration from (u, v): at t = 0 or its first extremum."""
     wd = omega * math.sqrt(1.0 - zeta * zeta)
@@ -107,32 +96,79 @@ def _free_vibration_peak(omega, zeta, u, v):
 
 
 @njit(cache=True)
-def peak_displacement(omega, zeta, steps, acc):
-    """Peak |u| [m] of one oscillator (omega [rad/s], zeta) under the record acc [m/s^2]."""
+def _coefficient_table(omegas, zeta, h, q):
+    """q[k, j]: coefficient k of :func:`step_coefficients` for oscillator j."""
+    for j in range(omegas.shape[0]):
+        c = step_coefficients(omegas[j], zeta, h)
+        for k in range(8):
+            q[k, j] = c[k]
+
+
+@njit(cache=True)
+def _block_peaks(omegas, zeta, steps, acc):
+    """Peak |u| [m] of a block of oscillators under the record acc [m/s^2].
+
+    The samples run in the outer loop and the oscillators in the inner one, which the compiler
+    vectorizes (keep the inner loop free of divisions and branches). A step whose velocity
+    changes sign is refined (:func:`_peak_inside`) when |u| + |v| h could exceed the peak: twice
+    the parabolic estimate of the excess, v tau / 2 with tau <= h the zero of the linear v; and
+    always when omega h > 1.5, where that estimate is poor.
+    """
+    m = omegas.shape[0]
+    q = np.empty((8, m))
     h = steps[0]
-    q = step_coefficients(omega, zeta, h)
-    u = 0.0
-    v = 0.0
-    peak = 0.0
+    _coefficient_table(omegas, zeta, h, q)
+    u = np.zeros(m)
+    v = np.zeros(m)
+    u0 = np.zeros(m)
+    v0 = np.zeros(m)
+    peak = np.zeros(m)
+    flag = np.zeros(m, dtype=np.bool_)
+    q0, q1, q2, q3, q4, q5, q6, q7 = q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7]
     f1 = -acc[0]
     for i in range(steps.shape[0]):
         if steps[i] != h:
             h = steps[i]
-            q = step_coefficients(omega, zeta, h)
+            _coefficient_table(omegas, zeta, h, q)
         f0 = f1
         f1 = -acc[i + 1]
-        u1, v1 = _advance(q, u, v, f0, f1)
-        peak = max(peak, abs(u1))
-        if v * v1 < 0.0 and _may_peak_inside(omega, h, u, v, v1, peak):
-            peak = max(peak, _peak_inside(omega, zeta, h, u, v, f0, f1, v1))
-        u, v = u1, v1
-    return max(peak, _free_vibration_peak(omega, zeta, u, v))
+        refine = False
+        for j in range(m):
+            uj = u[j]
+            vj = v[j]
+            u1 = q0[j] * uj + q1[j] * vj + q2[j] * f0 + q3[j] * f1
+            v1 = q4[j] * uj + q5[j] * vj + q6[j] * f0 + q7[j] * f1
+            p = max(peak[j], abs(u1))
+            f = (vj * v1 < 0.0) & ((abs(uj) + abs(vj) * h > p) | (omegas[j] * h > 1.5))
+            flag[j] = f
+            refine |= f
+            peak[j] = p
+            u0[j] = uj
+            v0[j] = vj
+            u[j] = u1
+            v[j] = v1
+        if refine:
+            for j in range(m):
+                if flag[j]:
+                    inside = _peak_inside(omegas[j], zeta, h, u0[j], v0[j], f0, f1, v[j])
+                    peak[j] = max(peak[j], inside)
+    for j in range(m):
+        peak[j] = max(peak[j], _free_vibration_peak(omegas[j], zeta, u[j], v[j]))
+    return peak
+
+
+#: Oscillators per block of :func:`peak_displacements` (the unit of parallel work).
+BLOCK = 32
 
 
 @njit(cache=True, parallel=True)
 def peak_displacements(omegas, zeta, steps, acc):
-    """:func:`peak_displacement` for many oscillators (parallel over omegas)."""
-    out = np.empty(omegas.shape[0])
-    for j in prange(omegas.shape[0]):
-        out[j] = peak_displacement(omegas[j], zeta, steps, acc)
+    """Peak |u| [m] of linear oscillators (omegas [rad/s], zeta) under acc [m/s^2] sampled at
+    the given steps [s], started at rest; blocks of oscillators run in parallel."""
+    n = omegas.shape[0]
+    out = np.empty(n)
+    for b in prange((n + BLOCK - 1) // BLOCK):
+        lo = b * BLOCK
+        hi = min(n, lo + BLOCK)
+        out[lo:hi] = _block_peaks(omegas[lo:hi], zeta, steps, acc)
     return out
