@@ -15,7 +15,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import xarray as xr
 from scipy.integrate import simpson
 
 from ..constants import G
@@ -187,7 +186,7 @@ def spectral_displacement(t, acc, periods, damping: float = 0.05):
     return _spectrum.peak_displacements(omegas, zeta, _steps(t), np.ascontiguousarray(acc))
 
 
-def response_spectrum(t, acc, periods, damping: float = 0.05) -> xr.Dataset:
+def response_spectrum(t, acc, periods, damping: float = 0.05):
     """Elastic response spectrum: ``sd`` [m], ``psv`` = omega SD [m/s], ``sa`` = omega^2 SD [m/s^2].
 
     Parameters
@@ -202,8 +201,13 @@ def response_spectrum(t, acc, periods, damping: float = 0.05) -> xr.Dataset:
     return response_spectrum_dataset(periods, sd, check_damping(damping))
 
 
-def response_spectrum_dataset(periods, sd, damping: float) -> xr.Dataset:
-    """The Dataset of :func:`response_spectrum` from SD [m] at ``periods`` [s]."""
+def response_spectrum_dataset(periods, sd, damping: float):
+    """The :class:`xarray.Dataset` of :func:`response_spectrum` from SD [m] at ``periods`` [s].
+
+    xarray is imported here, so that importing rockstudy does not pay for it.
+    """
+    import xarray as xr
+
     w = 2.0 * math.pi / periods
     coords = {"period": ("period", periods, {"units": "s"})}
     return xr.Dataset(

@@ -199,7 +199,9 @@ class Record(Motion):
             ``significant_duration`` [s] (5-95 %), ``mean_period`` [s] (Rathje et al. 2004),
             ``spectrum_intensity`` [m] (Housner 1952) and ``sa`` [m/s^2], an array over
             ``periods``. See :mod:`rockstudy.motions.intensity` for definitions and the
-            baseline correction of velocity and displacement.
+            baseline correction of velocity and displacement. PGD is only as good as the
+            record's processing: an unfiltered record drifts (elcentro_NS.dat of the shared
+            records gives 1.8 m, all of it the final offset).
         """
         periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
         damping = intensity.check_damping(damping)
