@@ -17,7 +17,8 @@ from numba import njit, prange
 
 @njit(cache=True)
 def step_coefficients(omega, zeta, h):
-    """The 8 coefficients of one exact step of length h (Nigam & Jennings 1969, eq. 20).
+    """The 8 coefficients of one exact step of length h (Nigam & Jennings 1969;
+    the coefficients as tabulated by Chopra, Dynamics of Structures, sec. 5.2).
 
     u1 = A u0 + B v0 + C f0 + D f1 and v1 = A' u0 + B' v0 + C' f0 + D' f1 for a force per
     unit mass f that is linear from f0 to f1 over the step; returns (A, B, C, D, A', B', C', D').

@@ -136,7 +136,7 @@ def significant_duration(t, acc, low: float = 0.05, high: float = 0.95) -> float
 
 
 def mean_period(t, acc) -> float:
-    """Mean period T_m [s] (Rathje et al. 1998, eq. 3; 2004).
+    """Mean period T_m [s] (Rathje et al. 1998; 2004).
 
     .. math::
         T_m = \\sum_i C_i^2 / f_i \\Big/ \\sum_i C_i^2, \\quad 0.25 \\le f_i \\le 20 \\text{ Hz}

@@ -4,7 +4,7 @@
     v(t) = \\frac{A}{2} \\left[1 + \\cos\\left(\\frac{2 \\pi f_p (t - t_0)}{\\gamma}\\right)\\right]
     \\cos\\left(2 \\pi f_p (t - t_0) + \\nu\\right), \\quad |t - t_0| \\le \\frac{\\gamma}{2 f_p}
 
-and zero elsewhere (eq. 5 of Mavroeidis & Papageorgiou 2003, BSSA 93(3)), with f_p = 1 / T_p.
+and zero elsewhere (Mavroeidis & Papageorgiou 2003, BSSA 93(3)), with f_p = 1 / T_p.
 The acceleration is its exact derivative.
 """
 

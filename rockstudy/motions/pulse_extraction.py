@@ -9,7 +9,7 @@ Method
    The scan keeps the (T_p, gamma, t_0) that explains the most velocity energy.
 2. Refine: :func:`scipy.optimize.least_squares` on all five parameters from the best scan
    points.
-3. Indicator (Baker 2007, eq. 1): with the residual velocity r = v - v_pulse,
+3. Indicator (Baker 2007, his logistic predictor): with the residual velocity r = v - v_pulse,
 
    .. math:: PI = 1 / \\left(1 + e^{-23.3 + 14.6 \\, PGV_r / PGV + 20.5 \\, E_r / E}\\right)
 
@@ -93,7 +93,7 @@ class VelocityPulse:
 
 
 def baker_indicator(pgv_ratio: float, energy_ratio: float) -> float:
-    """Baker's (2007) pulse indicator, eq. (1): 1 / (1 + exp(-23.3 + 14.6 PGV_r + 20.5 E_r))."""
+    """Baker's (2007) pulse indicator: 1 / (1 + exp(-23.3 + 14.6 PGV_r + 20.5 E_r))."""
     z = -23.3 + 14.6 * pgv_ratio + 20.5 * energy_ratio
     return 1.0 / (1.0 + math.exp(min(z, 700.0)))
 

@@ -43,7 +43,7 @@ def synthetic_near_fault(
 ) -> Record:
     """A near-fault record: Mavroeidis-Papageorgiou (2003) pulse + high-passed stochastic motion.
 
-    The pulse (eq. 5 of M-P 2003, centred at 0.35 of the duration) carries the velocity; the
+    The pulse (M-P 2003, centred at 0.35 of the duration) carries the velocity; the
     stochastic part (Kanai-Tajimi noise under a Jennings envelope, reused from
     :func:`stochastic_record`, high-passed by a 4th-order Butterworth filter at 2 / T_p so that
     it stays out of the pulse's band) carries the high-frequency acceleration. Its peak is
