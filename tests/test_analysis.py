@@ -212,6 +212,23 @@ def test_fragility_flags_a_median_outside_the_data():
     assert inside.loc["all"].theta_in_range and inside.loc["all"].band_in_range
 
 
+def test_fragility_keeps_groups_whose_outcome_never_changes():
+    """A block size that never overturns (or always does) has no curve to fit, but it is an
+    answer: its median is not reached (inf) or lies below the sampled range (0)."""
+    ds = _fragility_data(1.0, 0.3, (0.5, 2.0), n=600)
+    n = ds.sizes["sample"]
+    size = np.repeat([1.0, 2.0, 3.0], n // 3)
+    over = ds.overturned.values.copy()
+    over[size == 2.0], over[size == 3.0] = 0, 1
+    ds = ds.assign(size=("sample", size), overturned=("sample", over))
+    t = analysis.fragility(ds, "pga_ratio", by="size", n_boot=20)
+    assert list(t.index) == [1.0, 2.0, 3.0]
+    assert t.loc[2.0, "theta"] == np.inf and t.loc[2.0, "theta_hi"] == np.inf
+    assert t.loc[3.0, "theta"] == 0.0 and np.isnan(t.loc[3.0, "beta"])
+    assert not t.loc[[2.0, 3.0], "theta_in_range"].any()
+    assert (t["n"] == n // 3).all()
+
+
 def test_first_order_given_data_finds_the_driver():
     rng = np.random.default_rng(2)
     x = rng.random((4000, 3))

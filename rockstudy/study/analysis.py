@@ -202,7 +202,9 @@ def fragility(
         within the observed intensities) and ``band_in_range`` (so does its whole bootstrap
         band). A median outside the data is an extrapolation of the lognormal shape, not a
         measurement: read it as "not reached within the sampled range" (or "below it").
-        Groups with fewer than 10 samples, or whose outcome never changes, are left out.
+        A group whose outcome never changes has no fit: its ``theta`` and band are ``inf``
+        (the outcome never happened: not reached) or ``0`` (it always happened: below the
+        sampled range), its ``beta`` NaN. Groups with fewer than 10 samples are left out.
     """
     y, bad = _values(ds, outcome, failed)
     im = np.asarray(ds[intensity].values, float)
@@ -222,21 +224,25 @@ def fragility(
     lo_q, hi_q = 50 * (1 - conf_level), 50 * (1 + conf_level)
     for name, sel in groups.items():
         x, z = im[sel], y[sel]
-        if z.size < 10 or z.min() == z.max():
+        if z.size < 10:
             continue
-        theta, beta = _fit_lognormal(x, z)
-        start = np.log([theta, beta])
-        boot = np.array(
-            [
-                _fit_lognormal(x[k], z[k], start)
-                for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
-            ]
-        )
-        # percentiles at bootstrap samples (no interpolation: an infinite median stays inf)
-        (theta_lo, beta_lo), (theta_hi, beta_hi) = np.percentile(
-            boot, [lo_q, hi_q], axis=0, method="inverted_cdf"
-        )
         im_min, im_max = float(x.min()), float(x.max())
+        if z.min() == z.max():  # no fit: the median lies beyond the data, on one side
+            theta = theta_lo = theta_hi = np.inf if z.max() == 0 else 0.0
+            beta = beta_lo = beta_hi = np.nan
+        else:
+            theta, beta = _fit_lognormal(x, z)
+            start = np.log([theta, beta])
+            boot = np.array(
+                [
+                    _fit_lognormal(x[k], z[k], start)
+                    for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
+                ]
+            )
+            # percentiles at bootstrap samples (no interpolation: an infinite median stays inf)
+            (theta_lo, beta_lo), (theta_hi, beta_hi) = np.percentile(
+                boot, [lo_q, hi_q], axis=0, method="inverted_cdf"
+            )
         rows.append(
             {
                 by or "group": name,
@@ -255,8 +261,8 @@ def fragility(
         )
     if not rows:
         raise ValueError(
-            f"no group of {intensity!r} has 10 samples with both outcomes of {outcome!r}: "
-            "a fragility curve cannot be fitted"
+            f"no group has 10 samples with a finite, positive {intensity!r}: "
+            "no fragility curve can be fitted"
         )
     return pd.DataFrame(rows).set_index(by or "group")
 
@@ -264,7 +270,8 @@ def fragility(
 def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:
     """Evaluate fitted fragility curves (and their theta bands) at intensities ``im``."""
     im = np.asarray(im, float)
-    with np.errstate(divide="ignore"):  # an infinite band limit (not reached): P = 0 there
+    # an infinite band limit (not reached) gives P = 0; a group without a fit (beta NaN), NaN
+    with np.errstate(divide="ignore", invalid="ignore"):
         p = {
             k: np.array(
                 [stats.norm.cdf(np.log(im / r[t]) / r["beta"]) for _, r in table.iterrows()]
