@@ -28,6 +28,24 @@ frequency_ratio = 1.0
 """
 
 
+SOBOL_PULSE = """
+name = "sobol_pulse_design"
+seed = 5
+[sampler]
+kind = "sobol"
+n = 256
+[structure]
+kind = "block"
+half_diagonal = { dist = "loguniform", low = 0.3, high = 5.0 }
+slenderness = { dist = "uniform", low = 0.05, high = 0.35 }
+restitution = { dist = "uniform", low = 0.75, high = 0.95 }
+[motion]
+kind = "pulse"
+amplitude_ratio = { dist = "uniform", low = 1.0, high = 4.0 }
+period = { dist = "loguniform", low = 0.1, high = 2.0 }
+"""
+
+
 def ishigami_cube(n=2**13):
     """The Ishigami function on the study pipeline's own design: make_design draws the
     scrambled Sobol' points in the Saltelli layout and maps them through the three uniform
@@ -146,6 +164,16 @@ def test_collapse_metric_refuses_a_design_without_replicated_group_points():
     )
     with pytest.raises(ValueError, match="unexplained_share"):
         analysis.collapse_metric(ds, "dimensional", ["g1", "g2"])
+
+
+def test_collapse_metric_refuses_the_saltelli_coincidences():
+    """In a Saltelli design of a pulse study, the rows that differ from their base row only in
+    alpha share its (6.1) groups (g tan alpha / a_g, omega, eta): 2 of every 7 samples. Those
+    pairs made the block size R itself look perfectly self-similar (metric 0.0)."""
+    study = validate_text(SOBOL_PULSE)
+    ds = make_design(study)
+    with pytest.raises(ValueError, match="replicated design"):
+        analysis.collapse_metric(ds, "half_diagonal", ["uplift_ratio", "omega", "restitution"])
 
 
 def test_collapse_metric_counts_replicated_points_only():

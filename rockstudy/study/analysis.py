@@ -298,9 +298,11 @@ def collapse_metric(
     Raises
     ------
     ValueError
-        If no group point is met twice (the design is not replicated: every sample would be a
-        set of its own and the metric a meaningless 0; use :func:`unexplained_share` on such
-        designs), or if the response has no variance over the replicated samples.
+        If fewer than half of the samples share their group point with another sample: the
+        design is not replicated (``[sampler] replicates = k`` draws the group points first),
+        and the few coincident points it has (e.g. the Saltelli rows that differ only in an
+        input outside the groups) do not stand for it. Use :func:`unexplained_share` on such
+        designs. Also if the response has no variance over the replicated samples.
     """
     y, bad = _values(ds, response, failed)
     keys = np.column_stack([np.round(np.asarray(ds[g].values, float), decimals) for g in groups])[
@@ -310,12 +312,12 @@ def collapse_metric(
     _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
     replicated = counts[inverse] > 1
-    if not replicated.any():
+    if not replicated.mean() >= 0.5:
         raise ValueError(
-            f"collapse_metric needs a replicated design: no point of the groups {list(groups)} "
-            f"is shared by two of the {y.size} samples, so the within-set variance is 0 by "
-            "construction. Draw the design with [sampler] replicates = k, or use "
-            "unexplained_share on designs without replicated group points"
+            f"collapse_metric needs a replicated design: only {int(replicated.sum())} of the "
+            f"{y.size} samples share their point of the groups {list(groups)} with another "
+            "sample (at least half must). Draw the design with [sampler] replicates = k, or "
+            "use unexplained_share on designs without replicated group points"
         )
     y, inverse = y[replicated], inverse[replicated]
     means = np.bincount(inverse, weights=y) / np.maximum(np.bincount(inverse), 1)

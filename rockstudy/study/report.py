@@ -267,7 +267,7 @@ def _similarity(page, ds, study):
         try:
             collapse = analysis.collapse_metric(sub, "law_response", groups)
         except ValueError:  # too few survivors share a group point in this subset
-            collapse = "no replicated group point"
+            collapse = "not replicated (too few survivors share a group point)"
         row = {"collapse metric (design groups)": collapse}
         for law, resp, law_groups in (
             (
