@@ -291,9 +291,9 @@ def _similarity(page, ds, study):
         "collapse",
         "Share of the variance of the survivors' response within group points "
         f"({', '.join(groups)}), and left unexplained by a smooth fit over each law's "
-        "groups, next to that fit's floor (the share it leaves for a smooth response of the "
-        "groups alone on the same samples: values near the floor cannot be told from complete "
-        "similarity with this many samples)",
+        "groups, next to that fit's floor (the share it leaves for a smooth, cubic response of "
+        "the groups alone on the same samples; a lower estimate: values within a few times "
+        "the floor cannot be told from complete similarity with this many samples)",
     )
     if study.run.method == "linear" and study.motion.amplitude_a is not None:
         _eta_law(page, surv)
