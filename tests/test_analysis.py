@@ -1,4 +1,5 @@
-"""Analyses of cubes: Sobol' (SALib's Ishigami through our code), fragility, collapse."""
+"""Analyses of cubes: Sobol' (SALib's analytic Ishigami indices through the study's own
+design and analysis), fragility, collapse."""
 
 import math
 
@@ -7,20 +8,64 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from rockstudy.study import analysis
+from rockstudy.study import analysis, make_design, validate_text
+
+ISHIGAMI = """
+name = "ishigami"
+seed = 3
+[sampler]
+kind = "sobol"
+n = {n}
+[structure]
+kind = "equivalent_block"
+frequency_parameter = {{ dist = "uniform", low = 1.0, high = 3.0 }}
+critical_rotation = {{ dist = "uniform", low = 0.1, high = 0.2 }}
+restitution = {{ dist = "uniform", low = 0.5, high = 0.9 }}
+[motion]
+kind = "pulse"
+amplitude_ratio = 2.0
+frequency_ratio = 1.0
+"""
 
 
-def ishigami_cube(n=2**13, seed=3):
-    from SALib.sample import sobol as sobol_sample
+SOBOL_PULSE = """
+name = "sobol_pulse_design"
+seed = 5
+[sampler]
+kind = "sobol"
+n = 256
+[structure]
+kind = "block"
+half_diagonal = { dist = "loguniform", low = 0.3, high = 5.0 }
+slenderness = { dist = "uniform", low = 0.05, high = 0.35 }
+restitution = { dist = "uniform", low = 0.75, high = 0.95 }
+[motion]
+kind = "pulse"
+amplitude_ratio = { dist = "uniform", low = 1.0, high = 4.0 }
+period = { dist = "loguniform", low = 0.1, high = 2.0 }
+"""
+
+
+def ishigami_cube(n=2**13):
+    """The Ishigami function on the study pipeline's own design: make_design draws the
+    scrambled Sobol' points in the Saltelli layout and maps them through the three uniform
+    distributions; each input is mapped back linearly onto [-pi, pi]."""
     from SALib.test_functions import Ishigami
 
-    problem = {"num_vars": 3, "names": ["x1", "x2", "x3"], "bounds": [[-math.pi, math.pi]] * 3}
-    x = sobol_sample.sample(problem, n, calc_second_order=False, seed=seed)
-    y = Ishigami.evaluate(x)
-    ds = xr.Dataset({"y": ("sample", y), "status": ("sample", np.ones(y.size, np.int8))})
-    for j, name in enumerate(problem["names"]):
-        ds[name] = ("sample", x[:, j])
-    return ds
+    study = validate_text(ISHIGAMI.format(n=n))
+    ds = make_design(study)
+    names = list(study.parameters())
+    x = np.column_stack(
+        [
+            -math.pi + 2 * math.pi * (ds[name].values - dist.low) / (dist.high - dist.low)
+            for name, dist in study.parameters().items()
+        ]
+    )
+    assert x.min() >= -math.pi and x.max() <= math.pi
+    ds["y"] = ("sample", Ishigami.evaluate(x))
+    ds["status"] = ("sample", np.ones(ds.sizes["sample"], np.int8))
+    ds.attrs["study"] = study.normalized()
+    return ds, names
 
 
 def ishigami_analytic(a=7.0, b=0.1):
@@ -31,34 +76,30 @@ def ishigami_analytic(a=7.0, b=0.1):
     return np.array([v1, v2, 0.0]) / v, np.array([v1 + v13, v2, v13]) / v
 
 
-def test_ishigami_indices_through_our_analysis():
-    ds = ishigami_cube()
-    table = analysis.sobol_indices(
-        ds, "y", names=["x1", "x2", "x3"], second_order=False, num_resamples=200
-    )
+def test_ishigami_indices_through_the_study_pipeline():
+    ds, names = ishigami_cube()
+    assert ds.sizes["sample"] == 2**13 * (len(names) + 2)  # Saltelli, first order
+    table = analysis.sobol_indices(ds, "y", num_resamples=200)  # names from the study
+    assert list(table.index) == names
     s1, st = ishigami_analytic()
     # within SALib's own confidence intervals (and a small absolute floor)
     assert np.all(np.abs(table["S1"] - s1) <= np.maximum(2 * table["S1_conf"], 0.02))
     assert np.all(np.abs(table["ST"] - st) <= np.maximum(2 * table["ST_conf"], 0.02))
-    conv = analysis.sobol_convergence(
-        ds, "y", names=["x1", "x2", "x3"], second_order=False, num_resamples=50
-    )
+    conv = analysis.sobol_convergence(ds, "y", num_resamples=50)
     ns = conv.index.get_level_values("N").unique()
     assert list(ns) == [2**k for k in range(4, 14)]
-    err = [abs(conv.loc[(n, "x2"), "S1"] - s1[1]) for n in ns]
+    err = [abs(conv.loc[(n, names[1]), "S1"] - s1[1]) for n in ns]
     assert err[-1] < err[0]
 
 
 def test_failed_policy_for_sobol():
-    ds = ishigami_cube(n=2**10)
+    ds, names = ishigami_cube(n=2**10)
     status = ds.status.values.copy()
     status[7] = 2
     bad = ds.assign(status=("sample", status))
     with pytest.raises(ValueError, match="failed"):
-        analysis.sobol_indices(bad, "y", names=["x1", "x2", "x3"], second_order=False)
-    dropped = analysis.sobol_indices(
-        bad, "y", names=["x1", "x2", "x3"], second_order=False, failed="drop", num_resamples=20
-    )
+        analysis.sobol_indices(bad, "y")
+    dropped = analysis.sobol_indices(bad, "y", failed="drop", num_resamples=20)
     assert dropped.shape == (3, 4)
 
 
@@ -77,6 +118,7 @@ def test_fragility_recovers_known_parameters():
     assert row.theta == pytest.approx(theta, rel=0.05)
     assert row.beta == pytest.approx(beta, rel=0.1)
     assert row.theta_lo < theta < row.theta_hi
+    assert row.theta_in_range and row.band_in_range
     by = analysis.fragility(ds, "pga_ratio", by="size", n_boot=20)
     assert set(by.index) == {1.0, 2.0}
     curve = analysis.fragility_curve(table, [1.0, 2.5, 8.0])
@@ -104,9 +146,115 @@ def test_collapse_metric_zero_for_similar_one_for_noise():
     assert analysis.collapse_metric(ds, "similar", ["g1", "g2"]) < 1e-12
     assert analysis.collapse_metric(ds, "noise", ["g1", "g2"]) > 0.7
     assert 0.05 < analysis.collapse_metric(ds, "partly", ["g1", "g2"]) < 0.9
-    # the smooth-fit cross-check on an unreplicated design
-    assert analysis.unexplained_share(ds, "similar", ["g1", "g2"]) < 0.02
-    assert analysis.unexplained_share(ds, "noise", ["g1", "g2"]) > 0.9
+
+
+def test_collapse_metric_refuses_a_design_without_replicated_group_points():
+    """A Monte Carlo design (and the README's snippet on a sobol cube) has no two samples at
+    one group point: the within-set variance is 0 by construction, so the metric would read
+    'perfectly self-similar' for any response, even a dimensional one."""
+    rng = np.random.default_rng(5)
+    n = 2000
+    g1, g2, size = rng.uniform(1, 5, n), rng.uniform(0.2, 1, n), rng.uniform(0.5, 3, n)
+    ds = xr.Dataset(
+        {
+            "g1": ("sample", g1),
+            "g2": ("sample", g2),
+            "dimensional": ("sample", size * g1),  # depends on the size: not similar
+        }
+    )
+    with pytest.raises(ValueError, match="unexplained_share"):
+        analysis.collapse_metric(ds, "dimensional", ["g1", "g2"])
+
+
+def test_collapse_metric_refuses_the_saltelli_coincidences():
+    """In a Saltelli design of a pulse study, the rows that differ from their base row only in
+    alpha share its (6.1) groups (g tan alpha / a_g, omega, eta): 2 of every 7 samples. Those
+    pairs made the block size R itself look perfectly self-similar (metric 0.0)."""
+    study = validate_text(SOBOL_PULSE)
+    ds = make_design(study)
+    with pytest.raises(ValueError, match="replicated design"):
+        analysis.collapse_metric(ds, "half_diagonal", ["uplift_ratio", "omega", "restitution"])
+
+
+def test_collapse_metric_counts_replicated_points_only():
+    """K group points met twice with y = g -+ 1 (within-set SS 2K, total SS
+    2 sum (g - mean g)^2 + 2K), plus samples at group points of their own, whose wild values
+    must not dilute the share."""
+    K = 50
+    g = np.arange(K, dtype=float)
+    keys = np.concatenate([g, g, 1000.0 + np.arange(20)])
+    y = np.concatenate([g - 1, g + 1, np.full(20, 1e4)])
+    ds = xr.Dataset({"g": ("sample", keys), "y": ("sample", y)})
+    expected = 2 * K / (2 * np.sum((g - g.mean()) ** 2) + 2 * K)
+    assert analysis.collapse_metric(ds, "y", ["g"]) == pytest.approx(expected, rel=1e-12)
+    flat = ds.assign(y=("sample", np.ones(keys.size)))
+    with pytest.raises(ValueError, match="constant"):
+        analysis.collapse_metric(flat, "y", ["g"])
+
+
+def test_unexplained_share_states_its_floor():
+    """The floor is what the k-NN fit leaves for a response of the groups alone; an exactly
+    similar response sits near it, a noisy one far above it, and it falls with n."""
+    rng = np.random.default_rng(1)
+    floors = []
+    for n in (1000, 8000):
+        g1, g2 = rng.uniform(1, 5, n), rng.uniform(0.2, 1, n)
+        similar = np.tanh(2 * (g1 - 3)) * g2
+        ds = xr.Dataset(
+            {
+                "g1": ("sample", g1),
+                "g2": ("sample", g2),
+                "similar": ("sample", similar),
+                "noisy": ("sample", similar + 0.3 * rng.standard_normal(n)),
+                "noise": ("sample", rng.random(n)),
+            }
+        )
+        exact = analysis.unexplained_share(ds, "similar", ["g1", "g2"])
+        assert isinstance(exact, analysis.UnexplainedShare)
+        assert (exact.n, exact.k) == (n, 10)
+        assert 0 < exact.value < 3 * exact.floor and exact.floor < 3 * exact.value
+        noisy = analysis.unexplained_share(ds, "noisy", ["g1", "g2"])
+        assert noisy.value > 5 * noisy.floor
+        assert analysis.unexplained_share(ds, "noise", ["g1", "g2"]).value > 0.9
+        floors.append(exact.floor)
+    assert floors[1] < floors[0] / 2
+
+
+def _fragility_data(theta, beta, im_range, n=4000, seed=0):
+    rng = np.random.default_rng(seed)
+    im = np.exp(rng.uniform(*np.log(im_range), n))
+    p = 0.5 * (1 + np.vectorize(math.erf)(np.log(im / theta) / (beta * math.sqrt(2))))
+    over = (rng.random(im.size) < p).astype(np.int8)
+    return xr.Dataset({"pga_ratio": ("sample", im), "overturned": ("sample", over)})
+
+
+def test_fragility_flags_a_median_outside_the_data():
+    """Intensities sampled up to 2 while the true median capacity is 6: the data see only the
+    lower tail, and the fitted median is an extrapolation the table must mark."""
+    ds = _fragility_data(6.0, 0.5, (0.5, 2.0))
+    row = analysis.fragility(ds, "pga_ratio", n_boot=50).loc["all"]
+    assert row.im_min == pytest.approx(ds.pga_ratio.min()) and row.im_max <= 2.0
+    assert row.theta > row.im_max
+    assert not row.theta_in_range and not row.band_in_range
+    inside = analysis.fragility(_fragility_data(1.0, 0.3, (0.5, 2.0)), "pga_ratio", n_boot=50)
+    assert inside.loc["all"].theta_in_range and inside.loc["all"].band_in_range
+
+
+def test_fragility_keeps_groups_whose_outcome_never_changes():
+    """A block size that never overturns (or always does) has no curve to fit, but it is an
+    answer: its median is not reached (inf) or lies below the sampled range (0)."""
+    ds = _fragility_data(1.0, 0.3, (0.5, 2.0), n=600)
+    n = ds.sizes["sample"]
+    size = np.repeat([1.0, 2.0, 3.0], n // 3)
+    over = ds.overturned.values.copy()
+    over[size == 2.0], over[size == 3.0] = 0, 1
+    ds = ds.assign(size=("sample", size), overturned=("sample", over))
+    t = analysis.fragility(ds, "pga_ratio", by="size", n_boot=20)
+    assert list(t.index) == [1.0, 2.0, 3.0]
+    assert t.loc[2.0, "theta"] == np.inf and t.loc[2.0, "theta_hi"] == np.inf
+    assert t.loc[3.0, "theta"] == 0.0 and np.isnan(t.loc[3.0, "beta"])
+    assert not t.loc[[2.0, 3.0], "theta_in_range"].any()
+    assert (t["n"] == n // 3).all()
 
 
 def test_first_order_given_data_finds_the_driver():

@@ -2,28 +2,49 @@
 
 import math
 
+import numpy as np
 import pytest
+from scipy.integrate import dblquad
 
 import rockstudy as rs
 from rockstudy.constants import G
 
 
-def test_frequency_parameter_is_sqrt_3g_over_4R():
-    for R in (0.1, 1.0, 7.3):
-        assert rs.Block(R, 0.2).frequency_parameter == pytest.approx(
-            math.sqrt(3 * G / (4 * R)), rel=1e-15
-        )
+def rectangle_inertia(b, h):
+    """Polar moments of a uniform 2b x 2h rectangle of unit mass, by numerical integration:
+    about its centre of mass and about a bottom corner [m^2]."""
+
+    def polar(x0, y0):
+        val, _ = dblquad(lambda y, x: (x - x0) ** 2 + (y - y0) ** 2, 0, 2 * b, 0, 2 * h)
+        return val / (4 * b * h)
+
+    return polar(b, h), polar(0.0, 0.0)
 
 
-def test_housner_restitution_by_momentum_balance():
-    # angular momentum about the new pivot: I0 w- - 2 m b^2 w- ... = I0 w+, with I0 = 4/3 m R^2
-    # gives eta = 1 - 2 m b^2 / I0 * ... = 1 - 3/2 sin^2(alpha)
-    for alpha in (0.05, 0.2, 0.6):
-        blk = rs.Block(1.0, alpha)
-        b = math.sin(alpha)  # half-width for R = 1
-        i0 = 4.0 / 3.0
-        eta_momentum = (i0 - 2.0 * b * b) / i0
-        assert blk.restitution == pytest.approx(eta_momentum, rel=1e-14)
+@pytest.mark.parametrize("width, height", [(0.2, 1.0), (0.6, 2.4), (1.0, 1.5)])
+def test_frequency_parameter_of_a_rectangle(width, height):
+    """p^2 = m g R / I_O for rotation about a corner O (Housner): with I_O integrated over the
+    rectangle, not taken from a formula."""
+    blk = rs.Block.from_dimensions(width=width, height=height)
+    _, i_corner = rectangle_inertia(width / 2, height / 2)
+    R = math.hypot(width / 2, height / 2)
+    assert blk.frequency_parameter == pytest.approx(math.sqrt(G * R / i_corner), rel=1e-10)
+
+
+@pytest.mark.parametrize("width, height", [(0.2, 1.0), (0.6, 2.4), (1.0, 1.5)])
+def test_housner_restitution_by_momentum_balance(width, height):
+    """Angular momentum about the new pivot O' is conserved through the impact (Housner):
+    before it, the block turns at w about O, so H_O' = I_G w + m (r_O'G x v_G) with
+    v_G = w x r_OG; after it, H_O' = I_O' w+. eta = w+ / w, with the moments integrated."""
+    blk = rs.Block.from_dimensions(width=width, height=height)
+    b, h = width / 2, height / 2
+    i_centre, i_corner = rectangle_inertia(b, h)
+    w = 1.0  # rotation about O = (0, 0), just before O' = (2b, 0) lands
+    r_og = np.array([b, h])
+    v_g = w * np.array([-r_og[1], r_og[0]])  # w e_z x r_OG
+    r_pg = r_og - np.array([2 * b, 0.0])
+    h_before = i_centre * w + (r_pg[0] * v_g[1] - r_pg[1] * v_g[0])
+    assert blk.restitution == pytest.approx(h_before / (i_corner * w), rel=1e-10)
 
 
 def test_from_dimensions_recovers_R_and_alpha():

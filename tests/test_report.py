@@ -102,3 +102,43 @@ def test_report_renders_in_chromium(tmp_path, text):
     else:
         collapse = (tmp_path / "report" / "collapse.csv").read_text().splitlines()[1]
         assert float(collapse.split(",")[1]) < 1e-9  # complete similarity, linear model
+
+
+def test_fragility_section_marks_medians_outside_the_sampled_range(tmp_path):
+    """Small blocks overturn at a median 1.6 inside the sampled 1-3 (in both intensities),
+    the largest at 8, far above it: the page and its table show that median as not reached,
+    and the fitted numbers keep their flags in fragility_fit.csv."""
+    import pandas as pd
+    import xarray as xr
+    from scipy import stats
+
+    from rockstudy.study import report
+
+    rng = np.random.default_rng(7)
+    n = 6000
+    R = np.exp(rng.uniform(np.log(0.3), np.log(5.0), n))
+    ratio = rng.uniform(1.0, 3.0, n)
+    small = R < np.quantile(R, 2 / 3)
+    theta, beta = np.where(small, 1.6, 8.0), np.where(small, 0.3, 0.8)
+    over = (rng.random(n) < stats.norm.cdf(np.log(ratio / theta) / beta)).astype(np.int8)
+    ds = xr.Dataset(
+        {
+            "half_diagonal": ("sample", R),
+            "amplitude": ("sample", ratio),  # a_g = ratio in m/s^2: the same medians
+            "amplitude_ratio": ("sample", ratio),
+            "period": ("sample", rng.uniform(0.5, 1.0, n)),
+            "omega": ("sample", rng.uniform(1.0, 2.0, n)),
+            "overturned": ("sample", over),
+        }
+    )
+    page = report._Page(tmp_path)
+    report._fragility(page, ds)
+    fit = pd.read_csv(tmp_path / "fragility_fit.csv", index_col=0)
+    shown = pd.read_csv(tmp_path / "fragility.csv", index_col=0)
+    large = fit["theta"] > 4
+    assert large.sum() == 2 and (fit["im_max"] <= 3.0).all()
+    assert not fit["theta_in_range"][large].any() and fit["theta_in_range"][~large].all()
+    assert (shown["theta"][large.values] == report.NOT_REACHED).all()
+    np.testing.assert_allclose(shown["theta"][~large.values].astype(float), 1.6, rtol=0.1)
+    html_text = "".join(page.parts)
+    assert report.NOT_REACHED in html_text

@@ -298,7 +298,8 @@ class Record(Motion):
     ) -> Record:
         """Read a two-column text file of time [s] and acceleration in ``units``.
 
-        Lines starting with ``#`` are skipped; columns may be separated by commas or blanks.
+        Lines starting with ``#`` are skipped, and so is a first row of column names; columns
+        may be separated by commas or blanks.
 
         Parameters
         ----------
@@ -315,7 +316,9 @@ class Record(Motion):
         text = path.read_text()
         if delimiter is None:
             text = text.replace(",", " ")
-        data = np.loadtxt(text.splitlines(), comments="#", delimiter=delimiter, ndmin=2)
+        rows = [r for r in text.splitlines() if r.strip() and not r.lstrip().startswith("#")]
+        names = 1 if rows and re.match(r"\s*[A-Za-z_\"']", rows[0]) else 0  # a header row
+        data = np.loadtxt(rows[names:], delimiter=delimiter, ndmin=2)
         if data.shape[1] != 2:
             raise ValueError(
                 f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}"

@@ -13,7 +13,8 @@ failure.
 from __future__ import annotations
 
 import json
-from typing import Literal
+from itertools import combinations_with_replacement
+from typing import Literal, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -164,7 +165,8 @@ def _fit_lognormal(im, y, start=None):
     if start is None:
         start = np.array([np.median(x), np.log(max(np.std(x), 0.1))])
     res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
-    return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+    with np.errstate(over="ignore"):  # a median far above the data: inf, flagged by the caller
+        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
 
 def fragility(
@@ -195,7 +197,14 @@ def fragility(
     -------
     pandas.DataFrame
         One row per group: ``theta`` (median capacity), ``beta`` (log-standard deviation),
-        their bootstrap intervals, and the number of samples.
+        their bootstrap intervals, the number of samples ``n``, the observed intensity range
+        ``im_min``-``im_max`` of the group, and two flags: ``theta_in_range`` (the median lies
+        within the observed intensities) and ``band_in_range`` (so does its whole bootstrap
+        band). A median outside the data is an extrapolation of the lognormal shape, not a
+        measurement: read it as "not reached within the sampled range" (or "below it").
+        A group whose outcome never changes has no fit: its ``theta`` and band are ``inf``
+        (the outcome never happened: not reached) or ``0`` (it always happened: below the
+        sampled range), its ``beta`` NaN. Groups with fewer than 10 samples are left out.
     """
     y, bad = _values(ds, outcome, failed)
     im = np.asarray(ds[intensity].values, float)
@@ -215,27 +224,45 @@ def fragility(
     lo_q, hi_q = 50 * (1 - conf_level), 50 * (1 + conf_level)
     for name, sel in groups.items():
         x, z = im[sel], y[sel]
-        if z.size < 10 or z.min() == z.max():
+        if z.size < 10:
             continue
-        theta, beta = _fit_lognormal(x, z)
-        start = np.log([theta, beta])
-        boot = np.array(
-            [
-                _fit_lognormal(x[k], z[k], start)
-                for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
-            ]
-        )
+        im_min, im_max = float(x.min()), float(x.max())
+        if z.min() == z.max():  # no fit: the median lies beyond the data, on one side
+            theta = theta_lo = theta_hi = np.inf if z.max() == 0 else 0.0
+            beta = beta_lo = beta_hi = np.nan
+        else:
+            theta, beta = _fit_lognormal(x, z)
+            start = np.log([theta, beta])
+            boot = np.array(
+                [
+                    _fit_lognormal(x[k], z[k], start)
+                    for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
+                ]
+            )
+            # percentiles at bootstrap samples (no interpolation: an infinite median stays inf)
+            (theta_lo, beta_lo), (theta_hi, beta_hi) = np.percentile(
+                boot, [lo_q, hi_q], axis=0, method="inverted_cdf"
+            )
         rows.append(
             {
                 by or "group": name,
                 "theta": theta,
                 "beta": beta,
-                "theta_lo": np.percentile(boot[:, 0], lo_q),
-                "theta_hi": np.percentile(boot[:, 0], hi_q),
-                "beta_lo": np.percentile(boot[:, 1], lo_q),
-                "beta_hi": np.percentile(boot[:, 1], hi_q),
+                "theta_lo": theta_lo,
+                "theta_hi": theta_hi,
+                "beta_lo": beta_lo,
+                "beta_hi": beta_hi,
                 "n": int(z.size),
+                "im_min": im_min,
+                "im_max": im_max,
+                "theta_in_range": bool(im_min <= theta <= im_max),
+                "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
             }
+        )
+    if not rows:
+        raise ValueError(
+            f"no group has 10 samples with a finite, positive {intensity!r}: "
+            "no fragility curve can be fitted"
         )
     return pd.DataFrame(rows).set_index(by or "group")
 
@@ -243,10 +270,14 @@ def fragility(
 def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:
     """Evaluate fitted fragility curves (and their theta bands) at intensities ``im``."""
     im = np.asarray(im, float)
-    p = {
-        k: np.array([stats.norm.cdf(np.log(im / r[t]) / r["beta"]) for _, r in table.iterrows()])
-        for k, t in (("probability", "theta"), ("lower", "theta_hi"), ("upper", "theta_lo"))
-    }
+    # an infinite band limit (not reached) gives P = 0; a group without a fit (beta NaN), NaN
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = {
+            k: np.array(
+                [stats.norm.cdf(np.log(im / r[t]) / r["beta"]) for _, r in table.iterrows()]
+            )
+            for k, t in (("probability", "theta"), ("lower", "theta_hi"), ("upper", "theta_lo"))
+        }
     coords = {"group": table.index.astype(str).values, "intensity": im}
     return xr.Dataset({k: (("group", "intensity"), v) for k, v in p.items()}, coords=coords)
 
@@ -260,20 +291,71 @@ def collapse_metric(
     """Share of the response variance that lies within sets of samples sharing the same groups.
 
     Samples are grouped by their (rounded) values of ``groups``; the metric is the within-set
-    sum of squares over the total. It is 0 for a perfectly self-similar response and ~1 when
-    the groups explain nothing. The design must repeat each group point (``replicates``).
+    sum of squares over the total, both over the samples whose group point is replicated (a
+    group point met once carries no within-set variance: it says nothing about similarity).
+    It is 0 for a perfectly self-similar response and ~1 when the groups explain nothing.
+
+    Raises
+    ------
+    ValueError
+        If fewer than half of the samples share their group point with another sample: the
+        design is not replicated (``[sampler] replicates = k`` draws the group points first),
+        and the few coincident points it has (e.g. the Saltelli rows that differ only in an
+        input outside the groups) do not stand for it. Use :func:`unexplained_share` on such
+        designs. Also if the response has no variance over the replicated samples.
     """
     y, bad = _values(ds, response, failed)
     keys = np.column_stack([np.round(np.asarray(ds[g].values, float), decimals) for g in groups])[
         ~bad
     ]
     y = y[~bad]
-    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
-    means = np.bincount(inverse, weights=y) / np.bincount(inverse)
+    replicated = counts[inverse] > 1
+    if not replicated.mean() >= 0.5:
+        raise ValueError(
+            f"collapse_metric needs a replicated design: only {int(replicated.sum())} of the "
+            f"{y.size} samples share their point of the groups {list(groups)} with another "
+            "sample (at least half must). Draw the design with [sampler] replicates = k, or "
+            "use unexplained_share on designs without replicated group points"
+        )
+    y, inverse = y[replicated], inverse[replicated]
+    means = np.bincount(inverse, weights=y) / np.maximum(np.bincount(inverse), 1)
     within = np.sum((y - means[inverse]) ** 2)
     total = np.sum((y - y.mean()) ** 2)
-    return float(within / total) if total > 0 else 0.0
+    if not total > 0:
+        raise ValueError(
+            f"{response!r} is constant over the replicated samples: the share of its "
+            "variance within group points is undefined"
+        )
+    return float(within / total)
+
+
+class UnexplainedShare(NamedTuple):
+    """The result of :func:`unexplained_share`."""
+
+    #: share of the response variance left unexplained by the k-nearest-neighbour fit
+    value: float
+    #: the share the same fit leaves on these sample points for a smooth (cubic) response of
+    #: the groups alone: a lower estimate of the estimator's floor at this sample size
+    floor: float
+    #: number of samples used
+    n: int
+    #: number of neighbours of the fit
+    k: int
+
+
+def _knn_unexplained(x, y, k):
+    """Leave-one-out k-nearest-neighbour residual share of ``y`` over points ``x``."""
+    _, idx = cKDTree(x).query(x, k=k + 1)
+    fit = y[idx[:, 1:]].mean(axis=1)
+    return float(np.sum((y - fit) ** 2) / np.sum((y - y.mean()) ** 2))
+
+
+def _cubic_features(x):
+    """All monomials of degree <= 3 in the columns of ``x`` (the constant included)."""
+    terms = (c for deg in range(4) for c in combinations_with_replacement(range(x.shape[1]), deg))
+    return np.column_stack([np.prod(x[:, list(c)], axis=1) for c in terms])
 
 
 def unexplained_share(
@@ -283,17 +365,39 @@ def unexplained_share(
     k: int = 10,
     failed: FailedPolicy = "drop",
     log_groups: bool = True,
-) -> float:
+) -> UnexplainedShare:
     """Cross-check on any random design: the share of the response variance left unexplained
     by a smooth fit over the groups (the mean of the k nearest neighbours in standardised,
-    optionally logarithmic, group coordinates, leaving each sample out)."""
+    optionally logarithmic, group coordinates, leaving each sample out).
+
+    The fit has a floor that depends on the number of samples: even an exactly self-similar
+    response leaves a share unexplained, because the neighbours sit at other group points.
+    The floor returned next to the value is the share the same fit leaves, on the same sample
+    points, for the least-squares cubic in the groups fitted to the response (a smooth
+    response of the same trend that depends on the groups only). It falls as the sample grows.
+    It is a lower estimate: a response sharper than a cubic (steep near the overturning
+    boundaries) leaves more even when exactly self-similar (the linear flagship's survivors,
+    exactly similar: 0.046 against a floor of 0.018). A value within a few times its floor
+    cannot be told from complete similarity with this many samples.
+
+    Returns
+    -------
+    UnexplainedShare
+        ``(value, floor, n, k)``.
+    """
     y, bad = _values(ds, response, failed)
     x = np.column_stack([np.asarray(ds[g].values, float) for g in groups])
     keep = ~bad & np.all(np.isfinite(x), axis=1)
     x, y = x[keep], y[keep]
+    if y.size <= k + 1 or not np.ptp(y) > 0:
+        raise ValueError(
+            f"unexplained_share needs more than k + 1 = {k + 1} samples and a response that "
+            f"varies; {response!r} has {y.size} usable samples"
+        )
     if log_groups and np.all(x > 0):
         x = np.log(x)
     x = (x - x.mean(axis=0)) / np.where(x.std(axis=0) > 0, x.std(axis=0), 1.0)
-    _, idx = cKDTree(x).query(x, k=k + 1)
-    fit = y[idx[:, 1:]].mean(axis=1)
-    return float(np.sum((y - fit) ** 2) / np.sum((y - y.mean()) ** 2))
+    features = _cubic_features(x)
+    smooth = features @ np.linalg.lstsq(features, y, rcond=None)[0]
+    floor = _knn_unexplained(x, smooth, k) if np.ptp(smooth) > 0 else 0.0
+    return UnexplainedShare(_knn_unexplained(x, y, k), floor, int(y.size), int(k))

@@ -131,6 +131,24 @@ def _middle_third(values):
     return (values >= lo) & (values <= hi)
 
 
+NOT_REACHED = "not reached within the sampled range"
+BELOW_RANGE = "below the sampled range"
+
+
+def _capacities_as_measured(table: pd.DataFrame) -> pd.DataFrame:
+    """The fragility table as the report shows it: a median capacity or band limit outside
+    the group's observed intensities (``im_min``-``im_max``) is an extrapolation of the
+    lognormal shape, so it is shown as text, not as a number."""
+    shown = table.astype(object)
+    for col in ("theta", "theta_lo", "theta_hi"):
+        value = table[col].to_numpy(float)
+        shown[col] = [
+            NOT_REACHED if v > hi else BELOW_RANGE if v < lo else v
+            for v, lo, hi in zip(value, table["im_min"], table["im_max"], strict=True)
+        ]
+    return shown
+
+
 def _fragility(page, ds):
     """Fragility by block size: against a_g for pulses of similar period T_p (dimensional),
     and against a_g / (g tan alpha) for pulses of similar omega_g / p (the groups of 6.1)."""
@@ -152,18 +170,26 @@ def _fragility(page, ds):
         ),
     ):
         sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
-        t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
+        try:
+            t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
+        except ValueError as err:  # no block size saw both outcomes
+            page.text(f"Fragility against {im}: {err}")
+            continue
         t.insert(0, "intensity", im)
         t.insert(1, "band", band)
         tables.append(t)
         grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
         curve = analysis.fragility_curve(t, grid)
-        for g in curve.group.values:
+        for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
             c = curve.sel(group=g)
-            ax.plot(grid, c.probability, label=f"R {g} m")
+            note = "" if inside else " (median outside the data)"
+            ax.plot(grid, c.probability, "-" if inside else "--", label=f"R {g} m{note}")
             ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
         ax.set(xscale="log", xlabel=label, ylabel="P(overturn)")
         ax.legend(fontsize=8)
+    if not tables:
+        plt.close(fig)
+        return
     axes[0].set_title("dimensional intensity")
     axes[1].set_title("dimensionless groups (6.1)")
     fig.tight_layout()
@@ -172,17 +198,30 @@ def _fragility(page, ds):
         "fragility",
         "Lognormal fragility curves (MLE, 90 % bootstrap bands) by "
         "block size: in dimensional terms the sizes spread apart, in the groups they "
-        "collapse (to the extent the groups make the response self-similar)",
+        "collapse (to the extent the groups make the response self-similar); dashed: the "
+        "median lies outside the sampled intensities",
     )
+    fit = pd.concat(tables)
+    fit.to_csv(page.out / "fragility_fit.csv")
     page.table(
-        pd.concat(tables),
+        _capacities_as_measured(fit),
         "fragility",
-        "Fragility parameters: median capacity theta, log-standard deviation beta",
+        "Fragility parameters: median capacity theta, log-standard deviation beta; a median "
+        f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
+        f"'{NOT_REACHED}' (the fitted numbers and flags are in fragility_fit.csv)",
     )
-    spread = {t["intensity"].iloc[0]: float(t["theta"].max() / t["theta"].min()) for t in tables}
+    spread = []
+    for t in tables:
+        inside = t["theta"][t["theta_in_range"]]
+        spread.append(
+            f"{t['intensity'].iloc[0]}: {inside.max() / inside.min():.2f}"
+            if inside.size >= 2
+            else f"{t['intensity'].iloc[0]}: not measured (fewer than two medians within "
+            "the sampled range)"
+        )
     page.text(
-        "Spread of the median capacity between block sizes (max/min of theta): "
-        + ", ".join(f"{k}: {v:.2f}" for k, v in spread.items())
+        "Spread of the median capacity between block sizes (max/min of theta, medians within "
+        "the sampled range only): " + ", ".join(spread)
     )
 
 
@@ -225,31 +264,36 @@ def _similarity(page, ds, study):
         ("non-slender (alpha > 0.2)", surv["slenderness"].values > 0.2),
     ):
         sub = surv if label == "all" else surv.isel(sample=np.flatnonzero(sel))
-        rows[label] = {
-            "collapse metric (design groups)": analysis.collapse_metric(
-                sub, "law_response", groups
-            ),
-            "unexplained share, (4.11) groups": analysis.unexplained_share(
-                sub.assign(resp=sub["max_rotation"] * G / (sub["a"] * G * sub["slenderness"])),
-                "resp",
+        try:
+            collapse = analysis.collapse_metric(sub, "law_response", groups)
+        except ValueError:  # too few survivors share a group point in this subset
+            collapse = "not replicated (too few survivors share a group point)"
+        row = {"collapse metric (design groups)": collapse}
+        for law, resp, law_groups in (
+            (
+                "(4.11)",
+                sub["max_rotation"] * G / (sub["a"] * G * sub["slenderness"]),
                 ["a", "omega", "restitution"],
             ),
-            "unexplained share, (6.1) groups": analysis.unexplained_share(
-                sub.assign(
-                    resp=sub["max_rotation"]
-                    / (sub["uplift_ratio"] ** -1 * np.tan(sub["slenderness"]) * sub["cos_alpha"])
-                ),
-                "resp",
+            (
+                "(6.1)",
+                sub["max_rotation"]
+                / (sub["uplift_ratio"] ** -1 * np.tan(sub["slenderness"]) * sub["cos_alpha"]),
                 ["uplift_ratio", "omega", "restitution"],
             ),
-            "samples": sub.sizes["sample"],
-        }
+        ):
+            share = analysis.unexplained_share(sub.assign(resp=resp), "resp", law_groups)
+            row[f"unexplained share, {law} groups"] = share.value
+            row[f"its floor, {law} groups"] = share.floor
+        rows[label] = {**row, "samples": sub.sizes["sample"]}
     page.table(
         pd.DataFrame(rows).T,
         "collapse",
         "Share of the variance of the survivors' response within group points "
         f"({', '.join(groups)}), and left unexplained by a smooth fit over each law's "
-        "groups",
+        "groups, next to that fit's floor (the share it leaves for a smooth, cubic response of "
+        "the groups alone on the same samples; a lower estimate: values within a few times "
+        "the floor cannot be told from complete similarity with this many samples)",
     )
     if study.run.method == "linear" and study.motion.amplitude_a is not None:
         _eta_law(page, surv)
