@@ -8,27 +8,37 @@ sine, cosine and half-sine pulses. The reference is the nonlinear kernel at rtol
 counts as wrong on a robust scene: one whose reference decision holds for a_g x (1 +- 1e-4).
 
 For each rtol (1e-2, 1e-4, 1e-6) it runs auto twice:
-- asking only for ``max_rotation`` and ``overturned`` (the linear model allowed where the
-  table bounds it): wrong decisions (robust / all), share of the linear model, share of
-  surviving scenes with max rotation within rtol;
-- with the default outputs (all of them; no linear rows): the same, and the shares of
-  ``overturn_time`` and ``first_impact_time`` within rtol (relative) of the reference.
+- on the N x N grid, asking only for ``max_rotation`` and ``overturned`` (the linear model
+  allowed where the table bounds it): wrong decisions (robust / all), share of the linear
+  model, share of surviving scenes with max rotation within rtol;
+- on an M x M grid, with the default outputs (all of them; no linear rows): the same, and
+  the shares of ``overturn_time`` and ``first_impact_time`` within rtol (relative) of the
+  reference.
 
-    python benchmarks/bench_auto_decisions.py            # 400 x 400, about 8 min of one core
-    python benchmarks/bench_auto_decisions.py --n 100    # a quick look
+    python benchmarks/bench_auto_decisions.py                  # N 400, M 100: ~6 min, one core
+    python benchmarks/bench_auto_decisions.py --n 100 --m 50   # a quick look
 
-Writes benchmarks/results/auto_decisions.json.
+With ``--work-precision`` it measures auto on the scenes of bench_work_precision.py instead
+(its 200 scenes: sine, cosine, half-sine, Ricker and a record; the reference is solve_ivp's
+DOP853 at rtol 1e-12): the share of scenes within each tolerance (max rotation and
+overturning decision), through simulate() and the batch entry point (all outputs, and the
+covered ones only), and the share of first impact times within the tolerance.
+
+Writes benchmarks/results/auto_decisions.json (or auto_work_precision.json).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 
+from rockstudy import AccuracyWarning
 from rockstudy.constants import G
 from rockstudy.dynamics import _auto, simulate_batch
 from rockstudy.verification.accuracy import (
@@ -81,22 +91,23 @@ def decisions(kw, ref, out, rtol):
     }
 
 
-def main(n):
+def main(n, m):
     results = []
     t0 = time.perf_counter()
     for shape in SHAPES:
         for alpha in ALPHAS:
-            kw = grid_kwargs(shape, alpha, n)
+            kw, kw_m = grid_kwargs(shape, alpha, n), grid_kwargs(shape, alpha, m)
             ref = simulate_batch(**kw, rtol=1e-10)
+            ref_m = simulate_batch(**kw_m, rtol=1e-10)
             for rtol in RTOLS:
                 lean = simulate_batch(**kw, method="auto", rtol=rtol, outputs=COVERED)
-                full = simulate_batch(**kw, method="auto", rtol=rtol)
+                full = simulate_batch(**kw_m, method="auto", rtol=rtol)
                 row = {"shape": shape, "alpha": alpha, "rtol": rtol}
                 row["covered_only"] = decisions(kw, ref, lean, rtol)
-                row["all_outputs"] = decisions(kw, ref, full, rtol)
+                row["all_outputs"] = decisions(kw_m, ref_m, full, rtol)
                 for name in ("overturn_time", "first_impact_time"):
                     row["all_outputs"][f"{name}_within_rtol"] = share_within(
-                        full[name], ref[name], rtol
+                        full[name], ref_m[name], rtol
                     )
                 results.append(row)
                 a, b = row["covered_only"], row["all_outputs"]
@@ -115,11 +126,69 @@ def main(n):
     print(f"robust wrong decisions over all grids: {total}")
     OUT.mkdir(exist_ok=True)
     path = OUT / "auto_decisions.json"
-    path.write_text(json.dumps({"n": n, "results": results, "total": total}, indent=1))
+    path.write_text(json.dumps({"n": n, "m": m, "results": results, "total": total}, indent=1))
+    print(f"wrote {path}")
+
+
+def work_precision(n_scenes, record):
+    """auto on the work-precision scenes: shares within tolerance (see the module doc)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    import bench_work_precision as wp
+
+    wp.RECORD = Path(record) if record else wp.RECORD
+    scenes = wp.scene_set(n_scenes)
+    t0 = time.perf_counter()
+    ref = [wp.run_scipy(b, m, t, "DOP853", 1e-12) for b, m, t, _ in scenes]
+    ref_rot = {
+        "max_rotation": np.array([r[0] for r in ref]),
+        "overturned": np.array([r[1] for r in ref]),
+    }
+    ref_t1 = np.array([r[2] for r in ref])
+    print(f"reference: {len(scenes)} scenes in {time.perf_counter() - t0:.0f} s", flush=True)
+
+    def shares(outs, tol):
+        got = {
+            "max_rotation": np.array([o[0] for o in outs]),
+            "overturned": np.array([o[1] for o in outs]),
+        }
+        err = relative_max_rotation_error(got, ref_rot)
+        t1 = np.array([o[2] for o in outs])
+        has = np.isfinite(ref_t1)
+        return float(np.mean(err <= tol)), share_within(t1[has], ref_t1[has], tol)
+
+    rows = []
+    for tol in (1e-1, 1e-2, 1e-3, 1e-4, 1e-6):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", AccuracyWarning)
+            sim = [wp.run_simulate(b, m, t, method="auto", rtol=tol) for b, m, t, _ in scenes]
+        batch, _ = wp.batch_kernel(scenes, tol, method="auto")
+        row = {"tolerance": tol}
+        row["simulate"], row["simulate_first_impact"] = shares(sim, tol)
+        row["batch"], row["batch_first_impact"] = shares(batch, tol)
+        rows.append(row)
+        print(
+            f"auto tol {tol:.0e}: max rotation + decision within tol: simulate "
+            f"{row['simulate']:.3f}, batch {row['batch']:.3f}; first impact within tol: "
+            f"simulate {row['simulate_first_impact']:.3f}, batch {row['batch_first_impact']:.3f}",
+            flush=True,
+        )
+    OUT.mkdir(exist_ok=True)
+    path = OUT / "auto_work_precision.json"
+    path.write_text(json.dumps({"scenes": len(scenes), "rows": rows}, indent=1))
     print(f"wrote {path}")
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=400, help="grid points per axis")
-    main(parser.parse_args().n)
+    parser.add_argument("--n", type=int, default=400, help="grid points per axis (decisions)")
+    parser.add_argument("--m", type=int, default=100, help="grid points per axis (all outputs)")
+    parser.add_argument(
+        "--work-precision", action="store_true", help="the scenes of bench_work_precision.py"
+    )
+    parser.add_argument("--scenes", type=int, default=200, help="work-precision scenes")
+    parser.add_argument("--record", help="elcentro_NS.dat (default: bench_work_precision's)")
+    args = parser.parse_args()
+    if args.work_precision:
+        work_precision(args.scenes, args.record)
+    else:
+        main(args.n, args.m)
