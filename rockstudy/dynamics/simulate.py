@@ -228,8 +228,8 @@ def simulate(
 
     Parameters
     ----------
-    structure : Block or structure with ``equivalent_block()``
-        The rocking block, described by p, alpha and eta.
+    structure : Block or structure with ``mechanism()`` and ``equivalent_block()``
+        The rocking block (p, alpha, eta), or a structure of [003] (wall, arch, frame, ...).
     motion : Motion
         Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``.
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
@@ -237,9 +237,6 @@ def simulate(
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
         trigonometric pulses, the same kernel otherwise.
         ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
-        For a structure with a ``mechanism()`` (a wall, an arch, a frame), ``"nonlinear"``
-        (or ``"mechanism"``) integrates the full mechanism, eq. (8) of [003]; the other
-        methods run its equivalent block (kappa_1).
         ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
         (Housner's model as l -> 0; steps below l / 10 make it slow).
         ``"auto"``: the cheapest method whose error bound meets ``rtol``: no integration
@@ -248,9 +245,19 @@ def simulate(
         its error absolute). With a history to build the exact linear solver is not cheaper,
         so only :func:`rockstudy.simulate_batch` chooses it. ``result.info`` holds the model,
         the kernel's rtol and the linearization bound of the scene.
+        On a structure with a ``mechanism()``: ``"nonlinear"``, ``"mechanism"`` and
+        ``"auto"`` integrate the mechanism, eq. (8) of [003], in its rotation phi (``"auto"``
+        runs the equivalent block instead where it is exact: the Table I structures,
+        :data:`EXACT_EQUIVALENTS`, with phi = theta). The other methods run its kappa_1
+        equivalent block, in the block's theta = phi / kappa_1, and say so in
+        ``result.info`` (``structure_model``, ``coordinate``) and in an
+        :class:`~rockstudy.EquivalentBlockWarning` (none for the exact Table I blocks).
     rtol : float
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
-        For ``"auto"``: the relative accuracy asked of the max rotation.
+        For ``"auto"``: the relative accuracy of ``max_rotation``, with the overturning
+        decision of Housner's model (or of the mechanism); ``impact_times``,
+        ``overturn_time`` and the history are the kernel's at 0.05 ``rtol``, which rtol
+        does not bound.
     t_max : float, optional
         End of the history [s]. By default the free rocking after the motion is followed until
         the block comes to rest or overturns.
