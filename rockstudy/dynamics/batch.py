@@ -99,12 +99,13 @@ def simulate_batch(
         reaches g tan(alpha) (exact), the exact linear solver where its tabulated
         linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
         ``max_rotation`` and ``overturned`` are asked for (see ``outputs``), and the
-        nonlinear kernel at 0.05 ``rtol`` otherwise.
+        nonlinear kernel at 0.05 ``rtol`` (5e-6 at most, for the overturning decisions)
+        otherwise.
     rtol : float
         Relative tolerance of the integrator. For ``"auto"``: the relative accuracy of
         ``max_rotation``, with the overturning decision of Housner's model; ``rtol`` covers
-        no other output (``overturn_time`` and ``first_impact_time`` are the kernel's at 0.05
-        ``rtol``, ``n_impacts`` the kernel's count until its rest rule).
+        no other output (``overturn_time`` and ``first_impact_time`` are the kernel's at that
+        rtol, ``n_impacts`` the kernel's count until its rest rule).
     outputs : sequence of str, optional
         The outputs to return (names of :data:`OUTPUTS`; ``status`` always comes along).
         Default: all of them. With ``"auto"``, asking only for ``max_rotation`` and

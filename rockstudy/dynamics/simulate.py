@@ -169,9 +169,9 @@ def _warn_linearization(p, alpha, eta, motion, x0):
 
 
 def _auto_kernel(run, rtol, critical):
-    """(result, kernel rtol) of ``run(kernel_rtol)`` at the rtol ``auto`` needs: 0.05 ``rtol``,
-    and tighter again for responses below SMALL_ROTATION ``critical`` (chattering makes the
-    kernel's error absolute there; see :mod:`._auto`)."""
+    """(result, kernel rtol) of ``run(kernel_rtol)`` at the rtol ``auto`` needs: 0.05 ``rtol``
+    (5e-6 at most), and tighter again for responses below SMALL_ROTATION ``critical``
+    (chattering makes the kernel's error absolute there; see :mod:`._auto`)."""
     k_rtol = _auto.kernel_rtol(rtol)
     r = run(k_rtol)
     ratio = r.max_rotation / critical
@@ -241,10 +241,11 @@ def simulate(
         (Housner's model as l -> 0; steps below l / 10 make it slow).
         ``"auto"``: the cheapest method whose error bound meets ``rtol``: no integration
         where the ground never reaches g tan(alpha), otherwise the nonlinear kernel at
-        0.05 ``rtol`` (tighter again for responses below 0.1 alpha, where chattering makes
-        its error absolute). With a history to build the exact linear solver is not cheaper,
-        so only :func:`rockstudy.simulate_batch` chooses it. ``result.info`` holds the model,
-        the kernel's rtol and the linearization bound of the scene.
+        0.05 ``rtol``, 5e-6 at most (tighter again for responses below 0.1 alpha, where
+        chattering makes its error absolute). With a history to build the exact linear
+        solver is not cheaper, so only :func:`rockstudy.simulate_batch` chooses it.
+        ``result.info`` holds the model, the kernel's rtol and the scene's linearization
+        bound.
         On a structure with a ``mechanism()``: ``"nonlinear"``, ``"mechanism"`` and
         ``"auto"`` integrate the mechanism, eq. (8) of [003], in its rotation phi (``"auto"``
         runs the equivalent block instead where it is exact: the Table I structures,
@@ -256,7 +257,7 @@ def simulate(
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
         For ``"auto"``: the relative accuracy of ``max_rotation``, with the overturning
         decision of Housner's model (or of the mechanism); ``impact_times``,
-        ``overturn_time`` and the history are the kernel's at 0.05 ``rtol``, which rtol
+        ``overturn_time`` and the history are the kernel's at that rtol, which ``rtol``
         does not bound.
     t_max : float, optional
         End of the history [s]. By default the free rocking after the motion is followed until
