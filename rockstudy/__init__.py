@@ -11,6 +11,7 @@ from ._warnings import (
     ClosedFormValidityWarning,
     ComplexAccuracyWarning,
     ComplexFromRestWarning,
+    EquivalentBlockWarning,
     LinearizationWarning,
     LooseToleranceWarning,
 )
@@ -25,6 +26,7 @@ __all__ = [
     "ClosedFormValidityWarning",
     "ComplexAccuracyWarning",
     "ComplexFromRestWarning",
+    "EquivalentBlockWarning",
     "LinearizationWarning",
     "LooseToleranceWarning",
     "RockingResult",

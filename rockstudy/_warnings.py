@@ -27,3 +27,7 @@ class ComplexFromRestWarning(AccuracyWarning):
 
 class LooseToleranceWarning(AccuracyWarning):
     """The nonlinear kernel was run at a tolerance looser than its measured reliable range."""
+
+
+class EquivalentBlockWarning(AccuracyWarning):
+    """A structure was run as its equivalent block of [003], which only approximates it."""

@@ -71,6 +71,7 @@ def simulate_batch(
     method: Literal["nonlinear", "linear", "auto"] = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = 1_000_000,
+    outputs=None,
 ) -> dict:
     """Rock many blocks through many pulses (or scaled copies of one record) in one call.
 
@@ -96,11 +97,21 @@ def simulate_batch(
         trigonometric pulses uses the exact piecewise solution. ``"auto"`` chooses row by row
         the cheapest model whose error bound meets ``rtol``: rest where the ground never
         reaches g tan(alpha) (exact), the exact linear solver where its tabulated
-        linearization error (one-cycle trigonometric pulses) is below ``rtol``, and the
-        nonlinear kernel at 0.05 ``rtol`` otherwise.
+        linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
+        ``max_rotation`` and ``overturned`` are asked for (see ``outputs``), and the
+        nonlinear kernel at 0.05 ``rtol`` (5e-6 at most, for the overturning decisions)
+        otherwise.
     rtol : float
-        Relative tolerance of the integrator; for ``"auto"``, the relative accuracy asked of
-        the max rotation (and the overturning decision).
+        Relative tolerance of the integrator. For ``"auto"``: the relative accuracy of
+        ``max_rotation``, with the overturning decision of Housner's model; ``rtol`` covers
+        no other output (``overturn_time`` and ``first_impact_time`` are the kernel's at that
+        rtol, ``n_impacts`` the kernel's count until its rest rule).
+    outputs : sequence of str, optional
+        The outputs to return (names of :data:`OUTPUTS`; ``status`` always comes along).
+        Default: all of them. With ``"auto"``, asking only for ``max_rotation`` and
+        ``overturned`` (and ``steps``, ``model``) lets the rows whose bound allows it run the
+        cheaper linear model; asking for any other output runs the kernel on every row that
+        lifts, so that no returned value lies outside what ``auto`` promises.
 
     Returns
     -------
@@ -109,8 +120,9 @@ def simulate_batch(
         (until rest), ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s]
         (NaN if none), ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
         taken; 0 for the exact solver), ``model`` (0 rest without integration, 1 linear,
-        2 nonlinear: what each row ran).
+        2 nonlinear: what each row ran); only those of ``outputs`` (and ``status``) if given.
     """
+    wanted = _requested_outputs(outputs)
     try:
         model = _MODELS[method]
     except KeyError:
@@ -165,13 +177,26 @@ def simulate_batch(
         out = _run(rows, np.arange(n), model, rtol, max_steps)
         codes = np.full(n, _CODES[model], np.int8)
     else:
-        out, codes = _auto_rows(rows, pulse if record is None else None, cycles, rtol, max_steps)
+        linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
+        motion = pulse if record is None else None
+        out, codes = _auto_rows(rows, motion, cycles, rtol, max_steps, linear_ok)
     cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
     for name in ("status", "n_impacts", "steps"):
         cols[name] = cols[name].astype(np.int64)
     cols["overturned"] = cols["overturned"].astype(bool)
     cols["model"] = codes
-    return cols
+    return {name: cols[name] for name in wanted}
+
+
+def _requested_outputs(outputs):
+    """The output names to return, in the order of :data:`OUTPUTS`, ``status`` included."""
+    if outputs is None:
+        return OUTPUTS
+    names = [outputs] if isinstance(outputs, str) else list(outputs)
+    unknown = sorted(set(names) - set(OUTPUTS))
+    if unknown:
+        raise ValueError(f"outputs: unknown name(s) {unknown}; allowed: {list(OUTPUTS)}")
+    return tuple(name for name in OUTPUTS if name in names or name == "status")
 
 
 def _run(rows, idx, model, rtol, max_steps):
@@ -183,15 +208,16 @@ def _run(rows, idx, model, rtol, max_steps):
     return _rocking.scene_batch(*args, model, kind, mp[idx], times, samples, rtol, max_steps)
 
 
-def _auto_rows(rows, pulse, cycles, tolerance, max_steps):
-    """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`)."""
+def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
+    """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`); the
+    linear model only if ``linear_ok`` (no output outside its bound was asked for)."""
     p, alpha, eta, kind, mp, times, samples = rows
     n = p.size
     peak = np.abs(mp[:, 0]) * (1.0 if pulse is not None else np.max(np.abs(samples)))
     psi = peak / (G * np.tan(alpha))
     codes = np.full(n, _auto.MODEL_NONLINEAR, np.int8)
     codes[psi < 1.0] = _auto.MODEL_REST
-    if pulse is not None and kind == mk.KIND_TRIG:
+    if linear_ok and pulse is not None and kind == mk.KIND_TRIG:
         one_cycle = np.broadcast_to(np.asarray(cycles), (n,)) == 1
         omega = mp[:, 1] / p
         bound = _auto.linearization_bound(pulse, eta, alpha, psi, omega)

@@ -18,16 +18,27 @@ class RockingResult:
         twice: before and after the jump of ``theta_dot``.
     theta, theta_dot : ndarray
         Rotation [rad] and angular velocity [rad/s]; theta > 0 rocks on the positive pivot.
+        For a structure, the coordinate named in ``info["coordinate"]``: the mechanism's phi
+        (methods "nonlinear", "mechanism", "auto"), or the theta of its equivalent block
+        (other methods; phi = kappa_1 theta, eq. 14 of [003]).
     max_rotation : float
-        Max |theta| over the response [rad]; pi/2 when the block overturns.
+        Max |theta| over the response [rad]; pi/2 when the block or structure overturns
+        (also for a mechanism that collapses earlier, at ``info["fall_rotation"]``, where its
+        history ends).
     overturned : bool
-        Whether the block fell over (|theta| reached pi/2).
+        Whether the block fell over (|theta| reached pi/2, or the mechanism's collapse
+        amplitude).
     impact_times : ndarray
         Times of the impacts [s].
     overturn_time : float
         Time at which |theta| reached pi/2 [s], NaN if the block survived.
     method : str
         The method that produced the result.
+    info : dict
+        What ran: for ``"auto"``, ``model`` (the model each call chose) and ``rtol`` (the
+        kernel's); for a structure, ``structure_model`` (the mechanism, or which equivalent
+        block) and ``coordinate`` (what ``theta`` and ``max_rotation`` measure); solver
+        counters.
     """
 
     t: np.ndarray

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from typing import Literal
@@ -9,12 +10,13 @@ from typing import Literal
 import numpy as np
 
 from .. import _validate
-from .._warnings import LinearizationWarning
+from .._warnings import EquivalentBlockWarning, LinearizationWarning
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion
 from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
+from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
 from . import _auto, _linear, _rocking
 from .reference import simulate_reference
 from .result import RockingResult
@@ -23,6 +25,10 @@ from .result import RockingResult
 LINEAR_WARN = 0.1
 
 _SHAPES = {cls: name for name, cls in PULSES.items()}  # pulse class -> shape name
+
+#: Structures whose kappa_1 equivalent block is exact (Table I of [003]: kappa_1 = 1, so the
+#: block's theta is the structure's phi, and I_nl is constant): ``auto`` runs the block.
+EXACT_EQUIVALENTS = (PointMassStrut, ConicalShell, SymmetricFrame)
 
 Method = Literal["nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"]
 
@@ -147,7 +153,7 @@ def _warn_linearization(p, alpha, eta, motion, x0):
         what = (
             f"up to {bound:.2g}"
             if math.isfinite(bound)
-            else "unbounded: the two models disagree on overturning near this scene"
+            else "unbounded: one of the two models overturns near this scene"
         )
     elif not covered and alpha > _auto.largest_slenderness():
         what = "unknown here, and of order alpha^2 / 2 at best"
@@ -162,6 +168,19 @@ def _warn_linearization(p, alpha, eta, motion, x0):
     )
 
 
+def _auto_kernel(run, rtol, critical):
+    """(result, kernel rtol) of ``run(kernel_rtol)`` at the rtol ``auto`` needs: 0.05 ``rtol``
+    (5e-6 at most), and tighter again for responses below SMALL_ROTATION ``critical``
+    (chattering makes the kernel's error absolute there; see :mod:`._auto`)."""
+    k_rtol = _auto.kernel_rtol(rtol)
+    r = run(k_rtol)
+    ratio = r.max_rotation / critical
+    if 0.0 < ratio < _auto.SMALL_ROTATION:
+        k_rtol = float(_auto.kernel_rtol_small(rtol, ratio))
+        r = run(k_rtol)
+    return r, k_rtol
+
+
 def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
     """The cheapest method whose error bound meets ``rtol`` (see :mod:`._auto`). With a full
     history the exact linear solver is not cheaper than the kernel (it evaluates its phases on
@@ -169,13 +188,8 @@ def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x
     choice is rest or the kernel; :func:`simulate_batch` also uses the linear model."""
     psi, bound, _ = _linearization_bound(p, alpha, eta, motion, x0)
     rest = x0 == (0.0, 0.0) and psi < 1.0
-    k_rtol = _auto.kernel_rtol(rtol)
     args = (p, alpha, eta, motion, _rocking.MODEL_NONLINEAR)
-    r = _kernel(*args, k_rtol, t_max, max_steps, method, x0)
-    ratio = r.max_rotation / alpha
-    if 0.0 < ratio < _auto.SMALL_ROTATION:  # chattering: the absolute scale dominates
-        k_rtol = float(_auto.kernel_rtol_small(rtol, ratio))
-        r = _kernel(*args, k_rtol, t_max, max_steps, method, x0)
+    r, k_rtol = _auto_kernel(lambda k: _kernel(*args, k, t_max, max_steps, method, x0), rtol, alpha)
     chosen = _auto.MODEL_REST if rest else _auto.MODEL_NONLINEAR
     r.info.update(model=_auto.MODEL_NAMES[chosen], linearization_bound=bound, rtol=k_rtol)
     return r
@@ -214,8 +228,8 @@ def simulate(
 
     Parameters
     ----------
-    structure : Block or structure with ``equivalent_block()``
-        The rocking block, described by p, alpha and eta.
+    structure : Block or structure with ``mechanism()`` and ``equivalent_block()``
+        The rocking block (p, alpha, eta), or a structure of [003] (wall, arch, frame, ...).
     motion : Motion
         Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``.
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
@@ -223,20 +237,28 @@ def simulate(
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
         trigonometric pulses, the same kernel otherwise.
         ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
-        For a structure with a ``mechanism()`` (a wall, an arch, a frame), ``"nonlinear"``
-        (or ``"mechanism"``) integrates the full mechanism, eq. (8) of [003]; the other
-        methods run its equivalent block (kappa_1).
         ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
         (Housner's model as l -> 0; steps below l / 10 make it slow).
         ``"auto"``: the cheapest method whose error bound meets ``rtol``: no integration
         where the ground never reaches g tan(alpha), otherwise the nonlinear kernel at
-        0.05 ``rtol`` (tighter again for responses below 0.1 alpha, where chattering makes
-        its error absolute). With a history to build the exact linear solver is not cheaper,
-        so only :func:`rockstudy.simulate_batch` chooses it. ``result.info`` holds the model,
-        the kernel's rtol and the linearization bound of the scene.
+        0.05 ``rtol``, 5e-6 at most (tighter again for responses below 0.1 alpha, where
+        chattering makes its error absolute). With a history to build the exact linear
+        solver is not cheaper, so only :func:`rockstudy.simulate_batch` chooses it.
+        ``result.info`` holds the model, the kernel's rtol and the scene's linearization
+        bound.
+        On a structure with a ``mechanism()``: ``"nonlinear"``, ``"mechanism"`` and
+        ``"auto"`` integrate the mechanism, eq. (8) of [003], in its rotation phi (``"auto"``
+        runs the equivalent block instead where it is exact: the Table I structures,
+        :data:`EXACT_EQUIVALENTS`, with phi = theta). The other methods run its kappa_1
+        equivalent block, in the block's theta = phi / kappa_1, and say so in
+        ``result.info`` (``structure_model``, ``coordinate``) and in an
+        :class:`~rockstudy.EquivalentBlockWarning` (none for the exact Table I blocks).
     rtol : float
         Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
-        For ``"auto"``: the relative accuracy asked of the max rotation.
+        For ``"auto"``: the relative accuracy of ``max_rotation``, with the overturning
+        decision of Housner's model (or of the mechanism); ``impact_times``,
+        ``overturn_time`` and the history are the kernel's at that rtol, which ``rtol``
+        does not bound.
     t_max : float, optional
         End of the history [s]. By default the free rocking after the motion is followed until
         the block comes to rest or overturns.
@@ -274,25 +296,77 @@ def simulate(
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
     if method in ("nonlinear", "mechanism"):
         _auto.warn_loose_tolerance(rtol)
-    if hasattr(structure, "mechanism") and method in ("nonlinear", "mechanism"):
-        return _mechanism(structure, motion, rtol, t_max, int(max_steps), (th0, om0))
+    x0 = (th0, om0)
+    if hasattr(structure, "mechanism"):
+        return _simulate_structure(structure, motion, method, rtol, t_max, int(max_steps), x0, l)
     p, alpha, eta = block_parameters(structure)
+    return _simulate_block(p, alpha, eta, motion, method, rtol, t_max, int(max_steps), x0, l)
+
+
+def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l):
+    """A block (p, alpha, eta) through ``method``."""
+    runner, model = _METHODS[method]
     if method in ("linear", "scipy-linear"):
-        _warn_linearization(p, alpha, eta, motion, (th0, om0))
+        _warn_linearization(p, alpha, eta, motion, x0)
     if method == "complex":
-        return _complex(
-            p, alpha, eta, motion, None, rtol, t_max, int(max_steps), method, (th0, om0), l
+        return _complex(p, alpha, eta, motion, None, rtol, t_max, max_steps, method, x0, l)
+    return runner(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+
+
+def _simulate_structure(structure, motion, method, rtol, t_max, max_steps, x0, l):
+    """A structure with a ``mechanism()``: the mechanism, eq. (8) of [003], for "nonlinear",
+    "mechanism" and "auto" (the exact equivalent block for the Table I structures under
+    "auto"); the kappa_1 equivalent block for the other methods, said in ``result.info`` and
+    in an :class:`EquivalentBlockWarning` unless the block is exact."""
+    exact = isinstance(structure, EXACT_EQUIVALENTS)
+    if method in ("nonlinear", "mechanism"):
+        return _mechanism(structure, motion, rtol, t_max, max_steps, x0, method)
+    if method == "auto" and not exact:
+        params = _structure_parameters(structure)
+        r, k_rtol = _auto_kernel(
+            lambda k: _mechanism(structure, motion, k, t_max, max_steps, x0, method),
+            rtol,
+            params.critical_rotation,
         )
-    return runner(p, alpha, eta, motion, model, rtol, t_max, int(max_steps), method, (th0, om0))
+        r.info.update(model="mechanism", rtol=k_rtol)
+        return r
+    eq = structure.equivalent_block()
+    p, alpha, eta = block_parameters(eq)
+    name = type(structure).__name__
+    if exact:
+        model = f"exact equivalent block of the {name} (Table I of [003])"
+        coordinate = "phi (= theta of the exact equivalent block: kappa_1 = 1)"
+    else:
+        model = f"equivalent block of the {name}, kappa_1 = {eq.scale:.6g} (eq. 14-17 of [003])"
+        coordinate = f"theta of the equivalent block (phi = kappa_1 theta = {eq.scale:.6g} theta)"
+        warnings.warn(
+            f"method={method!r} runs the {model}, not the mechanism: "
+            f"max_rotation, theta and initial_rotation are the {coordinate}, and the block "
+            "only approximates the mechanism; use method='nonlinear' or 'auto' for the "
+            "mechanism, eq. (8) of [003]",
+            EquivalentBlockWarning,
+            stacklevel=3,
+        )
+    r = _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l)
+    r.info.update(structure_model=model, coordinate=coordinate)
+    return r
 
 
-def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
-    """The full mechanism, eq. (8) of [003], through the tabulated kernel."""
-    from ._structure_tables import structure_parameters, structure_table
+def _structure_parameters(structure):
+    """One direction's rocking parameters (the positive one of an asymmetric structure)."""
+    from ._structure_tables import structure_parameters
 
     params = structure_parameters(structure)
-    if isinstance(params, tuple):  # (positive, negative) of an asymmetric structure
-        params = params[0]
+    return params[0] if isinstance(params, tuple) else params
+
+
+def _mechanism(structure, motion, rtol, t_max, max_steps, x0, method="mechanism"):
+    """The full mechanism, eq. (8) of [003], through the tabulated kernel. An overturned
+    structure reports max_rotation = pi/2, as a block does (its history ends at
+    ``info["fall_rotation"]``, where the mechanism collapses or its kinematics end)."""
+    from ._structure_tables import structure_table
+
+    params = _structure_parameters(structure)
     if not params.restitution > 0:
         raise ValueError(f"{type(structure).__name__} needs a restitution (in (0, 1]) to rock")
     tab, fall = structure_table(structure)
@@ -305,10 +379,16 @@ def _mechanism(structure, motion, rtol, t_max, max_steps, x0):
         rtol,
         t_max,
         max_steps,
-        "mechanism",
+        method,
         x0,
         fall,
         tab,
     )
-    result.info["fall_rotation"] = fall
+    if result.overturned:
+        result = dataclasses.replace(result, max_rotation=FALL_ROTATION)
+    result.info.update(
+        fall_rotation=fall,
+        structure_model=f"mechanism of the {type(structure).__name__} (eq. 8 of [003])",
+        coordinate="phi (the mechanism's rotation)",
+    )
     return result

@@ -60,6 +60,13 @@ def _load_record(path: str, units: str) -> Record:
     return Record.from_csv(path, units=units)
 
 
+def engine_outputs(study: Study) -> tuple:
+    """The outputs of :func:`simulate_batch` that the study's outputs need (``auto`` runs the
+    linear model only where no output outside its bound is asked for)."""
+    names = {"max_rotation" if n == "max_rotation_ratio" else n for n in study.run.outputs}
+    return tuple(n for n in BATCH_OUTPUTS if n in names or n == "status")
+
+
 def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
     """Engine outputs for the rows ``idx`` of the chunk columns (may raise)."""
     mo = study.motion
@@ -70,6 +77,7 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
         method=study.run.method,
         rtol=study.run.rtol,
         max_steps=study.run.max_steps,
+        outputs=engine_outputs(study),
     )
     if mo.kind == "pulse":
         return simulate_batch(
@@ -164,7 +172,7 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
 
 def _rows_one_by_one(study, cols, base_dir, error):
     n = cols["sample"].size
-    raw = {k: np.zeros(n) for k in BATCH_OUTPUTS}
+    raw = {k: np.zeros(n) for k in engine_outputs(study)}
     failed = np.zeros(n, bool)
     for i in range(n):
         try:
