@@ -36,28 +36,69 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import reprlib
 import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    Tag,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from .distributions import Distribution
 
-Param = float | Distribution
+
+def _param_tag(value):
+    """Which member of a parameter union a TOML value is meant for (a table is a
+    distribution, anything else is meant as a number), so that an error names one."""
+    if isinstance(value, dict | BaseModel):
+        return "distribution"
+    if isinstance(value, str) and value == "housner":
+        return "housner"
+    return "number"
+
+
+_NUMBER = Annotated[float, Tag("number")]
+_DISTRIBUTION = Annotated[Distribution, Tag("distribution")]
+Param = Annotated[_NUMBER | _DISTRIBUTION, Discriminator(_param_tag)]
+_Restitution = Annotated[
+    _NUMBER | _DISTRIBUTION | Annotated[Literal["housner"], Tag("housner")],
+    Discriminator(_param_tag),
+]
+
+#: Housner's restitution 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], is > 0 only below this
+#: slenderness [rad] (sin^2 alpha = 2/3).
+HOUSNER_MAX_SLENDERNESS = math.asin(math.sqrt(2.0 / 3.0))
+
+
+class FieldError(ValueError):
+    """A problem of one field of a table, raised by a table's checks (so the message can
+    name ``table.field``)."""
+
+    def __init__(self, field, message):
+        self.field = field
+        super().__init__(message)
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: "1e-8" is not a number and true is not 1; inf and NaN are not accepted
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 def _check_positive(name, value):
     """A fixed parameter must be > 0; a distribution must have positive support."""
     if isinstance(value, (int, float)):
         if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be > 0, got {value}")
+            raise FieldError(name, f"must be > 0, got {value}")
     elif value is not None and not value.support_positive():
-        raise ValueError(f"{name}: the distribution must only give values > 0")
+        raise FieldError(name, "the distribution must only give values > 0")
 
 
 class BlockSpec(_Model):
@@ -66,7 +107,7 @@ class BlockSpec(_Model):
     kind: Literal["block"]
     half_diagonal: Param
     slenderness: Param
-    restitution: Param | Literal["housner"] = "housner"
+    restitution: _Restitution = "housner"
 
     @model_validator(mode="after")
     def _ranges(self):
@@ -74,6 +115,16 @@ class BlockSpec(_Model):
         _within("slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad")
         if self.restitution != "housner":
             _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
+        else:  # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
+            top = _largest(self.slenderness)
+            if not top < HOUSNER_MAX_SLENDERNESS:
+                raise FieldError(
+                    "slenderness",
+                    "Housner's restitution eta = 1 - 1.5 sin^2(alpha) (eq. 2.4 of [000]), "
+                    "derived from it, must lie in (0, 1], which needs slenderness < "
+                    f"{HOUSNER_MAX_SLENDERNESS:.4f} rad; slenderness reaches {top:g} rad. "
+                    "Narrow slenderness or give restitution",
+                )
         return self
 
 
@@ -111,12 +162,35 @@ class EquivalentBlockSpec(_Model):
         return self
 
 
+def _largest(value) -> float:
+    """The largest value a fixed parameter or a distribution can give."""
+    return float(value) if isinstance(value, (int, float)) else float(value.support()[1])
+
+
 def _within(name, value, low, high, label):
     if isinstance(value, (int, float)):
         if not (low < value < high):
-            raise ValueError(f"{name} must lie in {label}, got {value}")
+            raise FieldError(name, f"must lie in {label}, got {value}")
     elif not value.support_within(low, high):
-        raise ValueError(f"{name}: the distribution must only give values in {label}")
+        lo, hi = value.support()
+        raise FieldError(
+            name, f"the distribution must only give values in {label}; it spans {lo:g} to {hi:g}"
+        )
+
+
+def _nonzero(name, value):
+    """A fixed factor must be != 0; a distribution must not reach 0."""
+    if isinstance(value, (int, float)):
+        if value == 0:
+            raise FieldError(name, "must not be 0 (a record scaled by 0 is no motion)")
+        return
+    if value.dist == "choice" or (value.dist == "grid" and value.values is not None):
+        bad = 0.0 in value.values
+    else:
+        lo, hi = value.support()
+        bad = lo <= 0.0 <= hi
+    if bad:
+        raise FieldError(name, "the distribution must not give 0 (a record scaled by 0 is no motion)")
 
 
 class PulseSpec(_Model):
@@ -135,6 +209,13 @@ class PulseSpec(_Model):
     frequency_ratio: Param | None = None
     direction: Literal[1, -1] = 1
 
+    @field_validator("direction", mode="before")
+    @classmethod
+    def _not_a_boolean(cls, value):
+        if isinstance(value, bool):
+            raise ValueError(f"must be 1 or -1, not the boolean {str(value).lower()}")
+        return value
+
     @model_validator(mode="after")
     def _one_of_each(self):
         given = [x is not None for x in (self.amplitude, self.amplitude_ratio, self.amplitude_a)]
@@ -148,7 +229,7 @@ class PulseSpec(_Model):
         for name in ("amplitude", "amplitude_ratio", "amplitude_a", "period", "frequency_ratio"):
             _check_positive(name, getattr(self, name))
         if self.cycles != 1 and self.shape not in ("sine", "cosine"):
-            raise ValueError(f"cycles applies to sine and cosine pulses, not {self.shape}")
+            raise FieldError("cycles", f"applies to sine and cosine pulses, not {self.shape}")
         return self
 
 
@@ -162,12 +243,22 @@ class RecordSpec(_Model):
     scale: Param | None = None
     pga_ratio: Param | None = None
 
+    @field_validator("files")
+    @classmethod
+    def _paths(cls, files):
+        for i, name in enumerate(files):
+            if not name.strip() or "\0" in name:
+                raise ValueError(f"files[{i}] must be a path (not empty, no NUL character)")
+        return files
+
     @model_validator(mode="after")
     def _one(self):
         if (self.scale is None) == (self.pga_ratio is None):
             raise ValueError("give exactly one of scale or pga_ratio")
         if self.pga_ratio is not None:
             _check_positive("pga_ratio", self.pga_ratio)
+        else:
+            _nonzero("scale", self.scale)
         return self
 
 
@@ -184,7 +275,19 @@ class StochasticSpec(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("pga_ratio", self.pga_ratio)
+        if not self.ground_frequency * self.dt < 1.0:
+            raise FieldError(
+                "dt",
+                f"must resolve the ground frequency: ground_frequency * dt < 1, got "
+                f"{self.ground_frequency:g} rad/s * {self.dt:g} s",
+            )
+        if not self.duration >= 2.0 * self.dt:
+            raise FieldError("duration", f"must hold at least two steps dt = {self.dt:g} s")
         return self
+
+    def points(self) -> int:
+        """Samples of each synthesized record."""
+        return int(round(self.duration / self.dt)) + 1
 
 
 class SamplerSpec(_Model):
@@ -199,15 +302,15 @@ class SamplerSpec(_Model):
     def _n(self):
         if self.kind == "grid":
             if self.n is not None:
-                raise ValueError("a grid takes its size from the grid parameters; remove n")
+                raise FieldError("n", "a grid takes its size from the grid parameters; remove n")
         elif self.n is None:
-            raise ValueError(f"sampler {self.kind!r} needs n")
+            raise FieldError("n", f"sampler {self.kind!r} needs n")
         elif self.kind == "sobol" and self.n & (self.n - 1):
-            raise ValueError(f"sobol needs n = 2^k, got {self.n}")
+            raise FieldError("n", f"sobol needs n = 2^k, got {self.n}")
         if self.second_order and self.kind != "sobol":
-            raise ValueError("second_order applies to the sobol sampler only")
+            raise FieldError("second_order", "applies to the sobol sampler only")
         if self.replicates > 1 and self.kind not in ("monte_carlo", "lhs"):
-            raise ValueError("replicates applies to the monte_carlo and lhs samplers")
+            raise FieldError("replicates", "applies to the monte_carlo and lhs samplers")
         return self
 
 
@@ -234,7 +337,7 @@ class RunSpec(_Model):
     @model_validator(mode="after")
     def _unique(self):
         if len(set(self.outputs)) != len(self.outputs):
-            raise ValueError("outputs lists a name twice")
+            raise FieldError("outputs", "lists a name twice")
         return self
 
 
@@ -259,27 +362,44 @@ class Study(_Model):
         grid_params = [n for n, d in self.parameters().items() if d.dist == "grid"]
         if self.sampler.kind == "grid":
             if not grid_params:
-                raise ValueError("a grid sampler needs at least one parameter with dist = 'grid'")
+                raise FieldError(
+                    "sampler.kind", "a grid sampler needs at least one parameter with dist = 'grid'"
+                )
             others = [n for n, d in self.parameters().items() if d.dist != "grid"]
             if others:
-                raise ValueError(f"a grid sampler takes only grid parameters; {others} are not")
+                raise FieldError(
+                    "sampler.kind", f"a grid sampler takes only grid parameters; {others} are not"
+                )
         elif grid_params:
-            raise ValueError(f"{grid_params} use dist = 'grid', which needs sampler.kind = 'grid'")
+            raise FieldError(
+                "sampler.kind", f"{grid_params} use dist = 'grid', which needs kind = 'grid'"
+            )
         if self.sampler.kind == "sobol" and len(self.parameters()) < 2:
-            raise ValueError("sobol needs at least two distributed parameters")
+            raise FieldError("sampler.kind", "sobol needs at least two distributed parameters")
         if self.sampler.replicates > 1:
             mo, st = self.motion, self.structure
             if mo.kind != "pulse" or mo.amplitude is not None or mo.period is not None:
-                raise ValueError(
+                raise FieldError(
+                    "sampler.replicates",
                     "replicates need a pulse given by its groups: amplitude_ratio "
-                    "or amplitude_a, and frequency_ratio"
+                    "or amplitude_a, and frequency_ratio",
                 )
             if st.kind != "block" or st.restitution == "housner":
-                raise ValueError(
+                raise FieldError(
+                    "sampler.replicates",
                     "replicates need a block with a given restitution (Housner's "
-                    "depends on alpha, which would change the groups)"
+                    "depends on alpha, which would change the groups)",
                 )
         return self
+
+    def samples(self) -> int:
+        """Number of rows of the design (without making it)."""
+        s, params = self.sampler, self.parameters()
+        if s.kind == "grid":
+            return math.prod(d.size() for d in params.values())
+        if s.kind == "sobol":  # Saltelli layout: N (D + 2), or N (2 D + 2) with second order
+            return s.n * ((2 if s.second_order else 1) * len(params) + 2)
+        return s.n * s.replicates
 
     def group_parameters(self) -> list[str]:
         """Distributed parameters that are dimensionless groups (held fixed across the
@@ -306,11 +426,109 @@ class Study(_Model):
         return hashlib.sha256(self.normalized().encode()).hexdigest()
 
 
-def _format_errors(err: ValidationError) -> list[str]:
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = _SHORT.maxother = 40
+_SHORT.maxlevel = 2
+
+
+def _describe(value) -> str:
+    """A value as the user wrote it in TOML, shortened."""
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, str):
+        return f"the string {_SHORT.repr(value)}"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return "a list"
+    return _SHORT.repr(value)
+
+
+def _path(data, loc) -> list:
+    """The keys of ``loc`` that exist in the input (dropping pydantic's union tags and
+    validator names), as a list of keys and list indices."""
+    out, node = [], data
+    for key in loc:
+        if isinstance(node, dict) and key in node:
+            node = node[key]
+        elif isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node):
+            node = node[key]
+        else:
+            continue
+        out.append(key)
+    return out
+
+
+def _dotted(keys) -> str:
+    text = ""
+    for key in keys:
+        text += f"[{key}]" if isinstance(key, int) else (f".{key}" if text else str(key))
+    return text or "(top level)"
+
+
+_BOUNDS = {
+    "greater_than": ">",
+    "greater_than_equal": ">=",
+    "less_than": "<",
+    "less_than_equal": "<=",
+}
+
+
+def _sentence(e: dict, keys: list) -> str:
+    """One plain sentence for one pydantic error (``keys`` may be extended)."""
+    kind, ctx, value = e["type"], e.get("ctx", {}), e.get("input")
+    got = _describe(value)
+    if kind == "missing":
+        keys.append(e["loc"][-1])
+        return "is required"
+    if kind == "extra_forbidden":
+        return "is not a setting here (a typo?); `rockstudy schema` lists the settings"
+    if kind in ("float_type", "float_parsing"):
+        return f"must be a number, got {got}"
+    if kind in ("int_type", "int_parsing", "int_from_float"):
+        return f"must be an integer, got {got}"
+    if kind == "finite_number":
+        return f"must be a finite number, got {got}"
+    if kind == "string_type":
+        return f"must be a string, got {got}"
+    if kind == "bool_type":
+        return f"must be true or false, got {got}"
+    if kind == "list_type":
+        return f"must be a list, got {got}"
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        return f"must be a table, got {got}"
+    if kind == "literal_error":
+        return f"must be {ctx['expected']}, got {got}"
+    if kind in _BOUNDS:
+        bound = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
+        return f"must be {_BOUNDS[kind]} {bound}, got {got}"
+    if kind == "too_short":
+        return f"must hold at least {ctx['min_length']} item(s)"
+    if kind == "string_too_short":
+        return f"must hold at least {ctx['min_length']} character(s)"
+    if kind == "union_tag_invalid":
+        keys.append(ctx["discriminator"].strip("'"))
+        return f"must be one of {ctx['expected_tags']}, got {_describe(ctx['tag'])}"
+    if kind == "union_tag_not_found":
+        keys.append(ctx["discriminator"].strip("'"))
+        return "is required (it names the kind of table)"
+    if kind == "value_error":
+        error = ctx.get("error")
+        if isinstance(error, FieldError):
+            keys.extend(error.field.split("."))
+        return str(error)
+    return e["msg"]
+
+
+def _format_errors(err: ValidationError, data) -> list[str]:
     lines = []
     for e in err.errors():
-        loc = ".".join(str(x) for x in e["loc"] if not str(x).startswith("function-after"))
-        lines.append(f"{loc or '(top level)'}: {e['msg']}")
+        loc = e["loc"][:-1] if e["type"] == "missing" else e["loc"]
+        keys = _path(data, loc)
+        message = _sentence(e, keys)
+        line = f"{_dotted(keys)}: {message}"
+        if line not in lines:
+            lines.append(line)
     return lines
 
 
@@ -322,22 +540,76 @@ class StudyError(ValueError):
         super().__init__(f"{source}: {len(problems)} problem(s)\n  " + "\n  ".join(problems))
 
 
-def validate_text(text: str, source: str = "<study>") -> Study:
-    """Parse and validate a study from TOML text; raise :class:`StudyError` listing problems."""
+#: Deeper tables or lists than this are no study file (its deepest is motion.files[i]).
+MAX_DEPTH = 16
+
+
+def _depth(data) -> int:
+    """Nesting depth of parsed TOML (iterative: no recursion limit)."""
+    deepest, stack = 0, [(data, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if isinstance(node, dict | list):
+            deepest = max(deepest, depth)
+            if depth > MAX_DEPTH:
+                break
+            items = node.values() if isinstance(node, dict) else node
+            stack.extend((x, depth + 1) for x in items)
+    return deepest
+
+
+def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
+    """Parse and validate a study from TOML text; raise :class:`StudyError` listing problems.
+
+    Beyond the schema, a study that cannot produce a finite sample is refused before it runs:
+    its record files must be readable records (see :func:`record_path` for where they are
+    looked up; ``base_dir`` is the study file's folder, by default the working folder), and
+    its design and per-sample memory must fit this machine.
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise StudyError(source, [f"not valid TOML: {exc}"]) from None
+    except RecursionError:
+        raise StudyError(source, ["not a study file: its tables or lists nest too deeply"]) from None
+    if _depth(data) > MAX_DEPTH:
+        raise StudyError(
+            source, [f"not a study file: its tables or lists nest deeper than {MAX_DEPTH} levels"]
+        )
     try:
-        return Study.model_validate(data)
+        study = Study.model_validate(data)
     except ValidationError as exc:
-        raise StudyError(source, _format_errors(exc)) from None
+        raise StudyError(source, _format_errors(exc, data)) from None
+    from .feasibility import problems
+
+    found = problems(study, base_dir)
+    if found:
+        raise StudyError(source, found)
+    return study
+
+
+def record_path(name: str, base_dir=None) -> Path:
+    """Where a record file named in a study is read from.
+
+    An absolute path is used as written (that is the explicit choice). A relative path is
+    relative to ``base_dir``: the folder of the study file (:func:`load_study` and the command
+    line), or the working folder for a study given as text. Nothing else is tried.
+    """
+    path = Path(name)
+    if path.is_absolute():
+        return path
+    return Path(Path.cwd() if base_dir is None else base_dir) / path
 
 
 def load_study(path) -> Study:
-    """Read and validate a study file."""
+    """Read and validate a study file; its relative record paths are relative to its folder."""
     path = Path(path)
-    return validate_text(path.read_text(), str(path))
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+        raise StudyError(str(path), [f"cannot be read: {reason}"]) from None
+    return validate_text(text, str(path), base_dir=path.resolve().parent)
 
 
 def json_schema() -> dict:
