@@ -206,7 +206,7 @@ def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
     if info.st_size > max_bytes:
         raise ValueError(
             f"{path}: is {info.st_size / 2**20:.3g} MiB, more than the {max_bytes / 2**20:.3g} "
-            "MiB a record file may have"
+            "MiB allowed for it"
         )
     try:
         with open(path, "rb") as f:

@@ -36,6 +36,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 import reprlib
 import tomllib
 from pathlib import Path
@@ -540,6 +541,8 @@ class StudyError(ValueError):
         super().__init__(f"{source}: {len(problems)} problem(s)\n  " + "\n  ".join(problems))
 
 
+#: Largest study file read [bytes] (a study is a page of TOML).
+MAX_STUDY_BYTES = 2**20
 #: Deeper tables or lists than this are no study file (its deepest is motion.files[i]).
 MAX_DEPTH = 16
 
@@ -558,6 +561,19 @@ def _depth(data) -> int:
     return deepest
 
 
+_STRINGS_AND_COMMENTS = re.compile(
+    r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*'
+)
+_DOTTED = re.compile(r"[\w-]+(?:[ \t]*\.[ \t]*[\w-]+)+")
+
+
+def _dotted_depth(text: str) -> int:
+    """Most segments of a dotted key (``a.b.c``) in TOML text, found without parsing it:
+    tomllib takes minutes on a key of 10^5 segments."""
+    bare = _STRINGS_AND_COMMENTS.sub(lambda m: "" if m.group().startswith("#") else "q", text)
+    return max((m.group().count(".") + 1 for m in _DOTTED.finditer(bare)), default=0)
+
+
 def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     """Parse and validate a study from TOML text; raise :class:`StudyError` listing problems.
 
@@ -566,6 +582,10 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     looked up; ``base_dir`` is the study file's folder, by default the working folder), and
     its design and per-sample memory must fit this machine.
     """
+    if _dotted_depth(text) > MAX_DEPTH:
+        raise StudyError(
+            source, [f"not a study file: its keys nest deeper than {MAX_DEPTH} levels"]
+        )
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -603,12 +623,13 @@ def record_path(name: str, base_dir=None) -> Path:
 
 def load_study(path) -> Study:
     """Read and validate a study file; its relative record paths are relative to its folder."""
+    from ..motions.records import read_text_file
+
     path = Path(path)
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
-        raise StudyError(str(path), [f"cannot be read: {reason}"]) from None
+        text = read_text_file(path, MAX_STUDY_BYTES)
+    except (OSError, ValueError) as exc:
+        raise StudyError(str(path), [str(exc)]) from None
     return validate_text(text, str(path), base_dir=path.resolve().parent)
 
 
