@@ -61,7 +61,9 @@ def toml_key(k):
 
 
 def to_toml(study: dict) -> str:
-    lines = [f"{toml_key(k)} = {toml_value(v)}" for k, v in study.items() if not isinstance(v, dict)]
+    lines = [
+        f"{toml_key(k)} = {toml_value(v)}" for k, v in study.items() if not isinstance(v, dict)
+    ]
     for k, v in study.items():
         if isinstance(v, dict):
             lines.append(f"\n[{toml_key(k)}]")
@@ -77,9 +79,11 @@ def write_records(folder: Path):
     folder.mkdir()
     t = np.arange(300) * 0.01
     a = 0.3 * np.sin(2 * np.pi * 1.5 * t) * np.exp(-0.5 * t)
-    (folder / "good.csv").write_text("".join(f"{x:.17g}, {y:.17g}\n" for x, y in zip(t, a)))
+    (folder / "good.csv").write_text(
+        "".join(f"{x:.17g}, {y:.17g}\n" for x, y in zip(t, a, strict=True))
+    )
     body = "\n".join(" ".join(f"{x:.6E}" for x in a[i : i + 5]) for i in range(0, a.size, 5))
-    head = "PEER NGA STRONG MOTION DATABASE RECORD\nsynthetic\nACCELERATION TIME SERIES IN UNITS OF G\n"
+    head = "PEER NGA RECORD\nsynthetic\nACCELERATION TIME SERIES IN UNITS OF G\n"
     (folder / "good.AT2").write_text(head + f"NPTS= {a.size}, DT= .0100 SEC\n" + body + "\n")
     bad = {
         "empty.csv": "",
@@ -124,7 +128,13 @@ class Gen:
         if kind == "loguniform" and positive:
             return {"dist": "loguniform", "low": lo, "high": hi}
         if kind == "truncnormal":
-            return {"dist": "truncnormal", "mean": (lo + hi) / 2, "sigma": hi - lo, "low": lo, "high": hi}
+            return {
+                "dist": "truncnormal",
+                "mean": (lo + hi) / 2,
+                "sigma": hi - lo,
+                "low": lo,
+                "high": hi,
+            }
         if kind == "triangular":
             return {"dist": "triangular", "low": lo, "mode": r.uniform(lo, hi), "high": hi}
         return {"dist": "choice", "values": [round(r.uniform(lo, hi), 4) for _ in range(3)]}
@@ -133,7 +143,11 @@ class Gen:
         r = self.r
         kind = r.choice(["block", "block", "rocking_wall", "equivalent_block"])
         if kind == "block":
-            s = {"kind": kind, "half_diagonal": self.dist(0.3, 5.0), "slenderness": self.dist(0.05, 0.4)}
+            s = {
+                "kind": kind,
+                "half_diagonal": self.dist(0.3, 5.0),
+                "slenderness": self.dist(0.05, 0.4),
+            }
             if r.random() < 0.4:
                 s["restitution"] = self.dist(0.6, 0.95)
             elif r.random() < 0.3:
@@ -206,8 +220,16 @@ class Gen:
             sampler["n"] = r.choice([2, 4])
         else:
             sampler["n"] = r.randint(3, 16)
-        outputs = ["max_rotation", "max_rotation_ratio", "overturned", "n_impacts",
-                   "overturn_time", "first_impact_time", "steps", "model"]
+        outputs = [
+            "max_rotation",
+            "max_rotation_ratio",
+            "overturned",
+            "n_impacts",
+            "overturn_time",
+            "first_impact_time",
+            "steps",
+            "model",
+        ]
         method = r.choice(["nonlinear", "nonlinear", "linear", "auto"])
         run = {
             "method": method,
@@ -239,7 +261,11 @@ def param_paths(study):
     out = []
     for sec in ("structure", "motion"):
         for k, v in study[sec].items():
-            if isinstance(v, float | int) and not isinstance(v, bool) and k not in ("cycles", "direction"):
+            if (
+                isinstance(v, float | int)
+                and not isinstance(v, bool)
+                and k not in ("cycles", "direction")
+            ):
                 out.append((sec, k, None))
             elif isinstance(v, dict):
                 out += [(sec, k, b) for b, x in v.items() if isinstance(x, float)]
@@ -250,8 +276,24 @@ def mutate(g: Gen, study: dict, bad_records):
     """A broken (or hostile but valid) variant: (text or dict, category, field it must name)."""
     r = g.r
     cat = r.choice(
-        ["typo", "type", "type", "nonfinite", "nonfinite", "range", "housner", "records",
-         "records", "huge", "nesting", "hostile", "hostile", "structural", "garbage"]
+        [
+            "typo",
+            "type",
+            "type",
+            "nonfinite",
+            "nonfinite",
+            "range",
+            "housner",
+            "records",
+            "records",
+            "huge",
+            "nesting",
+            "hostile",
+            "hostile",
+            "structural",
+            "garbage",
+            "solver",
+        ]
     )
     sec, key, bound = r.choice(param_paths(study))
     where = f"{sec}.{key}" + (f".{bound}" if bound else "")
@@ -335,6 +377,13 @@ def mutate(g: Gen, study: dict, bad_records):
         }
         _ungrid(study)
         return study, cat, "motion.duration"
+    if cat == "solver":  # settings under which no sample can finish
+        if study["motion"]["kind"] == "pulse" and r.random() < 0.5:
+            study["motion"]["shape"] = "sine"
+            study["motion"]["cycles"] = r.choice([10**4, 10**6])
+            return study, cat, "motion.cycles"
+        study["run"]["rtol"] = r.choice([1e-15, 1e-300])
+        return study, cat, "run.rtol"
     if cat == "nesting":
         depth = r.choice([50, 2000, 100_000])
         text = to_toml(study) + r.choice(
@@ -410,7 +459,9 @@ def run_in_process(study, base_dir):
         if bad.any():
             problems.append(f"{int(bad.sum())} failed: {set(out['error'][bad].tolist())}")
         for name in study.run.outputs:
-            if name in ("max_rotation", "max_rotation_ratio") and not np.all(np.isfinite(out[name])):
+            if name in ("max_rotation", "max_rotation_ratio") and not np.all(
+                np.isfinite(out[name])
+            ):
                 problems.append(f"{name} not finite")
     for name, var in design.data_vars.items():
         if var.dtype.kind == "f" and not np.all(np.isfinite(var.values)):
@@ -471,8 +522,10 @@ def test_fuzz_each_file_is_refused_by_field_or_runs_clean(corpus, capsys):
             if field is not None:
                 anything_else.append(f"{path.name}: accepted although it breaks {field}")
     with capsys.disabled():
-        print(f"\nfuzz of {len(files)} study files: {dict(counts)}, anything else: "
-              f"{len(anything_else)}; by category: {dict(sorted(by_category.items()))}")
+        print(
+            f"\nfuzz of {len(files)} study files: {dict(counts)}, anything else: "
+            f"{len(anything_else)}; by category: {dict(sorted(by_category.items()))}"
+        )
     assert not anything_else, "\n".join(anything_else)
     assert len(files) >= 200 and counts["refused"] >= 50 and counts["succeeded"] >= 50
 

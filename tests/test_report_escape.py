@@ -16,9 +16,9 @@ from rockstudy.study.report import make_report
 MARK = "document.body.setAttribute('data-pwned','1')"
 HOSTILE = [
     f"<script>{MARK}</script>",
-    f"<img src=x onerror=\"{MARK}\">",
+    f'<img src=x onerror="{MARK}">',
     "<script>alert(document.domain)</script>",
-    f"'><svg onload=\"{MARK}\">",
+    f'\'><svg onload="{MARK}">',
 ]
 
 STUDY = """
@@ -100,6 +100,6 @@ def test_hostile_strings_run_no_script(hostile_cube, tmp_path, versions):
     dom = dump_dom(page)
     body = re.search(r"<body[^>]*>", dom).group()
     assert "data-pwned" not in body, body
-    assert "<svg" not in dom and "<img src=\"x\"" not in dom
+    assert "<svg" not in dom and '<img src="x"' not in dom
     assert "figures rendered" in dom  # the page's own script did run
     assert "&lt;script&gt;" in dom  # the hostile study name shows as text

@@ -60,11 +60,14 @@ files = [{files}]
 {scaling}
 """
 
-STOCHASTIC = PULSE.split("[motion]")[0] + """
+STOCHASTIC = (
+    PULSE.split("[motion]")[0]
+    + """
 [motion]
 kind = "stochastic"
 pga_ratio = { dist = "uniform", low = 0.8, high = 2.5 }
 """
+)
 
 PLUMBING = ("tagged-union", "function-after", "Input should", "Value error", "Extra inputs")
 
@@ -84,7 +87,9 @@ def record_study(files, scaling="pga_ratio = 2.0"):
 
 
 def write_csv(path, t, a):
-    path.write_text("# t [s], a [g]\n" + "".join(f"{x!r}, {y!r}\n" for x, y in zip(t, a)))
+    path.write_text(
+        "# t [s], a [g]\n" + "".join(f"{x!r}, {y!r}\n" for x, y in zip(t, a, strict=True))
+    )
     return path
 
 
@@ -142,7 +147,7 @@ def test_block_from_dimensions_names_the_slenderness():
         (("seed = 7", "seed = true"), "seed"),
         (("n = 50", "n = 50.0"), "sampler.n"),
         (("n = 50", "n = 1e12"), "sampler.n"),
-        (("shape = \"sine\"", "shape = \"sine\"\ndirection = true"), "motion.direction"),
+        (('shape = "sine"', 'shape = "sine"\ndirection = true'), "motion.direction"),
         (("chunk_size = 100", 'chunk_size = "100"'), "chunk_size"),
     ],
 )
@@ -230,7 +235,9 @@ def test_every_value_the_samplers_draw_is_finite_at_the_limits():
 # ------------------------------------------------------------------ records
 
 
-@pytest.mark.parametrize("scale", ["nan", "inf", "0.0", '{ dist = "uniform", low = -1.0, high = 1.0 }'])
+@pytest.mark.parametrize(
+    "scale", ["nan", "inf", "0.0", '{ dist = "uniform", low = -1.0, high = 1.0 }']
+)
 def test_record_scale_must_give_a_motion(tmp_path, scale):
     rec = write_csv(tmp_path / "r.csv", [0.0, 0.01, 0.02], [0.0, 0.1, -0.1])
     message = refused(record_study([rec], f"scale = {scale}"))
@@ -376,3 +383,17 @@ def test_validate_refuses_a_study_file_that_is_not_a_file(tmp_path, capsys):
     err = capsys.readouterr().err
     assert str(tmp_path) in err and "/dev/zero" in err
     assert os.path.isdir(tmp_path)
+
+
+@pytest.mark.parametrize("rtol", ["1e-15", "1e-300"])
+def test_rtol_beyond_double_precision_is_refused(rtol):
+    message = refused(PULSE.replace("rtol = 1e-8", f"rtol = {rtol}"))
+    assert "run.rtol: must be >= 2.2e-14" in message
+
+
+def test_pulse_cycles_beyond_max_steps_are_refused():
+    """10^6 cycles (each taking ~14 to 322 solver steps) cannot finish in 10^6 steps."""
+    text = PULSE.replace('shape = "sine"', 'shape = "sine"\ncycles = 1000000')
+    message = refused(text)
+    assert "motion.cycles" in message and "run.max_steps = 1000000" in message
+    validate_text(PULSE.replace('shape = "sine"', 'shape = "sine"\ncycles = 1000'))
