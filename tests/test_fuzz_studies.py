@@ -18,6 +18,7 @@ import sys
 from collections import Counter
 from contextlib import contextmanager
 from pathlib import Path
+from typing import get_args
 
 import numpy as np
 import pytest
@@ -25,6 +26,7 @@ import pytest
 from rockstudy.study import StudyError, load_study
 from rockstudy.study.evaluate import STATUS_OK, evaluate_chunk
 from rockstudy.study.sampling import make_design
+from rockstudy.study.spec import Output
 
 N_FILES = 240
 SEED = 20261125
@@ -220,16 +222,7 @@ class Gen:
             sampler["n"] = r.choice([2, 4])
         else:
             sampler["n"] = r.randint(3, 16)
-        outputs = [
-            "max_rotation",
-            "max_rotation_ratio",
-            "overturned",
-            "n_impacts",
-            "overturn_time",
-            "first_impact_time",
-            "steps",
-            "model",
-        ]
+        outputs = list(get_args(Output))
         method = r.choice(["nonlinear", "nonlinear", "linear", "auto"])
         run = {
             "method": method,

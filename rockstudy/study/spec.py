@@ -512,6 +512,23 @@ _BOUNDS = {
 }
 
 
+#: What a value of the wrong type must be, by pydantic error type.
+_MUST_BE = {
+    "float_type": "a number",
+    "float_parsing": "a number",
+    "int_type": "an integer",
+    "int_parsing": "an integer",
+    "int_from_float": "an integer",
+    "finite_number": "a finite number",
+    "string_type": "a string",
+    "bool_type": "true or false",
+    "list_type": "a list",
+    "model_type": "a table",
+    "model_attributes_type": "a table",
+    "dict_type": "a table",
+}
+
+
 def _sentence(e: dict, keys: list) -> str:
     """One plain sentence for one pydantic error (``keys`` may be extended)."""
     kind, ctx, value = e["type"], e.get("ctx", {}), e.get("input")
@@ -521,20 +538,8 @@ def _sentence(e: dict, keys: list) -> str:
         return "is required"
     if kind == "extra_forbidden":
         return "is not a setting here (a typo?); `rockstudy schema` lists the settings"
-    if kind in ("float_type", "float_parsing"):
-        return f"must be a number, got {got}"
-    if kind in ("int_type", "int_parsing", "int_from_float"):
-        return f"must be an integer, got {got}"
-    if kind == "finite_number":
-        return f"must be a finite number, got {got}"
-    if kind == "string_type":
-        return f"must be a string, got {got}"
-    if kind == "bool_type":
-        return f"must be true or false, got {got}"
-    if kind == "list_type":
-        return f"must be a list, got {got}"
-    if kind in ("model_type", "model_attributes_type", "dict_type"):
-        return f"must be a table, got {got}"
+    if kind in _MUST_BE:
+        return f"must be {_MUST_BE[kind]}, got {got}"
     if kind == "literal_error":
         return f"must be {ctx['expected']}, got {got}"
     if kind in _BOUNDS:
