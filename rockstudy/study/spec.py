@@ -2,7 +2,11 @@
 
 A study names a structure, a motion, a sampler and what to compute. Every parameter is either a
 number or a distribution (a table with ``dist = ...``). Unknown keys are errors, so a typo
-never passes silently; :func:`validate_text` reports every problem with the field it is in.
+never passes silently; types are strict (``"1e-8"`` is not a number, ``true`` is not 1), only
+finite numbers are accepted, and derived quantities (Housner's restitution) are checked over
+the whole support of the distributions. :func:`validate_text` reports every problem as one
+sentence naming its field, then checks what the study needs of this machine and its record
+files (:mod:`.feasibility`), so that a study that cannot succeed is refused before it runs.
 
 Example (``studies/quickstart.toml``)::
 
