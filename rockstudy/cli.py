@@ -71,8 +71,8 @@ def _validate(args) -> int:
         try:
             study = load_study(path)
             print(
-                f"{path}: ok ({study.sampler.kind}, {len(study.parameters())} distributed "
-                f"parameters, sha256 {study.sha256()[:12]})"
+                f"{path}: ok ({study.sampler.kind}, {study.samples()} samples, "
+                f"{len(study.parameters())} distributed parameters, sha256 {study.sha256()[:12]})"
             )
         except StudyError as exc:
             print(exc, file=sys.stderr)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -14,6 +15,9 @@ from ..constants import G
 from . import _kernels, intensity
 from .base import Motion
 from .pulse_extraction import VelocityPulse, extract_pulse
+
+#: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
+MAX_RECORD_BYTES = 64 * 2**20
 
 _UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
 
@@ -270,24 +274,27 @@ class Record(Motion):
         of the vertical component's ``.AT2`` file, on the same samples.
         """
         path = Path(path)
-        lines = path.read_text().splitlines()
+        lines = read_text_file(path).splitlines()
         if len(lines) < 5:
             raise ValueError(f"{path}: too short to be a PEER .AT2 file")
         header = lines[3]
         m = re.search(r"NPTS\s*=\s*(\d+)\s*,\s*DT\s*=\s*([-+0-9.Ee]+)", header, re.I)
-        if m:
-            npts, dt = int(m.group(1)), float(m.group(2))
-        else:
+        if not m:
             m = re.match(r"\s*(\d+)\s+([-+0-9.Ee]+)", header)
-            if not m:
-                raise ValueError(f"{path}: line 4 does not give NPTS and DT: {header.strip()!r}")
+        try:
             npts, dt = int(m.group(1)), float(m.group(2))
-        values = np.array(" ".join(lines[4:]).split(), dtype=float)
-        if values.size != npts:
-            raise ValueError(f"{path}: header says NPTS={npts} but {values.size} values follow")
+        except (AttributeError, ValueError):
+            raise ValueError(f"{path}: line 4 does not give NPTS and DT") from None
         if "UNITS OF G" not in lines[2].upper():
-            raise ValueError(f"{path}: line 3 must state 'UNITS OF G', got {lines[2].strip()!r}")
-        record = cls(values * G, dt=dt, name=path.stem)
+            raise ValueError(f"{path}: line 3 must state 'UNITS OF G'")
+        tokens = " ".join(lines[4:]).split()
+        if len(tokens) != npts:
+            raise ValueError(f"{path}: header says NPTS={npts} but {len(tokens)} values follow")
+        try:
+            values = np.array(tokens, dtype=float)
+        except ValueError:
+            raise ValueError(f"{path}: the values after line 4 are not all numbers") from None
+        record = _build(path, lambda: cls(values * G, dt=dt, name=path.stem))
         return (
             record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
         )
@@ -313,17 +320,99 @@ class Record(Motion):
         """
         factor = _unit_factor(units)
         path = Path(path)
-        text = path.read_text()
+        text = read_text_file(path)
         if delimiter is None:
             text = text.replace(",", " ")
         rows = [r for r in text.splitlines() if r.strip() and not r.lstrip().startswith("#")]
         names = 1 if rows and re.match(r"\s*[A-Za-z_\"']", rows[0]) else 0  # a header row
-        data = np.loadtxt(rows[names:], delimiter=delimiter, ndmin=2)
+        try:
+            data = np.loadtxt(rows[names:], comments="#", delimiter=delimiter, ndmin=2)
+        except ValueError:  # its message quotes the file: name the line instead
+            raise ValueError(
+                f"{path}: line {_first_bad_line(text.splitlines(), delimiter, names)} is not "
+                "two numbers (time, acceleration)"
+            ) from None
         if data.shape[1] != 2:
             raise ValueError(
                 f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}"
             )
-        record = cls(data[:, 1] * factor, time=data[:, 0], name=path.stem)
+        record = _build(path, lambda: cls(data[:, 1] * factor, time=data[:, 0], name=path.stem))
         if vertical is None:
             return record
         return record._with_vertical(cls.from_csv(vertical, units, delimiter), vertical)
+
+
+def _first_bad_line(lines, delimiter, skip_names=0) -> int:
+    """1-based number of the first data line that is not two numbers (0 if none is); the
+    first ``skip_names`` non-blank rows (column names) are not data."""
+    for i, line in enumerate(lines, 1):
+        body = line.split("#", 1)[0]
+        if skip_names and body.strip():
+            skip_names -= 1
+            continue
+        fields = body.split(delimiter) if delimiter else body.split()
+        if not body.strip():
+            continue
+        try:
+            values = [float(x) for x in fields]
+        except ValueError:
+            return i
+        if len(values) != 2:
+            return i
+    return 0
+
+
+def _build(path, make) -> Record:
+    """Make the record, naming the file in any complaint about its samples."""
+    try:
+        return make()
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
+
+
+def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
+    """The text of a regular file of at most ``max_bytes``, refusing anything else.
+
+    Folders, devices, pipes and pseudo-files (``/proc``) are refused before reading, and at
+    most ``max_bytes + 1`` bytes are ever read. Messages name the file and the reason, never
+    its contents.
+    """
+    path = Path(path)
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ValueError(f"{path}: is a folder, not a file")
+    if not stat.S_ISREG(info.st_mode):
+        raise ValueError(f"{path}: is not a regular file (a device, pipe or socket)")
+    if info.st_size == 0:
+        raise ValueError(f"{path}: is empty (or a pseudo-file of the system)")
+    if info.st_size > max_bytes:
+        raise ValueError(
+            f"{path}: is {info.st_size / 2**20:.3g} MiB, more than the {max_bytes / 2**20:.3g} "
+            "MiB allowed for it"
+        )
+    try:
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
+    if len(data) != info.st_size:
+        raise ValueError(f"{path}: changed size while it was read")
+    if b"\0" in data:
+        raise ValueError(f"{path}: holds binary data, not text")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")  # old headers; the numbers are ASCII either way
+
+
+def read_record(path, units: str = "g") -> Record:
+    """Read a record file: a PEER ``.AT2`` file (by its suffix), else two columns of time [s]
+    and acceleration in ``units``."""
+    if str(path).lower().endswith(".at2"):
+        return Record.from_at2(path)
+    return Record.from_csv(path, units=units)

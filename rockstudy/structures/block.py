@@ -69,8 +69,17 @@ class Block:
         alpha = _validate.in_open_interval(
             "slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad"
         )
-        eta = restitution_housner(alpha) if self.restitution is None else self.restitution
-        eta = _validate.restitution(eta)
+        if self.restitution is None:
+            eta = restitution_housner(alpha)
+            if not eta > 0.0:  # sin^2(alpha) >= 2/3: width / height >= sqrt(2)
+                raise ValueError(
+                    f"slenderness alpha = {alpha:.4g} rad gives Housner's restitution "
+                    f"1 - 1.5 sin^2(alpha) = {eta:.3g} (eq. 2.4 of [000]), which must lie in "
+                    "(0, 1]: it needs alpha < 0.9553 rad (width / height < sqrt(2)); give "
+                    "restitution for a squatter block"
+                )
+        else:
+            eta = _validate.restitution(self.restitution)
         object.__setattr__(self, "half_diagonal", R)
         object.__setattr__(self, "slenderness", alpha)
         object.__setattr__(self, "restitution", eta)

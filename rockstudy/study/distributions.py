@@ -1,8 +1,10 @@
 """Parameter distributions of study files: each maps uniform numbers in [0, 1) to values.
 
-Every distribution validates its own bounds (``low < high``, ``sigma > 0``, ...) and knows its
-support, so the structure and motion specs can reject, say, a slenderness that could be
-negative.
+Every distribution validates its own bounds (``low < high``, ``sigma > 0``, ...), finite numbers
+only, and knows its support, so the structure and motion specs can reject, say, a slenderness
+that could be negative. A distribution whose values could overflow (a span ``high - low`` or a
+ratio ``high / low`` beyond the largest float, a lognormal tail at infinity) is refused: every
+value the samplers can draw is finite.
 """
 
 from __future__ import annotations
@@ -14,9 +16,23 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from scipy import stats
 
+#: The extreme probabilities a sampler can draw (Monte Carlo draws in [0, 1), Sobol' is clipped
+#: below 1): the values there must be finite.
+_U_EXTREMES = np.array([2.0**-53, 0.5, 1.0 - 2.0**-53])
+
 
 class _Dist(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+    def _finite_tails(self):
+        """Raise unless the values at the extreme probabilities are finite numbers."""
+        with np.errstate(all="ignore"):
+            values = np.asarray(self.ppf(_U_EXTREMES), dtype=float)
+        if not np.all(np.isfinite(values)):
+            raise ValueError(
+                f"{self.dist} gives values beyond the largest float in its tails; "
+                "narrow it so that every sample is a finite number"
+            )
 
     def support(self) -> tuple[float, float]:
         raise NotImplementedError
@@ -42,6 +58,7 @@ class Uniform(_Dist):
     def _bounds(self):
         if not self.low < self.high:
             raise ValueError(f"uniform needs low < high, got low={self.low}, high={self.high}")
+        _finite_span("uniform", self.low, self.high)
         return self
 
     def support(self):
@@ -60,6 +77,10 @@ class LogUniform(_Dist):
     def _bounds(self):
         if not self.low < self.high:
             raise ValueError(f"loguniform needs 0 < low < high, got {self.low}, {self.high}")
+        if not math.isfinite(self.high / self.low):
+            raise ValueError(
+                f"loguniform needs a finite ratio high / low, got {self.high} / {self.low}"
+            )
         return self
 
     def support(self):
@@ -73,6 +94,11 @@ class Normal(_Dist):
     dist: Literal["normal"]
     mean: float
     sigma: float = Field(gt=0)
+
+    @model_validator(mode="after")
+    def _tails(self):
+        self._finite_tails()
+        return self
 
     def support(self):
         return -math.inf, math.inf
@@ -92,6 +118,8 @@ class TruncNormal(_Dist):
     def _bounds(self):
         if not self.low < self.high:
             raise ValueError(f"truncnormal needs low < high, got {self.low}, {self.high}")
+        _finite_span("truncnormal", self.low, self.high)
+        self._finite_tails()
         return self
 
     def support(self):
@@ -108,6 +136,17 @@ class LogNormal(_Dist):
     dist: Literal["lognormal"]
     median: float = Field(gt=0)
     sigma: float = Field(gt=0)
+
+    @model_validator(mode="after")
+    def _tails(self):
+        self._finite_tails()
+        with np.errstate(all="ignore"):
+            smallest = float(self.ppf(_U_EXTREMES[0]))
+        if not smallest > 0:
+            raise ValueError(
+                "lognormal gives values that round to 0 in its lower tail; use a smaller sigma"
+            )
+        return self
 
     def support(self):
         return 0.0, math.inf
@@ -129,6 +168,7 @@ class Triangular(_Dist):
     def _bounds(self):
         if not (self.low <= self.mode <= self.high and self.low < self.high):
             raise ValueError("triangular needs low <= mode <= high and low < high")
+        _finite_span("triangular", self.low, self.high)
         return self
 
     def support(self):
@@ -153,6 +193,8 @@ class Choice(_Dist):
                 raise ValueError("choice needs as many weights as values")
             if any(not (w > 0) for w in self.weights):
                 raise ValueError("choice weights must be > 0")
+            if not math.isfinite(math.fsum(self.weights)):
+                raise ValueError("choice weights must have a finite sum")
         return self
 
     def support(self):
@@ -190,7 +232,13 @@ class Grid(_Dist):
             raise ValueError(f"grid needs low < high, got {self.low}, {self.high}")
         elif self.scale == "log" and not self.low > 0:
             raise ValueError("a log grid needs low > 0")
+        else:
+            _finite_span("grid", self.low, self.high)
         return self
+
+    def size(self) -> int:
+        """Number of grid points (without making them)."""
+        return len(self.values) if self.values is not None else self.n
 
     def points(self) -> np.ndarray:
         if self.values is not None:
@@ -200,12 +248,14 @@ class Grid(_Dist):
         return np.linspace(self.low, self.high, self.n)
 
     def support(self):
-        pts = self.points()
-        return float(pts.min()), float(pts.max())
+        if self.values is None:  # the end points, without making a grid of any size
+            return self.low, self.high
+        return min(self.values), max(self.values)
 
-    def support_within(self, low, high):
-        pts = self.points()
-        return bool(np.all((pts > low) & (pts < high)))
+
+def _finite_span(name, low, high):
+    if not math.isfinite(high - low):
+        raise ValueError(f"{name} needs a finite span high - low, got {low} to {high}")
 
 
 Distribution = Annotated[

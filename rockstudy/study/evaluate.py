@@ -18,7 +18,8 @@ from ..constants import G
 from ..dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ..dynamics.batch import simulate_batch
 from ..motions import Record, stochastic_record
-from .spec import Study
+from ..motions.records import read_record
+from .spec import Study, record_path
 
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
 ERROR_WIDTH = 100
@@ -43,21 +44,13 @@ OUTPUTS = {
 
 
 def resolve_file(name: str, base_dir) -> Path:
-    """A record path as written in a study: absolute, relative to the working directory, or
-    relative to the study file's directory."""
-    path = Path(name)
-    if path.is_absolute() or path.exists():
-        return path
-    if base_dir is not None and (Path(base_dir) / path).exists():
-        return Path(base_dir) / path
-    raise FileNotFoundError(f"motion.files: {name!r} not found (from {Path.cwd()} or {base_dir})")
+    """A record path as written in a study: see :func:`rockstudy.study.spec.record_path`."""
+    return record_path(name, base_dir)
 
 
 @lru_cache(maxsize=32)
 def _load_record(path: str, units: str) -> Record:
-    if path.lower().endswith(".at2"):
-        return Record.from_at2(path)
-    return Record.from_csv(path, units=units)
+    return read_record(path, units)
 
 
 def engine_outputs(study: Study) -> tuple:

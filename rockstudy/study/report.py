@@ -336,6 +336,16 @@ def _eta_law(page, surv):
     page.figure(fig, "eta_law", "The eta^2 law against the solver")
 
 
+def _version(versions) -> str:
+    """rockstudy's version from a cube's ``versions`` attribute (JSON), as plain text: the
+    attribute comes from a file that may have been made or edited by anyone."""
+    try:
+        value = json.loads(versions)
+    except (TypeError, ValueError):
+        return "?"
+    return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
+
+
 def make_report(result, out=None) -> Path:
     """Write the report of a result cube into ``out`` (default: RESULT's name + '_report')."""
     result = Path(result)
@@ -358,10 +368,9 @@ def make_report(result, out=None) -> Path:
     if study.sampler.replicates > 1 and "overturned" in ds:
         page.heading("Self-similarity")
         _similarity(page, ds, study)
-    versions = json.loads(ds.attrs.get("versions", "{}"))
     meta = (
         f"<p>{html.escape(study.description)}</p><p class='cap'>study sha256 "
-        f"{ds.attrs.get('study_sha256', '')[:16]}, seed {study.seed}, rockstudy "
-        f"{versions.get('rockstudy', '?')}</p>"
+        f"{html.escape(str(ds.attrs.get('study_sha256', ''))[:16])}, seed {study.seed}, "
+        f"rockstudy {html.escape(_version(ds.attrs.get('versions')))}</p>"
     )
     return page.write(f"rockstudy report: {study.name}", meta)
