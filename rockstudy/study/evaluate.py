@@ -19,7 +19,8 @@ from ..dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ..dynamics.batch import simulate_batch
 from ..motions import Record, stochastic_record
 from ..motions.records import read_record
-from .spec import Study, record_path
+from .feasibility import record_path
+from .spec import Study
 
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
 ERROR_WIDTH = 100
@@ -44,7 +45,7 @@ OUTPUTS = {
 
 
 def resolve_file(name: str, base_dir) -> Path:
-    """A record path as written in a study: see :func:`rockstudy.study.spec.record_path`."""
+    """A record path as written in a study: see :func:`rockstudy.study.feasibility.record_path`."""
     return record_path(name, base_dir)
 
 

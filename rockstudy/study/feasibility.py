@@ -8,9 +8,9 @@ problem is one sentence naming the field, the quantity and what is allowed.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 from ..motions.records import read_record
-from .spec import Study, record_path
 
 GIB = 2.0**30
 #: Bytes per design row: the ~20 design columns, the unit samples and the outputs (8 bytes
@@ -27,13 +27,13 @@ def machine_memory() -> float:
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
-def design_bytes(study: Study) -> float:
+def design_bytes(study) -> float:
     """Estimated memory of the whole design and its result columns [bytes]."""
     per_row = _ROW_BYTES + 8 * (2 * len(study.parameters()) + len(study.run.outputs))
     return float(study.samples()) * per_row
 
 
-def problems(study: Study, base_dir=None) -> list[str]:
+def problems(study, base_dir=None) -> list[str]:
     """Why ``study`` cannot produce a finite result for every sample here (empty if it can)."""
     found = []
     memory = machine_memory()
@@ -90,3 +90,16 @@ def _too_long(field, points, max_steps) -> str:
         "the solver ends a step on every record sample while the block rocks, so rocking "
         "samples would fail. Shorten the record or raise run.max_steps"
     )
+
+
+def record_path(name: str, base_dir=None) -> Path:
+    """Where a record file named in a study is read from.
+
+    An absolute path is used as written (that is the explicit choice). A relative path is
+    relative to ``base_dir``: the folder of the study file (:func:`load_study` and the command
+    line), or the working folder for a study given as text. Nothing else is tried.
+    """
+    path = Path(name)
+    if path.is_absolute():
+        return path
+    return Path(Path.cwd() if base_dir is None else base_dir) / path

@@ -58,6 +58,7 @@ from pydantic import (
 )
 
 from .distributions import Distribution
+from .feasibility import problems
 
 
 def _param_tag(value):
@@ -246,7 +247,8 @@ class RecordSpec(_Model):
     ``pga_ratio`` x g tan(alpha).
 
     A file path is absolute as written, or relative to the study file's folder (never to the
-    working folder; see :func:`record_path`). Only regular text files up to 64 MiB are read.
+    working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
+    are read.
     """
 
     kind: Literal["record"]
@@ -624,8 +626,8 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     """Parse and validate a study from TOML text; raise :class:`StudyError` listing problems.
 
     Beyond the schema, a study that cannot produce a finite sample is refused before it runs:
-    its record files must be readable records (see :func:`record_path` for where they are
-    looked up; ``base_dir`` is the study file's folder, by default the working folder), and
+    its record files must be readable records (see :func:`.feasibility.record_path` for where
+    they are looked up; ``base_dir`` is the study file's folder, by default the working folder), and
     its design and per-sample memory must fit this machine.
     """
     if _dotted_depth(text) > MAX_DEPTH:
@@ -648,25 +650,11 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
         study = Study.model_validate(data)
     except ValidationError as exc:
         raise StudyError(source, _format_errors(exc, data)) from None
-    from .feasibility import problems
 
     found = problems(study, base_dir)
     if found:
         raise StudyError(source, found)
     return study
-
-
-def record_path(name: str, base_dir=None) -> Path:
-    """Where a record file named in a study is read from.
-
-    An absolute path is used as written (that is the explicit choice). A relative path is
-    relative to ``base_dir``: the folder of the study file (:func:`load_study` and the command
-    line), or the working folder for a study given as text. Nothing else is tried.
-    """
-    path = Path(name)
-    if path.is_absolute():
-        return path
-    return Path(Path.cwd() if base_dir is None else base_dir) / path
 
 
 def load_study(path) -> Study:
