@@ -349,21 +349,30 @@ def _sinh_minus_x(x):
 
 
 @njit(cache=True, inline="always")
+def _seg_functions(sig):
+    """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation."""
+    half = math.sinh(0.5 * sig)
+    return math.sinh(sig), 2.0 * half * half, _sinh_minus_x(sig)
+
+
+@njit(cache=True, inline="always")
+def _seg_advance(th0, v0, g0, f1, sh, cm1, smx):
+    """theta and theta' after sigma on a record segment, given :func:`_seg_functions` of sigma."""
+    return th0 + v0 * sh + (th0 - g0) * cm1 - f1 * smx, v0 + (th0 - g0) * sh + (v0 - f1) * cm1
+
+
+@njit(cache=True, inline="always")
 def _seg_state(th0, v0, g0, f1, sig):
     """theta [rad] and theta' = d theta / d tau at sigma on a record segment (closed form
     above)."""
-    sh = math.sinh(sig)
-    half = math.sinh(0.5 * sig)
-    cm1 = 2.0 * half * half  # cosh(sigma) - 1
-    th = th0 + v0 * sh + (th0 - g0) * cm1 - f1 * _sinh_minus_x(sig)
-    v = v0 + (th0 - g0) * sh + (v0 - f1) * cm1
-    return th, v
+    sh, cm1, smx = _seg_functions(sig)
+    return _seg_advance(th0, v0, g0, f1, sh, cm1, smx)
 
 
 @njit(cache=True)
-def _seg_turning_points(th0, v0, g0, f1, length):
+def _seg_turning_points(th0, v0, g0, f1, length, e_length):
     """The sigma in (0, length) where theta' = 0 (B x^2 + f1 x - A = 0, x = e^sigma), in order;
-    inf where there is none."""
+    inf where there is none. ``e_length`` is e^length (no logarithm unless a root is inside)."""
     A = 0.5 * ((th0 - g0) - (v0 - f1))
     B = 0.5 * ((th0 - g0) + (v0 - f1))
     r1 = r2 = np.inf
@@ -372,12 +381,13 @@ def _seg_turning_points(th0, v0, g0, f1, length):
             r1 = A / f1
     else:
         disc = f1 * f1 + 4.0 * A * B
-        if disc >= 0.0:
-            qq = -0.5 * (f1 + math.copysign(math.sqrt(disc), f1))
-            r1 = qq / B
-            r2 = -A / qq if qq != 0.0 else np.inf
-    s1 = math.log(r1) if 1.0 < r1 < np.inf else np.inf
-    s2 = math.log(r2) if 1.0 < r2 < np.inf else np.inf
+        if disc < 0.0:
+            return np.inf, np.inf
+        qq = -0.5 * (f1 + math.copysign(math.sqrt(disc), f1))
+        r1 = qq / B
+        r2 = -A / qq if qq != 0.0 else np.inf
+    s1 = math.log(r1) if 1.0 < r1 < e_length else np.inf
+    s2 = math.log(r2) if 1.0 < r2 < e_length else np.inf
     s1 = s1 if s1 < length else np.inf
     s2 = s2 if s2 < length else np.inf
     return min(s1, s2), max(s1, s2)
@@ -413,13 +423,20 @@ def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
     ground is below g alpha). Returns (code, k, tau, theta, theta', side)."""
     n = times.shape[0]
     rest_v = REST_FRACTION * alpha
+    known = -1.0  # the segment length whose functions are in (sh, cm1, smx, e_length)
+    sh = cm1 = smx = e_length = 0.0
     while k < n - 1:
         t0 = p * times[k]
         f1 = scale * (samples[k + 1] - samples[k]) / (G * (p * times[k + 1] - t0))
         f0 = scale * samples[k] / G + f1 * (tau - t0)
         g0 = alpha * s + f0
         length = p * times[k + 1] - tau
-        c1, c2 = _seg_turning_points(th, v, g0, f1, length)
+        if abs(length - known) > 1e-13 * length:  # uniform records: once per phase
+            known = length
+            sh, cm1, smx = _seg_functions(length)
+            e_length = math.exp(length)
+        c1, c2 = _seg_turning_points(th, v, g0, f1, length, e_length)
+        th_end, v_end = _seg_advance(th, v, g0, f1, sh, cm1, smx)
         lo = 0.0
         u_lo = s * th
         hit = -1.0
@@ -427,7 +444,7 @@ def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
         for hi in (c1, c2, length):
             if hi == np.inf or hi < lo:
                 continue
-            u_hi = s * _seg_state(th, v, g0, f1, hi)[0]
+            u_hi = s * (th_end if hi == length else _seg_state(th, v, g0, f1, hi)[0])
             if u_lo > 0.0 and u_hi <= 0.0:
                 hit = _seg_root(0.0, th, v, g0, f1, s, lo, hi)
                 break
@@ -437,7 +454,7 @@ def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
             ta[_MAXU] = max(ta[_MAXU], u_hi)
             lo, u_lo = hi, u_hi
         if hit < 0.0:  # on to the next segment
-            th, v = _seg_state(th, v, g0, f1, length)
+            th, v = th_end, v_end
             tau = p * times[k + 1]
             k += 1
             continue
