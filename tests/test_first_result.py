@@ -43,18 +43,18 @@ numba.core.caching.Cache.load_overload = load_overload
 """
 
 
-def run_python(code, cwd=ROOT):
-    """Run ``code`` in a fresh interpreter; return the JSON it prints on its last line."""
+def run(args, cwd=ROOT):
+    """Run ``python args`` in a fresh interpreter; return its standard output."""
     proc = subprocess.run(
-        [sys.executable, "-c", textwrap.dedent(code)],
-        env=ENV,
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        timeout=900,
+        [sys.executable, *args], env=ENV, cwd=cwd, capture_output=True, text=True, timeout=1800
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return proc.stdout
+
+
+def run_python(code, cwd=ROOT):
+    """Run ``code`` in a fresh interpreter; return the JSON it prints on its last line."""
+    return json.loads(run(["-c", textwrap.dedent(code)], cwd).strip().splitlines()[-1])
 
 
 def test_import_rockstudy_loads_neither_numba_nor_scipy(tmp_path):
@@ -129,16 +129,7 @@ outputs = ["max_rotation", "overturned"]
 @pytest.fixture(scope="module")
 def warmed_up():
     """``rockstudy compile`` in its own process (fast when the cache is already primed)."""
-    proc = subprocess.run(
-        [sys.executable, "-m", "rockstudy.cli", "compile"],
-        env=ENV,
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=1800,
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    assert "rockstudy kernels ready" in proc.stdout
+    assert "rockstudy kernels ready" in run(["-m", "rockstudy.cli", "compile"])
 
 
 def test_after_warm_up_a_new_process_compiles_nothing(warmed_up, tmp_path):
