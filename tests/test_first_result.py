@@ -241,3 +241,29 @@ def test_run_says_when_it_compiles(monkeypatch, capsys):
     assert "compiling the numba kernels" in err and "12.5 s" in err
     runner._prime("{}", {}, None, progress=False)
     assert capsys.readouterr().err == ""
+
+
+def test_warm_up_clears_the_cache_when_a_kernel_source_changes(tmp_path, monkeypatch):
+    """numba checks only each kernel's own file; a change in any kernel source (or in the
+    constants) clears the package's cache before the warm-up compiles again."""
+    from rockstudy.study._warmup import purge_stale_cache
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    (tmp_path / "pkg" / "__pycache__").mkdir(parents=True)
+    kernel, other = tmp_path / "pkg" / "_k.py", tmp_path / "pkg" / "report.py"
+    kernel.write_text("from numba import njit\n")
+    other.write_text("import json\n")
+    cached = [tmp_path / "pkg" / "__pycache__" / f"_k.f-3.py311.{ext}" for ext in ("nbi", "nbc")]
+
+    def cache():
+        for path in cached:
+            path.write_bytes(b"x")
+
+    cache()
+    assert purge_stale_cache(tmp_path) == 2 and not any(p.exists() for p in cached)
+    cache()
+    assert purge_stale_cache(tmp_path) == 0  # nothing changed since
+    other.write_text("import json, math\n")  # not a kernel source
+    assert purge_stale_cache(tmp_path) == 0
+    kernel.write_text("from numba import njit\nX = 2\n")
+    assert purge_stale_cache(tmp_path) == 2 and not any(p.exists() for p in cached)

@@ -9,20 +9,65 @@ kernel through the public entry points with small inputs, so the signatures it l
 cache are the ones ``simulate``, ``simulate_batch``, the closed forms and studies use (a
 kernel compiled for other argument types would be compiled again on first use).
 
+numba checks only the file of each kernel: a kernel that calls (or inlines) a kernel of another
+file, or reads a constant of ``constants.py``, keeps its stale machine code when only that other
+file changes. So the warm-up also fingerprints every source file that holds kernels or their
+constants, and clears the package's numba cache when the fingerprint has changed since the last
+warm-up (:func:`purge_stale_cache`).
+
 ``python -m rockstudy.study._warmup`` does the same as ``rockstudy compile``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import math
+import os
+import re
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 
 from ..constants import G
+
+PACKAGE = Path(__file__).resolve().parents[1]
+STAMP = "numba-sources.sha256"
+_USES_NUMBA = re.compile(r"^(from numba import|import numba$)", re.MULTILINE)
+
+
+def _kernel_sources(root):
+    """The source files whose code or constants numba compiles into the kernels."""
+    return sorted(
+        path
+        for path in Path(root).rglob("*.py")
+        if path.name == "constants.py" or _USES_NUMBA.search(path.read_text())
+    )
+
+
+def purge_stale_cache(root=PACKAGE) -> int:
+    """Delete numba's cache files under ``root`` if its kernel sources changed since the last
+    call (a fingerprint in ``root/__pycache__``); returns how many were deleted.
+
+    Does nothing when NUMBA_CACHE_DIR moves the cache elsewhere.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return 0
+    digest = hashlib.sha256()
+    for path in _kernel_sources(root):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    stamp = Path(root) / "__pycache__" / STAMP
+    if stamp.exists() and stamp.read_text() == digest.hexdigest():
+        return 0
+    stale = [f for ext in ("nbi", "nbc") for f in Path(root).rglob(f"__pycache__/*.{ext}")]
+    for path in stale:
+        path.unlink(missing_ok=True)
+    stamp.parent.mkdir(exist_ok=True)
+    stamp.write_text(digest.hexdigest())
+    return len(stale)
 
 
 class _CompileCounter:
@@ -107,6 +152,7 @@ def compile_kernels(on_first_compile=None) -> dict:
         ``seconds``: wall time [s].
     """
     t0 = time.perf_counter()
+    purge_stale_cache()
     with _CompileCounter(on_first_compile).listening() as counter, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         _simulate_calls()
@@ -128,6 +174,7 @@ def prime_study(study_json: str, columns: dict, base_dir=None, on_first_compile=
     from .evaluate import evaluate_chunk
 
     t0 = time.perf_counter()
+    purge_stale_cache()
     threads = numba.get_num_threads()
     head = {k: v[:2] for k, v in columns.items()}
     try:
