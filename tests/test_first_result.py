@@ -267,3 +267,22 @@ def test_warm_up_clears_the_cache_when_a_kernel_source_changes(tmp_path, monkeyp
     assert purge_stale_cache(tmp_path) == 0
     kernel.write_text("from numba import njit\nX = 2\n")
     assert purge_stale_cache(tmp_path) == 2 and not any(p.exists() for p in cached)
+
+
+def test_compile_counter_sees_compilation_and_not_cache_hits():
+    """The warm-up and the runner learn that numba compiles from its "numba:compile" event."""
+    from numba import njit
+
+    from rockstudy.study._warmup import _CompileCounter
+
+    @njit  # no cache: compiled on its first call
+    def twice(x):
+        return 2.0 * x
+
+    calls = []
+    with _CompileCounter(lambda: calls.append(1)).listening() as counter:
+        assert twice(1.5) == 3.0
+    assert counter.count == 1 and calls == [1]
+    with _CompileCounter(lambda: calls.append(1)).listening() as counter:
+        twice(2.5)  # already compiled for float64
+    assert counter.count == 0 and calls == [1]
