@@ -512,25 +512,15 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
         )
         if code != PH_REST:
             break
-    tau_ex = p * dur
-    if code == PH_END:
-        if use_map:
-            over, peak, n_post = free_rocking_map(
-                s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
-            )
-            n_before = ta[_NIMP]
-            tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, ta, over)
-            if not over:
-                ta[_MAXU] = max(ta[_MAXU], peak)
-                ta[_NIMP] = n_before + n_post
-            code = PH_OVER if over else PH_END
-        else:
-            code, tau, th, v, s = _trig_phase(
-                alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, ta, no_log
-            )
     if code == PH_OVER:
         return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p
-    return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
+    # the free rocking after the record: trig_scene under a motion of zero length, from here
+    tail = trig_scene(
+        p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_tail - dur, no_log, th, v * p
+    )
+    first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
+    peak = max(ta[_MAXU], tail[1])
+    return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first
 
 
 @njit(cache=True, parallel=True)
