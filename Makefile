@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+# numba's on-disk cache of the kernels, primed once per install (and again after an edit)
+KERNELS := $(VENV)/.kernels-compiled
 
 .PHONY: setup debian demo test bench figures lint clean
 
@@ -12,7 +14,11 @@ $(STAMP): pyproject.toml
 	$(BIN)/pip install -e '.[test]'
 	touch $(STAMP)
 
-setup: $(STAMP)
+$(KERNELS): $(STAMP) $(shell find rockstudy -name '*.py')
+	$(BIN)/rockstudy compile
+	touch $(KERNELS)
+
+setup: $(KERNELS)
 
 # Debian packages the tests need: headless Chromium renders the HTML reports
 debian:
@@ -21,16 +27,16 @@ debian:
 	    apt-get update -qq && apt-get install -y -qq --no-install-recommends chromium; \
 	  else echo "please install Debian's chromium (needed by tests/test_report.py)"; exit 1; fi; }
 
-demo: $(STAMP)
+demo: $(KERNELS)
 	rm -rf results/quickstart.zarr results/quickstart.nc
 	$(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr
 	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report
 	$(BIN)/rockstudy demo --out results/demo
 
-test: $(STAMP) debian
+test: $(KERNELS) debian
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(KERNELS)
 	$(BIN)/python benchmarks/bench_engine.py
 	$(BIN)/python benchmarks/bench_closedform.py
 	$(BIN)/python benchmarks/bench_study.py
@@ -38,6 +44,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_report.py
 	$(BIN)/python -W ignore benchmarks/bench_work_precision.py
 	$(BIN)/python -W ignore benchmarks/bench_failure_maps.py
+	$(BIN)/python benchmarks/bench_first_result.py
 
 figures: $(STAMP)
 	$(BIN)/rockstudy figures --out results/figures

@@ -3,9 +3,17 @@
 Housner's rocking block, its linearization and closed forms (Dimitrakopoulos & DeJong 2012),
 the single-ODE formulation (Prieto & Lourenco 2005), dynamically equivalent structures
 (DeJong & Dimitrakopoulos 2014), and parametric studies on top.
+
+The subpackages and the solvers are imported on first use (PEP 562 module ``__getattr__``):
+``import rockstudy`` loads neither numba nor scipy, ``rockstudy.simulate`` does. The numba
+kernels are compiled once per install by ``rockstudy compile`` (``make setup`` runs it).
 """
 
-from . import closedform, motions, similarity, structures
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 from ._warnings import (
     AccuracyWarning,
     ClosedFormValidityWarning,
@@ -15,10 +23,25 @@ from ._warnings import (
     LinearizationWarning,
     LooseToleranceWarning,
 )
-from .dynamics import RockingResult, simulate, simulate_batch
-from .structures import Block
+
+if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
+    from . import closedform, motions, similarity, structures
+    from .dynamics import RockingResult, simulate, simulate_batch
+    from .structures import Block
 
 __version__ = "0.1.0"
+
+#: Public name -> (module, attribute or None for the module itself), imported on first use.
+_LAZY = {
+    "Block": (".structures", "Block"),
+    "RockingResult": (".dynamics", "RockingResult"),
+    "simulate": (".dynamics", "simulate"),
+    "simulate_batch": (".dynamics", "simulate_batch"),
+    "closedform": (".closedform", None),
+    "motions": (".motions", None),
+    "similarity": (".similarity", None),
+    "structures": (".structures", None),
+}
 
 __all__ = [
     "AccuracyWarning",
@@ -38,3 +61,19 @@ __all__ = [
     "structures",
     "__version__",
 ]
+
+
+def __getattr__(name: str):
+    try:
+        module, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    value = importlib.import_module(module, __name__)
+    if attr is not None:
+        value = getattr(value, attr)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -32,8 +32,9 @@ def restitution(value: float) -> float:
 
 
 def finite_array(name: str, values) -> np.ndarray:
-    """Return a 1-D float array, or raise if it is empty or holds NaN/inf."""
-    arr = np.asarray(values, dtype=float)
+    """Return a 1-D float array (a contiguous, writable copy: the numba kernels that read it
+    are compiled for that layout only), or raise if it is empty or holds NaN/inf."""
+    arr = np.array(values, dtype=float)
     if arr.ndim != 1 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 1-D sequence of numbers")
     bad = np.flatnonzero(~np.isfinite(arr))

@@ -63,6 +63,13 @@ def _run(args) -> int:
     return 0
 
 
+def _compile(args) -> int:
+    """Prime numba's on-disk cache with every kernel (once per install; ``make setup``)."""
+    from .study._warmup import main as compile_main
+
+    return compile_main()
+
+
 def _validate(args) -> int:
     from .study import StudyError, load_study
 
@@ -117,6 +124,7 @@ def main(argv=None) -> int:
     val = sub.add_parser("validate", help="check study files, naming every problem")
     val.add_argument("study", nargs="+")
     sub.add_parser("schema", help="print the JSON schema of study files")
+    sub.add_parser("compile", help="compile the numba kernels into their cache (once per install)")
     rep = sub.add_parser("report", help="an HTML report (figures, CSV tables) of a result cube")
     rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
     rep.add_argument("--out", help="directory (default: RESULT_report)")
@@ -128,6 +136,8 @@ def main(argv=None) -> int:
             return _run(args)
         if args.command == "validate":
             return _validate(args)
+        if args.command == "compile":
+            return _compile(args)
         if args.command == "report":
             from .study.report import make_report
 

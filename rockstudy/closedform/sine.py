@@ -6,14 +6,17 @@ psi = arcsin(1/a) (eq. 3.3 with the erratum 1/a). The block first rocks on the s
 the acceleration; rotations are in units of alpha and velocities in units of p alpha.
 
 Every public function is a numpy ufunc (numba ``vectorize``; :func:`max_rotation` wraps one and
-warns outside the region where it is exact): it broadcasts over arrays and
+warns outside the region where it is exact), built on its first use so that importing the module
+compiles nothing (:class:`_LazyUfunc`): it broadcasts over arrays and
 returns NaN where a <= 1 (no uplift), where a quantity does not exist (e.g. no impact), or where
 exp(p T_ex) overflows (omega below about 0.009).
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import threading
 import warnings
 
 import numpy as np
@@ -23,6 +26,64 @@ from .._warnings import ClosedFormValidityWarning
 
 _F2 = [float64(float64, float64)]
 _F3 = [float64(float64, float64, float64)]
+
+
+class _LazyUfunc:
+    """A numba ``vectorize`` ufunc built (compiled, or loaded from numba's cache) on first use.
+
+    Building all the ufuncs of this module eagerly cost about 1 s on every ``import rockstudy``
+    even with a warm cache. The wrapper calls and forwards attributes (``outer``, ``reduce``,
+    ``types``, ...) to the built ufunc, and pickles by name.
+    """
+
+    _lock = threading.RLock()
+
+    def __init__(self, func, signatures, options):
+        functools.update_wrapper(self, func)
+        self._func, self._signatures, self._options, self._ufunc = func, signatures, options, None
+
+    def build(self):
+        """The numpy ufunc itself (built once)."""
+        if self._ufunc is None:
+            with self._lock:
+                if self._ufunc is None:
+                    self._ufunc = vectorize(self._signatures, cache=True, **self._options)(
+                        self._func
+                    )
+        return self._ufunc
+
+    def __call__(self, *args, **kwargs):
+        return self.build()(*args, **kwargs)
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        return getattr(self.build(), name)
+
+    def __reduce__(self):
+        return _by_name, (self.__name__,)
+
+    def __repr__(self):
+        return f"<lazy numba ufunc {self.__module__}.{self.__name__}>"
+
+
+def _by_name(name):
+    return globals()[name]
+
+
+def _lazy_vectorize(signatures, **options):
+    """``numba.vectorize(signatures, cache=True, **options)``, compiled on first use."""
+    return lambda func: _LazyUfunc(func, signatures, options)
+
+
+def build_all():
+    """Build every ufunc of the module now (compile, or load from numba's cache); returns
+    their names. The warm-up step (``rockstudy compile``) calls this once per install."""
+    lazy = {k: v for k, v in globals().items() if isinstance(v, _LazyUfunc)}
+    for ufunc in lazy.values():
+        ufunc.build()
+    return sorted(lazy)
+
 
 MODES = (
     "no_uplift",
@@ -201,7 +262,7 @@ def _mode(a, w, eta):
 # ---------------------------------------------------------------------------- public ufuncs
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def pulse_end_time(a, omega):
     r"""Time from uplift to the end of the pulse, p T_ex [-], eq. (3.2)-(3.3) of [000].
 
@@ -210,7 +271,7 @@ def pulse_end_time(a, omega):
     return _tau_ex(a, omega) if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def d0_star(a, omega):
     r"""D0* of eq. (3.9) of [000], product form (the expanded form there has lost a square).
 
@@ -221,7 +282,7 @@ def d0_star(a, omega):
     return _d0(a, omega) if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def first_impact_time_after_pulse(a, omega):
     r"""tau_i2: the first impact from uplift when it follows the pulse, eq. (3.13) of [000].
 
@@ -238,7 +299,7 @@ def first_impact_time_after_pulse(a, omega):
     return math.log((1.0 + math.sqrt(1.0 - d)) / den)
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def impact_velocity_after_pulse(a, omega):
     r"""theta_dot / (p alpha) just before that impact, eqs. (3.14)-(3.15) of [000].
 
@@ -250,7 +311,7 @@ def impact_velocity_after_pulse(a, omega):
     return math.sqrt(1.0 - d) if d <= 1.0 else np.nan
 
 
-@vectorize(_F3, cache=True)
+@_lazy_vectorize(_F3)
 def impact_velocity_during_pulse(a, omega, tau):
     r"""theta_dot / (p alpha) at time tau before the first impact, eq. (3.22) of [000].
 
@@ -261,7 +322,7 @@ def impact_velocity_during_pulse(a, omega, tau):
     return 0.5 * _velocity2(a, omega, tau) if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def kappa(a, omega):
     r"""kappa of eq. (3.26) of [000].
 
@@ -270,7 +331,7 @@ def kappa(a, omega):
     return _kappa_lambda(a, omega)[0] if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def lambda_(a, omega):
     r"""lambda of eq. (3.26) of [000] (trailing underscore: ``lambda`` is a keyword).
 
@@ -279,7 +340,7 @@ def lambda_(a, omega):
     return _kappa_lambda(a, omega)[1] if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def first_impact_time_during_pulse(a, omega):
     """tau_i1: first root of eq. (3.21) of [000] in (0, p T_ex]; NaN if none (numerical form)."""
     return _tau_i1(a, omega) if a > 1.0 else np.nan
@@ -308,7 +369,7 @@ def first_impact_time_during_pulse_approx(a, omega, *, check=True):
     return out
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def _tau_i1_hat_ufunc(a, omega):
     """eq. (3.29) of [000]; see :func:`first_impact_time_during_pulse_approx`."""
     return _tau_i1_hat(a, omega) if a > 1.0 else np.nan
@@ -325,7 +386,7 @@ def _warn_outside(mask, out, what):
         )
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def case2_residual(a, omega):
     r"""Overturning without impact, eq. (3.10) of [000]: zero on the boundary, < 0 overturns.
 
@@ -336,7 +397,7 @@ def case2_residual(a, omega):
     return omega - math.sqrt(a * a - 1.0) + a * math.exp(-_tau_ex(a, omega))
 
 
-@vectorize(_F3, cache=True)
+@_lazy_vectorize(_F3)
 def case12_residual(a, omega, eta):
     r"""Overturning after one impact that follows the pulse, eq. (3.18) of [000]: zero on the
     boundary, >= 0 overturns.
@@ -346,7 +407,7 @@ def case12_residual(a, omega, eta):
     return eta * eta * (1.0 - _d0(a, omega)) - 1.0 if a > 1.0 else np.nan
 
 
-@vectorize(_F3, cache=True)
+@_lazy_vectorize(_F3)
 def case11_residual(a, omega, eta):
     """Overturning after one impact during the pulse, eqs. (3.20)-(3.21) of [000] (numerical
     form): zero on the boundary, >= 0 overturns; NaN if there is no impact during the pulse."""
@@ -372,7 +433,7 @@ def case11_residual_approx(a, omega, eta, *, check=True):
     return out
 
 
-@vectorize(_F3, cache=True)
+@_lazy_vectorize(_F3)
 def _case11_approx_ufunc(a, omega, eta):
     """eq. (3.30) of [000]; see :func:`case11_residual_approx`."""
     if not a > 1.0:
@@ -380,7 +441,7 @@ def _case11_approx_ufunc(a, omega, eta):
     return _case11_lhs(a, omega, eta, _tau_i1_hat(a, omega))
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def limit_residual(a, omega):
     r"""The limit tau_i = p T_ex between cases 1.1 and 1.2, eq. (3.31) of [000]: zero on the
     curve, > 0 where the first impact comes before the end of the pulse.
@@ -394,7 +455,7 @@ def limit_residual(a, omega):
     return A / e + B * e - 2.0
 
 
-@vectorize([int8(float64, float64, float64)], cache=True, target="parallel")
+@_lazy_vectorize([int8(float64, float64, float64)], target="parallel")
 def overturning_mode_code(a, omega, eta):
     """Index into :data:`MODES` of the overturning mode (see :func:`overturning_mode`)."""
     return _mode(a, omega, eta)
@@ -447,7 +508,7 @@ def max_rotation(a, omega, eta, *, check=True):
     return out
 
 
-@vectorize(_F3, cache=True, target="parallel")
+@_lazy_vectorize(_F3, target="parallel")
 def _max_rotation(a, omega, eta):
     """eq. (4.13) of [000]; see :func:`max_rotation`."""
     if not a > 1.0:
@@ -457,7 +518,7 @@ def _max_rotation(a, omega, eta):
     return 1.0 - math.sqrt(x) if x > 0.0 and d0 <= 1.0 else np.nan
 
 
-@vectorize(_F3, cache=True)
+@_lazy_vectorize(_F3)
 def max_rotation_small(a, omega, eta):
     r"""Small-velocity form of (4.13): theta_max / alpha, eq. (4.14) of [000].
 
@@ -469,7 +530,7 @@ def max_rotation_small(a, omega, eta):
     return 0.5 * eta * eta * (1.0 - _d0(a, omega)) if a > 1.0 else np.nan
 
 
-@vectorize(_F2, cache=True)
+@_lazy_vectorize(_F2)
 def restitution_scaling_function(a, omega):
     r"""f(a, omega) of the restitution law theta_m / alpha ~ f eta^2 / 2, eq. (4.16) of [000].
 

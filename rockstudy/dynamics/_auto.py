@@ -173,7 +173,7 @@ def linearization_bound(shape, restitution, slenderness, psi, omega):
     )
     out = np.full(args[0].shape, np.inf)
     if shape in tab["shape_index"]:
-        flat = [np.ascontiguousarray(a).ravel() for a in args]
+        flat = [np.array(a).ravel() for a in args]  # writable copies: one kernel signature
         res = np.empty(flat[0].size)
         K = tab["K"][tab["shape_index"][shape]]
         _lookup(K, tab["eta"], tab["alpha"], tab["psi"], tab["omega"], *flat, res)

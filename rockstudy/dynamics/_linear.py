@@ -19,6 +19,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..constants import FALL_ROTATION, G
+from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
 from ._rocking import (
     MODEL_LINEAR,
     PH_END,
@@ -28,6 +29,7 @@ from ._rocking import (
     STATUS_OK,
     _uplift_trig,
     free_rocking_map,
+    next_uplift,
 )
 
 
@@ -317,3 +319,217 @@ def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40
         oms.append(p * (c * W * np.cos(x) - A * em + B * ep))
     impacts = rec[1 : n + 1][rec[1 : n + 1, 6] == 1.0, 1] / p
     return np.concatenate(ts), np.concatenate(ths), np.concatenate(oms), impacts
+
+
+# ------------------------------------------------- records: piecewise-linear ground acceleration
+#
+# On a record segment the ground term of eq. (3.1) of [000] is linear in tau, F = f0 + f1 sigma
+# (F = u_g'' / g, sigma = tau - tau_k), so theta'' = theta - g0 - f1 sigma with g0 = alpha s + f0
+# has the closed form, from theta0 and v0 = theta'(0),
+#
+#     theta(sigma) = theta0 + v0 sinh + (theta0 - g0)(cosh - 1) - f1 (sinh - sigma),
+#
+# written so that no large terms cancel where theta is small (near impacts). theta' = 0 where
+# x = e^sigma solves B x^2 + f1 x - A = 0 (A, B of theta = g0 + f1 sigma + A e^-sigma + B e^sigma):
+# at most two turning points per segment. Between them theta is monotone, so an impact (s theta
+# reaching 0) or the fall (s theta reaching FALL_ROTATION) is the single root of a bracketed
+# monotone function, and the peaks are the turning points themselves. Nothing is integrated:
+# each segment is a 2 x 2 exponential recursion of (theta, theta').
+
+
+@njit(cache=True, inline="always")
+def _sinh_minus_x(x):
+    """sinh(x) - x without cancellation (Taylor series to x^13 below 0.25)."""
+    if abs(x) >= 0.25:
+        return math.sinh(x) - x
+    x2 = x * x
+    c = 1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (1.0 / 5040.0 + x2 * (1.0 / 362880.0)))
+    c += x2 * x2 * x2 * x2 * (1.0 / 39916800.0 + x2 / 6227020800.0)
+    return x * x2 * c
+
+
+@njit(cache=True, inline="always")
+def _seg_functions(sig):
+    """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation."""
+    half = math.sinh(0.5 * sig)
+    return math.sinh(sig), 2.0 * half * half, _sinh_minus_x(sig)
+
+
+@njit(cache=True, inline="always")
+def _seg_advance(th0, v0, g0, f1, sh, cm1, smx):
+    """theta and theta' after sigma on a record segment, given :func:`_seg_functions` of sigma."""
+    return th0 + v0 * sh + (th0 - g0) * cm1 - f1 * smx, v0 + (th0 - g0) * sh + (v0 - f1) * cm1
+
+
+@njit(cache=True, inline="always")
+def _seg_state(th0, v0, g0, f1, sig):
+    """theta [rad] and theta' = d theta / d tau at sigma on a record segment (closed form
+    above)."""
+    sh, cm1, smx = _seg_functions(sig)
+    return _seg_advance(th0, v0, g0, f1, sh, cm1, smx)
+
+
+@njit(cache=True)
+def _seg_turning_points(th0, v0, g0, f1, length, e_length):
+    """The sigma in (0, length) where theta' = 0 (B x^2 + f1 x - A = 0, x = e^sigma), in order;
+    inf where there is none. ``e_length`` is e^length (no logarithm unless a root is inside)."""
+    A = 0.5 * ((th0 - g0) - (v0 - f1))
+    B = 0.5 * ((th0 - g0) + (v0 - f1))
+    r1 = r2 = np.inf
+    if B == 0.0:
+        if f1 != 0.0:
+            r1 = A / f1
+    else:
+        disc = f1 * f1 + 4.0 * A * B
+        if disc < 0.0:
+            return np.inf, np.inf
+        qq = -0.5 * (f1 + math.copysign(math.sqrt(disc), f1))
+        r1 = qq / B
+        r2 = -A / qq if qq != 0.0 else np.inf
+    s1 = math.log(r1) if 1.0 < r1 < e_length else np.inf
+    s2 = math.log(r2) if 1.0 < r2 < e_length else np.inf
+    s1 = s1 if s1 < length else np.inf
+    s2 = s2 if s2 < length else np.inf
+    return min(s1, s2), max(s1, s2)
+
+
+@njit(cache=True)
+def _seg_root(target, th0, v0, g0, f1, s, lo, hi):
+    """sigma in [lo, hi] where s theta - target changes sign, theta monotone on [lo, hi]
+    (Newton steps safeguarded by bisection, to rounding)."""
+    u_lo = s * _seg_state(th0, v0, g0, f1, lo)[0] - target
+    x = 0.5 * (lo + hi)
+    for _ in range(200):
+        th, v = _seg_state(th0, v0, g0, f1, x)
+        f = s * th - target
+        if (f >= 0.0) == (u_lo >= 0.0):
+            lo = x
+        else:
+            hi = x
+        xn = x - f / (s * v) if v != 0.0 else 0.5 * (lo + hi)
+        if not lo < xn < hi:
+            xn = 0.5 * (lo + hi)
+        if abs(xn - x) <= 1e-16 * max(1.0, abs(x)) or hi - lo <= 1e-16 * max(1.0, hi):
+            return xn
+        x = xn
+    return x
+
+
+@njit(cache=True)
+def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
+    """Rock exactly from (tau, theta, theta', side) on record segment k until rest, overturning
+    or the end of the record (eq. 3.1 of [000]; impacts with restitution eta and the Zeno rule
+    of the kernel: rest when the speed after an impact is below REST_FRACTION alpha and the
+    ground is below g alpha). Returns (code, k, tau, theta, theta', side)."""
+    n = times.shape[0]
+    rest_v = REST_FRACTION * alpha
+    known = -1.0  # the segment length whose functions are in (sh, cm1, smx, e_length)
+    sh = cm1 = smx = e_length = 0.0
+    while k < n - 1:
+        t0 = p * times[k]
+        f1 = scale * (samples[k + 1] - samples[k]) / (G * (p * times[k + 1] - t0))
+        f0 = scale * samples[k] / G + f1 * (tau - t0)
+        g0 = alpha * s + f0
+        length = p * times[k + 1] - tau
+        if abs(length - known) > 1e-13 * length:  # uniform records: once per phase
+            known = length
+            sh, cm1, smx = _seg_functions(length)
+            e_length = math.exp(length)
+        c1, c2 = _seg_turning_points(th, v, g0, f1, length, e_length)
+        th_end, v_end = _seg_advance(th, v, g0, f1, sh, cm1, smx)
+        lo = 0.0
+        u_lo = s * th
+        hit = -1.0
+        fall = False
+        for hi in (c1, c2, length):
+            if hi == np.inf or hi < lo:
+                continue
+            u_hi = s * (th_end if hi == length else _seg_state(th, v, g0, f1, hi)[0])
+            if u_lo > 0.0 and u_hi <= 0.0:
+                hit = _seg_root(0.0, th, v, g0, f1, s, lo, hi)
+                break
+            if u_hi >= FALL_ROTATION:
+                hit, fall = _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi), True
+                break
+            ta[_MAXU] = max(ta[_MAXU], u_hi)
+            lo, u_lo = hi, u_hi
+        if hit < 0.0:  # on to the next segment
+            th, v = th_end, v_end
+            tau = p * times[k + 1]
+            k += 1
+            continue
+        tau += hit
+        if fall:
+            ta[_MAXU] = FALL_ROTATION
+            return PH_OVER, k, tau, s * FALL_ROTATION, 0.0, s
+        v_post = eta * _seg_state(th, v, g0, f1, hit)[1]
+        _impact_tally(ta, tau)
+        th = 0.0
+        if abs(v_post) < rest_v:
+            f = f0 + f1 * hit
+            if abs(f) < alpha:
+                return PH_REST, k, tau, 0.0, 0.0, s
+            s = -1.0 if f > 0.0 else 1.0
+            v = 0.0
+        else:
+            s = -s
+            v = v_post
+    return PH_END, n - 1, tau, th, v, s
+
+
+@njit(cache=True)
+def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=0.0, om_init=0.0):
+    """Linearized block under a sampled record (linear between samples), exactly.
+
+    Nothing is integrated: every record segment is the closed form of :func:`_seg_state`. The
+    block lifts off where |scale samples| first exceeds g alpha (eq. 3.1 of [000]). After the
+    record the free rocking is mapped (``use_map``) or followed in closed form until rest,
+    overturning or ``t_tail`` [s]. Returns (status, max rotation [rad], overturned, impacts,
+    overturning time [s], first impact time [s]), as :func:`trig_scene`.
+    """
+    dur = times[-1]
+    mp = np.array([scale, 0.0, 0.0, dur])
+    thr = G * alpha
+    ta = np.array([abs(th_init), 0.0, np.nan])
+    no_log = np.empty((0, 7))
+    rocking = th_init != 0.0 or om_init != 0.0
+    tau, th, v = 0.0, th_init, om_init / p
+    s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
+    k = 0
+    code = PH_END
+    while True:
+        if not rocking:
+            t_up = next_uplift(KIND_RECORD, mp, times, samples, thr, thr, tau / p)
+            if t_up >= dur:
+                return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
+            k = segment_index(times, t_up, k)
+            a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t_up, k)
+            s = -1.0 if a_g > 0.0 else 1.0
+            tau, th, v = p * t_up, 0.0, 0.0
+        rocking = False
+        code, k, tau, th, v, s = _record_phase(
+            alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta
+        )
+        if code != PH_REST:
+            break
+    if code == PH_OVER:
+        return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p
+    # the free rocking after the record: trig_scene under a motion of zero length, from here
+    tail = trig_scene(
+        p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_tail - dur, no_log, th, v * p
+    )
+    first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
+    peak = max(ta[_MAXU], tail[1])
+    return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first
+
+
+@njit(cache=True, parallel=True)
+def record_batch(p, alpha, eta, scale, times, samples):
+    """:func:`record_scene` over rows (one record, scaled row by row), in parallel; an (n, 7)
+    array of ``BATCH_COLUMNS``."""
+    out = np.empty((p.shape[0], 7))
+    for i in prange(p.shape[0]):
+        r = record_scene(p[i], alpha[i], eta[i], scale[i], times, samples, True, np.inf)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
+        out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
+    return out

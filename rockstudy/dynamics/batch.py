@@ -94,9 +94,9 @@ def simulate_batch(
         Use this record instead of a pulse, multiplied row by row by ``scale``.
     method : {"nonlinear", "linear", "auto"}
         Housner's eq. (2.2) or the linearized eq. (3.1) of [000]. The linear model under
-        trigonometric pulses uses the exact piecewise solution. ``"auto"`` chooses row by row
-        the cheapest model whose error bound meets ``rtol``: rest where the ground never
-        reaches g tan(alpha) (exact), the exact linear solver where its tabulated
+        trigonometric pulses and under records uses the exact piecewise solution. ``"auto"``
+        chooses row by row the cheapest model whose error bound meets ``rtol``: rest where the
+        ground never reaches g tan(alpha) (exact), the exact linear solver where its tabulated
         linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
         ``max_rotation`` and ``overturned`` are asked for (see ``outputs``), and the
         nonlinear kernel at 0.05 ``rtol`` (5e-6 at most, for the overturning decisions)
@@ -205,6 +205,8 @@ def _run(rows, idx, model, rtol, max_steps):
     args = (p[idx], alpha[idx], eta[idx])
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
         return _linear.trig_batch(*args, mp[idx])
+    if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD:
+        return _linear.record_batch(*args, mp[idx, 0], times, samples)
     return _rocking.scene_batch(*args, model, kind, mp[idx], times, samples, rtol, max_steps)
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from . import store
+from ._warmup import prime_study
 from .evaluate import STATUS_FAILED, evaluate_chunk
 from .sampling import make_design
 from .spec import Study
@@ -53,6 +54,25 @@ class _Progress:
         if self.done == self.total:
             sys.stderr.write("\n")
         sys.stderr.flush()
+
+
+def _prime(study_json, columns, base_dir, progress):
+    """Compile the study's kernels in this process, once, before the workers start: they then
+    load them from numba's cache instead of each compiling them (see :mod:`._warmup`)."""
+
+    def say(text):
+        if progress:
+            sys.stderr.write(text)
+            sys.stderr.flush()
+
+    r = prime_study(
+        study_json,
+        columns,
+        base_dir,
+        lambda: say("compiling the numba kernels (once per install; `rockstudy compile`) ..."),
+    )
+    if r["compiled"]:
+        say(f" done in {r['seconds']:.1f} s\n")
 
 
 def _client(workers=None, scheduler=None, scheduler_file=None):
@@ -123,6 +143,8 @@ def run_study(
     study_json = study.normalized()
     own = client is None
     cluster = None
+    if todo:
+        _prime(study_json, columns, base_dir, progress)
     if own and todo:
         client, cluster = _client(workers, scheduler, scheduler_file)
     bar = _Progress(len(todo), progress)

@@ -1,0 +1,206 @@
+"""Compile the numba kernels once per install: ``rockstudy compile`` (``make setup`` runs it).
+
+Every kernel is decorated ``cache=True``, so numba keeps its machine code next to the source
+(``__pycache__/*.nbi``, ``*.nbc``) and a new process, or a dask worker, loads it in
+milliseconds instead of compiling it again (about 10 s for ``simulate`` alone, a minute for
+everything). The index of each source file is keyed by that file's modification time and
+size: editing a module recompiles only its kernels. :func:`compile_kernels` drives every
+kernel through the public entry points with small inputs, so the signatures it leaves in the
+cache are the ones ``simulate``, ``simulate_batch``, the closed forms and studies use (a
+kernel compiled for other argument types would be compiled again on first use).
+
+numba checks only the file of each kernel: a kernel that calls (or inlines) a kernel of another
+file, or reads a constant of ``constants.py``, keeps its stale machine code when only that other
+file changes. So the warm-up also fingerprints every source file that holds kernels or their
+constants, and clears the package's numba cache when the fingerprint has changed since the last
+warm-up (:func:`purge_stale_cache`).
+
+``python -m rockstudy.study._warmup`` does the same as ``rockstudy compile``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import math
+import os
+import re
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..constants import G
+
+PACKAGE = Path(__file__).resolve().parents[1]
+STAMP = "numba-sources.sha256"
+_USES_NUMBA = re.compile(r"^(from numba import|import numba$)", re.MULTILINE)
+
+
+def _kernel_sources(root):
+    """The source files whose code or constants numba compiles into the kernels."""
+    return sorted(
+        path
+        for path in Path(root).rglob("*.py")
+        if path.name == "constants.py" or _USES_NUMBA.search(path.read_text())
+    )
+
+
+def purge_stale_cache(root=PACKAGE) -> int:
+    """Delete numba's cache files under ``root`` if its kernel sources changed since the last
+    call (a fingerprint in ``root/__pycache__``); returns how many were deleted.
+
+    Does nothing when NUMBA_CACHE_DIR moves the cache elsewhere.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return 0
+    digest = hashlib.sha256()
+    for path in _kernel_sources(root):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    stamp = Path(root) / "__pycache__" / STAMP
+    if stamp.exists() and stamp.read_text() == digest.hexdigest():
+        return 0
+    stale = [f for ext in ("nbi", "nbc") for f in Path(root).rglob(f"__pycache__/*.{ext}")]
+    for path in stale:
+        path.unlink(missing_ok=True)
+    stamp.parent.mkdir(exist_ok=True)
+    stamp.write_text(digest.hexdigest())
+    return len(stale)
+
+
+class _CompileCounter:
+    """Counts numba dispatcher compilations (cache misses); calls ``on_first`` at the first."""
+
+    def __init__(self, on_first=None):
+        self.count, self.on_first = 0, on_first
+
+    @contextlib.contextmanager
+    def listening(self):
+        from numba.core import event
+
+        class _Listener(event.Listener):
+            def on_start(_, ev):
+                if self.count == 0 and self.on_first is not None:
+                    self.on_first()
+                self.count += 1
+
+            def on_end(_, ev):
+                pass
+
+        with event.install_listener("numba:compile", _Listener()):
+            yield self
+
+
+def _simulate_calls():
+    """One small call of every method of :func:`rockstudy.simulate` on a pulse and a record."""
+    from ..dynamics import simulate
+    from ..motions import RickerWavelet, SinePulse, stochastic_record
+    from ..structures import Block, PointMassStrut
+
+    alpha = 0.2
+    block = Block(1.0, alpha)
+    pulse = SinePulse(3.0 * G * math.tan(alpha), 0.5)
+    record = stochastic_record(peak=3.0 * G * math.tan(alpha), duration=2.0, dt=0.01, seed=0)
+    for motion in (pulse, RickerWavelet(3.0 * G * math.tan(alpha), 0.5), record):
+        motion.ground_acceleration(np.linspace(0.0, 1.0, 3))
+        for method in ("nonlinear", "linear", "auto"):
+            simulate(block, motion, method=method)
+        simulate(block, motion, method="complex", initial_rotation=0.5 * alpha, t_max=0.05)
+    simulate(PointMassStrut(1.0, alpha), pulse)  # the mechanism (tabulated) kernel
+
+
+def _batch_calls(methods=("nonlinear", "linear", "auto")):
+    """:func:`rockstudy.simulate_batch` on pulses and on a record, for each of ``methods``."""
+    from ..dynamics import simulate_batch
+    from ..motions import stochastic_record
+
+    alpha = np.array([0.15, 0.2])
+    peak = 3.0 * G * np.tan(alpha)
+    record = stochastic_record(peak=1.0, duration=2.0, dt=0.01, seed=0)
+    for method in methods:
+        common = dict(half_diagonal=1.0, slenderness=alpha, method=method)
+        for shape in ("sine", "ricker"):
+            simulate_batch(pulse=shape, amplitude=peak, period=0.5, **common)
+        simulate_batch(record=record, scale=peak, **common)
+
+
+def _closedform_calls():
+    """Every ufunc of :mod:`rockstudy.closedform.sine`, and the boundary-curve kernel."""
+    from ..closedform import overturning_boundary, sine
+
+    names = sine.build_all()
+    sine.overturning_mode(np.array([2.0]), np.array([1.0]), np.array([0.9]))
+    overturning_boundary(np.array([1.0]), 0.9, "1.2", n_grid=8)
+    return names
+
+
+def compile_kernels(on_first_compile=None) -> dict:
+    """Compile every numba kernel signature the package uses, or load it from numba's cache.
+
+    Parameters
+    ----------
+    on_first_compile : callable, optional
+        Called with no argument when the first kernel has to be compiled (not found in the
+        cache), e.g. to tell the user why the wait.
+
+    Returns
+    -------
+    dict
+        ``compiled``: dispatchers compiled now (0 when the cache was already primed);
+        ``seconds``: wall time [s].
+    """
+    t0 = time.perf_counter()
+    purge_stale_cache()
+    with _CompileCounter(on_first_compile).listening() as counter, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        _simulate_calls()
+        _batch_calls()
+        _closedform_calls()
+    return {"compiled": counter.count, "seconds": time.perf_counter() - t0}
+
+
+def prime_study(study_json: str, columns: dict, base_dir=None, on_first_compile=None) -> dict:
+    """Put the kernels of a study in numba's cache before the dask workers start, so that they
+    load them instead of each compiling them: the study's first rows run in this process (its
+    kernels, with its argument types), and for ``method="auto"``, whose rows choose their model
+    by their values, the batch kernels of both models.
+
+    Returns the dict of :func:`compile_kernels` for this step.
+    """
+    import numba
+
+    from .evaluate import evaluate_chunk
+
+    t0 = time.perf_counter()
+    purge_stale_cache()
+    threads = numba.get_num_threads()
+    head = {k: v[:2] for k, v in columns.items()}
+    try:
+        with _CompileCounter(on_first_compile).listening() as counter:
+            evaluate_chunk(study_json, head, base_dir)
+            if json.loads(study_json)["run"]["method"] == "auto":
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    _batch_calls(("linear", "nonlinear", "auto"))
+    finally:
+        numba.set_num_threads(threads)  # evaluate_chunk pins one thread for the workers
+    return {"compiled": counter.count, "seconds": time.perf_counter() - t0}
+
+
+def main() -> int:
+    """``rockstudy compile``: prime numba's cache and say what it did."""
+    import sys
+
+    def note():
+        print("compiling the numba kernels (once per install; a minute or two) ...", flush=True)
+
+    r = compile_kernels(note)
+    what = f"compiled {r['compiled']} kernels" if r["compiled"] else "all kernels were cached"
+    print(f"rockstudy kernels ready: {what} in {r['seconds']:.1f} s", file=sys.stdout)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
