@@ -29,6 +29,7 @@ from ._rocking import (
     STATUS_OK,
     _uplift_trig,
     free_rocking_map,
+    free_tail_end,
     next_uplift,
 )
 
@@ -268,7 +269,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
             break
         t = tau / p
     if code == PH_END:
-        if use_map:
+        if use_map and eta < 1.0:  # eta = 1 never rests: followed up to t_tail instead
             over, peak, n_post = free_rocking_map(
                 s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
             )
@@ -293,7 +294,8 @@ def trig_batch(p, alpha, eta, mp):
     out = np.empty((p.shape[0], 7))
     no_log = np.empty((0, 7))
     for i in prange(p.shape[0]):
-        r = trig_scene(p[i], alpha[i], eta[i], mp[i], True, np.inf, no_log)
+        t_tail = free_tail_end(p[i], eta[i], mp[i, 3])
+        r = trig_scene(p[i], alpha[i], eta[i], mp[i], True, t_tail, no_log)
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
         out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
     return out

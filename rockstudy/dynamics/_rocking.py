@@ -5,6 +5,11 @@ explicitly (never sgn(theta)), so the right-hand side is smooth across theta = 0
 is a root of theta on the quintic Hermite interpolant of an accepted DOP853 step. After the
 excitation ends nothing is integrated unless the block overturns: the free-rocking map
 (energy conservation between impacts, eta per impact) gives the peaks and the decision.
+
+A block at rest lifts off where its own acceleration on the side pushed towards turns
+positive (:func:`_lift`, the right-hand side itself), found on the motion's monotone pieces
+between analytic extrema; the Zeno rule restarts a settling block by the same test, so a
+block said to lift always rises and a chatter at the threshold cannot go on without end.
 """
 
 from __future__ import annotations
@@ -50,8 +55,19 @@ TOL_SAFETY = 0.1
 MIN_STEP = 1e-9
 #: Absolute error scales of theta and theta_dot, as fractions of alpha and p*alpha.
 ATOL_FRACTION = 1e-3
-#: Impact count reported when eta = 1 (the block never comes to rest).
+#: Impact count of :func:`free_rocking_map` when eta = 1 (the block never comes to rest).
+#: The solvers do not report it: they count the impacts up to :func:`free_tail_end` instead.
 NEVER_AT_REST = 2**31 - 1
+#: Length of the free rocking followed after the motion when eta = 1, in units of 1/p.
+UNDAMPED_WINDOW = 100.0
+
+
+@njit(cache=True)
+def free_tail_end(p, eta, duration):
+    """End of the free rocking that the solvers follow after a motion of ``duration`` [s]:
+    until rest (inf), or for a block that never rests (eta >= 1) until duration + 100/p, so
+    that impacts are counted within that window, the same way by every path."""
+    return duration + UNDAMPED_WINDOW / p if eta >= 1.0 else np.inf
 
 
 @njit(cache=True, inline="always")
@@ -85,11 +101,10 @@ def _mechanism_accel(u, v, a_g, tab):
 
 
 @njit(cache=True)
-def _rhs(t, th, om, args):
-    """theta_ddot on side s: eq. (2.2) of [000] (nonlinear), eq. (3.1) (linearized) or a
-    tabulated mechanism, eq. (8) of [003], in the amplitude u = s theta."""
-    p, alpha, s, model, kind, mp, times, samples, k, tab = args
-    a_g = ground_acceleration(kind, mp, times, samples, t, k)
+def _accel(a_g, th, om, p, alpha, s, model, tab):
+    """theta_ddot on side s under the ground acceleration a_g: eq. (2.2) of [000]
+    (nonlinear), eq. (3.1) (linearized) or a tabulated mechanism, eq. (8) of [003], in the
+    amplitude u = s theta."""
     if model == MODEL_TABLE:
         return s * _mechanism_accel(s * th, s * om, s * a_g, tab[0] if s > 0.0 else tab[1])
     a = a_g / G
@@ -99,13 +114,38 @@ def _rhs(t, th, om, args):
     return -p * p * (math.sin(x) + a * math.cos(x))
 
 
-_step = make_dop853_step(_rhs)
+@njit(cache=True)
+def _rhs(t, th, om, args):
+    """theta_ddot at time t on side s (see :func:`_accel`)."""
+    p, alpha, s, model, kind, mp, times, samples, k, tab = args
+    return _accel(
+        ground_acceleration(kind, mp, times, samples, t, k), th, om, p, alpha, s, model, tab
+    )
 
 
 @njit(cache=True)
-def uplift_threshold(alpha, model):
-    """|u_g''| at which a block at rest starts rocking: g tan(alpha); g alpha if linearized."""
-    return G * alpha if model == MODEL_LINEAR else G * math.tan(alpha)
+def _lift(a_g, p, alpha, model, tab):
+    """u_ddot of a block at rest on the side that a_g pushes it towards (s = -sign a_g).
+
+    The block lifts off iff this is > 0, i.e. iff |a_g| exceeds g tan(alpha) (nonlinear),
+    g alpha (linearized) or g lambda (a mechanism, eq. 10 of [003]). It is computed by the
+    right-hand side itself, so that a block said to lift does rise: a threshold test in
+    other arithmetic can disagree with it within a few ulps of the threshold, where the
+    Zeno rule would then restart a block that falls straight back, without end.
+    """
+    s = -1.0 if a_g > 0.0 else 1.0
+    return s * _accel(a_g, 0.0, 0.0, p, alpha, s, model, tab)
+
+
+_step = make_dop853_step(_rhs)
+
+
+@njit(cache=True, inline="always")
+def _ground_after(kind, mp, times, samples, t, k):
+    """u_g'' just after t: zero from the end of the motion on. A step, or a decision to lift,
+    taken at t = duration must see the still ground that follows (a cosine pulse jumps there
+    from a_g to 0), not the motion's last value."""
+    return 0.0 if t >= mp[3] else ground_acceleration(kind, mp, times, samples, t, k)
 
 
 @njit(cache=True)
@@ -127,71 +167,68 @@ def _uplift_trig(mp, thr, t0):
     return t if t <= dur else np.inf
 
 
-@njit(cache=True, inline="always")
-def _excess(a, thr_p, thr_n):
-    """By how much u_g'' = a exceeds the uplift threshold of the side it pushes towards:
-    a > 0 lifts onto the negative pivot (threshold thr_n), a < 0 onto the positive (thr_p)."""
-    return a - thr_n if a > 0.0 else -a - thr_p
+@njit(cache=True)
+def _next_break(kind, mp, times, t, k):
+    """The first time after t at which the ground acceleration has an extremum or a zero
+    (or the motion ends): between two such times it is monotone and of one sign.
+
+    Analytic for the pulses: a sin(omega t + phase) at phases k pi / 2; the Ricker wavelet
+    a (1 - 2 x^2) exp(-x^2), x = pi f (t - t0), at x = 0 (peak), +-1/sqrt(2) (zeros) and
+    +-sqrt(3/2) (side lobes, where d/dx = 2 x (2 x^2 - 3) exp(-x^2) vanishes). A record is
+    linear between its samples.
+    """
+    dur = mp[3]
+    if kind == KIND_RECORD:
+        return min(times[segment_index(times, t, k) + 1], dur)
+    if kind == KIND_TRIG:
+        q = 0.5 * math.pi
+        j = math.floor((mp[1] * t + mp[2]) / q) + 1.0
+        tb = (j * q - mp[2]) / mp[1]
+        if tb <= t:
+            tb = ((j + 1.0) * q - mp[2]) / mp[1]
+        return min(tb, dur)
+    for x in (-math.sqrt(1.5), -math.sqrt(0.5), 0.0, math.sqrt(0.5), math.sqrt(1.5)):
+        tb = mp[2] + x / (math.pi * mp[1])
+        if tb > t:
+            return min(tb, dur)
+    return dur
 
 
 @njit(cache=True)
-def _uplift_scan(kind, mp, times, samples, thr_p, thr_n, t0):
-    """First t >= t0 with a non-negative excess, by a scan at T_p/256 and bisection."""
+def next_uplift(kind, mp, times, samples, p, alpha, model, tab, t0):
+    """First time >= t0 at which a block at rest lifts off (:func:`_lift` > 0), or inf.
+
+    The motion is cut at its extrema and zeros (:func:`_next_break`); on each piece the lift
+    is monotone, so it is checked at the piece's end and located by bisection to the ulp.
+    No short excursion above the threshold between scan points can be missed.
+    """
     dur = mp[3]
-    dt = (2.0 * math.pi / mp[1] if kind == KIND_TRIG else 1.0 / mp[1]) / 256.0
+    if t0 > dur:
+        return np.inf
+    k = segment_index(times, t0, 0) if kind == KIND_RECORD else 0
     lo = t0
-    if _excess(ground_acceleration(kind, mp, times, samples, lo, 0), thr_p, thr_n) >= 0.0:
+    if _lift(ground_acceleration(kind, mp, times, samples, lo, k), p, alpha, model, tab) > 0.0:
         return lo
     while lo < dur:
-        hi = min(lo + dt, dur)
-        if _excess(ground_acceleration(kind, mp, times, samples, hi, 0), thr_p, thr_n) >= 0.0:
-            for _ in range(200):
+        hi = _next_break(kind, mp, times, lo, k)
+        if kind == KIND_RECORD:
+            k = segment_index(times, lo, k)
+        a_hi = ground_acceleration(
+            kind, mp, times, samples, hi, segment_index(times, hi, k) if kind == KIND_RECORD else 0
+        )
+        if _lift(a_hi, p, alpha, model, tab) > 0.0:
+            for _ in range(2000):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                a = ground_acceleration(kind, mp, times, samples, mid, 0)
-                if _excess(a, thr_p, thr_n) >= 0.0:
+                a = ground_acceleration(kind, mp, times, samples, mid, k)
+                if _lift(a, p, alpha, model, tab) > 0.0:
                     hi = mid
                 else:
                     lo = mid
             return hi
         lo = hi
     return np.inf
-
-
-@njit(cache=True)
-def _uplift_record(mp, times, samples, thr_p, thr_n, t0):
-    """First t >= t0 with a non-negative excess on the piecewise-linear record, or inf."""
-    n = times.shape[0]
-    if t0 > times[n - 1]:
-        return np.inf
-    k = segment_index(times, t0, 0)
-    a0 = ground_acceleration(KIND_RECORD, mp, times, samples, t0, k)
-    if _excess(a0, thr_p, thr_n) >= 0.0:
-        return t0
-    ta = t0
-    while k < n - 1:
-        tb = times[k + 1]
-        b = mp[0] * samples[k + 1]
-        if _excess(b, thr_p, thr_n) >= 0.0:
-            target = thr_n if b > 0 else -thr_p
-            return ta + (target - a0) / (b - a0) * (tb - ta)
-        ta, a0 = tb, b
-        k += 1
-    return np.inf
-
-
-@njit(cache=True)
-def next_uplift(kind, mp, times, samples, thr_p, thr_n, t0):
-    """First time >= t0 at which the ground acceleration reaches the uplift threshold of the
-    side it pushes towards (thr_p onto the positive pivot, thr_n onto the negative)."""
-    if t0 > mp[3]:
-        return np.inf
-    if kind == KIND_RECORD:
-        return _uplift_record(mp, times, samples, thr_p, thr_n, t0)
-    if kind == KIND_TRIG and thr_p == thr_n:
-        return _uplift_trig(mp, thr_p, t0)
-    return _uplift_scan(kind, mp, times, samples, thr_p, thr_n, t0)
 
 
 @njit(cache=True)
@@ -287,13 +324,13 @@ def _step_events(s, h, th, om, f0, th1, om1, f1):
 def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
-    blk = (p, alpha, eta, model, thr_p, thr_n, omega_rest, tol, max_steps, fall, tab),
+    blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
     mot = (kind, mp, times, samples), log = (hist, imps) (empty arrays: no history).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact).
     """
-    p, alpha, eta, model, thr_p, thr_n, omega_rest, tol, max_steps, fall, tab = blk
+    p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
     kind, mp, times, samples = mot
     hist, imps = log
     rec = hist.shape[0] > 0
@@ -302,7 +339,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     kx = np.empty(13)
     kv = np.empty(13)
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
-    f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k, tab))
+    f0 = _accel(_ground_after(kind, mp, times, samples, t, k), th, om, p, alpha, s, model, tab)
     steps = 0
     code = PH_END
     while t < t_stop:
@@ -380,8 +417,8 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if kind == KIND_RECORD:
             k = segment_index(times, min(t, dur), k)
         if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
-            a_g = ground_acceleration(kind, mp, times, samples, t, k)
-            if _excess(a_g, thr_p, thr_n) < 0.0:
+            a_g = _ground_after(kind, mp, times, samples, t, k)
+            if not _lift(a_g, p, alpha, model, tab) > 0.0:
                 om = 0.0
                 code = PH_REST
                 break
@@ -392,21 +429,45 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if ta[NIMP] == stop_at_impacts:
             code = PH_IMPACT
             break
-        f0 = _rhs(t, th, om, (p, alpha, s, model, kind, mp, times, samples, k, tab))
+        a_g = _ground_after(kind, mp, times, samples, t, k)
+        f0 = _accel(a_g, th, om, p, alpha, s, model, tab)
     st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
     return code
 
 
 @njit(cache=True, inline="always")
-def _c(x, model):
-    """Normalised potential shape: cos x (nonlinear) or its quadratic 1 - x^2/2 (linearized)."""
-    return 1.0 - 0.5 * x * x if model == MODEL_LINEAR else math.cos(x)
+def _rise(u, alpha, model):
+    r"""Potential energy at rotation u above that at theta = 0, / p^2 [-]:
+    :math:`\cos(\alpha - u) - \cos\alpha = 2 \sin(\alpha - u/2) \sin(u/2)` (nonlinear) or
+    :math:`\alpha u - u^2/2` (linearized), in forms free of cancellation for small u, alpha."""
+    if model == MODEL_LINEAR:
+        return u * (alpha - 0.5 * u)
+    return 2.0 * math.sin(alpha - 0.5 * u) * math.sin(0.5 * u)
 
 
 @njit(cache=True, inline="always")
-def _cinv(y, model):
-    """Inverse of :func:`_c` on [0, pi]."""
-    return math.sqrt(max(2.0 * (1.0 - y), 0.0)) if model == MODEL_LINEAR else math.acos(min(y, 1.0))
+def _rise_to_top(alpha, model):
+    """:func:`_rise` at the top u = alpha: 1 - cos(alpha) = 2 sin^2(alpha/2), or alpha^2/2."""
+    if model == MODEL_LINEAR:
+        return 0.5 * alpha * alpha
+    return 2.0 * math.sin(0.5 * alpha) ** 2
+
+
+@njit(cache=True)
+def _rotation_at(k, alpha, model):
+    r"""The rotation u in [0, alpha] with :func:`_rise` (u) = k, for 0 <= k <= the top.
+
+    With :math:`s = \sin(\alpha/2)` and :math:`b = \sin((\alpha - u)/2) = \sqrt{s^2 - k/2}`,
+    :math:`u/2 = \arcsin s - \arcsin b = \arcsin\frac{k/2}{s\sqrt{1-b^2} + b\cos(\alpha/2)}`
+    (nonlinear); :math:`u = 2k / (\alpha + \sqrt{\alpha^2 - 2k})` (linearized). Both keep
+    the relative precision of k, where :math:`\alpha - \arccos(\cos\alpha + k)` loses it.
+    """
+    if model == MODEL_LINEAR:
+        return 2.0 * k / (alpha + math.sqrt(max(alpha * alpha - 2.0 * k, 0.0)))
+    sa = math.sin(0.5 * alpha)
+    b = math.sqrt(max(sa * sa - 0.5 * k, 0.0))
+    x = 0.5 * k / (sa * math.sqrt(1.0 - b * b) + b * math.cos(0.5 * alpha))
+    return 2.0 * math.asin(min(x, 1.0))
 
 
 @njit(cache=True)
@@ -429,23 +490,25 @@ def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
     :math:`\cos(\alpha - \theta_{max}) = \cos\alpha + \dot\theta^2 / 2p^2` (eq. 4.12 of [000]
     for the linearized block). Returns (overturns, peak u, impacts until rest).
     """
-    e = 0.5 * (v / p) ** 2 + _c(alpha - u, model)
+    k = 0.5 * (v / p) ** 2 + _rise(u, alpha, model)  # energy above the impact level, / p^2
+    top = _rise_to_top(alpha, model)
     peak = u
-    if e >= 1.0:
+    if k >= top:
         if (u < alpha and v > 0.0) or (u >= alpha and v >= 0.0):
             return True, FALL_ROTATION, 0
     elif u > alpha:
         return True, FALL_ROTATION, 0
     elif v > 0.0:
-        peak = alpha - _cinv(e, model)
-    w = math.sqrt(max(2.0 * (e - _c(alpha, model)), 0.0))  # speed at the first impact, / p
+        peak = _rotation_at(k, alpha, model)
+    # speed at the first impact, / p; that impact always happens (counted, as integration
+    # does, even when it leaves the block at rest)
+    w = math.sqrt(max(2.0 * k, 0.0))
     rest = omega_rest / p
-    if w < rest:
-        return False, peak, 0
     w1 = eta * w
-    if _c(alpha, model) + 0.5 * w1 * w1 >= 1.0:
+    k1 = 0.5 * w1 * w1
+    if k1 >= top:
         return True, FALL_ROTATION, 1
-    peak = max(peak, alpha - _cinv(_c(alpha, model) + 0.5 * w1 * w1, model))
+    peak = max(peak, _rotation_at(k1, alpha, model))
     return False, peak, _impacts_until_rest(w1, rest, eta)
 
 
@@ -496,8 +559,6 @@ def _free_map_table(u, v, eta, tab, other, omega_rest):
     elif v > 0.0:
         peak = _potential_level(e, u, phi_cr, tab)
     w = math.sqrt(max(2.0 * G * (e - tab[0, TAB_V]) / tab[0, TAB_I], 0.0))  # impact speed
-    if w < omega_rest:
-        return False, peak, 0
     w1 = eta * w
     e1 = 0.5 * other[0, TAB_I] * w1 * w1 / G + other[0, TAB_V]
     phi_cr1 = _critical(other)
@@ -518,13 +579,8 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     impact times recorded, DOP853 steps, first impact time).
     """
     kind, mp, times, samples = mot
-    if model == MODEL_TABLE:  # g lambda of each direction, eq. (10) of [003]
-        thr_p = -G * tab[0, 0, TAB_G] / tab[0, 0, TAB_B]
-        thr_n = -G * tab[1, 0, TAB_G] / tab[1, 0, TAB_B]
-    else:
-        thr_p = thr_n = uplift_threshold(alpha, model)
     omega_rest = REST_FRACTION * p * alpha
-    blk = (p, alpha, eta, model, thr_p, thr_n, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
+    blk = (p, alpha, eta, model, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
     hist = log[0]
     rec = hist.shape[0] > 0
     dur = mp[3]
@@ -541,7 +597,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             code = PH_FAIL
             break
         if at_rest:
-            t_up = next_uplift(kind, mp, times, samples, thr_p, thr_n, st[T])
+            t_up = next_uplift(kind, mp, times, samples, p, alpha, model, tab, st[T])
             if t_up >= dur:
                 break
             k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
@@ -567,10 +623,11 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             over, peak, n_post = _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
         else:
             over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
-        if use_map and not over:
+        if use_map and not over and eta < 1.0:
             ta[MAXU] = max(ta[MAXU], peak)
             ta[NIMP] += n_post
-        else:  # integrate the free rocking: for the history, or to time the overturning
+        else:  # integrate the free rocking: for the history, to time the overturning, or to
+            # count the impacts of a block that never rests (eta = 1) up to t_tail
             code = _phase(blk, mot, log, st, ta, t_tail)
     status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
     over = code == PH_OVER
@@ -609,7 +666,7 @@ def scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps)
             mot,
             rtol,
             True,
-            np.inf,
+            free_tail_end(p[i], eta[i], mp[i, 3]),
             no_log,
             max_steps,
             0.0,

@@ -10,6 +10,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import _validate
 from ..constants import G
 from ..motions import Record
 from ..motions import _kernels as mk
@@ -41,6 +42,28 @@ def _column(name, values, n, low=None, high=None, low_open=True, high_open=True)
         hi = "inf" if high is None else f"{high:g}" + (")" if high_open else "]")
         raise ValueError(f"{name}[{i}] = {arr[i]!r} is outside the allowed range {lo}, {hi}")
     return np.ascontiguousarray(arr)
+
+
+def _common_length(**columns) -> int:
+    """The length n that the scalar and 1-D arguments broadcast to; a ValueError naming the
+    argument for anything of more dimensions or of another length."""
+    lengths = {}
+    for name, x in columns.items():
+        if x is None:
+            continue
+        shape = np.shape(x)
+        if len(shape) > 1:
+            raise ValueError(f"{name} must be a scalar or a 1-D array, got shape {shape}")
+        if shape == (0,):
+            raise ValueError(f"{name} is empty: give a scalar or a non-empty 1-D array")
+        if shape and shape[0] != 1:
+            lengths[name] = shape[0]
+    if len(set(lengths.values())) > 1:
+        raise ValueError(
+            "the 1-D arguments must have one common length (or length 1), got "
+            + ", ".join(f"{k}: {v}" for k, v in lengths.items())
+        )
+    return max(max(lengths.values(), default=1), 1)
 
 
 def _pulse_params(pulse, amplitude, period, cycles, n):
@@ -102,23 +125,28 @@ def simulate_batch(
         nonlinear kernel at 0.05 ``rtol`` (5e-6 at most, for the overturning decisions)
         otherwise.
     rtol : float
-        Relative tolerance of the integrator. For ``"auto"``: the relative accuracy of
-        ``max_rotation``, with the overturning decision of Housner's model; ``rtol`` covers
-        no other output (``overturn_time`` and ``first_impact_time`` are the kernel's at that
-        rtol, ``n_impacts`` the kernel's count until its rest rule).
+        Relative tolerance of the integrator, in [1e-12, 1). For ``"auto"``: the relative
+        accuracy of ``max_rotation``, with the overturning decision of Housner's model;
+        ``rtol`` covers no other output (``overturn_time`` and ``first_impact_time`` are the
+        kernel's at that rtol, ``n_impacts`` the kernel's count until its rest rule).
     outputs : sequence of str, optional
         The outputs to return (names of :data:`OUTPUTS`; ``status`` always comes along).
         Default: all of them. With ``"auto"``, asking only for ``max_rotation`` and
         ``overturned`` (and ``steps``, ``model``) lets the rows whose bound allows it run the
         cheaper linear model; asking for any other output runs the kernel on every row that
         lifts, so that no returned value lies outside what ``auto`` promises.
+    max_steps : int
+        Cap on the integrator steps in one rocking phase of a row (status 1 when reached), a
+        whole number in [1, 1e12].
 
     Returns
     -------
     dict of ndarrays
         ``max_rotation`` [rad] (pi/2 if overturned), ``overturned`` (bool), ``n_impacts``
-        (until rest), ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s]
-        (NaN if none), ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
+        (until rest; with restitution 1 the block never rests, and the impacts are counted up
+        to duration + 100/p, the end of :func:`rockstudy.simulate`'s default history),
+        ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s] (NaN if none),
+        ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
         taken; 0 for the exact solver), ``model`` (0 rest without integration, 1 linear,
         2 nonlinear: what each row ran); only those of ``outputs`` (and ``status``) if given.
     """
@@ -127,28 +155,22 @@ def simulate_batch(
         model = _MODELS[method]
     except KeyError:
         raise ValueError(f"method must be one of {sorted(_MODELS)}, got {method!r}") from None
-    if not 0.0 < rtol < 1.0:
-        raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
+    rtol = _validate.rtol(rtol)
+    max_steps = _validate.max_steps(max_steps)
     if method == "nonlinear":
         _auto.warn_loose_tolerance(rtol)
     if (half_diagonal is None) == (frequency_parameter is None):
         raise ValueError("give exactly one of half_diagonal or frequency_parameter")
-    shapes = [
-        np.shape(x)
-        for x in (
-            half_diagonal,
-            frequency_parameter,
-            slenderness,
-            restitution,
-            amplitude,
-            period,
-            scale,
-            cycles,
-        )
-        if x is not None
-    ]
-    n = int(np.prod(np.broadcast_shapes(*shapes))) if shapes else 1
-    n = max(n, 1)
+    n = _common_length(
+        half_diagonal=half_diagonal,
+        frequency_parameter=frequency_parameter,
+        slenderness=slenderness,
+        restitution=restitution,
+        amplitude=amplitude,
+        period=period,
+        scale=scale,
+        cycles=cycles,
+    )
     alpha = _column("slenderness", slenderness, n, 0.0, np.pi / 2)
     if half_diagonal is not None:
         R = _column("half_diagonal", half_diagonal, n, 0.0)

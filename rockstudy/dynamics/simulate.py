@@ -120,9 +120,7 @@ def _tail_end(p, eta, motion, t_max):
     """End of the free-rocking history: t_max, or open-ended unless the block never rests."""
     if t_max is not None:
         return t_max
-    if eta >= 1.0:
-        return motion.duration + 100.0 / p  # an undamped block never comes to rest
-    return math.inf
+    return _rocking.free_tail_end(p, eta, motion.duration)
 
 
 def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l=1e-4):
@@ -254,7 +252,8 @@ def simulate(
         ``result.info`` (``structure_model``, ``coordinate``) and in an
         :class:`~rockstudy.EquivalentBlockWarning` (none for the exact Table I blocks).
     rtol : float
-        Relative tolerance, in (0, 1); absolute tolerances scale with alpha and p*alpha.
+        Relative tolerance, in [1e-12, 1) (below 1e-12 the kernels' error target drowns in
+        rounding); absolute tolerances scale with alpha and p*alpha.
         For ``"auto"``: the relative accuracy of ``max_rotation``, with the overturning
         decision of Housner's model (or of the mechanism); ``impact_times``,
         ``overturn_time`` and the history are the kernel's at that rtol, which ``rtol``
@@ -266,7 +265,7 @@ def simulate(
         theta [rad] and theta_dot [rad/s] at t = 0; |theta| < pi/2. Both zero (default): the
         block starts at rest. Use with :class:`rockstudy.motions.NoMotion` for free rocking.
     max_steps : int
-        Safety cap on the integrator steps in one rocking phase.
+        Safety cap on the integrator steps in one rocking phase, a whole number in [1, 1e12].
     l : float
         The complex formulation's l (method ``"complex"`` only), in (0, 0.1).
 
@@ -285,7 +284,13 @@ def simulate(
             "motion has a vertical component, which the solvers do not take yet; "
             "simulate Record(motion.acceleration, time=motion.time) for the horizontal alone"
         )
-    rtol = _validate.in_open_interval("rtol", rtol, 0.0, 1.0, "(0, 1)")
+    rtol = _validate.rtol(rtol)
+    max_steps = _validate.max_steps(max_steps)
+    if method == "mechanism" and not hasattr(structure, "mechanism"):
+        raise ValueError(
+            f"method='mechanism' needs a structure with a mechanism() (a wall, an arch, a "
+            f"frame); a {type(structure).__name__} has none: use method='nonlinear'"
+        )
     if t_max is not None:
         t_max = _validate.positive("t_max", t_max)
     th0 = _validate.in_open_interval(

@@ -23,6 +23,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import _validate
 from ..constants import G
 from ._jet import Jet
 
@@ -92,12 +93,12 @@ class EquivalentBlock:
     scale: float = 1.0
 
     def __post_init__(self):
-        if not (self.frequency_parameter > 0):
-            raise ValueError(f"frequency_parameter must be > 0, got {self.frequency_parameter}")
-        if not 0 < self.slenderness < math.pi / 2:
-            raise ValueError(f"critical rotation must lie in (0, pi/2), got {self.slenderness}")
-        if not 0 < self.restitution <= 1:
-            raise ValueError(f"restitution must lie in (0, 1], got {self.restitution}")
+        _validate.positive("frequency_parameter", self.frequency_parameter)
+        _validate.in_open_interval(
+            "slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad (theta_cr)"
+        )
+        _validate.restitution(self.restitution)
+        _validate.positive("scale", self.scale)
 
 
 Pose = Callable[[Jet], tuple[list[Jet], list[Jet], list[Jet]]]
@@ -159,12 +160,16 @@ class Mechanism:
 
     def critical_rotation(self) -> float:
         """phi_cr: the first root of V' in (0, phi_max), eq. (9) of [003]."""
-        grid = np.linspace(0.0, self.phi_max, 2001)[1:]
+        # the grid starts at phi = 0, where G_nl(0) = -lambda B_nl(0) < 0 for any lambda > 0:
+        # phi_cr -> 0 with lambda (thin arches), so it may lie before the first grid step
+        grid = np.linspace(0.0, self.phi_max, 2001)
         with np.errstate(invalid="ignore"):  # a linkage may lock before phi_max: NaN there
             g = self.terms(grid)["G"]
-        sign = np.flatnonzero(np.diff(np.sign(g)) != 0)
-        if g[0] >= 0:
-            raise ValueError("the mechanism is not stable at rest (G_nl(0+) >= 0)")
+        if not g[0] < 0:
+            raise ValueError(
+                "the mechanism is not stable at rest (G_nl(0) >= 0: uplift multiplier lambda <= 0)"
+            )
+        sign = np.flatnonzero(g[1:] >= 0)
         if sign.size == 0:
             raise ValueError("no unstable equilibrium within the kinematic range")
         lo, hi = grid[sign[0]], grid[sign[0] + 1]
