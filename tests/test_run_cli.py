@@ -142,7 +142,7 @@ def test_ctrl_c_prints_one_line_with_the_resume_command(tmp_path):
     t0 = time.time()
     while time.time() - t0 < 120:
         try:
-            if (xr.open_zarr(out).status.values != 0).sum() >= 20:
+            if (xr.open_zarr(out, consolidated=True).status.values != 0).sum() >= 20:
                 break
         except Exception:  # noqa: BLE001 - not written yet
             pass

@@ -8,6 +8,7 @@ nothing finished: ``resume=True`` computes only the chunks whose status is still
 
 from __future__ import annotations
 
+import logging
 import multiprocessing
 import sys
 import time
@@ -132,6 +133,7 @@ def _local_cluster(workers):
                 host="127.0.0.1",
                 dashboard_address="127.0.0.1:0",  # an HTTP server always starts: no routes
                 scheduler_kwargs={"dashboard": False},
+                silence_logs=logging.ERROR,  # a stopped run prints one line, not its workers'
             )
     except Exception as exc:  # noqa: BLE001 - reported in one sentence, with its cause
         raise RuntimeError(
