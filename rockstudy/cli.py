@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import shlex
 import sys
 from pathlib import Path
@@ -87,6 +88,15 @@ def _security(args):
     )
 
 
+def _quiet_dask() -> None:
+    """dask's own log lines (a lost scheduler, cancelled tasks) would bury our one line."""
+    import distributed  # noqa: F401 - importing it configures the loggers quietened here
+
+    names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]
+    for name in ("distributed", *names):
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def _run(args) -> int:
     from concurrent.futures import CancelledError
 
@@ -95,6 +105,7 @@ def _run(args) -> int:
     from .study.store import StoreError
 
     study = load_study(args.study)
+    _quiet_dask()
     try:
         report = run_study(
             study,

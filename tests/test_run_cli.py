@@ -20,47 +20,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from test_study import ROCKSTUDY, SLOW, study_text  # the studies of the study-layer tests
 
 from rockstudy.study import run_study, validate_text
 
-ROCKSTUDY = str(Path(sys.executable).with_name("rockstudy"))
 DASK = str(Path(sys.executable).with_name("dask"))
-
-STUDY = """
-name = "cli"
-seed = 5
-chunk_size = {chunk}
-
-[sampler]
-kind = "monte_carlo"
-n = {n}
-
-[structure]
-kind = "block"
-half_diagonal = {{ dist = "uniform", low = 0.5, high = 3.0 }}
-slenderness = {{ dist = "uniform", low = 0.1, high = 0.3 }}
-
-[motion]
-kind = "{motion}"
-{motion_fields}
-
-[run]
-outputs = ["max_rotation", "overturned"]
-max_steps = {max_steps}
-"""
-PULSE = """shape = "sine"
-amplitude_ratio = { dist = "uniform", low = 0.8, high = 5.0 }
-period = { dist = "loguniform", low = 0.1, high = 2.0 }"""
-STOCHASTIC = """pga_ratio = { dist = "uniform", low = 0.8, high = 2.5 }
-duration = 20.0"""
 
 
 def write_study(folder, n=40, chunk=10, max_steps=1_000_000, motion="pulse"):
     path = Path(folder) / "study.toml"
-    fields = PULSE if motion == "pulse" else STOCHASTIC
-    path.write_text(
-        STUDY.format(n=n, chunk=chunk, max_steps=max_steps, motion=motion, motion_fields=fields)
-    )
+    text = SLOW.format(chunk=chunk, n=n) if motion == "stochastic" else None
+    path.write_text(text or study_text(chunk=chunk, n=n, max_steps=max_steps))
     return path
 
 
@@ -103,13 +73,11 @@ def test_error_messages_are_stored_whole(tmp_path):
     t = np.arange(0.0, 2.0, 0.01)
     np.savetxt(record, np.column_stack([t, 0.3 * np.sin(2 * np.pi * t)]))
     study = validate_text(
-        STUDY.format(
-            n=2,
-            chunk=2,
-            max_steps=1000,
-            motion="record",
-            motion_fields=f'files = ["{record}"]\nscale = 1.0',
-        )
+        study_text(n=2, chunk=2)
+        .replace('kind = "pulse"', f'kind = "record"\nfiles = ["{record}"]\nscale = 1.0')
+        .replace('shape = "sine"\n', "")
+        .replace('amplitude_ratio = { dist = "uniform", low = 0.8, high = 5.0 }\n', "")
+        .replace('period = { dist = "loguniform", low = 0.1, high = 2.0 }\n', "")
     )
     record.unlink()  # gone after validation: every row fails, naming the whole path
     cols = {
@@ -246,6 +214,40 @@ def test_scheduler_without_workers_or_out_of_reach_is_said_in_time(tmp_path):
         assert time.time() - t0 < 60
     finally:
         _stop([sched])
+
+
+def test_lost_scheduler_is_one_error_line(tmp_path):
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = {**os.environ, "NUMBA_NUM_THREADS": "1"}
+    procs = [_start([DASK, "scheduler", "--host", "127.0.0.1", "--port", str(port)], env=env)]
+    try:
+        _wait_for_port(port)
+        worker = [DASK, "worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard"]
+        procs.append(_start(worker, env=env))
+        study = write_study(tmp_path, n=400, chunk=10, motion="stochastic")
+        out = tmp_path / "cube.zarr"
+        run = subprocess.Popen(
+            [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler", address, "--quiet",
+             "--timeout", "5"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        t0 = time.time()
+        while time.time() - t0 < 120 and run.poll() is None:
+            try:
+                if (xr.open_zarr(out, consolidated=True).status.values != 0).sum() >= 20:
+                    break
+            except Exception:  # noqa: BLE001 - not written yet
+                pass
+            time.sleep(0.2)
+        _stop(procs[:1])  # the scheduler dies mid-run
+        _, stderr = run.communicate(timeout=180)
+        lines = error_lines(stderr)
+        assert run.returncode == 1 and len(lines) == 1, stderr
+        assert lines[0].startswith("error: ") and "samples are saved in" in lines[0]
+        assert f"--out {out} --resume --scheduler {address}" in lines[0]
+    finally:
+        _stop(procs)
 
 
 def _file_size_limit(limit):

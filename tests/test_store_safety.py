@@ -10,46 +10,20 @@ import os
 import shutil
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
+from test_study import ROCKSTUDY, study_text  # the pulse study of the study-layer tests
 
 from rockstudy import simulate_batch
-
-ROCKSTUDY = str(Path(sys.executable).with_name("rockstudy"))
-
-STUDY = """
-name = "safety"
-seed = {seed}
-chunk_size = {chunk}
-
-[sampler]
-kind = "monte_carlo"
-n = {n}
-
-[structure]
-kind = "block"
-half_diagonal = {{ dist = "uniform", low = 0.5, high = 3.0 }}
-slenderness = {{ dist = "uniform", low = 0.1, high = 0.3 }}
-
-[motion]
-kind = "pulse"
-shape = "sine"
-amplitude_ratio = {{ dist = "uniform", low = 0.8, high = 5.0 }}
-period = {{ dist = "loguniform", low = 0.1, high = 2.0 }}
-
-[run]
-outputs = ["max_rotation", "overturned", "n_impacts"]
-"""
 
 
 def write_study(folder, n=60, chunk=10, seed=7, name="study.toml"):
     path = Path(folder) / name
-    path.write_text(STUDY.format(n=n, chunk=chunk, seed=seed))
+    path.write_text(study_text(chunk=chunk, n=n).replace("seed = 7", f"seed = {seed}"))
     return path
 
 
