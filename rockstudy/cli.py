@@ -124,8 +124,9 @@ def _run(args) -> int:
     except FailedSamplesError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
-    except (StoreError, FileExistsError, FileNotFoundError, ValueError):
-        raise  # refused before anything was written: one line from main
+    except (StoreError, FileExistsError, FileNotFoundError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)  # refused: nothing was written
+        return 2
     except KeyboardInterrupt:
         print(
             f"\ninterrupted: {_saved(args.out)}; continue with: {_resume_command(args)}",
@@ -134,8 +135,9 @@ def _run(args) -> int:
         return 130
     except (OSError, SchedulerError, CancelledError, TimeoutError) as exc:
         # disk full, read-only file system, scheduler lost or unreachable
+        message = " ".join(str(exc).split())  # dask's messages span lines
         print(
-            f"error: {type(exc).__name__}: {exc}; {_saved(args.out)}; continue with: "
+            f"error: {type(exc).__name__}: {message}; {_saved(args.out)}; continue with: "
             f"{_resume_command(args)}",
             file=sys.stderr,
         )
@@ -227,8 +229,6 @@ def main(argv=None) -> int:
     rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
     rep.add_argument("--out", help="directory (default: RESULT_report)")
     args = parser.parse_args(argv)
-    from .study.store import StoreError
-
     try:
         if args.command == "simulate":
             return _simulate(args)
@@ -262,7 +262,7 @@ def main(argv=None) -> int:
             )
         print(f"wrote {args.out}/demo.png and {args.out}/demo.json")
         return 0
-    except (ValueError, FileExistsError, FileNotFoundError, StoreError) as exc:
+    except (ValueError, FileExistsError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

@@ -9,6 +9,7 @@ import json
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import time
 from pathlib import Path
@@ -129,25 +130,37 @@ def _lock_holder(out):
 
 
 def test_second_run_is_refused_and_a_killed_runs_lock_is_stale(tmp_path):
-    study = write_study(tmp_path, n=2000, chunk=100)
+    study = write_study(tmp_path)
     out = tmp_path / "cube.zarr"
+    with socket.socket() as s:  # a scheduler nobody answers at: the first run waits, locked
+        s.bind(("127.0.0.1", 0))
+        nowhere = f"tcp://127.0.0.1:{s.getsockname()[1]}"
     first = subprocess.Popen(
-        [ROCKSTUDY, "run", str(study), "--out", str(out), "--workers", "1", "--quiet"],
-        start_new_session=True,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
+        [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler", nowhere,
+         "--timeout", "600", "--quiet"],
+        start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
     try:
         t0 = time.time()
         while (_lock_holder(out) or {}).get("pid") != first.pid and time.time() - t0 < 60:
             time.sleep(0.05)
         assert (_lock_holder(out) or {}).get("pid") == first.pid, "the first run never started"
-        for extra in (["--resume"], []):
-            t0 = time.time()
-            code, _, err = rockstudy_run(study, out, *extra)
-            assert code != 0 and time.time() - t0 < 30  # refused at once, not after a run
+        t0 = time.time()
+        seconds = [
+            subprocess.Popen(
+                [ROCKSTUDY, "run", str(study), "--out", str(out), "--workers", "1", *extra],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )  # fmt: skip
+            for extra in (["--resume"], [])
+        ]
+        for second in seconds:
+            _, err = second.communicate(timeout=120)
+            assert second.returncode != 0
             assert_one_error_line(err)
             assert f"PID {first.pid}" in err and "in use" in err, err
+        assert first.poll() is None and time.time() - t0 < 60  # refused at once
     finally:
         os.killpg(first.pid, signal.SIGKILL)
         first.wait()
