@@ -97,6 +97,18 @@ def test_error_messages_are_stored_whole(tmp_path):
 # ------------------------------------------------------------------ stopping and starting
 
 
+def _wait_for_samples(out, proc, k, timeout=120):
+    """Until the run ``proc`` has saved ``k`` samples in ``out`` (or ended)."""
+    t0 = time.time()
+    while time.time() - t0 < timeout and proc.poll() is None:
+        try:
+            if (xr.open_zarr(out, consolidated=True).status.values != 0).sum() >= k:
+                return
+        except Exception:  # noqa: BLE001 - not written yet
+            pass
+        time.sleep(0.2)
+
+
 def test_ctrl_c_prints_one_line_with_the_resume_command(tmp_path):
     study = write_study(tmp_path, n=400, chunk=10, motion="stochastic")
     out = tmp_path / "cube.zarr"
@@ -107,14 +119,7 @@ def test_ctrl_c_prints_one_line_with_the_resume_command(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
     )
-    t0 = time.time()
-    while time.time() - t0 < 120:
-        try:
-            if (xr.open_zarr(out, consolidated=True).status.values != 0).sum() >= 20:
-                break
-        except Exception:  # noqa: BLE001 - not written yet
-            pass
-        time.sleep(0.2)
+    _wait_for_samples(out, proc, 20)
     os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C sends: the whole foreground group
     _, stderr = proc.communicate(timeout=120)
     lines = error_lines(stderr)
@@ -232,14 +237,7 @@ def test_lost_scheduler_is_one_error_line(tmp_path):
              "--timeout", "5"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         )  # fmt: skip
-        t0 = time.time()
-        while time.time() - t0 < 120 and run.poll() is None:
-            try:
-                if (xr.open_zarr(out, consolidated=True).status.values != 0).sum() >= 20:
-                    break
-            except Exception:  # noqa: BLE001 - not written yet
-                pass
-            time.sleep(0.2)
+        _wait_for_samples(out, run, 20)
         _stop(procs[:1])  # the scheduler dies mid-run
         _, stderr = run.communicate(timeout=180)
         lines = error_lines(stderr)
