@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
+import shlex
 import sys
 from pathlib import Path
 
@@ -38,20 +40,108 @@ def _simulate(args) -> int:
     return 0
 
 
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed: give a whole number >= 1")
+    return value
+
+
+def _share(text: str) -> float:
+    value = float(text)
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"{text} is not a share in [0, 1]")
+    return value
+
+
+def _resume_command(args) -> str:
+    words = ["rockstudy", "run", args.study, "--out", args.out, "--resume"]
+    for flag in ("workers", "scheduler", "scheduler_file", "tls_ca_file", "tls_cert", "tls_key"):
+        if getattr(args, flag) is not None:
+            words += ["--" + flag.replace("_", "-"), str(getattr(args, flag))]
+    return shlex.join(words)
+
+
+def _saved(out) -> str:
+    """What a stopped run kept, read from its store."""
+    import numpy as np
+
+    from .study.store import read_status
+
+    try:
+        status = read_status(out)
+    except Exception:  # noqa: BLE001 - a store that does not open has kept nothing readable
+        return f"nothing readable is saved in {out}"
+    return f"{np.count_nonzero(status)} of {status.size} samples are saved in {out}"
+
+
+def _security(args):
+    if not (args.tls_ca_file or args.tls_cert or args.tls_key):
+        return None  # dask's configuration (distributed.comm.tls.*) applies
+    from distributed.security import Security
+
+    return Security(
+        tls_ca_file=args.tls_ca_file,
+        tls_client_cert=args.tls_cert,
+        tls_client_key=args.tls_key,
+        require_encryption=True,
+    )
+
+
+def _quiet_dask() -> None:
+    """dask's own log lines (a lost scheduler, cancelled tasks) would bury our one line."""
+    import distributed  # noqa: F401 - importing it configures the loggers quietened here
+
+    names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]
+    for name in ("distributed", *names):
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def _run(args) -> int:
+    from concurrent.futures import CancelledError
+
     from .study import load_study, run_study
+    from .study.runner import FailedSamplesError, SchedulerError
+    from .study.store import StoreError
 
     study = load_study(args.study)
-    report = run_study(
-        study,
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        scheduler_file=args.scheduler_file,
-        resume=args.resume,
-        base_dir=Path(args.study).resolve().parent,
-        progress=not args.quiet,
-    )
+    _quiet_dask()
+    try:
+        report = run_study(
+            study,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            scheduler_file=args.scheduler_file,
+            resume=args.resume,
+            base_dir=Path(args.study).resolve().parent,
+            progress=not args.quiet,
+            overwrite=args.overwrite,
+            max_failed=args.max_failed,
+            security=_security(args),
+            timeout=args.timeout,
+        )
+    except FailedSamplesError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except (StoreError, FileExistsError, FileNotFoundError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)  # refused: nothing was written
+        return 2
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: {_saved(args.out)}; continue with: {_resume_command(args)}",
+            file=sys.stderr,
+        )
+        return 130
+    except (OSError, SchedulerError, CancelledError, TimeoutError) as exc:
+        # disk full, read-only file system, scheduler lost or unreachable
+        message = " ".join(str(exc).split())  # dask's messages span lines
+        print(
+            f"error: {type(exc).__name__}: {message}; {_saved(args.out)}; continue with: "
+            f"{_resume_command(args)}",
+            file=sys.stderr,
+        )
+        return 1
     print(
         f"{study.name}: {report.samples} samples in {report.chunks_total} chunks; computed "
         f"{len(report.chunks_computed)} chunks in {report.seconds:.1f} s; "
@@ -116,11 +206,29 @@ def main(argv=None) -> int:
     run.add_argument("study")
     run.add_argument("--out", required=True, help="the zarr store to write (PATH.nc too)")
     where = run.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, help="local cluster size (default 2)")
-    where.add_argument("--scheduler", help="address of a running dask scheduler")
+    where.add_argument("--workers", type=_positive_int, help="local cluster size (default 2)")
+    where.add_argument("--scheduler", help="address of a running dask scheduler (tls://...)")
     where.add_argument("--scheduler-file", help="scheduler file of a running dask cluster")
     run.add_argument("--resume", action="store_true", help="compute only pending chunks")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument(
+        "--overwrite", action="store_true", help="let the export replace an existing OUT.nc"
+    )
+    run.add_argument(
+        "--max-failed",
+        type=_share,
+        default=0.0,
+        help="largest share of failed samples that still exits 0 (default 0: none)",
+    )
+    run.add_argument(
+        "--timeout",
+        type=float,
+        default=60.0,
+        help="seconds to wait for a remote scheduler and its first worker (default 60)",
+    )
+    for flag, what in (("ca-file", "CA certificate"), ("cert", "client certificate")):
+        run.add_argument(f"--tls-{flag}", help=f"{what} (PEM) for a tls:// scheduler")
+    run.add_argument("--tls-key", help="client private key (PEM) for a tls:// scheduler")
     val = sub.add_parser("validate", help="check study files, naming every problem")
     val.add_argument("study", nargs="+")
     sub.add_parser("schema", help="print the JSON schema of study files")

@@ -23,8 +23,6 @@ from .feasibility import record_path
 from .spec import Study
 
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
-ERROR_WIDTH = 100
-ERROR_DTYPE = f"S{ERROR_WIDTH}"  # ASCII bytes: a quarter of the size of unicode
 
 #: Outputs: (long_name, units, dtype, fill value for failed rows)
 OUTPUTS = {
@@ -140,16 +138,14 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
     wanted = study.run.outputs
     result = {name: np.full(n, OUTPUTS[name][3], dtype=OUTPUTS[name][2]) for name in wanted}
     status = np.full(n, STATUS_OK, dtype=np.int8)
-    error = np.full(n, b"", dtype=ERROR_DTYPE)
+    error = np.full(n, "", dtype=object)  # whole messages (a variable-length text array)
     try:
         raw = _run_rows(study, cols, np.arange(n), base_dir)
         failed = np.zeros(n, bool)
     except Exception:  # isolate the failing rows, keep the others
         raw, failed = _rows_one_by_one(study, cols, base_dir, error)
     kernel_failed = (raw["status"] != 0) & ~failed
-    error[kernel_failed] = (
-        f"kernel stopped: more than max_steps={study.run.max_steps} steps".encode()
-    )
+    error[kernel_failed] = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
     failed |= kernel_failed
     status[failed] = STATUS_FAILED
     ok = ~failed
@@ -175,6 +171,5 @@ def _rows_one_by_one(study, cols, base_dir, error):
                 raw[k][i] = one[k][0]
         except Exception as exc:  # recorded per sample, never aborts the run
             failed[i] = True
-            message = f"{type(exc).__name__}: {exc}"
-            error[i] = message.encode("ascii", "replace")[:ERROR_WIDTH]
+            error[i] = f"{type(exc).__name__}: {exc}"  # whole
     return raw, failed

@@ -8,6 +8,8 @@ nothing finished: ``resume=True`` computes only the chunks whose status is still
 
 from __future__ import annotations
 
+import logging
+import multiprocessing
 import sys
 import time
 from dataclasses import dataclass, field
@@ -33,6 +35,8 @@ class RunReport:
     failed_samples: int = 0
     seconds: float = 0.0
     netcdf: Path | None = None
+    damaged_chunks: list = field(default_factory=list)
+    errors: dict = field(default_factory=dict)
 
 
 class _Progress:
@@ -75,17 +79,112 @@ def _prime(study_json, columns, base_dir, progress):
         say(f" done in {r['seconds']:.1f} s\n")
 
 
-def _client(workers=None, scheduler=None, scheduler_file=None):
-    from distributed import Client, LocalCluster
+_GUARD = (
+    'put the call to run_study under `if __name__ == "__main__":` (dask starts its worker '
+    "processes by importing the script again)"
+)
 
-    if scheduler is not None:
-        return Client(scheduler), None
-    if scheduler_file is not None:
-        return Client(scheduler_file=str(scheduler_file)), None
-    cluster = LocalCluster(
-        n_workers=workers or 2, threads_per_worker=1, processes=True, dashboard_address=None
-    )
+
+class SchedulerError(RuntimeError):
+    """The dask scheduler cannot be reached, or no worker joined it in time."""
+
+
+class FailedSamplesError(RuntimeError):
+    """More samples failed than the run allows; the cube is complete and kept.
+
+    ``report`` is the :class:`RunReport`, ``report.errors`` the distinct messages and counts.
+    """
+
+    def __init__(self, message, report):
+        super().__init__(message)
+        self.report = report
+
+
+def _check_workers(workers) -> None:
+    if workers is not None and (
+        isinstance(workers, bool) or int(workers) != workers or workers < 1
+    ):
+        raise ValueError(f"workers: {workers!r} is not allowed; give a whole number >= 1")
+
+
+def _remote_client(scheduler, scheduler_file, security, timeout):
+    """A client of a running cluster that has at least one worker, or SchedulerError."""
+    from distributed import Client
+
+    where = scheduler or f"the scheduler file {scheduler_file}"
+    kw = {"timeout": timeout} if security is None else {"timeout": timeout, "security": security}
+    try:
+        if scheduler is not None:
+            client = Client(scheduler, **kw)
+        else:
+            client = Client(scheduler_file=str(scheduler_file), **kw)
+    except (OSError, TimeoutError) as exc:
+        raise SchedulerError(
+            f"cannot reach the dask scheduler at {where} within {timeout:g} s ({exc})"
+        ) from None
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        client.close()
+        raise SchedulerError(
+            f"no worker joined the dask scheduler at {where} within {timeout:g} s: start "
+            "workers on it (dask worker ADDRESS) or check the address"
+        ) from None
+    return client
+
+
+def _local_cluster(workers):
+    """A local cluster on loopback, without a dashboard, whose workers ignore Ctrl-C (the
+    client handles it: one message, then the cluster is closed)."""
+    import signal
+    import threading
+
+    import dask
+    from distributed import LocalCluster
+
+    main_thread = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
+    try:
+        with dask.config.set({"distributed.scheduler.http.routes": []}):
+            return LocalCluster(
+                n_workers=workers or 2,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",  # an HTTP server always starts: no routes
+                scheduler_kwargs={"dashboard": False},
+                silence_logs=logging.ERROR,  # a stopped run prints one line, not its workers'
+            )
+    except Exception as exc:  # noqa: BLE001 - reported in one sentence, with its cause
+        raise RuntimeError(
+            f"the local dask cluster did not start ({type(exc).__name__}: {exc}); if you "
+            f"called run_study from a script, {_GUARD}"
+        ) from None
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGINT, old)
+
+
+def _client(workers=None, scheduler=None, scheduler_file=None, security=None, timeout=60.0):
+    from distributed import Client
+
+    if scheduler is not None or scheduler_file is not None:
+        return _remote_client(scheduler, scheduler_file, security, timeout), None
+    cluster = _local_cluster(workers)
     return Client(cluster), cluster
+
+
+def error_summary(path) -> dict:
+    """Distinct error messages of the failed samples of a store, with their counts."""
+    from collections import Counter
+
+    import xarray as xr
+
+    ds = xr.open_zarr(Path(path), consolidated=True)
+    failed = ds["status"].values == STATUS_FAILED
+    messages = ds["error"].values[failed]
+    text = (m.decode("utf-8", "replace") if isinstance(m, bytes) else str(m) for m in messages)
+    return dict(Counter(text).most_common())
 
 
 def run_study(
@@ -100,6 +199,10 @@ def run_study(
     progress: bool = True,
     netcdf: bool = True,
     client=None,
+    overwrite: bool = False,
+    max_failed: float = 0.0,
+    security=None,
+    timeout: float = 60.0,
 ) -> RunReport:
     """Run ``study`` into the zarr store ``out`` (opened later with ``xarray.open_zarr``).
 
@@ -108,35 +211,104 @@ def run_study(
     workers : int, optional
         Size of the local cluster (default 2 processes of one thread).
     scheduler, scheduler_file : optional
-        Join an existing cluster by address or scheduler file instead.
+        Join an existing cluster by address (``tcp://`` or ``tls://``) or scheduler file.
     resume : bool
-        Continue a killed run: compute only the chunks still pending in ``out``.
+        Continue a killed run: compute only the chunks still pending in ``out``, and those
+        marked done that do not read back whole. ``out`` must hold a store of the same study,
+        input files and rockstudy version.
     base_dir : path, optional
         Where relative record paths may also be found (the study file's folder).
     netcdf : bool
         Also write ``out`` with the suffix ``.nc`` at the end.
     client : distributed.Client, optional
         Use this client (for tests and notebooks).
+    overwrite : bool
+        Let the netCDF export replace a file that is not an export of this study.
+    max_failed : float
+        Largest share of failed samples [0, 1] accepted; above it :class:`FailedSamplesError`
+        is raised after the cube is complete (default 0: any failed sample).
+    security : distributed.Security, optional
+        TLS credentials for a ``tls://`` scheduler (default: dask's configuration).
+    timeout : float
+        Seconds to wait for a remote scheduler to answer and for its first worker [s].
     """
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        # a process being spawned (a worker of the local cluster) imports the user's script,
+        # as multiprocessing's own check (spawn._check_not_importing_main) sees it: leave
+        raise SystemExit(f"rockstudy: run_study ran again as a dask worker started: {_GUARD}")
     t0 = time.perf_counter()
     out = Path(out)
+    _check_workers(workers)
+    if not 0.0 <= max_failed <= 1.0:
+        raise ValueError(f"max_failed: {max_failed!r} is not a share in [0, 1]")
+    nc = out.with_suffix(".nc") if netcdf else None
+    if nc == out:
+        raise ValueError(f"out: {out} ends in .nc, the name of its netCDF export; use .zarr")
     design = make_design(study)
     n = design.sizes["sample"]
     bounds = store.chunk_bounds(n, study.chunk_size)
-    template = None
-    if out.exists() and not resume:
-        raise FileExistsError(f"{out} exists: pass resume=True (--resume) or a new path")
-    if out.exists() and store.template_complete(out):
-        if store.study_sha256(out) != study.sha256():
-            raise ValueError(f"{out} holds a different study (sha256 mismatch); cannot resume")
-        todo = store.pending_chunks(out, study.chunk_size)
+    inputs = store.input_hashes(study, base_dir)
+    if nc is not None and not resume:  # refused before the folder is even created
+        store.check_export_target(nc, study.sha256(), overwrite)
+    lock, complete = store.claim(out, study, inputs, resume)
+    try:
+        if nc is not None and resume:  # after the store was found to hold this study
+            store.check_export_target(nc, study.sha256(), overwrite)
+        report = _run_locked(
+            study,
+            out,
+            design,
+            bounds,
+            inputs,
+            complete,
+            base_dir,
+            progress,
+            client,
+            (workers, scheduler, scheduler_file, security, timeout),
+        )
+        if nc is not None:
+            report.netcdf = store.export_netcdf(out, nc)
+    except BaseException:
+        if not complete:  # failed before its template was written: leave no trace
+            store.discard_if_unused(out)
+        raise
+    finally:
+        lock.release()
+    report.seconds = time.perf_counter() - t0
+    if report.failed_samples > max_failed * n:
+        raise FailedSamplesError(_failure_message(report, max_failed), report)
+    return report
+
+
+def _failure_message(report, max_failed) -> str:
+    lines = [
+        f"{report.failed_samples} of {report.samples} samples failed (allowed: "
+        f"{max_failed:.0%}); the cube is kept in {report.path}. Errors:"
+    ]
+    for message, count in list(report.errors.items())[:10]:
+        lines.append(f"  {count:8d} x {message}")
+    if len(report.errors) > 10:
+        lines.append(f"  ... and {len(report.errors) - 10} other messages")
+    return "\n".join(lines)
+
+
+def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress, client, where):
+    """The run proper, while the store's lock is held."""
+    if complete:
+        pending, damaged = store.chunks_to_compute(out, design, study.chunk_size)
+        todo, template = sorted(pending + damaged), None
+        if damaged:
+            sys.stderr.write(
+                f"note: {len(damaged)} chunk(s) of {out} marked done did not read back whole "
+                "(missing or damaged files): computing them again\n"
+            )
     else:  # new, or killed while its template was written: nothing finished yet
 
         def template():
-            store.create_store(out, design, study, overwrite=True)
+            store.create_store(out, design, study, inputs)
 
-        todo = bounds
-    report = RunReport(out, n, len(bounds))
+        todo, damaged = bounds, []
+    report = RunReport(out, design.sizes["sample"], len(bounds), damaged_chunks=damaged)
     cols_names = [name for name, v in design.data_vars.items() if v.dims == ("sample",)]
     columns = {name: design[name].values for name in cols_names}
     columns["sample"] = design["sample"].values
@@ -146,7 +318,7 @@ def run_study(
     if todo:
         _prime(study_json, columns, base_dir, progress)
     if own and todo:
-        client, cluster = _client(workers, scheduler, scheduler_file)
+        client, cluster = _client(*where)
     bar = _Progress(len(todo), progress)
     try:
         if todo:
@@ -160,9 +332,7 @@ def run_study(
                 cluster.close()
     status = store.read_status(out)
     report.failed_samples = int(np.count_nonzero(status == STATUS_FAILED))
-    if netcdf:
-        report.netcdf = store.export_netcdf(out, out.with_suffix(".nc"))
-    report.seconds = time.perf_counter() - t0
+    report.errors = error_summary(out) if report.failed_samples else {}
     return report
 
 

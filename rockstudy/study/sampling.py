@@ -73,6 +73,8 @@ def unit_samples(study: Study) -> np.ndarray:
 def _inputs(study: Study) -> tuple[dict, dict]:
     """Columns of the distributed parameters, and the grid axes (grid sampler only)."""
     params = study.parameters()
+    if not params:
+        return {}, {}
     if study.sampler.kind == "grid":
         axes = {name: dist.points() for name, dist in params.items()}
         mesh = np.meshgrid(*axes.values(), indexing="ij")
@@ -106,7 +108,8 @@ def make_design(study: Study) -> xr.Dataset:
     ``grid_dims`` lists them, so :func:`rockstudy.study.store.open_result` can unstack.
     """
     cols, axes = _inputs(study)
-    n = len(next(iter(cols.values())))
+    # no distributed parameter: the fixed values, once on a grid, else the sampler's n times
+    n = len(next(iter(cols.values()))) if cols else (study.sampler.n or 1)
     if study.sampler.replicates > 1:
         reps = study.sampler.replicates
         cols["group_point"] = np.repeat(np.arange(n // reps), reps)
