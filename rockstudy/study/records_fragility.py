@@ -291,6 +291,13 @@ def stripe_fragility(
     return pd.DataFrame(rows).set_index(by or "group")
 
 
+def _fit_records(cap, top, censored, keep, rows):
+    """fit_capacities on the records ``rows`` (an index or a resample) of (record, structure)
+    arrays: capacities where not censored, censoring levels where censored."""
+    kk, cc = keep[rows], censored[rows]
+    return fit_capacities(cap[rows][kk & ~cc], top[rows][kk & cc])
+
+
 def ida_fragility(
     ds: xr.Dataset,
     im: str | None = None,
@@ -331,11 +338,7 @@ def ida_fragility(
     for label, mask in _groups(ds, by, bins).items():
         c, t, cens, keep = cap[:, mask], top[:, mask], cens_all[:, mask], ok[:, mask]
 
-        def fit(k=slice(None)):
-            kk, cc = keep[k], cens[k]
-            return fit_capacities(c[k][kk & ~cc], t[k][kk & cc])
-
-        theta, beta = fit()
+        theta, beta = _fit_records(c, t, cens, keep, slice(None))
         n_unc = int((keep & ~cens).sum())
         if not cens[keep].any() and n_unc >= 2:
             s = np.std(np.log(c[keep]), ddof=1)
@@ -346,7 +349,9 @@ def ida_fragility(
                 tuple(np.sqrt((n_unc - 1) * s**2 / chi)),
             )
         elif np.isfinite(beta):
-            boot = [fit(rng.integers(0, n_rec, n_rec)) for _ in range(n_boot)]
+            boot = [
+                _fit_records(c, t, cens, keep, rng.integers(0, n_rec, n_rec)) for _ in range(n_boot)
+            ]
             band = _percentiles(np.array(boot), conf_level)
         else:
             band = (theta, theta), (np.nan, np.nan)
