@@ -170,19 +170,17 @@ def fit_capacities(capacities, censored_at=None) -> tuple[float, float]:
     if not cens.size:
         return float(np.exp(mu)), beta
 
-    def nll(q):
+    def nll(q):  # q = (ln theta, ln beta), with the exact gradient
         b = np.exp(q[1])
-        return -(
-            np.sum(stats.norm.logpdf((c - q[0]) / b) - q[1])
-            + np.sum(stats.norm.logsf((cens - q[0]) / b))
-        )
+        u, v = (c - q[0]) / b, (cens - q[0]) / b
+        ls = stats.norm.logsf(v)
+        h = np.exp(stats.norm.logpdf(v) - ls)  # hazard of the censored terms
+        f = -(np.sum(-0.5 * u * u - q[1]) + np.sum(ls))
+        grad = -np.array([(np.sum(u) + np.sum(h)) / b, np.sum(u * u - 1.0) + np.sum(h * v)])
+        return f, grad
 
-    res = optimize.minimize(
-        nll,
-        [mu, np.log(max(beta, 0.05))],
-        method="Nelder-Mead",
-        options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000},
-    )
+    start = [mu, np.log(max(beta, 0.05))]
+    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-10})
     with np.errstate(over="ignore"):
         return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
