@@ -93,8 +93,8 @@ def part_a(n_rec, n_blk):
         ("same_tolerance", step, 1.25, 0),
         ("same_tolerance_growth_1.5", step, 1.5, 0),
         ("same_tolerance_growth_2", step, 2.0, 0),
-        ("one_percent", 0.01, 1.25, 0),
-        ("one_percent_with_scan", 0.01, 1.25, 4),
+        ("one_percent", 0.01, 1.5, 0),
+        ("one_percent_with_scan", 0.01, 1.5, 4),
     ):
         t0 = time.perf_counter()
         ds = incremental_dynamic_analysis(

@@ -36,16 +36,7 @@ DIMENSIONLESS = {"pga_ratio": "pga", "pgv_ratio": "pgv"}
 SCALABLE = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd") + tuple(
     DIMENSIONLESS
 )
-_SCALARS = (
-    "pga",
-    "pgv",
-    "pgd",
-    "arias",
-    "cav",
-    "significant_duration",
-    "mean_period",
-    "spectrum_intensity",
-)
+_SCALARS = tuple(k for k in _im.UNITS if k not in _im.SPECTRAL)
 _STRUCTURE_KEYS = ("half_diagonal", "frequency_parameter", "slenderness", "restitution")
 
 
@@ -333,7 +324,7 @@ def incremental_dynamic_analysis(
     im: str = "pga",
     period=None,
     tolerance: float = 0.01,
-    growth: float = 1.25,
+    growth: float = 1.5,
     max_pga_ratio: float = 30.0,
     scan: int = 4,
     periods=(),
@@ -404,6 +395,7 @@ def incremental_dynamic_analysis(
         raise ValueError(f"scan must be a whole number >= 0, got {scan!r}")
     ds = _record_dataset(records, st, periods, damping)
     n = st["slenderness"].size
+    measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
     results = [
         _ida_record(r, st, tolerance, growth, max_pga_ratio, int(scan), method, rtol, max_steps)
         for r in records
@@ -423,7 +415,6 @@ def incremental_dynamic_analysis(
                 steps[i, j, : len(h)] = h
     for c, k in enumerate(("step_scale", "step_max_rotation", "step_overturned")):
         ds[k] = (dims + ("step",), steps[..., c])
-    measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
     power = 2.0 if im == "arias" else 1.0
     ds["capacity"] = (
         dims,
