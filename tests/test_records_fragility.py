@@ -214,5 +214,7 @@ def test_intensity_in_quoted_units_and_bad_names():
         rf.intensity(ds, "sa", 2.0)
     with pytest.raises(ValueError, match="needs a period"):
         rf.intensity(ds, "sa")
+    with pytest.raises(ValueError, match="im='cav' is not stored"):
+        rf.intensity(ds, "cav")
     with pytest.raises(ValueError, match="by must be"):
         rf.ida_fragility(ds, by="nothing")

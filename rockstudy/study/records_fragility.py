@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import optimize, stats
+from scipy import optimize, special, stats
 
 from ..constants import G
 
@@ -39,6 +39,7 @@ QUOTED_UNITS = {
     "pulse_amplitude_ratio": ("-", 1.0),
 }
 _SPECTRAL = ("sa", "psv", "sd")
+_LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: candidates of :func:`im_efficiency` (with ``sa`` at every stored period).
 DEFAULT_CANDIDATES = (
     "pga",
@@ -70,6 +71,8 @@ def intensity(ds: xr.Dataset, im: str, period=None, scale: str = "scale") -> xr.
     if im not in QUOTED_UNITS:
         raise ValueError(f"im must be one of {sorted(QUOTED_UNITS)}, got {im!r}")
     unit, factor = QUOTED_UNITS[im]
+    if (im if im not in _SPECTRAL else "sa") not in ds:
+        raise ValueError(f"im={im!r} is not stored in the dataset")
     if im in _SPECTRAL:
         if period is None:
             raise ValueError(f"im={im!r} needs a period [s]")
@@ -122,6 +125,7 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     n = np.asarray(n_total, float)
     if not (x.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
         raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
+    n_sum = n.sum()
     if z.sum() == 0:
         return np.inf, np.nan
     if z.sum() == n.sum():
@@ -130,20 +134,20 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     def nll(q):
         beta = np.exp(np.clip(q[1], -12.0, 6.0))
         u = (x - q[0]) / beta
-        lp, lq, ld = stats.norm.logcdf(u), stats.norm.logsf(u), stats.norm.logpdf(u)
-        r = z * np.exp(ld - lp) - (n - z) * np.exp(ld - lq)  # d loglik / du
-        return -np.sum(z * lp + (n - z) * lq), np.array([np.sum(r) / beta, np.sum(r * u)])
+        lp, lq, ld = special.log_ndtr(u), special.log_ndtr(-u), -0.5 * u * u - _LOG_SQRT_2PI
+        r = (z * np.exp(ld - lp) - (n - z) * np.exp(ld - lq)) / n_sum  # d loglik / du, per trial
+        return -np.sum(z * lp + (n - z) * lq) / n_sum, np.array([np.sum(r) / beta, np.sum(r * u)])
 
     if start is None:
         w = n / n.sum()
         sd = np.sqrt(np.sum(w * (x - np.sum(w * x)) ** 2))
         start = np.array([np.sum(w * x), np.log(max(sd, 0.1))])
-    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-10})
+    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
     with np.errstate(over="ignore"):
         return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
 
-def fit_capacities(capacities, censored_at=None) -> tuple[float, float]:
+def fit_capacities(capacities, censored_at=None, start=None) -> tuple[float, float]:
     """Maximum-likelihood lognormal fit of IDA capacities.
 
     Without censoring it is closed form: ln theta = mean(ln c), beta = std(ln c) (the MLE,
@@ -152,6 +156,8 @@ def fit_capacities(capacities, censored_at=None) -> tuple[float, float]:
 
     .. math:: \\max \\sum_{uncensored} \\ln \\phi(u_i) - \\ln\\beta
               + \\sum_{censored} \\ln[1 - \\Phi(u_k)], \\quad u = (\\ln c - \\ln\\theta) / \\beta
+
+    ``start`` = (ln theta, ln beta) starts the numerical fit (default: the uncensored fit).
 
     Returns
     -------
@@ -173,14 +179,15 @@ def fit_capacities(capacities, censored_at=None) -> tuple[float, float]:
     def nll(q):  # q = (ln theta, ln beta), with the exact gradient
         b = np.exp(q[1])
         u, v = (c - q[0]) / b, (cens - q[0]) / b
-        ls = stats.norm.logsf(v)
-        h = np.exp(stats.norm.logpdf(v) - ls)  # hazard of the censored terms
-        f = -(np.sum(-0.5 * u * u - q[1]) + np.sum(ls))
-        grad = -np.array([(np.sum(u) + np.sum(h)) / b, np.sum(u * u - 1.0) + np.sum(h * v)])
+        ls = special.log_ndtr(-v)
+        h = np.exp(-0.5 * v * v - _LOG_SQRT_2PI - ls)  # hazard of the censored terms
+        m = u.size + v.size  # mean over the points: a gradient tolerance independent of n
+        f = -(np.sum(-0.5 * u * u - q[1]) + np.sum(ls)) / m
+        grad = -np.array([(np.sum(u) + np.sum(h)) / b, np.sum(u * u - 1.0) + np.sum(h * v)]) / m
         return f, grad
 
-    start = [mu, np.log(max(beta, 0.05))]
-    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-10})
+    start = [mu, np.log(max(beta, 0.05))] if start is None else start
+    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
     with np.errstate(over="ignore"):
         return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
@@ -289,11 +296,11 @@ def stripe_fragility(
     return pd.DataFrame(rows).set_index(by or "group")
 
 
-def _fit_records(cap, top, censored, keep, rows):
+def _fit_records(cap, top, censored, keep, rows, start=None):
     """fit_capacities on the records ``rows`` (an index or a resample) of (record, structure)
     arrays: capacities where not censored, censoring levels where censored."""
     kk, cc = keep[rows], censored[rows]
-    return fit_capacities(cap[rows][kk & ~cc], top[rows][kk & cc])
+    return fit_capacities(cap[rows][kk & ~cc], top[rows][kk & cc], start)
 
 
 def ida_fragility(
@@ -348,7 +355,8 @@ def ida_fragility(
             )
         elif np.isfinite(beta):
             boot = [
-                _fit_records(c, t, cens, keep, rng.integers(0, n_rec, n_rec)) for _ in range(n_boot)
+                _fit_records(c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta]))
+                for _ in range(n_boot)
             ]
             band = _percentiles(np.array(boot), conf_level)
         else:
@@ -359,7 +367,7 @@ def ida_fragility(
 
 
 def im_efficiency(
-    ds: xr.Dataset, candidates=DEFAULT_CANDIDATES, by=None, bins=None, **kw
+    ds: xr.Dataset, candidates=DEFAULT_CANDIDATES, by=None, bins=None, n_boot: int = 100, **kw
 ) -> pd.DataFrame:
     """Which intensity measure predicts overturning best: the dispersion beta of each.
 
@@ -375,8 +383,8 @@ def im_efficiency(
     ----------
     candidates : sequence
         Measure names (``"sa"`` expands to every stored period) or ``(name, period)`` pairs.
-    by, bins, kw
-        Passed to the fit.
+    by, bins, n_boot, kw
+        Passed to the fit (``n_boot`` resamples for the bands, where they are bootstrapped).
 
     Returns
     -------
@@ -397,7 +405,7 @@ def im_efficiency(
     for name, period in specs:
         if name == "pulse_amplitude_ratio" and not np.isfinite(ds[name].values).any():
             continue  # no record has a pulse
-        t = fit(ds, im=name, period=period, by=by, bins=bins, **kw)
+        t = fit(ds, im=name, period=period, by=by, bins=bins, n_boot=n_boot, **kw)
         t.insert(0, "im", _label(name, period))
         t["dimensionless"] = QUOTED_UNITS[name][0] == "-"
         frames.append(t.reset_index())
