@@ -6,6 +6,7 @@ from .pulse_extraction import VelocityPulse
 from .pulses import PULSES, CosinePulse, HalfSinePulse, NoMotion, RickerWavelet, SinePulse
 from .records import Record
 from .stochastic import envelope_jennings, kanai_tajimi_filter, stochastic_record
+from .suites import RECORD_SUFFIXES, load_suite
 from .synthetic import synthetic_near_fault
 
 __all__ = [
@@ -17,6 +18,8 @@ __all__ = [
     "RickerWavelet",
     "NoMotion",
     "Record",
+    "RECORD_SUFFIXES",
+    "load_suite",
     "stochastic_record",
     "envelope_jennings",
     "kanai_tajimi_filter",

@@ -3,6 +3,8 @@
 Imports run one way: ``study`` uses the physics packages, never the reverse.
 """
 
+from .records_designs import cloud, incremental_dynamic_analysis, multiple_stripes
+from .records_fragility import ida_fragility, im_efficiency, stripe_fragility
 from .runner import RunReport, run_study
 from .sampling import make_design, salib_problem
 from .spec import Study, StudyError, json_schema, load_study, validate_text
@@ -10,6 +12,12 @@ from .store import export_netcdf, open_result
 
 __all__ = [
     "RunReport",
+    "cloud",
+    "ida_fragility",
+    "im_efficiency",
+    "incremental_dynamic_analysis",
+    "multiple_stripes",
+    "stripe_fragility",
     "Study",
     "StudyError",
     "export_netcdf",

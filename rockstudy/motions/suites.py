@@ -1,0 +1,163 @@
+"""Record suites: a folder, a glob or a list of record files, read into :class:`Record` objects.
+
+Every file named is read or the call fails: no record is silently skipped. A folder is read for
+the files whose suffix is one of :data:`RECORD_SUFFIXES` (PEER ``.AT2`` acceleration files and
+two-column text files); any other file must be named by a glob or a list.
+"""
+
+from __future__ import annotations
+
+import glob
+import re
+from pathlib import Path
+
+from .records import Record
+
+#: Suffixes (case-insensitive) of the files read from a folder.
+RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
+
+
+def _is_glob(text: str) -> bool:
+    return any(c in text for c in "*?[")
+
+
+def _expand(item) -> list[Path]:
+    """The record files named by one source item: a file, a folder or a glob."""
+    text = str(item)
+    if _is_glob(text):
+        paths = sorted(Path(p) for p in glob.glob(text) if Path(p).is_file())
+        if not paths:
+            raise ValueError(f"source: the glob {text!r} matches no file")
+        return paths
+    path = Path(item)
+    if path.is_dir():
+        paths = sorted(p for p in path.iterdir() if p.is_file() and _suffix_ok(p))
+        if not paths:
+            raise ValueError(
+                f"source: the folder {str(path)!r} holds no record files "
+                f"(suffixes {', '.join(RECORD_SUFFIXES)}, any case)"
+            )
+        return paths
+    if not path.is_file():
+        raise ValueError(f"source: {text!r} is neither a file, a folder nor a glob that matches")
+    return [path]
+
+
+def _suffix_ok(path: Path) -> bool:
+    return path.suffix.lower() in RECORD_SUFFIXES
+
+
+def _read(path: Path, units: str, field: str) -> Record:
+    """One record file; any failure is a ValueError naming ``field`` and the file."""
+    try:
+        if path.suffix.lower() == ".at2":
+            return Record.from_at2(path)
+        return Record.from_csv(path, units=units)
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"{field}: cannot read the record file {str(path)!r}: {exc}") from exc
+
+
+def _vertical_rule(vertical):
+    if vertical is None:
+        return None
+    try:
+        if isinstance(vertical, (str, bytes)):
+            raise TypeError("a single string")
+        pattern, replacement = vertical
+        return re.compile(pattern), str(replacement)
+    except (TypeError, ValueError, re.error) as exc:
+        raise ValueError(
+            "vertical must be None or a (regex, replacement) pair that maps a horizontal file "
+            f"name to its vertical file's name, e.g. (r'\\d{{3}}\\.AT2$', '-UP.AT2'); got "
+            f"{vertical!r} ({exc})"
+        ) from None
+
+
+def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
+    """Read a suite of ground-motion records.
+
+    Parameters
+    ----------
+    source : path-like, str or sequence
+        A folder (its files with a suffix in :data:`RECORD_SUFFIXES`), a glob pattern
+        (``"records/*.AT2"``: every file it matches), a file, or a sequence of these. An item
+        of a sequence may also be an explicit ``(horizontal, vertical)`` pair of files.
+        ``.AT2`` files are read by :meth:`Record.from_at2`, the others as two-column text
+        (time [s], acceleration) by :meth:`Record.from_csv`.
+    vertical : (str, str), optional
+        H/V pairing: a regular expression and its replacement (``re.sub``) mapping each
+        horizontal file's name to its vertical component's file name in the same folder, e.g.
+        ``(r"\\d{3}\\.AT2$", "-UP.AT2")`` pairs ``RSN126_GAZLI_GAZ000.AT2`` with
+        ``RSN126_GAZLI_GAZ-UP.AT2``. Files that are some record's vertical component are not
+        read as horizontal records. A horizontal file whose name the expression does not match,
+        or whose vertical file is missing, is an error.
+    units : {"g", "m/s2", "cm/s2"}
+        Units of the acceleration column of text files (``.AT2`` files are in g).
+
+    Returns
+    -------
+    list of Record
+        In the order of ``source`` (each folder and glob sorted by name); names are the file
+        stems.
+
+    Raises
+    ------
+    ValueError
+        Naming the field (``source`` or ``vertical``) and the file: a folder or glob without
+        record files, a file that cannot be read, a file listed twice, a missing vertical
+        file, or an H/V pair of different lengths or steps.
+    """
+    items = list(source) if isinstance(source, (list, tuple)) else [source]
+    if not items:
+        raise ValueError("source: an empty list names no record")
+    rule = _vertical_rule(vertical)
+    pairs: list[tuple[Path, Path | None]] = []
+    for item in items:
+        if isinstance(item, tuple):
+            if len(item) != 2:
+                raise ValueError(f"source: a pair must be (horizontal, vertical), got {item!r}")
+            pairs.append((Path(item[0]), Path(item[1])))
+        else:
+            pairs.extend((p, None) for p in _expand(item))
+    if rule is not None:
+        pairs = _pair_by_name(pairs, rule)
+    seen = {}
+    for h, _ in pairs:
+        key = h.resolve()
+        if key in seen:
+            raise ValueError(f"source: the file {str(h)!r} is named twice")
+        seen[key] = h
+    records = []
+    for h, v in pairs:
+        rec = _read(h, units, "source")
+        if v is not None:
+            rec = rec._with_vertical(_read(v, units, "vertical"), v)
+        records.append(rec)
+    return records
+
+
+def _pair_by_name(pairs, rule):
+    """Attach to each horizontal file its vertical file by the (regex, replacement) rule."""
+    pattern, replacement = rule
+    out = []
+    verticals = set()
+    for h, v in pairs:
+        if v is not None:
+            out.append((h, v))
+            continue
+        if not pattern.search(h.name):
+            continue  # decided below: a vertical file of another record, or an error
+        v = h.with_name(pattern.sub(replacement, h.name))
+        verticals.add(v.resolve())
+        out.append((h, v))
+    for h, v in pairs:
+        if v is None and not pattern.search(h.name) and h.resolve() not in verticals:
+            raise ValueError(
+                f"vertical: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
+                "record's vertical component; every file must be one or the other"
+            )
+    out = [(h, v) for h, v in out if h.resolve() not in verticals]
+    for h, v in out:
+        if not v.is_file():
+            raise ValueError(f"vertical: the vertical file {str(v)!r} of {str(h)!r} is missing")
+    return out

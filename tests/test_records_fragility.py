@@ -1,0 +1,220 @@
+"""Fragility of record designs against independent oracles: data drawn from known lognormal
+fragilities, scipy's own maximum-likelihood fits (plain and censored), a direct maximisation
+of the binomial likelihood, and datasets built so that one measure collapses the capacities."""
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy import optimize, stats
+
+from rockstudy.constants import G
+from rockstudy.study import records_fragility as rf
+
+
+def _ida_dataset(capacity_scale, pga, pgv, uplift, p, censored=None, sa=None):
+    """A dataset shaped like records_designs.incremental_dynamic_analysis's output."""
+    cap = np.asarray(capacity_scale, float)
+    cens = np.zeros(cap.shape, bool) if censored is None else np.asarray(censored)
+    sa = np.asarray(pga, float)[:, None] if sa is None else sa
+    ds = xr.Dataset(
+        {
+            "pga": ("record", np.asarray(pga, float)),
+            "pgv": ("record", np.asarray(pgv, float)),
+            "sa": (("record", "period"), sa),
+            "uplift_acceleration": ("structure", np.asarray(uplift, float)),
+            "frequency_parameter": ("structure", np.asarray(p, float)),
+            "capacity_scale": (("record", "structure"), np.where(cens, np.nan, cap)),
+            "capacity_scale_lower": (("record", "structure"), cap / 1.01),
+            "censored": (("record", "structure"), cens),
+            "status": (("record", "structure"), np.zeros(cap.shape, np.int64)),
+        },
+        coords={"period": [1.0], "structure": np.arange(cap.shape[1])},
+        attrs={"design": "ida", "im": "pga", "im_period": np.nan},
+    )
+    ds["pga_ratio"] = ds["pga"] / ds["uplift_acceleration"]
+    ds["pgv_ratio"] = ds["pgv"] * ds["frequency_parameter"] / ds["uplift_acceleration"]
+    return ds
+
+
+def _binomial_data(theta, beta, levels, n, seed):
+    rng = np.random.default_rng(seed)
+    return rng.binomial(n, stats.norm.cdf(np.log(levels / theta) / beta))
+
+
+def test_binomial_mle_recovers_a_known_fragility():
+    levels = np.geomspace(0.1, 1.6, 10)
+    z = _binomial_data(0.4, 0.35, levels, 4000, seed=3)
+    theta, beta = rf.fit_binomial(levels, z, np.full(10, 4000))
+    assert theta == pytest.approx(0.4, rel=0.02)
+    assert beta == pytest.approx(0.35, rel=0.04)
+
+
+def test_binomial_mle_maximises_the_binomial_likelihood():
+    levels = np.array([0.2, 0.3, 0.45, 0.7, 1.0])
+    n = np.array([20, 20, 15, 20, 10])
+    z = _binomial_data(0.5, 0.5, levels, n, seed=5)
+
+    def nll(q):  # direct, in (theta, beta), by scipy's binomial pmf
+        if q[0] <= 0 or q[1] <= 0:
+            return np.inf
+        return -np.sum(stats.binom.logpmf(z, n, stats.norm.cdf(np.log(levels / q[0]) / q[1])))
+
+    ref = optimize.minimize(
+        nll,
+        [0.6, 0.6],
+        method="Nelder-Mead",
+        options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 5000},
+    ).x
+    np.testing.assert_allclose(rf.fit_binomial(levels, z, n), ref, rtol=1e-5)
+
+
+def test_binomial_without_outcome_change_has_no_fit():
+    assert rf.fit_binomial([1.0, 2.0], [0, 0], [5, 5]) == (
+        np.inf,
+        pytest.approx(np.nan, nan_ok=True),
+    )
+    assert rf.fit_binomial([1.0, 2.0], [5, 5], [5, 5])[0] == 0.0
+    with pytest.raises(ValueError, match="n_overturned"):
+        rf.fit_binomial([1.0], [3], [2])
+
+
+def test_ida_fit_is_scipy_lognormal_mle():
+    c = np.random.default_rng(2).lognormal(np.log(0.3), 0.4, 25)
+    shape, _, scale = stats.lognorm.fit(c, floc=0)
+    np.testing.assert_allclose(rf.fit_capacities(c), (scale, shape), rtol=1e-6)
+
+
+def test_censored_ida_fit_is_scipy_censored_mle():
+    rng = np.random.default_rng(4)
+    c = rng.lognormal(0.0, 0.5, 400)
+    top = 1.4
+    data = stats.CensoredData(uncensored=c[c <= top], right=np.full((c > top).sum(), top))
+    shape, _, scale = stats.lognorm.fit(data, floc=0)
+    np.testing.assert_allclose(
+        rf.fit_capacities(c[c <= top], np.full((c > top).sum(), top)), (scale, shape), rtol=1e-4
+    )
+    assert rf.fit_capacities([], [1.0, 2.0])[0] == np.inf
+
+
+def test_ida_fragility_units_closed_form_and_band_coverage():
+    rng = np.random.default_rng(7)
+    pga = rng.uniform(2.0, 6.0, 30)
+    cap_g = rng.lognormal(np.log(0.5), 0.3, 30)  # capacities in g
+    ds = _ida_dataset((cap_g * G / pga)[:, None], pga, pga / 10, [G * 0.2], [2.7])
+    t = rf.ida_fragility(ds)
+    assert t.loc["all", "unit"] == "g"
+    assert t.loc["all", "theta"] == pytest.approx(np.exp(np.mean(np.log(cap_g))), rel=1e-12)
+    assert t.loc["all", "beta"] == pytest.approx(np.std(np.log(cap_g)), rel=1e-12)
+    assert t.loc["all", "theta_in_range"]
+    # the 90 % band of the median covers the true median ~90 % of the time
+    hits = 0
+    for seed in range(300):
+        c = np.random.default_rng(seed).lognormal(np.log(0.5), 0.3, 12)
+        r = rf.ida_fragility(
+            _ida_dataset((c * G)[:, None], np.full(12, 1.0), np.ones(12), [1.0], [1.0])
+        )
+        hits += r.loc["all", "theta_lo"] <= 0.5 <= r.loc["all", "theta_hi"]
+    assert 0.85 <= hits / 300 <= 0.95
+
+
+def test_fragility_median_outside_the_data_is_flagged():
+    rng = np.random.default_rng(9)
+    cap = rng.lognormal(0.0, 0.5, (40, 1))
+    top = 0.6  # most blocks stand at the top of the range: the median lies above it
+    ds = _ida_dataset(
+        np.minimum(cap, top), np.full(40, G), np.ones(40), [1.0], [1.0], censored=cap > top
+    )
+    ds["capacity_scale_lower"] = ds["capacity_scale_lower"].where(~ds["censored"], top)
+    t = rf.ida_fragility(ds, n_boot=50)
+    assert t.loc["all", "theta"] > t.loc["all", "im_max"]
+    assert not t.loc["all", "theta_in_range"]
+    # stripes whose levels stay below the median
+    levels = np.array([0.1, 0.15, 0.2])
+    stripes = xr.Dataset(
+        {
+            "pga": ("record", np.full(50, G)),
+            "overturned": (
+                ("record", "structure", "level"),
+                (rng.random((50, 1, 3)) < stats.norm.cdf(np.log(levels / 1.0) / 0.4)),
+            ),
+            "status": (("record", "structure", "level"), np.zeros((50, 1, 3), np.int64)),
+            "scale": (("record", "structure", "level"), np.broadcast_to(levels, (50, 1, 3))),
+        },
+        coords={"level": levels * G, "structure": [0]},
+        attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
+    )
+    s = rf.stripe_fragility(stripes, n_boot=50)
+    assert s.loc["all", "unit"] == "g"
+    assert s.loc["all", "im_max"] == pytest.approx(0.2)
+    assert not s.loc["all", "theta_in_range"] and not s.loc["all", "band_in_range"]
+
+
+def test_stripe_fragility_recovers_the_fragility_of_its_points():
+    rng = np.random.default_rng(11)
+    levels = np.geomspace(0.1, 1.0, 8)
+    n_rec = 400
+    y = rng.random((n_rec, 1, 8)) < stats.norm.cdf(np.log(levels / 0.35) / 0.45)
+    ds = xr.Dataset(
+        {
+            "pga": ("record", rng.uniform(1.0, 5.0, n_rec)),
+            "overturned": (("record", "structure", "level"), y),
+            "status": (("record", "structure", "level"), np.zeros(y.shape, np.int64)),
+        },
+        coords={"level": levels * G, "structure": [0]},
+        attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
+    )
+    ds["scale"] = (xr.DataArray(levels * G, dims="level") / ds["pga"]).broadcast_like(
+        ds["overturned"]
+    )
+    t = rf.stripe_fragility(ds, n_boot=40)
+    assert t.loc["all", "theta"] == pytest.approx(0.35, rel=0.06)
+    assert t.loc["all", "beta"] == pytest.approx(0.45, rel=0.12)
+    assert t.loc["all", "theta_lo"] < t.loc["all", "theta"] < t.loc["all", "theta_hi"]
+
+
+def test_im_efficiency_ranks_the_collapsing_measure_first():
+    # capacities that are exactly a fixed PGV p / (g tan alpha), times 5 % scatter, over blocks
+    # of different sizes: PGA in g spreads apart, the dimensionless PGV collapses them
+    rng = np.random.default_rng(12)
+    n_rec, p = 30, np.array([1.5, 3.0, 6.0])
+    uplift = G * np.tan(np.array([0.2, 0.15, 0.25]))
+    pga, pgv = rng.uniform(2, 8, n_rec), rng.uniform(0.2, 1.0, n_rec)
+    target = 1.2 * np.exp(0.05 * rng.standard_normal((n_rec, 3)))
+    scale = target * uplift / (pgv[:, None] * p)
+    ds = _ida_dataset(scale, pga, pgv, uplift, p)
+    table = rf.im_efficiency(ds, candidates=("pga", "pgv", "sa", "pga_ratio", "pgv_ratio"))
+    best = table.index[0][0]
+    assert best == "pgv_ratio"
+    assert table.loc[("pgv_ratio", "all"), "beta"] == pytest.approx(
+        np.std(np.log(target)), rel=1e-9
+    )
+    assert table.loc[("pgv_ratio", "all"), "dimensionless"]
+    assert table.loc[("pga", "all"), "beta"] > 5 * table.loc[("pgv_ratio", "all"), "beta"]
+    assert "sa(T=1 s)" in table.index.get_level_values("im")
+    # within one block, a measure and its ratio share beta
+    per = rf.im_efficiency(ds, candidates=("pga", "pga_ratio"), by="structure")
+    np.testing.assert_allclose(
+        per.xs("pga", level="im")["beta"].sort_index(),
+        per.xs("pga_ratio", level="im")["beta"].sort_index(),
+        rtol=1e-12,
+    )
+
+
+def test_intensity_in_quoted_units_and_bad_names():
+    ds = _ida_dataset([[2.0]], [G / 2], [0.3], [G * 0.2], [2.0])
+    ds["arias"] = ("record", [0.5])
+    assert rf.intensity(ds, "pga", scale="capacity_scale").item() == pytest.approx(1.0)
+    assert rf.intensity(ds, "pgv", scale="capacity_scale").item() == pytest.approx(0.6)
+    assert rf.intensity(ds, "arias", scale="capacity_scale").item() == pytest.approx(2.0)
+    assert rf.intensity(ds, "sa", 1.0, scale="capacity_scale").item() == pytest.approx(1.0)
+    assert rf.intensity(ds, "sa", 1.0).attrs["unit"] == "g"
+    with pytest.raises(ValueError, match="im must be one of"):
+        rf.intensity(ds, "pgz")
+    with pytest.raises(ValueError, match="period: 2.0 s is not stored"):
+        rf.intensity(ds, "sa", 2.0)
+    with pytest.raises(ValueError, match="needs a period"):
+        rf.intensity(ds, "sa")
+    with pytest.raises(ValueError, match="im='cav' is not stored"):
+        rf.intensity(ds, "cav")
+    with pytest.raises(ValueError, match="by must be"):
+        rf.ida_fragility(ds, by="nothing")
