@@ -4,12 +4,12 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup debian demo test bench figures lint clean
+.PHONY: setup debian demo test docs bench figures lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --upgrade pip
-	$(BIN)/pip install -e '.[test]'
+	$(BIN)/pip install -e '.[test,docs]'
 	touch $(STAMP)
 
 setup: $(STAMP)
@@ -30,6 +30,12 @@ demo: $(STAMP)
 test: $(STAMP) debian
 	$(BIN)/python -m pytest -q
 
+# The documentation site (Sphinx, numpydoc, sphinx-gallery; examples executed), warnings as
+# errors, into docs/_build/html
+docs: $(STAMP)
+	rm -rf docs/_build docs/generated docs/auto_examples
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_engine.py
 	$(BIN)/python benchmarks/bench_closedform.py
@@ -46,4 +52,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check rockstudy tests benchmarks
 
 clean:
-	rm -rf $(VENV) results
+	rm -rf $(VENV) results docs/_build docs/generated docs/auto_examples
