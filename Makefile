@@ -27,8 +27,8 @@ demo: $(STAMP)
 	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report
 	$(BIN)/rockstudy demo --out results/demo
 
-test: $(STAMP) debian
-	$(BIN)/python -m pytest -q
+test: $(STAMP) debian docs
+	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q
 
 # The documentation site (Sphinx, numpydoc, sphinx-gallery; examples executed), warnings as
 # errors, into docs/_build/html
