@@ -6,12 +6,12 @@ STAMP  := $(VENV)/.installed
 # numba's on-disk cache of the kernels, primed once per install (and again after an edit)
 KERNELS := $(VENV)/.kernels-compiled
 
-.PHONY: setup debian demo test bench figures lint clean
+.PHONY: setup debian demo test docs bench figures lint clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --upgrade pip
-	$(BIN)/pip install -e '.[test]'
+	$(BIN)/pip install -e '.[test,docs]'
 	touch $(STAMP)
 
 $(KERNELS): $(STAMP) $(shell find rockstudy -name '*.py')
@@ -33,8 +33,14 @@ demo: $(KERNELS)
 	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report
 	$(BIN)/rockstudy demo --out results/demo
 
-test: $(KERNELS) debian
-	$(BIN)/python -m pytest -q
+test: $(KERNELS) debian docs
+	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q
+
+# The documentation site (Sphinx, numpydoc, sphinx-gallery; examples executed), warnings as
+# errors, into docs/_build/html
+docs: $(KERNELS)
+	rm -rf docs/_build docs/generated docs/auto_examples
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
 
 bench: $(KERNELS)
 	$(BIN)/python benchmarks/bench_engine.py
@@ -53,4 +59,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check rockstudy tests benchmarks
 
 clean:
-	rm -rf $(VENV) results
+	rm -rf $(VENV) results docs/_build docs/generated docs/auto_examples
