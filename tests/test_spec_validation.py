@@ -291,7 +291,7 @@ def test_run_never_stores_file_bytes_in_the_cube(tmp_path, monkeypatch):
     out = evaluate_chunk(study.normalized(), cols, base_dir=tmp_path)
     assert np.all(out["status"] == 2)
     for message in out["error"]:
-        text = message.decode()
+        text = message.decode() if isinstance(message, bytes) else str(message)
         assert "/proc/self/environ" in text, text
         assert SECRET not in text and "H5_LEAK" not in text, text
 

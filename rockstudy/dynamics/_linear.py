@@ -22,6 +22,7 @@ from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
 from ._rocking import (
     MODEL_LINEAR,
+    NO_TABLE,
     PH_END,
     PH_OVER,
     PH_REST,
@@ -491,7 +492,6 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
     """
     dur = times[-1]
     mp = np.array([scale, 0.0, 0.0, dur])
-    thr = G * alpha
     ta = np.array([abs(th_init), 0.0, np.nan])
     no_log = np.empty((0, 7))
     rocking = th_init != 0.0 or om_init != 0.0
@@ -501,7 +501,9 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
     code = PH_END
     while True:
         if not rocking:
-            t_up = next_uplift(KIND_RECORD, mp, times, samples, thr, thr, tau / p)
+            t_up = next_uplift(
+                KIND_RECORD, mp, times, samples, p, alpha, MODEL_LINEAR, NO_TABLE, tau / p
+            )
             if t_up >= dur:
                 return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
             k = segment_index(times, t_up, k)

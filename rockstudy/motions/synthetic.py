@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 from .. import _validate
 from ..constants import G
@@ -24,6 +23,8 @@ def _high_frequency(peak, duration, dt, corner, seed, ground_frequency):
     rec = stochastic_record(
         1.0, duration=duration, dt=dt, ground_frequency=ground_frequency, seed=seed
     )
+    from scipy import signal  # imported on use: it costs ~0.6 s (see stochastic.py)
+
     sos = signal.butter(HIGH_PASS_ORDER, corner, "highpass", fs=1.0 / dt, output="sos")
     acc = signal.sosfiltfilt(sos, rec.acceleration)
     return acc * (peak / np.max(np.abs(acc)))
