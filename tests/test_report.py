@@ -143,3 +143,78 @@ def test_fragility_section_marks_medians_outside_the_sampled_range(tmp_path):
     np.testing.assert_allclose(shown["median capacity"][~large.values].astype(float), 1.6, rtol=0.1)
     html_text = "".join(page.parts)
     assert report.NOT_REACHED in html_text
+
+
+MONTE_CARLO = """
+name = "tiny_monte_carlo"
+description = "blocks <b>under</b> sine pulses"
+seed = 5
+chunk_size = 600
+[sampler]
+kind = "monte_carlo"
+n = 600
+[structure]
+kind = "block"
+half_diagonal = { dist = "uniform", low = 0.5, high = 3.0 }
+slenderness = { dist = "uniform", low = 0.1, high = 0.3 }
+[motion]
+kind = "pulse"
+shape = "sine"
+amplitude_ratio = { dist = "uniform", low = 1.0, high = 5.0 }
+period = { dist = "loguniform", low = 0.1, high = 2.0 }
+[run]
+outputs = ["max_rotation", "max_rotation_ratio", "overturned", "n_impacts"]
+"""
+
+
+def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
+    """A Monte Carlo study's page: four figures (response, overturning map, first-order
+    sensitivity, fragility) all decoded by the browser, the inputs table and the study itself
+    (escaped), counts as integers, bins in three significant figures, no debug line."""
+    import html as html_mod
+
+    study = validate_text(MONTE_CARLO)
+    cube = tmp_path / "cube.zarr"
+    run_study(study, cube, workers=1, progress=False)
+    page = make_report(cube, tmp_path / "report")
+    shown, total = chromium_figures(page)
+    assert total >= 4 and shown == total
+    names = {p.stem for p in (tmp_path / "report").glob("*.png")}
+    assert {"response", "overturning_map", "first_order", "fragility"} <= names
+    source = page.read_text()
+    text = re.sub(r"<img[^>]*>", "", source)
+    assert "figures rendered" not in text
+    assert "<b>under</b>" not in text and html_mod.escape("<b>under</b>") in text
+    assert "&quot;amplitude_ratio&quot;" in text  # the study file itself
+    inputs = (tmp_path / "report" / "inputs.csv").read_text()
+    assert "loguniform" in inputs and "pulse period T_p [s]" in inputs
+    assert "<td>600</td>" in text and not re.search(r"<td>\d(\.\d+)?e\+\d+</td>", text)
+    bins = re.findall(r"R (\S+) to (\S+) m", text)
+    assert bins and all(len(v.replace(".", "").lstrip("0")) <= 3 for b in bins for v in b)
+    assert "theta" not in (tmp_path / "report" / "fragility.csv").read_text().splitlines()[0]
+
+
+def test_failed_samples_counted_by_message(tmp_path):
+    import pandas as pd
+    import xarray as xr
+
+    from rockstudy.study import report
+
+    status = np.array([1, 2, 2, 1, 2, 0], np.int8)
+    error = np.array([b"", b"step limit", b"step limit", b"", b"bad record", b""])
+    ds = xr.Dataset({"status": ("sample", status), "error": ("sample", error)})
+    page = report._Page(tmp_path)
+    report._failures(page, ds)
+    counts = pd.read_csv(tmp_path / "failures.csv", index_col=0)["samples"]
+    assert counts.to_dict() == {"step limit": 2, "bad record": 1}
+    assert "<td>2</td>" in "".join(page.parts)
+
+
+def test_cells_have_three_significant_figures_and_counts_are_integers():
+    from rockstudy.study.report import _shown
+
+    assert _shown(20000) == "20000" and _shown(np.int64(20000)) == "20000"
+    assert (
+        _shown(0.5000531) == "0.5" and _shown(1.33309) == "1.33" and _shown(123456.0) == "1.23e+05"
+    )
+    assert _shown(np.nan) == "" and _shown("not reached") == "not reached"

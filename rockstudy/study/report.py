@@ -117,9 +117,9 @@ def _summary(page, ds):
     if "max_rotation_ratio" in ds and "overturned" in ds:
         r = ds["max_rotation_ratio"].values[(ds["overturned"].values == 0) & (status == 1)]
         for q in (0.5, 0.9, 0.99):
-            rows[f"peak rotation / critical rotation of the survivors, {int(q * 100)} % quantile"] = (
-                float(np.quantile(r, q)) if r.size else float("nan")
-            )
+            rows[
+                f"peak rotation / critical rotation of the survivors, {int(q * 100)} % quantile"
+            ] = float(np.quantile(r, q)) if r.size else float("nan")
     page.table(pd.Series(rows, dtype=object).to_frame("value"), "summary", "Outcomes")
 
 
@@ -506,7 +506,9 @@ def _response(page, ds):
         a2.stairs(share, edges, fill=True, alpha=0.6, color="C3")
         a2.set(xlabel=_label(im), ylabel="overturned share [-]", ylim=(0, 1))
     else:
-        a2.bar(["survived", "overturned"], [int((~over).sum()), int(over.sum())], color=["C0", "C3"])
+        a2.bar(
+            ["survived", "overturned"], [int((~over).sum()), int(over.sum())], color=["C0", "C3"]
+        )
         a2.set(ylabel="samples (count)")
     a2.set_title(f"overturned share {over.mean():.3g} ({int(over.sum())} samples)")
     fig.tight_layout()
