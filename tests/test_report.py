@@ -145,26 +145,14 @@ def test_fragility_section_marks_medians_outside_the_sampled_range(tmp_path):
     assert report.NOT_REACHED in html_text
 
 
-MONTE_CARLO = """
-name = "tiny_monte_carlo"
-description = "blocks <b>under</b> sine pulses"
-seed = 5
-chunk_size = 600
-[sampler]
-kind = "monte_carlo"
-n = 600
-[structure]
-kind = "block"
-half_diagonal = { dist = "uniform", low = 0.5, high = 3.0 }
-slenderness = { dist = "uniform", low = 0.1, high = 0.3 }
-[motion]
-kind = "pulse"
-shape = "sine"
-amplitude_ratio = { dist = "uniform", low = 1.0, high = 5.0 }
-period = { dist = "loguniform", low = 0.1, high = 2.0 }
-[run]
-outputs = ["max_rotation", "max_rotation_ratio", "overturned", "n_impacts"]
-"""
+def quickstart_text(n):
+    """The shipped quickstart study with n samples and a description that must be escaped."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "studies" / "quickstart.toml").read_text()
+    text = re.sub(r"(?m)^n = \d+", f"n = {n}", text)
+    text = re.sub(r"(?m)^chunk_size = \d+", f"chunk_size = {n}", text)
+    return re.sub(r'(?m)^description = ".*"', 'description = "blocks <b>under</b> pulses"', text)
 
 
 def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
@@ -173,7 +161,7 @@ def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
     (escaped), counts as integers, bins in three significant figures, no debug line."""
     import html as html_mod
 
-    study = validate_text(MONTE_CARLO)
+    study = validate_text(quickstart_text(600))
     cube = tmp_path / "cube.zarr"
     run_study(study, cube, workers=1, progress=False)
     page = make_report(cube, tmp_path / "report")
