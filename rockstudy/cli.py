@@ -9,34 +9,86 @@ import shlex
 import sys
 from pathlib import Path
 
+from . import __version__
+
 
 def _simulate(args) -> int:
     from . import Block, simulate
     from .motions import PULSES, Record
 
-    block = Block(args.half_diagonal, args.slenderness, args.restitution)
+    if (args.half_diagonal is None) != (args.slenderness is None) or (args.width is None) != (
+        args.height is None
+    ):
+        return _usage("give --half-diagonal with --slenderness, or --width with --height")
+    if (args.half_diagonal is None) == (args.width is None):
+        return _usage(
+            "give the block as --half-diagonal and --slenderness, or as --width "
+            "and --height (not both)"
+        )
+    pulse_options = [
+        f"--{name.replace('_', '-')}"
+        for name in ("amplitude", "period", "cycles", "pulse")
+        if getattr(args, name) is not None
+    ]
+    if args.record and pulse_options:
+        return _usage(f"--record contradicts the pulse options {', '.join(pulse_options)}")
+    if not args.record and args.scale is not None:
+        return _usage("--scale applies to a --record only")
+    if args.width is not None:
+        block = Block.from_dimensions(args.width, args.height, args.restitution)
+    else:
+        block = Block(args.half_diagonal, args.slenderness, args.restitution)
     if args.record:
         path = args.record
         motion = Record.from_at2(path) if path.lower().endswith(".at2") else Record.from_csv(path)
-        if args.scale != 1.0:
+        if args.scale is not None:
             motion = motion.scaled(args.scale)
+        described = {"record": path, "scale": 1.0 if args.scale is None else args.scale}
     else:
         if args.amplitude is None or args.period is None:
-            print(
-                "error: a pulse needs --amplitude and --period (or give --record)", file=sys.stderr
-            )
-            return 2
-        cls = PULSES[args.pulse]
-        kw = {"cycles": args.cycles} if args.pulse in ("sine", "cosine") else {}
-        motion = cls(args.amplitude, args.period, **kw)
-    res = simulate(block, motion, method=args.method, rtol=args.rtol)
+            return _usage("a pulse needs --amplitude and --period (or give --record)")
+        shape = args.pulse or "sine"
+        cycles = 1 if args.cycles is None else args.cycles
+        kw = {"cycles": cycles} if shape in ("sine", "cosine") else {}
+        motion = PULSES[shape](args.amplitude, args.period, **kw)
+        described = {"pulse": shape, "amplitude": args.amplitude, "period": args.period, **kw}
+    res = simulate(
+        block,
+        motion,
+        method=args.method,
+        rtol=args.rtol,
+        initial_rotation=args.initial_rotation,
+        initial_velocity=args.initial_velocity,
+    )
+    if args.out:
+        _write_history(res, Path(args.out))
     summary = res.summary()
+    impacts = res.impact_times
+    summary.pop("first_impact_time", None)
+    summary["impacts"] = {
+        "count": int(impacts.size),
+        "first": float(impacts[0]) if impacts.size else None,
+        "last": float(impacts[-1]) if impacts.size else None,
+    }
+    inputs = {
+        "half_diagonal": block.half_diagonal,
+        "slenderness": block.slenderness,
+        "width": block.width,
+        "height": block.height,
+        "restitution": block_restitution(block),
+        **described,
+        "method": args.method,
+        "rtol": args.rtol,
+        "initial_rotation": args.initial_rotation,
+        "initial_velocity": args.initial_velocity,
+    }
     if args.json:
-        summary["impact_times"] = res.impact_times.tolist()
-        print(json.dumps(summary, indent=2))
+        print(json.dumps({"inputs": inputs, "result": summary}, indent=2))
     else:
-        for key, value in summary.items():
+        for key, value in {**inputs, **summary}.items():
             print(f"{key:18s} {value}")
+        if args.out:
+            print(f"wrote {args.out}")
     return 0
 
 
@@ -95,6 +147,28 @@ def _quiet_dask() -> None:
     names = [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")]
     for name in ("distributed", *names):
         logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+def block_restitution(block) -> float:
+    """The block's coefficient of restitution (Housner's when none was given)."""
+    from .structures.block import block_parameters
+
+    return float(block_parameters(block)[2])
+
+
+def _write_history(result, path: Path):
+    """The history to CSV (``.csv``) or netCDF (``.nc``), by the file's suffix."""
+    if path.suffix == ".csv":
+        result.to_dataframe().to_csv(path, index=False)
+    elif path.suffix == ".nc":
+        result.to_xarray().to_netcdf(path)
+    else:
+        raise ValueError(f"--out must end in .csv or .nc, got {str(path)!r}")
+
+
+def _usage(message) -> int:
+    print(f"error: {message}", file=sys.stderr)
+    return 2
 
 
 def _run(args) -> int:
@@ -177,33 +251,86 @@ def _validate(args) -> int:
     return status
 
 
+class _Help(argparse.HelpFormatter):
+    """Help that shows an option's default where it has one (not None or a flag's False) and
+    its text does not already say it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        default = action.default
+        if (
+            not any(default is v for v in (None, False, argparse.SUPPRESS))
+            and "default" not in text
+            and action.option_strings
+        ):
+            text += " (default: %(default)s)"
+        return text
+
+
 def main(argv=None) -> int:
     """Entry point of the ``rockstudy`` command."""
-    parser = argparse.ArgumentParser(prog="rockstudy", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    sim = sub.add_parser("simulate", help="rock one block through one motion")
-    sim.add_argument("--half-diagonal", type=float, required=True, help="R [m]")
-    sim.add_argument("--slenderness", type=float, required=True, help="alpha [rad]")
-    sim.add_argument("--restitution", type=float, default=None, help="eta (default Housner)")
-    sim.add_argument("--pulse", choices=["sine", "cosine", "half-sine", "ricker"], default="sine")
-    sim.add_argument("--amplitude", type=float, help="a_g [m/s^2]")
-    sim.add_argument("--period", type=float, help="T_p [s]")
-    sim.add_argument("--cycles", type=int, default=1)
-    sim.add_argument("--record", help="a PEER .AT2 file or a two-column (t [s], a [g]) file")
-    sim.add_argument("--scale", type=float, default=1.0, help="factor on the record")
+    parser = argparse.ArgumentParser(
+        prog="rockstudy",
+        description="Rocking blocks and structures in earthquakes: simulate one, run a study "
+        "file on dask, report on its results.",
+        formatter_class=_Help,
+    )
+    parser.add_argument("--version", action="version", version=f"rockstudy {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sim = sub.add_parser(
+        "simulate",
+        help="rock one block through one motion",
+        formatter_class=_Help,
+        description="Rock one rectangular block through a pulse or a record. Units: SI "
+        "(m, s, m/s^2, rad); the block as R and alpha or as width and height.",
+    )
+    sim.add_argument("--half-diagonal", type=float, help="R, half the diagonal [m]")
+    sim.add_argument("--slenderness", type=float, help="alpha = atan(width / height) [rad]")
+    sim.add_argument("--width", type=float, help="width 2b [m] (with --height)")
+    sim.add_argument("--height", type=float, help="height 2h [m] (with --width)")
+    sim.add_argument(
+        "--restitution",
+        type=float,
+        default=None,
+        help="eta; default: Housner's 1 - 1.5 sin^2 alpha",
+    )
+    sim.add_argument(
+        "--pulse",
+        choices=["sine", "cosine", "half-sine", "ricker"],
+        help="pulse shape (default: sine)",
+    )
+    sim.add_argument("--amplitude", type=float, help="pulse amplitude a_g [m/s^2]")
+    sim.add_argument("--period", type=float, help="pulse period T_p [s]")
+    sim.add_argument("--cycles", type=int, help="cycles of a sine or cosine pulse (default: 1)")
+    sim.add_argument(
+        "--record", help="a PEER .AT2 file or a two-column file (t [s], a [g]) instead of a pulse"
+    )
+    sim.add_argument("--scale", type=float, help="factor on the record (default: 1)")
+    sim.add_argument("--initial-rotation", type=float, default=0.0, help="theta at t = 0 [rad]")
+    sim.add_argument(
+        "--initial-velocity", type=float, default=0.0, help="theta_dot at t = 0 [rad/s]"
+    )
     sim.add_argument(
         "--method",
         default="nonlinear",
         choices=["nonlinear", "linear", "scipy", "scipy-linear", "complex", "auto"],
+        help="the model and solver",
     )
-    sim.add_argument("--rtol", type=float, default=1e-8)
-    sim.add_argument("--json", action="store_true", help="print the summary as JSON")
-    demo = sub.add_parser("demo", help="the demo job: a plot and a JSON summary")
-    demo.add_argument("--out", default="results/demo")
-    figs = sub.add_parser("figures", help="recompute the figures of paper 000 as PNGs")
-    figs.add_argument("--out", default="results/figures")
-    run = sub.add_parser("run", help="run a study file into a zarr cube")
-    run.add_argument("study")
+    sim.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance")
+    sim.add_argument("--out", help="write the history to this .csv or .nc (netCDF) file")
+    sim.add_argument(
+        "--json", action="store_true", help="print the inputs and the outcomes as JSON"
+    )
+    demo = sub.add_parser(
+        "demo", help="the demo job: a plot and a JSON summary", formatter_class=_Help
+    )
+    demo.add_argument("--out", default="results/demo", help="directory to write")
+    figs = sub.add_parser(
+        "figures", help="recompute the figures of paper 000 as PNGs", formatter_class=_Help
+    )
+    figs.add_argument("--out", default="results/figures", help="directory to write")
+    run = sub.add_parser("run", help="run a study file into a zarr cube", formatter_class=_Help)
+    run.add_argument("study", help="the study file (TOML)")
     run.add_argument("--out", required=True, help="the zarr store to write (PATH.nc too)")
     where = run.add_mutually_exclusive_group()
     where.add_argument("--workers", type=_positive_int, help="local cluster size (default 2)")
@@ -229,11 +356,17 @@ def main(argv=None) -> int:
     for flag, what in (("ca-file", "CA certificate"), ("cert", "client certificate")):
         run.add_argument(f"--tls-{flag}", help=f"{what} (PEM) for a tls:// scheduler")
     run.add_argument("--tls-key", help="client private key (PEM) for a tls:// scheduler")
-    val = sub.add_parser("validate", help="check study files, naming every problem")
-    val.add_argument("study", nargs="+")
+    val = sub.add_parser(
+        "validate", help="check study files, naming every problem", formatter_class=_Help
+    )
+    val.add_argument("study", nargs="+", help="study files (TOML)")
     sub.add_parser("schema", help="print the JSON schema of study files")
     sub.add_parser("compile", help="compile the numba kernels into their cache (once per install)")
-    rep = sub.add_parser("report", help="an HTML report (figures, CSV tables) of a result cube")
+    rep = sub.add_parser(
+        "report",
+        help="an HTML report (figures, CSV tables) of a result cube",
+        formatter_class=_Help,
+    )
     rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
     rep.add_argument("--out", help="directory (default: RESULT_report)")
     args = parser.parse_args(argv)

@@ -77,7 +77,8 @@ def chromium_figures(page):
         text=True,
         timeout=120,
     )
-    m = re.search(r"figures rendered: (\d+)/(\d+)", out.stdout)
+    # the page's own check writes "shown/total" into a data attribute, never into its text
+    m = re.search(r'<body[^>]*data-figures="(\d+)/(\d+)"', out.stdout)
     assert m, out.stdout[-2000:]
     return int(m.group(1)), int(m.group(2))
 
@@ -138,7 +139,70 @@ def test_fragility_section_marks_medians_outside_the_sampled_range(tmp_path):
     large = fit["theta"] > 4
     assert large.sum() == 2 and (fit["im_max"] <= 3.0).all()
     assert not fit["theta_in_range"][large].any() and fit["theta_in_range"][~large].all()
-    assert (shown["theta"][large.values] == report.NOT_REACHED).all()
-    np.testing.assert_allclose(shown["theta"][~large.values].astype(float), 1.6, rtol=0.1)
+    assert (shown["median capacity"][large.values] == report.NOT_REACHED).all()
+    np.testing.assert_allclose(shown["median capacity"][~large.values].astype(float), 1.6, rtol=0.1)
     html_text = "".join(page.parts)
     assert report.NOT_REACHED in html_text
+
+
+def quickstart_text(n):
+    """The shipped quickstart study with n samples and a description that must be escaped."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "studies" / "quickstart.toml").read_text()
+    text = re.sub(r"(?m)^n = \d+", f"n = {n}", text)
+    text = re.sub(r"(?m)^chunk_size = \d+", f"chunk_size = {n}", text)
+    return re.sub(r'(?m)^description = ".*"', 'description = "blocks <b>under</b> pulses"', text)
+
+
+def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
+    """A Monte Carlo study's page: four figures (response, overturning map, first-order
+    sensitivity, fragility) all decoded by the browser, the inputs table and the study itself
+    (escaped), counts as integers, bins in three significant figures, no debug line."""
+    import html as html_mod
+
+    study = validate_text(quickstart_text(600))
+    cube = tmp_path / "cube.zarr"
+    run_study(study, cube, workers=1, progress=False)
+    page = make_report(cube, tmp_path / "report")
+    shown, total = chromium_figures(page)
+    assert total >= 4 and shown == total
+    names = {p.stem for p in (tmp_path / "report").glob("*.png")}
+    assert {"response", "overturning_map", "first_order", "fragility"} <= names
+    source = page.read_text()
+    text = re.sub(r"<img[^>]*>", "", source)
+    assert "figures rendered" not in text
+    assert "<b>under</b>" not in text and html_mod.escape("<b>under</b>") in text
+    assert "&quot;amplitude_ratio&quot;" in text  # the study file itself
+    inputs = (tmp_path / "report" / "inputs.csv").read_text()
+    assert "loguniform" in inputs and "pulse period T_p [s]" in inputs
+    assert "<td>600</td>" in text and not re.search(r"<td>\d(\.\d+)?e\+\d+</td>", text)
+    bins = re.findall(r"R (\S+) to (\S+) m", text)
+    assert bins and all(len(v.replace(".", "").lstrip("0")) <= 3 for b in bins for v in b)
+    assert "theta" not in (tmp_path / "report" / "fragility.csv").read_text().splitlines()[0]
+
+
+def test_failed_samples_counted_by_message(tmp_path):
+    import pandas as pd
+    import xarray as xr
+
+    from rockstudy.study import report
+
+    status = np.array([1, 2, 2, 1, 2, 0], np.int8)
+    error = np.array([b"", b"step limit", b"step limit", b"", b"bad record", b""])
+    ds = xr.Dataset({"status": ("sample", status), "error": ("sample", error)})
+    page = report._Page(tmp_path)
+    report._failures(page, ds)
+    counts = pd.read_csv(tmp_path / "failures.csv", index_col=0)["samples"]
+    assert counts.to_dict() == {"step limit": 2, "bad record": 1}
+    assert "<td>2</td>" in "".join(page.parts)
+
+
+def test_cells_have_three_significant_figures_and_counts_are_integers():
+    from rockstudy.study.report import _shown
+
+    assert _shown(20000) == "20000" and _shown(np.int64(20000)) == "20000"
+    assert (
+        _shown(0.5000531) == "0.5" and _shown(1.33309) == "1.33" and _shown(123456.0) == "1.23e+05"
+    )
+    assert _shown(np.nan) == "" and _shown("not reached") == "not reached"

@@ -95,7 +95,8 @@ def simulate_batch(
     rtol: float = 1e-8,
     max_steps: int = 1_000_000,
     outputs=None,
-) -> dict:
+    as_dataset: bool = False,
+):
     """Rock many blocks through many pulses (or scaled copies of one record) in one call.
 
     Every argument broadcasts to a common length n. The rows run in parallel (numba
@@ -139,9 +140,15 @@ def simulate_batch(
         Cap on the integrator steps in one rocking phase of a row (status 1 when reached), a
         whole number in [1, 1e12].
 
+    as_dataset : bool
+        Return an :class:`xarray.Dataset` on a ``scene`` dimension instead: the inputs
+        (``frequency_parameter`` p [rad/s], ``slenderness``, ``restitution``, and
+        ``amplitude``, ``period``, ``cycles`` of the pulse or the record's ``scale``; with
+        ``half_diagonal`` if given) as coordinates with units, the outputs as variables.
+
     Returns
     -------
-    dict of ndarrays
+    dict of ndarrays (or xarray.Dataset with ``as_dataset``)
         ``max_rotation`` [rad] (pi/2 if overturned), ``overturned`` (bool), ``n_impacts``
         (until rest; with restitution 1 the block never rests, and the impacts are counted up
         to duration + 100/p, the end of :func:`rockstudy.simulate`'s default history),
@@ -207,7 +214,60 @@ def simulate_batch(
         cols[name] = cols[name].astype(np.int64)
     cols["overturned"] = cols["overturned"].astype(bool)
     cols["model"] = codes
-    return {name: cols[name] for name in wanted}
+    result = {name: cols[name] for name in wanted}
+    if not as_dataset:
+        return result
+    inputs = {"frequency_parameter": p, "slenderness": alpha, "restitution": eta}
+    if half_diagonal is not None:
+        inputs["half_diagonal"] = R
+    if record is not None:
+        inputs["scale"] = mp[:, 0]
+    else:
+        for name, value in (("amplitude", amplitude), ("period", period), ("cycles", cycles)):
+            inputs[name] = np.broadcast_to(np.asarray(value), (n,))
+    return _as_dataset(
+        result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
+    )
+
+
+#: long name and CF units of the inputs and outputs of :func:`simulate_batch`
+_BATCH_UNITS = {
+    "half_diagonal": ("half-diagonal R", "m"),
+    "frequency_parameter": ("frequency parameter p", "rad s-1"),
+    "slenderness": ("slenderness alpha", "rad"),
+    "restitution": ("coefficient of restitution eta", "1"),
+    "amplitude": ("pulse amplitude a_g", "m s-2"),
+    "period": ("pulse period T_p", "s"),
+    "cycles": ("pulse cycles", "1"),
+    "scale": ("factor on the record", "1"),
+    "max_rotation": ("maximum |theta|", "rad"),
+    "overturned": ("overturned", "1"),
+    "n_impacts": ("number of impacts", "1"),
+    "overturn_time": ("time of overturning", "s"),
+    "first_impact_time": ("time of the first impact", "s"),
+    "status": ("0 ok, 1 step limit reached", "1"),
+    "steps": ("DOP853 steps", "1"),
+    "model": ("0 rest, 1 linear, 2 nonlinear", "1"),
+}
+
+
+def _as_dataset(result, inputs, method, rtol, motion):
+    """The outputs of :func:`simulate_batch` with its inputs as ``scene`` coordinates."""
+    import xarray as xr
+
+    def var(name, values):
+        long_name, units = _BATCH_UNITS.get(name, (name, "1"))
+        return ("scene", np.asarray(values), {"long_name": long_name, "units": units})
+
+    return xr.Dataset(
+        {k: var(k, v) for k, v in result.items()},
+        coords={k: var(k, v) for k, v in inputs.items()},
+        attrs={
+            "method": method,
+            "rtol": rtol,
+            "motion": motion,
+        },
+    )
 
 
 def _requested_outputs(outputs):

@@ -303,9 +303,29 @@ def simulate(
         _auto.warn_loose_tolerance(rtol)
     x0 = (th0, om0)
     if hasattr(structure, "mechanism"):
-        return _simulate_structure(structure, motion, method, rtol, t_max, int(max_steps), x0, l)
-    p, alpha, eta = block_parameters(structure)
-    return _simulate_block(p, alpha, eta, motion, method, rtol, t_max, int(max_steps), x0, l)
+        r = _simulate_structure(structure, motion, method, rtol, t_max, int(max_steps), x0, l)
+    else:
+        p, alpha, eta = block_parameters(structure)
+        r = _simulate_block(p, alpha, eta, motion, method, rtol, t_max, int(max_steps), x0, l)
+    r.info.update(
+        motion=_describe(motion),
+        rtol_requested=rtol,
+        initial_rotation=th0,
+        initial_velocity=om0,
+    )
+    return r
+
+
+def _describe(motion) -> str:
+    """A one-line description of a motion: its class and scalar parameters."""
+    if dataclasses.is_dataclass(motion):
+        scalars = {
+            f.name: getattr(motion, f.name)
+            for f in dataclasses.fields(motion)
+            if not f.name.startswith("_") and isinstance(getattr(motion, f.name), (int, float, str))
+        }
+        return f"{type(motion).__name__}({', '.join(f'{k}={v!r}' for k, v in scalars.items())})"
+    return type(motion).__name__
 
 
 def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l):
@@ -314,8 +334,19 @@ def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l
     if method in ("linear", "scipy-linear"):
         _warn_linearization(p, alpha, eta, motion, x0)
     if method == "complex":
-        return _complex(p, alpha, eta, motion, None, rtol, t_max, max_steps, method, x0, l)
-    return runner(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        r = _complex(p, alpha, eta, motion, None, rtol, t_max, max_steps, method, x0, l)
+    else:
+        r = runner(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+    _record_parameters(r, p, alpha, eta)
+    return r
+
+
+def _record_parameters(r, p, alpha, eta):
+    """The rocking parameters of what ran, in ``r.info``: p [rad/s], the critical rotation
+    [rad] of ``theta`` (alpha for a block) and the restitution."""
+    r.info.update(
+        frequency_parameter=float(p), critical_rotation=float(alpha), restitution=float(eta)
+    )
 
 
 def _simulate_structure(structure, motion, method, rtol, t_max, max_steps, x0, l):
@@ -391,6 +422,9 @@ def _mechanism(structure, motion, rtol, t_max, max_steps, x0, method="mechanism"
     )
     if result.overturned:
         result = dataclasses.replace(result, max_rotation=FALL_ROTATION)
+    _record_parameters(
+        result, params.frequency_parameter, params.critical_rotation, params.restitution
+    )
     result.info.update(
         fall_rotation=fall,
         structure_model=f"mechanism of the {type(structure).__name__} (eq. 8 of [003])",

@@ -12,6 +12,7 @@ import base64
 import html
 import io
 import json
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ import pandas as pd
 
 from ..constants import G
 from . import analysis
+from .sampling import VARIABLES
 from .store import open_result
 
 
@@ -29,6 +31,18 @@ def _plt():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def _shown(value):
+    """A table cell as the page shows it: counts as integers, other numbers with three
+    significant figures, text as it is."""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return "" if np.isnan(value) else f"{value:.3g}"
+    return value
 
 
 class _Page:
@@ -43,12 +57,16 @@ class _Page:
     def text(self, text):
         self.parts.append(f"<p>{html.escape(text)}</p>")
 
+    def preformatted(self, text):
+        self.parts.append(f"<pre>{html.escape(text)}</pre>")
+
     def table(self, frame: pd.DataFrame, name: str, caption: str):
         frame.to_csv(self.out / f"{name}.csv")
         self.parts.append(
             f"<p class='cap'>{html.escape(caption)} (<a href='{name}.csv'>{name}.csv</a>)</p>"
         )
-        self.parts.append(frame.to_html(float_format=lambda x: f"{x:.4g}", classes="t"))
+        shown = frame.map(_shown).rename(index=_shown, columns=_shown)
+        self.parts.append(shown.to_html(classes="t"))  # to_html escapes every cell
 
     def figure(self, fig, name: str, caption: str):
         buf = io.BytesIO()
@@ -71,11 +89,12 @@ class _Page:
             "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
             ".cap{color:#555}</style></head><body>"
         )
+        # a check for headless browsers, invisible to the reader: the count of decoded figures
+        # goes into the body's data-figures attribute ("shown/total")
         check = (
-            "<p id='figcheck'>figures not checked</p><script>window.addEventListener("
-            "'load',()=>{const im=[...document.images];const ok=im.filter(i=>i.complete"
-            "&&i.naturalWidth>0).length;document.getElementById('figcheck').textContent="
-            "'figures rendered: '+ok+'/'+im.length;});</script>"
+            "<script>window.addEventListener('load',()=>{const im=[...document.images];"
+            "const ok=im.filter(i=>i.complete&&i.naturalWidth>0).length;"
+            "document.body.dataset.figures=ok+'/'+im.length;});</script>"
         )
         body = f"<h1>{html.escape(title)}</h1>{meta}" + "".join(self.parts) + check
         path = self.out / "index.html"
@@ -86,18 +105,22 @@ class _Page:
 def _summary(page, ds):
     status = ds["status"].values if "status" in ds else np.ones(ds.sizes["sample"])
     rows = {
-        "samples": status.size,
-        "ok": int((status == 1).sum()),
+        "samples": int(status.size),
+        "computed": int((status == 1).sum()),
         "failed": int((status == 2).sum()),
         "pending": int((status == 0).sum()),
     }
     if "overturned" in ds:
-        rows["overturned share"] = float(np.mean(ds["overturned"].values == 1))
+        rows["overturned share of the computed samples"] = float(
+            np.mean(ds["overturned"].values[status == 1] == 1)
+        )
     if "max_rotation_ratio" in ds and "overturned" in ds:
-        r = ds["max_rotation_ratio"].values[ds["overturned"].values == 0]
+        r = ds["max_rotation_ratio"].values[(ds["overturned"].values == 0) & (status == 1)]
         for q in (0.5, 0.9, 0.99):
-            rows[f"theta_max / theta_cr, survivors, q{int(q * 100)}"] = float(np.quantile(r, q))
-    page.table(pd.DataFrame({"value": rows}), "summary", "Outcomes")
+            rows[
+                f"peak rotation / critical rotation of the survivors, {int(q * 100)} % quantile"
+            ] = float(np.quantile(r, q)) if r.size else float("nan")
+    page.table(pd.Series(rows, dtype=object).to_frame("value"), "summary", "Outcomes")
 
 
 def _sobol(page, ds, study):
@@ -149,6 +172,27 @@ def _capacities_as_measured(table: pd.DataFrame) -> pd.DataFrame:
     return shown
 
 
+_FRAGILITY_NAMES = {
+    "theta": "median capacity",
+    "theta_lo": "median capacity, lower",
+    "theta_hi": "median capacity, upper",
+    "beta_lo": "beta, lower",
+    "beta_hi": "beta, upper",
+    "n": "samples",
+    "im_min": "lowest intensity",
+    "im_max": "highest intensity",
+    "theta_in_range": "median within the samples",
+    "band_in_range": "band within the samples",
+    "band": "subset of the samples",
+}
+
+
+_BANDS = {
+    "period": "pulse period T_p in its middle third",
+    "omega": "omega_g / p in its middle third",
+}
+
+
 def _fragility(page, ds):
     """Fragility by block size: against a_g for pulses of similar period T_p (dimensional),
     and against a_g / (g tan alpha) for pulses of similar omega_g / p (the groups of 6.1)."""
@@ -161,12 +205,17 @@ def _fragility(page, ds):
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.8))
     tables = []
     for ax, im, band, label in (
-        (axes[0], "abs_amplitude", "period", "a_g [m/s^2], T_p in its middle third"),
+        (
+            axes[0],
+            "abs_amplitude",
+            "period",
+            "pulse amplitude a_g [m/s^2], pulse period T_p in its middle third",
+        ),
         (
             axes[1],
             "amplitude_ratio",
             "omega",
-            "a_g / (g tan alpha), omega_g / p in its middle third",
+            "amplitude ratio a_g / (g tan alpha) [-], omega_g / p in its middle third",
         ),
     ):
         sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
@@ -175,6 +224,12 @@ def _fragility(page, ds):
         except ValueError as err:  # no block size saw both outcomes
             page.text(f"Fragility against {im}: {err}")
             continue
+        # the groups by readable names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
+        t.index = [
+            f"R {lo:.3g} to {hi:.3g} m"
+            for lo, hi in (map(float, g.split("-")) for g in t.index.astype(str))
+        ]
+        t.index.name = "block size"
         t.insert(0, "intensity", im)
         t.insert(1, "band", band)
         tables.append(t)
@@ -183,9 +238,10 @@ def _fragility(page, ds):
         for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
             c = curve.sel(group=g)
             note = "" if inside else " (median outside the data)"
-            ax.plot(grid, c.probability, "-" if inside else "--", label=f"R {g} m{note}")
+            ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
             ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
-        ax.set(xscale="log", xlabel=label, ylabel="P(overturn)")
+        ax.set(xscale="log", xlabel=label, ylabel="probability of overturning")
+        _plain_log_ticks(ax)
         ax.legend(fontsize=8)
     if not tables:
         plt.close(fig)
@@ -204,9 +260,12 @@ def _fragility(page, ds):
     fit = pd.concat(tables)
     fit.to_csv(page.out / "fragility_fit.csv")
     page.table(
-        _capacities_as_measured(fit),
+        _capacities_as_measured(fit)
+        .replace({"intensity": _SHORT, "band": _BANDS})
+        .rename(columns=_FRAGILITY_NAMES),
         "fragility",
-        "Fragility parameters: median capacity theta, log-standard deviation beta; a median "
+        "Fragility parameters (intensity: a_g [m/s^2] or a_g / (g tan alpha) [-]): median "
+        "capacity, its 90 % bootstrap band and the log-standard deviation beta; a median "
         f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
         f"'{NOT_REACHED}' (the fitted numbers and flags are in fragility_fit.csv)",
     )
@@ -220,7 +279,7 @@ def _fragility(page, ds):
             "the sampled range)"
         )
     page.text(
-        "Spread of the median capacity between block sizes (max/min of theta, medians within "
+        "Spread of the median capacity between block sizes (largest over smallest, medians within "
         "the sampled range only): " + ", ".join(spread)
     )
 
@@ -336,6 +395,231 @@ def _eta_law(page, surv):
     page.figure(fig, "eta_law", "The eta^2 law against the solver")
 
 
+#: short names in words for figure labels (the cube's long names are for the tables)
+_SHORT = {
+    "half_diagonal": "half-diagonal R [m]",
+    "slenderness": "slenderness alpha [rad]",
+    "restitution": "restitution eta [-]",
+    "amplitude": "pulse amplitude a_g [m/s^2]",
+    "abs_amplitude": "pulse amplitude a_g [m/s^2]",
+    "amplitude_ratio": "amplitude ratio a_g / (g tan alpha) [-]",
+    "amplitude_a": "a = a_g / (g alpha) [-]",
+    "period": "pulse period T_p [s]",
+    "frequency_ratio": "frequency ratio omega_g / p [-]",
+    "omega": "frequency ratio omega_g / p [-]",
+    "max_rotation_ratio": "peak rotation / critical rotation [-]",
+    "overturned": "overturned (0 or 1)",
+}
+
+
+def _units(name):
+    """'long name [units]' of a cube variable, in words."""
+    long_name, units = VARIABLES.get(name, (name, "1"))
+    return f"{long_name} [{'-' if units == '1' else units}]"
+
+
+def _label(name):
+    """A short label in words with units, for axes and legends."""
+    return _SHORT.get(name) or _units(name)
+
+
+def _plain_log_ticks(ax):
+    """Tick labels of a logarithmic x axis as plain numbers (2, 3, 10), not 2 x 10^0."""
+    from matplotlib.ticker import FuncFormatter
+
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    ax.xaxis.set_major_formatter(plain)
+    ax.xaxis.set_minor_formatter(plain)
+    ax.tick_params(axis="x", which="minor", labelsize=7)
+
+
+def _study_file(page, study):
+    """The input distributions as a table, and the study itself as the cube stores it."""
+    rows = {}
+    for name, dist in study.parameters().items():
+        spec = dist.model_dump(mode="json")
+        kind = spec.pop("dist")
+        rows[name] = {
+            "quantity": _units(name),
+            "distribution": kind,
+            "parameters": ", ".join(f"{k} = {_shown(v)}" for k, v in spec.items()),
+        }
+    if rows:
+        page.table(
+            pd.DataFrame(rows).T.rename_axis("parameter"),
+            "inputs",
+            "Input distributions of the sampled parameters",
+        )
+    page.text("The study as stored in the result (defaults filled in):")
+    page.preformatted(json.dumps(json.loads(study.normalized()), indent=2))
+
+
+def _failures(page, ds):
+    """Failed samples counted by their error message."""
+    if "status" not in ds or "error" not in ds:
+        return
+    failed = ds["status"].values == 2
+    if not failed.any():
+        return
+    messages = [
+        m.decode("utf-8", "replace") if isinstance(m, bytes) else str(m)
+        for m in ds["error"].values[failed]
+    ]
+    counts = pd.Series(messages, dtype=object).value_counts()
+    page.heading("Failed samples")
+    page.table(
+        pd.DataFrame({"samples": counts.astype(object)}).rename_axis("message"),
+        "failures",
+        f"{int(failed.sum())} failed samples, counted by their error message",
+    )
+
+
+def _computed(ds):
+    """The samples that were computed (status 1)."""
+    if "status" not in ds:
+        return ds
+    return ds.isel(sample=np.flatnonzero(ds["status"].values == 1))
+
+
+def _response(page, ds):
+    """Distributions of the response: theta_max / theta_cr of the survivors, and the
+    overturned share against the amplitude ratio."""
+    if "max_rotation_ratio" not in ds or "overturned" not in ds:
+        return
+    d = _computed(ds)
+    over = d["overturned"].values == 1
+    ratio = d["max_rotation_ratio"].values[~over]
+    plt = _plt()
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 3.8))
+    a1.hist(ratio, bins=40, range=(0.0, 1.0), color="C0")
+    a1.set(
+        xlabel="peak rotation / critical rotation, theta_max / theta_cr [-]",
+        ylabel="survivors (count)",
+        title=f"survivors: {int((~over).sum())} of {over.size}",
+    )
+    im = "amplitude_ratio" if "amplitude_ratio" in d else None
+    if im is not None:
+        x = d[im].values
+        edges = np.quantile(x, np.linspace(0, 1, 11))
+        idx = np.clip(np.digitize(x, edges) - 1, 0, 9)
+        share = np.array([over[idx == i].mean() if np.any(idx == i) else np.nan for i in range(10)])
+        a2.stairs(share, edges, fill=True, alpha=0.6, color="C3")
+        a2.set(xlabel=_label(im), ylabel="overturned share [-]", ylim=(0, 1))
+    else:
+        a2.bar(
+            ["survived", "overturned"], [int((~over).sum()), int(over.sum())], color=["C0", "C3"]
+        )
+        a2.set(ylabel="samples (count)")
+    a2.set_title(f"overturned share {over.mean():.3g} ({int(over.sum())} samples)")
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "response",
+        "Left: the peak rotation over the critical rotation of the blocks that did not "
+        "overturn. Right: the share of samples that overturned, in ten equally populated bins "
+        "of the amplitude ratio",
+    )
+
+
+#: slenderness up to which the closed forms of [000] (linearized, slender) are drawn
+SLENDER_LIMIT = 0.35
+
+
+def _overturning_map(page, ds, study):
+    """The samples in the plane of the groups (omega_g / p, a_g / (g tan alpha)), coloured by
+    outcome, with the closed-form boundaries of [000] Fig. 4 (sine pulse, linearized slender
+    block) where they apply."""
+    if not {"omega", "amplitude_ratio", "overturned"} <= set(ds.variables):
+        return
+    from ..closedform import overturning_boundary
+
+    d = _computed(ds)
+    w, a, over = d["omega"].values, d["amplitude_ratio"].values, d["overturned"].values == 1
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 5))
+    ax.scatter(w[~over], a[~over], s=3, c="C0", alpha=0.4, lw=0, label="survived")
+    ax.scatter(w[over], a[over], s=3, c="C3", alpha=0.4, lw=0, label="overturned")
+    applies = (
+        getattr(study.motion, "shape", None) == "sine"
+        and "slenderness" in d
+        and float(d["slenderness"].max()) <= SLENDER_LIMIT
+    )
+    if applies:
+        eta = float(np.median(d["restitution"].values)) if "restitution" in d else 1.0
+        grid = np.geomspace(max(w.min(), 0.05), w.max(), 400)
+        for case, style, label in (
+            ("2", "k-", "no impact (3.10)"),
+            ("1.2", "k--", f"one impact after the pulse (3.18), eta = {eta:.3g}"),
+            ("1.1", "k:", f"one impact during the pulse (3.20-3.21), eta = {eta:.3g}"),
+        ):
+            roots = overturning_boundary(grid, eta=eta, case=case, a_max=float(a.max()) * 1.5)
+            for k in range(roots.shape[1]):
+                r = roots[:, k].copy()
+                r[1:][np.abs(np.diff(np.log(r))) > 0.1] = np.nan  # no line across branches
+                ax.plot(grid, r, style, lw=1.2, label=label if k == 0 else None)
+        note = (
+            "Lines: the closed-form boundaries of [000] Fig. 4 for a sine pulse and the "
+            "linearized slender block, in a = a_g / (g alpha), which differs from "
+            "a_g / (g tan alpha) by under 4 % for alpha <= 0.35; eta is the median restitution "
+            "of the samples. They do not apply to other pulse shapes, records, or blocks that "
+            "are not slender; for the nonlinear model they are a guide."
+        )
+    else:
+        note = (
+            "No closed-form boundary drawn: those of [000] Fig. 4 hold for a sine pulse on a "
+            f"slender block (alpha <= {SLENDER_LIMIT}) only."
+        )
+    ax.set(
+        xscale="log",
+        xlabel="frequency ratio omega_g / p [-]",
+        ylabel="amplitude ratio a_g / (g tan alpha) [-]",
+        ylim=(float(a.min()) * 0.95, float(a.max()) * 1.05),
+        title="overturning map over the dimensionless groups",
+    )
+    _plain_log_ticks(ax)
+    ax.legend(fontsize=8, markerscale=4, loc="upper left")
+    fig.tight_layout()
+    page.figure(fig, "overturning_map", "Samples in the plane of the groups, by outcome. " + note)
+
+
+def _first_order(page, ds, study):
+    """First-order sensitivity (RBD-FAST on the given samples) on the inputs and on the
+    dimensionless groups."""
+    inputs = [v for v in study.parameters() if v in ds]
+    groups = [v for v in ("omega", "amplitude_ratio", "slenderness") if v in ds]
+    outputs = [v for v in ("max_rotation_ratio", "overturned") if v in ds]
+    if not inputs or not outputs:
+        return
+    d = _computed(ds)
+    if d.sizes["sample"] < 100:
+        page.text("First-order sensitivity: not computed (fewer than 100 computed samples).")
+        return
+    plt = _plt()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
+    tables = []
+    for ax, (label, names) in zip(axes, (("inputs", inputs), ("groups", groups)), strict=True):
+        x = np.arange(len(names))
+        for k, out in enumerate(outputs):
+            t = analysis.first_order_given_data(d, out, names)
+            t.index = [_label(n) for n in names]
+            t.index.name = "variable"
+            t.insert(0, "output", _label(out))
+            t.insert(0, "on", label)
+            tables.append(t)
+            ax.bar(x + (k - 0.5) * 0.4, t["S1"], 0.4, yerr=t["S1_conf"], label=_label(out))
+        ax.set_xticks(x, ["\n".join(textwrap.wrap(_label(n), 18)) for n in names], fontsize=8)
+        ax.set(title=f"on the {label}", ylabel="first-order index S1 [-]")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "first_order",
+        "First-order sensitivity indices (RBD-FAST on the samples, with their 95 % intervals) of "
+        "the peak rotation ratio and of overturning, on the sampled inputs and on the groups",
+    )
+    page.table(pd.concat(tables), "first_order", "First-order indices")
+
+
 def _version(versions) -> str:
     """rockstudy's version from a cube's ``versions`` attribute (JSON), as plain text: the
     attribute comes from a file that may have been made or edited by anyone."""
@@ -356,6 +640,14 @@ def make_report(result, out=None) -> Path:
     page = _Page(out)
     page.heading("Summary")
     _summary(page, ds)
+    _failures(page, ds)
+    if study.sampler.kind in ("monte_carlo", "lhs"):
+        page.heading("Response")
+        _response(page, ds)
+        page.heading("Overturning map")
+        _overturning_map(page, ds, study)
+        page.heading("First-order sensitivity")
+        _first_order(page, ds, study)
     if study.sampler.kind == "sobol":
         page.heading("Sensitivity")
         _sobol(page, ds, study)
@@ -368,6 +660,8 @@ def make_report(result, out=None) -> Path:
     if study.sampler.replicates > 1 and "overturned" in ds:
         page.heading("Self-similarity")
         _similarity(page, ds, study)
+    page.heading("Study")
+    _study_file(page, study)
     meta = (
         f"<p>{html.escape(study.description)}</p><p class='cap'>study sha256 "
         f"{html.escape(str(ds.attrs.get('study_sha256', ''))[:16])}, seed {study.seed}, "
