@@ -46,11 +46,12 @@ def finite_array(name: str, values) -> np.ndarray:
     return arr
 
 
-#: The tightest rtol the kernels honour: their local error target is 0.1 rtol, and below it
-#: the rounding of a DOP853 step on small responses near uplift (where the two terms of
-#: eq. 2.2 of [000] cancel) makes the steps shrink without end: on 600 random scenes half of
-#: them just above uplift, none needed more than 25,000 steps at 1e-12, while 16 exceeded
-#: 200,000 at 1e-13.
+#: The tightest rtol offered. The kernels' local error target is 0.1 rtol, which as rtol -> 0
+#: drowns in the rounding of a DOP853 step (steps shrink without end: rtol = 1e-300 ran for
+#: minutes). Measured on 1,600 random pulse scenes (alpha 0.005-0.45, R 1 mm-20 m, half of
+#: them 1e-15 to 0.1 above uplift): at 1e-12 and at 1e-13 every scene finished, the only ones
+#: above 200,000 steps being two with 112,486 impacts of real free rocking. 1e-12 is also
+#: the tolerance at which the kernels are calibrated against the scipy reference.
 RTOL_MIN = 1e-12
 #: The largest step cap: step counts are tallied in float64 and int64 inside the kernels.
 MAX_STEPS_MAX = 10**12

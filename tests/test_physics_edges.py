@@ -181,6 +181,47 @@ def test_one_ulp_above_uplift_ends_in_bounded_work():
     assert float(out.stdout.split()[-1]) < 5.0  # seconds for the 4 scenes, both paths
 
 
+_ULP_LINEAR_SCRIPT = """
+import itertools, math, time
+import rockstudy as rs
+from rockstudy.constants import G
+from rockstudy.dynamics.batch import simulate_batch
+motions = {"cosine": rs.motions.CosinePulse, "sine": rs.motions.SinePulse,
+           "half-sine": rs.motions.HalfSinePulse}
+blocks = [(1e-3, 1e-4), (2.0, 0.05)]
+simulate_batch(half_diagonal=1.0, slenderness=0.1, amplitude=1.0, period=1.0, method="linear")
+rs.simulate(rs.Block(1.0, 0.1), rs.motions.CosinePulse(2.0, 1.0), method="linear")
+t = time.perf_counter()
+for (R, alpha), period, pulse in itertools.product(blocks, (0.3, 1.0), motions):
+    a = G * alpha * (1 + 2.2e-16)  # the linearized block lifts at g alpha
+    bound = 1e-12 * alpha  # far below any rotation the exact solver resolves (rounding of alpha)
+    for method in ("linear", "auto"):
+        out = simulate_batch(half_diagonal=R, slenderness=alpha, restitution=None, pulse=pulse,
+                             amplitude=a, period=period, method=method)
+        assert out["status"][0] == 0 and not out["overturned"][0], (pulse, R, period, out)
+        assert 0.0 <= out["max_rotation"][0] < bound, (pulse, R, period, method, out)
+    res = rs.simulate(rs.Block(R, alpha), motions[pulse](a, period), method="linear")
+    assert not res.overturned and 0.0 <= res.max_rotation < bound, (pulse, R, period, res)
+print(time.perf_counter() - t)
+"""
+
+
+def test_exact_linear_solver_one_ulp_above_uplift_ends_in_bounded_work():
+    """a_g = g alpha (1 + 2.2e-16), the uplift of the linearized block, under cosine, sine and
+    half-sine pulses: the exact solver (batch, auto and simulate) finishes at once, at rest.
+    The excess acceleration is 2.2e-16 g alpha, so the true rotation is far below the rounding
+    of alpha; the solver used to decide "lifts" by a threshold test in other arithmetic than
+    the block's own acceleration and restarted a block that fell straight back, for ever."""
+    out = subprocess.run(
+        [sys.executable, "-c", _ULP_LINEAR_SCRIPT],
+        check=True,
+        timeout=300,
+        capture_output=True,
+        text=True,
+    )
+    assert float(out.stdout.split()[-1]) < 5.0  # seconds for the 12 scenes, three paths
+
+
 # -- 6. restitution 1: the impacts are counted within the window, the same on both paths ---
 
 

@@ -9,7 +9,15 @@ so nothing is integrated: impacts, peaks and overturning are roots of this smoot
 function, bracketed on a grid of at most a quarter forcing period (and 0.5 in tau) and polished
 by safeguarded Newton steps. Free rocking after the pulse is the closed-form map of
 ``_rocking.free_rocking_map``; the time to fall is a root of a quadratic in e^tau.
+
+Lift-off and the Zeno rule are the kernel's (``_rocking.next_uplift``, ``_rocking._lift``): an
+impact slower than REST_FRACTION alpha leaves the block at rest, and a block at rest lifts
+where its own acceleration on the side pushed towards turns positive, with the still ground
+after the motion's end. Both decisions use the same arithmetic, so a block said to be at rest
+is not lifted again at the same instant by a separate threshold test (the chatter, without
+end, one ulp above uplift).
 """
+
 
 from __future__ import annotations
 
@@ -19,7 +27,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..constants import FALL_ROTATION, G
-from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ..motions._kernels import KIND_RECORD, KIND_TRIG, ground_acceleration, segment_index
 from ._rocking import (
     MODEL_LINEAR,
     NO_TABLE,
@@ -28,11 +36,55 @@ from ._rocking import (
     PH_REST,
     REST_FRACTION,
     STATUS_OK,
-    _uplift_trig,
+    _ground_after,
+    _lift,
+    _next_break as _ground_break,
     free_rocking_map,
     free_tail_end,
     next_uplift,
 )
+
+_NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record
+
+
+@njit(cache=True)
+def _lifts(kind, mp, times, samples, p, alpha, t, k):
+    """Whether the ground just after t [s] lifts a block at rest (``_rocking._lift`` > 0)."""
+    a_g = _ground_after(kind, mp, times, samples, t, k)
+    return _lift(a_g, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
+
+
+@njit(cache=True)
+def _lift_ends(kind, mp, times, samples, p, alpha, t0):
+    """First time >= t0 [s] at which the ground stops lifting a block at rest, or the end of
+    the motion: the counterpart of ``_rocking.next_uplift``, on the same monotone pieces.
+
+    A block lifted from rest has u'' > 0 while the ground lifts it (eq. 3.1 of [000] at u >= 0),
+    so it cannot come back before this time. When the closed form brings it back earlier, the
+    excess of the ground over g alpha is within rounding and the rotation below the solver's
+    resolution: the block is left at rest until here, not lifted again at the same instant
+    (or an ulp earlier, after the round trip t -> p t -> t), which makes no progress, without
+    end.
+    """
+    dur = mp[3]
+    k = segment_index(times, t0, 0) if kind == KIND_RECORD else 0
+    lo = t0
+    while lo < dur:
+        hi = _ground_break(kind, mp, times, lo, k)
+        if kind == KIND_RECORD:
+            k = segment_index(times, lo, k)
+        if not _lifts(kind, mp, times, samples, p, alpha, hi, k):
+            for _ in range(2000):
+                mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
+                if _lifts(kind, mp, times, samples, p, alpha, mid, k):
+                    lo = mid
+                else:
+                    hi = mid
+            return hi
+        lo = hi
+    return dur
 
 
 @njit(cache=True, inline="always")
@@ -170,15 +222,10 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
         tau0 += s_imp
         _impact_tally(ta, tau0)
         th0 = 0.0
-        if abs(v_post) < rest_v:
-            qa = q * math.sin(W * tau0 + ph)
-            if abs(qa) < alpha:
-                return PH_REST, tau0, 0.0, 0.0, s
-            s = -1.0 if qa > 0.0 else 1.0
-            v0 = 0.0
-        else:
-            s = -s
-            v0 = v_post
+        if abs(v_post) < rest_v:  # Zeno rule: at rest; the caller decides whether it lifts
+            return PH_REST, tau0, 0.0, 0.0, s
+        s = -s
+        v0 = v_post
 
 
 @njit(cache=True)
@@ -245,7 +292,6 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
     q = a_g / G
     W = w / p
     tau_ex = p * dur
-    thr = G * alpha
     ta = np.array([abs(th_init), 0.0, np.nan])
     t = 0.0
     rocking = th_init != 0.0 or om_init != 0.0
@@ -254,11 +300,15 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
     s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
     code = PH_END
     while True:
+        lifted = not rocking  # this phase starts from rest
         if not rocking:
-            t_up = _uplift_trig(mp, thr, t)
-            if t_up >= dur:
+            t_up = next_uplift(
+                KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, p, alpha, MODEL_LINEAR, NO_TABLE, t
+            )
+            if t_up >= dur:  # the still ground after the motion never lifts a block
                 return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
-            s = -1.0 if a_g * math.sin(w * t_up + ph) > 0.0 else 1.0
+            a_up = ground_acceleration(KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, t_up, 0)
+            s = -1.0 if a_up > 0.0 else 1.0
             t = t_up
             th = 0.0
             v = 0.0
@@ -269,6 +319,8 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         if code != PH_REST:
             break
         t = tau / p
+        if lifted:
+            t = max(t, _lift_ends(KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, p, alpha, t_up))
     if code == PH_END:
         if use_map and eta < 1.0:  # eta = 1 never rests: followed up to t_tail instead
             over, peak, n_post = free_rocking_map(
@@ -421,9 +473,9 @@ def _seg_root(target, th0, v0, g0, f1, s, lo, hi):
 @njit(cache=True)
 def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
     """Rock exactly from (tau, theta, theta', side) on record segment k until rest, overturning
-    or the end of the record (eq. 3.1 of [000]; impacts with restitution eta and the Zeno rule
-    of the kernel: rest when the speed after an impact is below REST_FRACTION alpha and the
-    ground is below g alpha). Returns (code, k, tau, theta, theta', side)."""
+    or the end of the record (eq. 3.1 of [000]; impacts with restitution eta; rest when the
+    speed after an impact is below REST_FRACTION alpha, the caller deciding by the kernel's
+    lift test whether the block rises again). Returns (code, k, tau, theta, theta', side)."""
     n = times.shape[0]
     rest_v = REST_FRACTION * alpha
     known = -1.0  # the segment length whose functions are in (sh, cm1, smx, e_length)
@@ -469,14 +521,9 @@ def _record_phase(alpha, eta, p, scale, times, samples, k, tau, th, v, s, ta):
         _impact_tally(ta, tau)
         th = 0.0
         if abs(v_post) < rest_v:
-            f = f0 + f1 * hit
-            if abs(f) < alpha:
-                return PH_REST, k, tau, 0.0, 0.0, s
-            s = -1.0 if f > 0.0 else 1.0
-            v = 0.0
-        else:
-            s = -s
-            v = v_post
+            return PH_REST, k, tau, 0.0, 0.0, s
+        s = -s
+        v = v_post
     return PH_END, n - 1, tau, th, v, s
 
 
@@ -485,7 +532,8 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
     """Linearized block under a sampled record (linear between samples), exactly.
 
     Nothing is integrated: every record segment is the closed form of :func:`_seg_state`. The
-    block lifts off where |scale samples| first exceeds g alpha (eq. 3.1 of [000]). After the
+    block lifts off where |scale samples| first exceeds g alpha (eq. 3.1 of [000]), by the
+    kernel's test (``_rocking.next_uplift``), also after a Zeno rest. After the
     record the free rocking is mapped (``use_map``) or followed in closed form until rest,
     overturning or ``t_tail`` [s]. Returns (status, max rotation [rad], overturned, impacts,
     overturning time [s], first impact time [s]), as :func:`trig_scene`.
@@ -500,6 +548,7 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
     k = 0
     code = PH_END
     while True:
+        lifted = not rocking  # this phase starts from rest
         if not rocking:
             t_up = next_uplift(
                 KIND_RECORD, mp, times, samples, p, alpha, MODEL_LINEAR, NO_TABLE, tau / p
@@ -516,6 +565,8 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
         )
         if code != PH_REST:
             break
+        if lifted:
+            tau = max(tau, p * _lift_ends(KIND_RECORD, mp, times, samples, p, alpha, t_up))
     if code == PH_OVER:
         return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p
     # the free rocking after the record: trig_scene under a motion of zero length, from here
