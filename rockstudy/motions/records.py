@@ -263,7 +263,9 @@ class Record(Motion):
 
     def kernel_spec(self):
         params = np.array([1.0, 0.0, 0.0, self.duration])
-        return _kernels.KIND_RECORD, params, self._times, self.acceleration
+        # writable copies: numba types read-only arrays apart, and one compiled signature per
+        # kernel (the one ``rockstudy compile`` primes) must serve every record
+        return _kernels.KIND_RECORD, params, np.array(self._times), np.array(self.acceleration)
 
     @classmethod
     def from_at2(cls, path, vertical=None) -> Record:
