@@ -38,10 +38,12 @@ from ._rocking import (
     STATUS_OK,
     _ground_after,
     _lift,
-    _next_break as _ground_break,
     free_rocking_map,
     free_tail_end,
     next_uplift,
+)
+from ._rocking import (
+    _next_break as _ground_break,
 )
 
 _NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record
