@@ -226,7 +226,6 @@ def fragility(
         x, z = im[sel], y[sel]
         if z.size < 10:
             continue
-        im_min, im_max = float(x.min()), float(x.max())
         if z.min() == z.max():  # no fit: the median lies beyond the data, on one side
             theta = theta_lo = theta_hi = np.inf if z.max() == 0 else 0.0
             beta = beta_lo = beta_hi = np.nan
@@ -243,28 +242,36 @@ def fragility(
             (theta_lo, beta_lo), (theta_hi, beta_hi) = np.percentile(
                 boot, [lo_q, hi_q], axis=0, method="inverted_cdf"
             )
-        rows.append(
-            {
-                by or "group": name,
-                "theta": theta,
-                "beta": beta,
-                "theta_lo": theta_lo,
-                "theta_hi": theta_hi,
-                "beta_lo": beta_lo,
-                "beta_hi": beta_hi,
-                "n": int(z.size),
-                "im_min": im_min,
-                "im_max": im_max,
-                "theta_in_range": bool(im_min <= theta <= im_max),
-                "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
-            }
-        )
+        bands = ((theta_lo, theta_hi), (beta_lo, beta_hi))
+        rows.append(fragility_row(name, theta, beta, bands, z.size, x, by))
     if not rows:
         raise ValueError(
             f"no group has 10 samples with a finite, positive {intensity!r}: "
             "no fragility curve can be fitted"
         )
     return pd.DataFrame(rows).set_index(by or "group")
+
+
+def fragility_row(label, theta, beta, band, n, im, by=None) -> dict:
+    """One row of a fragility table: the fit, its bands, the sample count, the observed
+    intensity range of ``im`` and whether the median (``theta_in_range``) and its whole band
+    (``band_in_range``) lie inside it. ``band`` is ((theta_lo, theta_hi), (beta_lo, beta_hi))."""
+    (theta_lo, theta_hi), (beta_lo, beta_hi) = band
+    im_min, im_max = (float(np.min(im)), float(np.max(im))) if np.size(im) else (np.nan, np.nan)
+    return {
+        by or "group": label,
+        "theta": theta,
+        "beta": beta,
+        "theta_lo": theta_lo,
+        "theta_hi": theta_hi,
+        "beta_lo": beta_lo,
+        "beta_hi": beta_hi,
+        "n": int(n),
+        "im_min": im_min,
+        "im_max": im_max,
+        "theta_in_range": bool(im_min <= theta <= im_max),
+        "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
+    }
 
 
 def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:

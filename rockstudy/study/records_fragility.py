@@ -22,6 +22,7 @@ import xarray as xr
 from scipy import optimize, special, stats
 
 from ..constants import G
+from .analysis import fragility_row
 
 #: measure -> (quoted unit, factor from SI to it).
 QUOTED_UNITS = {
@@ -212,23 +213,7 @@ def _groups(ds, by, bins):
 
 
 def _row(label, theta, beta, band, n, x, unit, by):
-    (theta_lo, theta_hi), (beta_lo, beta_hi) = band
-    im_min, im_max = (float(np.min(x)), float(np.max(x))) if np.size(x) else (np.nan, np.nan)
-    return {
-        by or "group": label,
-        "theta": theta,
-        "beta": beta,
-        "theta_lo": theta_lo,
-        "theta_hi": theta_hi,
-        "beta_lo": beta_lo,
-        "beta_hi": beta_hi,
-        "n": int(n),
-        "im_min": im_min,
-        "im_max": im_max,
-        "theta_in_range": bool(im_min <= theta <= im_max),
-        "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
-        "unit": unit,
-    }
+    return {**fragility_row(label, theta, beta, band, n, x, by), "unit": unit}
 
 
 def _percentiles(boot, conf_level):
