@@ -149,25 +149,6 @@ def _ground_after(kind, mp, times, samples, t, k):
 
 
 @njit(cache=True)
-def _uplift_trig(mp, thr, t0):
-    """First t >= t0 with |a sin(omega t + phase)| >= thr, or inf."""
-    a, w, ph, dur = mp[0], mp[1], mp[2], mp[3]
-    if abs(a) <= thr:
-        return np.inf
-    r = thr / abs(a)
-    if r >= 1.0:
-        return np.inf
-    asr = math.asin(r)
-    x0 = w * t0 + ph
-    m = x0 % math.pi
-    if asr < m < math.pi - asr:
-        return t0
-    x = x0 + (asr - m) if m <= asr else x0 + (math.pi - m) + asr
-    t = (x - ph) / w
-    return t if t <= dur else np.inf
-
-
-@njit(cache=True)
 def _next_break(kind, mp, times, t, k):
     """The first time after t at which the ground acceleration has an extremum or a zero
     (or the motion ends): between two such times it is monotone and of one sign.
