@@ -36,7 +36,7 @@ def _run(p, alpha, eta, model, kind, mp, fall, tab):
             alpha,
             eta,
             model,
-            (kind, mp[i], z, z),
+            (kind, mp[i], z, z, z[:0]),
             1e-8,
             True,
             np.inf,

@@ -135,7 +135,17 @@ def test_linear_exact_matches_linear_kernel_in_batch():
         kind, mp = pulse_kernel_rows(shape, amp, period)
         exact = _linear.trig_batch(p, alpha, eta, mp).T
         rk = _rocking.scene_batch(
-            p, alpha, eta, _rocking.MODEL_LINEAR, kind, mp, np.zeros(2), np.zeros(2), 1e-11, 10**6
+            p,
+            alpha,
+            eta,
+            _rocking.MODEL_LINEAR,
+            kind,
+            mp,
+            np.zeros(2),
+            np.zeros(2),
+            np.empty(0),
+            1e-11,
+            10**6,
         ).T
         col = {name: i for i, name in enumerate(_rocking.BATCH_COLUMNS)}
         over = exact[col["overturned"]] == 1.0

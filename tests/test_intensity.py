@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize, signal
 
-import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.motions import Record, SinePulse
 from rockstudy.motions.intensity import UNITS
@@ -296,14 +295,6 @@ def test_csv_pair(tmp_path):
     np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.01]) * G)
     with pytest.raises(ValueError, match="vertical.*bad.csv"):
         Record.from_csv(h, vertical=bad)
-
-
-def test_solvers_refuse_a_vertical_component_for_now():
-    rec = Record(np.full(200, 3.0), dt=0.01, vertical=np.full(200, 1.0))
-    with pytest.raises(NotImplementedError, match="vertical"):
-        rs.simulate(rs.Block(1.0, 0.2), rec)
-    with pytest.raises(NotImplementedError, match="vertical"):
-        rs.simulate_batch(half_diagonal=1.0, slenderness=0.2, record=rec)
 
 
 # --- the shared real records ----------------------------------------------------------------

@@ -22,7 +22,7 @@ SCENES = [
 
 def exact(block, record, use_map=False, scale=1.0):
     p, alpha, eta = block_parameters(block)
-    times, samples = record.kernel_spec()[2:]
+    times, samples = record.kernel_spec()[2:4]
     return _linear.record_scene(p, alpha, eta, scale, times, samples, use_map, np.inf)
 
 
@@ -41,7 +41,7 @@ def test_exact_linear_record_matches_the_reference(R, alpha, pga_ratio, seed):
         np.testing.assert_allclose(t_ot, ref.overturn_time, rtol=0, atol=1e-9)
     # the batch form maps the free rocking after the record instead of following it
     p, a, eta = block_parameters(block)
-    times, samples = record.kernel_spec()[2:]
+    times, samples = record.kernel_spec()[2:4]
     row = _linear.record_batch(
         np.array([p]), np.array([a]), np.array([eta]), np.ones(1), times, samples
     )[0]

@@ -18,7 +18,6 @@ is not lifted again at the same instant by a separate threshold test (the chatte
 end, one ulp above uplift).
 """
 
-
 from __future__ import annotations
 
 import math
@@ -46,14 +45,14 @@ from ._rocking import (
     _next_break as _ground_break,
 )
 
-_NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record
+_NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record; no vertical
 
 
 @njit(cache=True)
 def _lifts(kind, mp, times, samples, p, alpha, t, k):
     """Whether the ground just after t [s] lifts a block at rest (``_rocking._lift`` > 0)."""
     a_g = _ground_after(kind, mp, times, samples, t, k)
-    return _lift(a_g, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
+    return _lift(a_g, 0.0, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
 
 
 @njit(cache=True)
@@ -305,7 +304,16 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         lifted = not rocking  # this phase starts from rest
         if not rocking:
             t_up = next_uplift(
-                KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, p, alpha, MODEL_LINEAR, NO_TABLE, t
+                KIND_TRIG,
+                mp,
+                _NO_SAMPLES,
+                _NO_SAMPLES,
+                _NO_SAMPLES,
+                p,
+                alpha,
+                MODEL_LINEAR,
+                NO_TABLE,
+                t,
             )
             if t_up >= dur:  # the still ground after the motion never lifts a block
                 return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
@@ -539,6 +547,10 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
     record the free rocking is mapped (``use_map``) or followed in closed form until rest,
     overturning or ``t_tail`` [s]. Returns (status, max rotation [rad], overturned, impacts,
     overturning time [s], first impact time [s]), as :func:`trig_scene`.
+
+    Horizontal only: the closed form needs constant coefficients, which a vertical
+    component (p^2 (1 + u_v''/g) in time) breaks; the callers run the kernel with
+    MODEL_LINEAR for a record that has one.
     """
     dur = times[-1]
     mp = np.array([scale, 0.0, 0.0, dur])
@@ -553,7 +565,16 @@ def record_scene(p, alpha, eta, scale, times, samples, use_map, t_tail, th_init=
         lifted = not rocking  # this phase starts from rest
         if not rocking:
             t_up = next_uplift(
-                KIND_RECORD, mp, times, samples, p, alpha, MODEL_LINEAR, NO_TABLE, tau / p
+                KIND_RECORD,
+                mp,
+                times,
+                samples,
+                _NO_SAMPLES,
+                p,
+                alpha,
+                MODEL_LINEAR,
+                NO_TABLE,
+                tau / p,
             )
             if t_up >= dur:
                 return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p

@@ -10,6 +10,10 @@ A block at rest lifts off where its own acceleration on the side pushed towards 
 positive (:func:`_lift`, the right-hand side itself), found on the motion's monotone pieces
 between analytic extrema; the Zeno rule restarts a settling block by the same test, so a
 block said to lift always rises and a chatter at the threshold cannot go on without end.
+
+A record's vertical component u_v'' (``vsamples`` of the motion tuple, empty for none) turns
+gravity into g + u_v'' in every model (:func:`_accel`), in the lift test and so in the uplift
+search and the Zeno rule; the solvers refuse u_v'' <= -g (free fall) before calling a kernel.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from ..motions._kernels import (
     KIND_TRIG,
     ground_acceleration,
     segment_index,
+    vertical_acceleration,
 )
 from ._dop853 import dop853_error, hermite5, make_dop853_step
 
@@ -92,49 +97,58 @@ def _hermite3(u, tab, col, dcol):
 
 
 @njit(cache=True)
-def _mechanism_accel(u, v, a_g, tab):
-    """u'' of a mechanism from eq. (8) of [003]: I u'' + I'/2 u'^2 - G g = -B a_g."""
+def _mechanism_accel(u, v, a_g, a_v, tab):
+    """u'' of a mechanism from eq. (8) of [003]: I u'' + I'/2 u'^2 - G (g + a_v) = -B a_g.
+
+    The vertical ground acceleration a_v [m/s^2, upwards] enters as gravity does: in the
+    frame of the base every mass feels g + a_v downwards, so G g of eq. (8), the generalized
+    force of the weights (-dV/dphi, V = g sum m_i y_i), becomes G (g + a_v).
+    """
     inertia, d_inertia = _hermite3(u, tab, TAB_I, TAB_DI)
     g_nl = _hermite3(u, tab, TAB_G, TAB_DG)[0]
     b_nl = _hermite3(u, tab, TAB_B, TAB_DB)[0]
-    return (g_nl * G - 0.5 * d_inertia * v * v - b_nl * a_g) / inertia
+    return (g_nl * (G + a_v) - 0.5 * d_inertia * v * v - b_nl * a_g) / inertia
 
 
 @njit(cache=True)
-def _accel(a_g, th, om, p, alpha, s, model, tab):
-    """theta_ddot on side s under the ground acceleration a_g: eq. (2.2) of [000]
-    (nonlinear), eq. (3.1) (linearized) or a tabulated mechanism, eq. (8) of [003], in the
-    amplitude u = s theta."""
+def _accel(a_g, a_v, th, om, p, alpha, s, model, tab):
+    """theta_ddot on side s under the ground accelerations a_g (horizontal) and a_v
+    (vertical, upwards) [m/s^2]: eq. (2.2) of [000] with gravity g + a_v,
+    -p^2 [(1 + a_v/g) sin(alpha s - theta) + (a_g/g) cos(alpha s - theta)] (nonlinear),
+    its linearization p^2 [(1 + a_v/g)(theta - alpha s) - a_g/g] (eq. 3.1 at a_v = 0), or a
+    tabulated mechanism, eq. (8) of [003], in the amplitude u = s theta."""
     if model == MODEL_TABLE:
-        return s * _mechanism_accel(s * th, s * om, s * a_g, tab[0] if s > 0.0 else tab[1])
+        return s * _mechanism_accel(s * th, s * om, s * a_g, a_v, tab[0] if s > 0.0 else tab[1])
     a = a_g / G
+    gv = 1.0 + a_v / G
     if model == MODEL_LINEAR:
-        return p * p * (th - alpha * s - a)
+        return p * p * (gv * (th - alpha * s) - a)
     x = alpha * s - th
-    return -p * p * (math.sin(x) + a * math.cos(x))
+    return -p * p * (gv * math.sin(x) + a * math.cos(x))
 
 
 @njit(cache=True)
 def _rhs(t, th, om, args):
     """theta_ddot at time t on side s (see :func:`_accel`)."""
-    p, alpha, s, model, kind, mp, times, samples, k, tab = args
-    return _accel(
-        ground_acceleration(kind, mp, times, samples, t, k), th, om, p, alpha, s, model, tab
-    )
+    p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab = args
+    a_g = ground_acceleration(kind, mp, times, samples, t, k)
+    a_v = vertical_acceleration(kind, mp, times, vsamples, t, k)
+    return _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
 
 
 @njit(cache=True)
-def _lift(a_g, p, alpha, model, tab):
+def _lift(a_g, a_v, p, alpha, model, tab):
     """u_ddot of a block at rest on the side that a_g pushes it towards (s = -sign a_g).
 
-    The block lifts off iff this is > 0, i.e. iff |a_g| exceeds g tan(alpha) (nonlinear),
-    g alpha (linearized) or g lambda (a mechanism, eq. 10 of [003]). It is computed by the
-    right-hand side itself, so that a block said to lift does rise: a threshold test in
-    other arithmetic can disagree with it within a few ulps of the threshold, where the
-    Zeno rule would then restart a block that falls straight back, without end.
+    The block lifts off iff this is > 0, i.e. iff |a_g| exceeds (g + a_v) tan(alpha)
+    (nonlinear), (g + a_v) alpha (linearized) or (g + a_v) lambda (a mechanism, eq. 10 of
+    [003]). It is computed by the right-hand side itself, so that a block said to lift does
+    rise: a threshold test in other arithmetic can disagree with it within a few ulps of the
+    threshold, where the Zeno rule would then restart a block that falls straight back,
+    without end.
     """
     s = -1.0 if a_g > 0.0 else 1.0
-    return s * _accel(a_g, 0.0, 0.0, p, alpha, s, model, tab)
+    return s * _accel(a_g, a_v, 0.0, 0.0, p, alpha, s, model, tab)
 
 
 _step = make_dop853_step(_rhs)
@@ -146,6 +160,12 @@ def _ground_after(kind, mp, times, samples, t, k):
     taken at t = duration must see the still ground that follows (a cosine pulse jumps there
     from a_g to 0), not the motion's last value."""
     return 0.0 if t >= mp[3] else ground_acceleration(kind, mp, times, samples, t, k)
+
+
+@njit(cache=True, inline="always")
+def _vertical_after(kind, mp, times, vsamples, t, k):
+    """u_v'' just after t, as :func:`_ground_after`: zero from the end of the motion on."""
+    return 0.0 if t >= mp[3] else vertical_acceleration(kind, mp, times, vsamples, t, k)
 
 
 @njit(cache=True)
@@ -176,34 +196,44 @@ def _next_break(kind, mp, times, t, k):
 
 
 @njit(cache=True)
-def next_uplift(kind, mp, times, samples, p, alpha, model, tab, t0):
+def _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, t, k):
+    """:func:`_lift` under the ground accelerations at time t (record segment k)."""
+    a_g = ground_acceleration(kind, mp, times, samples, t, k)
+    a_v = vertical_acceleration(kind, mp, times, vsamples, t, k)
+    return _lift(a_g, a_v, p, alpha, model, tab)
+
+
+@njit(cache=True)
+def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
     """First time >= t0 at which a block at rest lifts off (:func:`_lift` > 0), or inf.
 
-    The motion is cut at its extrema and zeros (:func:`_next_break`); on each piece the lift
-    is monotone, so it is checked at the piece's end and located by bisection to the ulp.
-    No short excursion above the threshold between scan points can be missed.
+    The motion is cut at its extrema and zeros (:func:`_next_break`); on each piece of a pulse
+    the lift is monotone, so it is checked at the piece's end and located by bisection to
+    the ulp. On a record segment both components are linear in t, so the lift is affine in
+    t on each side of the zero of u_g'' (c |u_g''| - d (g + u_v''), c, d > 0: convex on the
+    segment), and negative at that zero: where it is not > 0 at both samples it is not > 0
+    between them, and where it turns positive it does so once. No short excursion above the
+    threshold between scan points can be missed.
     """
     dur = mp[3]
     if t0 > dur:
         return np.inf
-    k = segment_index(times, t0, 0) if kind == KIND_RECORD else 0
+    rec = kind == KIND_RECORD
+    k = segment_index(times, t0, 0) if rec else 0
     lo = t0
-    if _lift(ground_acceleration(kind, mp, times, samples, lo, k), p, alpha, model, tab) > 0.0:
+    if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, lo, k) > 0.0:
         return lo
     while lo < dur:
         hi = _next_break(kind, mp, times, lo, k)
-        if kind == KIND_RECORD:
+        if rec:
             k = segment_index(times, lo, k)
-        a_hi = ground_acceleration(
-            kind, mp, times, samples, hi, segment_index(times, hi, k) if kind == KIND_RECORD else 0
-        )
-        if _lift(a_hi, p, alpha, model, tab) > 0.0:
+        k_hi = segment_index(times, hi, k) if rec else 0
+        if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, hi, k_hi) > 0.0:
             for _ in range(2000):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
-                a = ground_acceleration(kind, mp, times, samples, mid, k)
-                if _lift(a, p, alpha, model, tab) > 0.0:
+                if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, mid, k) > 0:
                     hi = mid
                 else:
                     lo = mid
@@ -306,13 +336,13 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
     blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
-    mot = (kind, mp, times, samples), log = (hist, imps) (empty arrays: no history).
+    mot = (kind, mp, times, samples, vsamples), log = (hist, imps) (empty arrays: no history).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact).
     """
     p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
-    kind, mp, times, samples = mot
+    kind, mp, times, samples, vsamples = mot
     hist, imps = log
     rec = hist.shape[0] > 0
     t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
@@ -320,7 +350,17 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     kx = np.empty(13)
     kv = np.empty(13)
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
-    f0 = _accel(_ground_after(kind, mp, times, samples, t, k), th, om, p, alpha, s, model, tab)
+    f0 = _accel(
+        _ground_after(kind, mp, times, samples, t, k),
+        _vertical_after(kind, mp, times, vsamples, t, k),
+        th,
+        om,
+        p,
+        alpha,
+        s,
+        model,
+        tab,
+    )
     steps = 0
     code = PH_END
     while t < t_stop:
@@ -335,7 +375,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             t_next = min(t_next, times[k + 1])
         last = h >= t_next - t
         hs = t_next - t if last else h
-        args = (p, alpha, s, model, kind, mp, times, samples, k, tab)
+        args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
         th1, om1 = _step(args, t, th, om, f0, hs, kx, kv)
         t1 = t_next if last else t + hs
         f1 = _rhs(t1, th1, om1, args)
@@ -397,9 +437,10 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             _push(hist, ta, t, 0.0, om)
         if kind == KIND_RECORD:
             k = segment_index(times, min(t, dur), k)
+        a_v = _vertical_after(kind, mp, times, vsamples, t, k)
         if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
             a_g = _ground_after(kind, mp, times, samples, t, k)
-            if not _lift(a_g, p, alpha, model, tab) > 0.0:
+            if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
                 om = 0.0
                 code = PH_REST
                 break
@@ -411,7 +452,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             code = PH_IMPACT
             break
         a_g = _ground_after(kind, mp, times, samples, t, k)
-        f0 = _accel(a_g, th, om, p, alpha, s, model, tab)
+        f0 = _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
     st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
     return code
 
@@ -553,13 +594,14 @@ def _free_map_table(u, v, eta, tab, other, omega_rest):
 def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0, om0, fall, tab):
     """Rock one block (or tabulated mechanism) through one motion, from rest or (th0, om0).
 
-    mot = (kind, mp, times, samples); log = (hist, imps), empty arrays for no history. For
+    mot = (kind, mp, times, samples, vsamples) (see :mod:`rockstudy.motions._kernels`);
+    log = (hist, imps), empty arrays for no history. For
     MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
     table and ``fall`` the amplitude at which it is taken to have collapsed.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
     impact times recorded, DOP853 steps, first impact time).
     """
-    kind, mp, times, samples = mot
+    kind, mp, times, samples, vsamples = mot
     omega_rest = REST_FRACTION * p * alpha
     blk = (p, alpha, eta, model, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
     hist = log[0]
@@ -578,7 +620,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             code = PH_FAIL
             break
         if at_rest:
-            t_up = next_uplift(kind, mp, times, samples, p, alpha, model, tab, st[T])
+            t_up = next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, st[T])
             if t_up >= dur:
                 break
             k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
@@ -630,15 +672,16 @@ BATCH_COLUMNS = (
 
 
 @njit(cache=True, parallel=True)
-def scene_batch(p, alpha, eta, model, kind, mp, times, samples, rtol, max_steps):
-    """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel.
+def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
+    """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
+    (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
 
     Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
     """
     out = np.empty((p.shape[0], 7))
     no_log = (np.empty((0, 3)), np.empty(0))
     for i in prange(p.shape[0]):
-        mot = (kind, mp[i], times, samples)
+        mot = (kind, mp[i], times, samples, vsamples)
         r = scene(
             p[i],
             alpha[i],

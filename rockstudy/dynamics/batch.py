@@ -18,6 +18,7 @@ from ..motions.pulses import PULSES, pulse_kernel_rows
 from ..structures.block import frequency_parameter as _p_of_R
 from ..structures.block import restitution_housner
 from . import _auto, _linear, _rocking
+from ._vertical import refuse_free_fall, uplift_ratio
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
 _MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR, "auto": None}
@@ -115,10 +116,14 @@ def simulate_batch(
     cycles : int or array_like
         Number of cycles of sine and cosine pulses.
     record : Record, optional
-        Use this record instead of a pulse, multiplied row by row by ``scale``.
+        Use this record instead of a pulse, multiplied row by row by ``scale`` (its vertical
+        component, if any, by ``|scale|``; it acts as gravity g + u_v'', and a row where
+        that reaches 0, free fall, is refused with a ValueError before any integration).
     method : {"nonlinear", "linear", "auto"}
         Housner's eq. (2.2) or the linearized eq. (3.1) of [000]. The linear model under
-        trigonometric pulses and under records uses the exact piecewise solution. ``"auto"``
+        trigonometric pulses and under records uses the exact piecewise solution (under a
+        record with a vertical component, whose time-varying gravity it cannot take, the
+        DOP853 kernel of the linear model: ``steps`` > 0 says so). ``"auto"``
         chooses row by row the cheapest model whose error bound meets ``rtol``: rest where the
         ground never reaches g tan(alpha) (exact), the exact linear solver where its tabulated
         linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
@@ -188,20 +193,18 @@ def simulate_batch(
         eta = np.vectorize(restitution_housner)(alpha)
     else:
         eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
-    if record is not None and getattr(record, "vertical", None) is not None:
-        raise NotImplementedError(
-            "record has a vertical component, which the solvers do not take yet"
-        )
     if record is not None:
-        kind, p1, times, samples = record.kernel_spec()
+        kind, p1, times, samples, vsamples = record.kernel_spec()
         mp = np.tile(p1, (n, 1))
         mp[:, 0] = _column("scale", scale, n)
+        refuse_free_fall(vsamples, mp[:, 0], batch=True)
     else:
         kind, mp = _pulse_params(pulse, amplitude, period, cycles, n)
         times = samples = np.zeros(2)
+        vsamples = mk.NO_VERTICAL
     p = np.ascontiguousarray(p, dtype=float)
     eta = np.ascontiguousarray(eta, dtype=float)
-    rows = (p, alpha, eta, kind, mp, times, samples)
+    rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
     if model is not None:
         out = _run(rows, np.arange(n), model, rtol, max_steps)
         codes = np.full(n, _CODES[model], np.int8)
@@ -282,23 +285,28 @@ def _requested_outputs(outputs):
 
 
 def _run(rows, idx, model, rtol, max_steps):
-    """Outputs (n, 7) of the rows ``idx`` under one model."""
-    p, alpha, eta, kind, mp, times, samples = rows
+    """Outputs (n, 7) of the rows ``idx`` under one model. The exact linear record solver
+    has constant coefficients: a record with a vertical component runs the kernel."""
+    p, alpha, eta, kind, mp, times, samples, vsamples = rows
     args = (p[idx], alpha[idx], eta[idx])
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
         return _linear.trig_batch(*args, mp[idx])
-    if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD:
+    if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD and not vsamples.size:
         return _linear.record_batch(*args, mp[idx, 0], times, samples)
-    return _rocking.scene_batch(*args, model, kind, mp[idx], times, samples, rtol, max_steps)
+    return _rocking.scene_batch(
+        *args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps
+    )
 
 
 def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
     """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`); the
     linear model only if ``linear_ok`` (no output outside its bound was asked for)."""
-    p, alpha, eta, kind, mp, times, samples = rows
+    p, alpha, eta, kind, mp, times, samples, vsamples = rows
     n = p.size
-    peak = np.abs(mp[:, 0]) * (1.0 if pulse is not None else np.max(np.abs(samples)))
-    psi = peak / (G * np.tan(alpha))
+    if pulse is not None:
+        psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
+    else:  # max |u_h''| / ((g + u_v'') tan alpha): exact with or without a vertical
+        psi = uplift_ratio(mp[:, 0], alpha, samples, vsamples)
     codes = np.full(n, _auto.MODEL_NONLINEAR, np.int8)
     codes[psi < 1.0] = _auto.MODEL_REST
     if linear_ok and pulse is not None and kind == mk.KIND_TRIG:

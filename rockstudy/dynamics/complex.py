@@ -164,7 +164,12 @@ def simulate_complex(
     """
     if not 0 < l < 0.1:
         raise ValueError(f"l must lie in (0, 0.1), got {l!r}")
-    kind, mp, times, samples = motion.kernel_spec()
+    kind, mp, times, samples, vsamples = motion.kernel_spec()
+    if vsamples.size:
+        raise ValueError(
+            "motion: the complex formulation of [001] takes no vertical component (its "
+            "gravity is constant); use the nonlinear kernel or the scipy reference"
+        )
     th0, om0 = x0
     chi0 = max(abs(th0) / alpha, chi_c(alpha, l))
     psi0 = 0.0 if th0 >= 0 else math.pi

@@ -17,11 +17,21 @@ from scipy.optimize import brentq
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
 from ._rocking import MODEL_LINEAR, REST_FRACTION, free_rocking_map
+from ._vertical import refuse_free_fall
+
+
+def _scalar_vertical(motion: Motion):
+    """A plain-Python u_v''(t) [m/s^2, upwards] for the reference path, or None."""
+    _, mp, times, _, vsamples = motion.kernel_spec()
+    if not vsamples.size:
+        return None
+    a, dur = abs(mp[0]), mp[3]
+    return lambda t: float(np.interp(t, times, vsamples)) * a if 0.0 <= t <= dur else 0.0
 
 
 def _scalar_acceleration(motion: Motion):
     """A plain-Python u_g''(t) [m/s^2] for the reference path (zero outside the motion)."""
-    kind, mp, times, samples = motion.kernel_spec()
+    kind, mp, times, samples, _ = motion.kernel_spec()
     a, w, ph, dur = mp
     if isinstance(motion, Record):
         return lambda t: float(np.interp(t, times, samples)) * a if 0.0 <= t <= dur else 0.0
@@ -35,16 +45,16 @@ def _scalar_acceleration(motion: Motion):
     return ricker
 
 
-def _uplift_time(acc, thr, t0, dur, grid):
-    """First t >= t0 with |acc(t)| >= thr, by a scan on ``grid`` and Brent's method."""
-    if abs(acc(t0)) >= thr:
+def _uplift_time(excess, t0, dur, grid):
+    """First t >= t0 with excess(t) >= 0, by a scan on ``grid`` and Brent's method."""
+    if excess(t0) >= 0.0:
         return t0
     pts = np.concatenate([[t0], grid[grid > t0], [dur]])
     for lo, hi in zip(pts[:-1], pts[1:], strict=True):
-        if abs(acc(hi)) >= thr:
+        if excess(hi) >= 0.0:
             if hi <= lo:
                 return hi
-            return brentq(lambda t: abs(acc(t)) - thr, lo, hi, xtol=1e-15)
+            return brentq(excess, lo, hi, xtol=1e-15)
     return math.inf
 
 
@@ -69,7 +79,9 @@ def simulate_reference(
         Frequency parameter [rad/s], slenderness [rad] and restitution [-].
     motion : Motion
     model : int
-        0 for Housner's nonlinear equation (2.2) of [000], 1 for the linearized (3.1).
+        0 for Housner's nonlinear equation (2.2) of [000], 1 for the linearized (3.1); a
+        record's vertical component u_v'' turns g into g + u_v'' in either (refused where
+        u_v'' <= -g, free fall).
     rtol : float
         Relative tolerance; the absolute tolerances are rtol * alpha and rtol * p * alpha.
     integrator : str
@@ -88,6 +100,9 @@ def simulate_reference(
     dict with keys t, theta, theta_dot, max_rotation, overturned, impact_times, overturn_time.
     """
     acc = _scalar_acceleration(motion)
+    _, mp, _, _, vsamples = motion.kernel_spec()
+    refuse_free_fall(vsamples, mp[0])
+    vert = _scalar_vertical(motion) or (lambda t: 0.0)
     dur = motion.duration
     linear = model == MODEL_LINEAR
     thr = G * alpha if linear else G * math.tan(alpha)
@@ -99,12 +114,16 @@ def simulate_reference(
     else:
         grid, breaks = np.linspace(0.0, dur, 4097), None
 
+    def excess(t):  # >= 0 where a block at rest lifts: |u_h''| >= (g + u_v'') tan alpha
+        return abs(acc(t)) - thr * (1.0 + vert(t) / G)
+
     def rhs(t, y, s):
         a = acc(t) / G
+        gv = 1.0 + vert(t) / G
         if linear:
-            return [y[1], p * p * (y[0] - alpha * s - a)]
+            return [y[1], p * p * (gv * (y[0] - alpha * s) - a)]
         x = alpha * s - y[0]
-        return [y[1], -p * p * (math.sin(x) + a * math.cos(x))]
+        return [y[1], -p * p * (gv * math.sin(x) + a * math.cos(x))]
 
     th, om = (float(x) for x in initial_state)
     ts, ths, oms, impacts = [0.0], [th], [om], []
@@ -115,7 +134,7 @@ def simulate_reference(
     s = math.copysign(1.0, th if th != 0.0 else om)
     while True:
         if at_rest:
-            t_up = _uplift_time(acc, thr, t, dur, grid)
+            t_up = _uplift_time(excess, t, dur, grid)
             if t_up >= dur:
                 break
             t, th, om = t_up, 0.0, 0.0
@@ -176,7 +195,7 @@ def simulate_reference(
             th = 0.0
             if abs(om_post) < omega_rest:
                 a = acc(t)
-                if abs(a) < thr:
+                if excess(t) < 0.0:
                     at_rest = True
                     om = 0.0
                     continue

@@ -18,6 +18,7 @@ from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
 from . import _auto, _linear, _rocking
+from ._vertical import refuse_free_fall, uplift_ratio
 from .reference import simulate_reference
 from .result import RockingResult
 
@@ -47,7 +48,7 @@ def _kernel(
     fall=FALL_ROTATION,
     tab=_rocking.NO_TABLE,
 ):
-    kind, mp, times, samples = motion.kernel_spec()
+    kind, mp, times, samples, vsamples = motion.kernel_spec()
     t_tail = _tail_end(p, eta, motion, t_max)
     cap = 4096
     while True:
@@ -58,7 +59,7 @@ def _kernel(
             alpha,
             eta,
             model,
-            (kind, mp, times, samples),
+            (kind, mp, times, samples, vsamples),
             rtol,
             False,
             t_tail,
@@ -88,10 +89,18 @@ def _kernel(
 
 
 def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
-    """Exact piecewise solution for trigonometric pulses; the kernel for other motions."""
-    kind, mp, _, _ = motion.kernel_spec()
+    """Exact piecewise solution for trigonometric pulses; the kernel for other motions (also
+    for a record with a vertical component, which the constant-coefficient closed forms
+    cannot take: said in ``info["solver"]``)."""
+    kind, mp, _, _, vsamples = motion.kernel_spec()
     if kind != mk.KIND_TRIG:
-        return _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        r = _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        if vsamples.size:
+            r.info["solver"] = (
+                "DOP853 kernel of the linearized eq. (3.1) of [000] with gravity g + u_v'' "
+                "(the exact record solver has constant coefficients: no vertical component)"
+            )
+        return r
     t_tail = _tail_end(p, eta, motion, t_max)
     cap = 1024
     while True:
@@ -133,7 +142,11 @@ def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l
 def _linearization_bound(p, alpha, eta, motion, x0):
     """(psi, error bound of the linear model, whether the table covers the scene) for one
     scene; the bound is inf where none is tabulated."""
-    psi = motion.peak / (G * math.tan(alpha))
+    _, mp, _, samples, vsamples = motion.kernel_spec()
+    if vsamples.size:  # max |u_h''| / ((g + u_v'') tan alpha): > 1 where the block can lift
+        psi = float(uplift_ratio(mp[0], alpha, samples, vsamples)[0])
+    else:
+        psi = motion.peak / (G * math.tan(alpha))
     shape = _SHAPES.get(type(motion))
     tabulated = shape in _auto.bound_table()["shape_index"]
     if x0 != (0.0, 0.0) or not tabulated or getattr(motion, "cycles", 1) != 1:
@@ -229,7 +242,11 @@ def simulate(
     structure : Block or structure with ``mechanism()`` and ``equivalent_block()``
         The rocking block (p, alpha, eta), or a structure of [003] (wall, arch, frame, ...).
     motion : Motion
-        Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``.
+        Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``. A
+        record's vertical component u_v'' (upwards) acts as gravity g + u_v'' (Housner's
+        equation with vertical shaking; eq. 8 of [003] with G (g + u_v'') for a mechanism) in
+        every method but ``"complex"``, which refuses it; u_v'' <= -g anywhere (free fall)
+        is refused with a ValueError before any integration.
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
         ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven DOP853 kernel.
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
@@ -279,10 +296,13 @@ def simulate(
         raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}") from None
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
-    if getattr(motion, "vertical", None) is not None:
-        raise NotImplementedError(
-            "motion has a vertical component, which the solvers do not take yet; "
-            "simulate Record(motion.acceleration, time=motion.time) for the horizontal alone"
+    _, mp, _, _, vsamples = motion.kernel_spec()
+    refuse_free_fall(vsamples, mp[0])
+    if vsamples.size and method == "complex":
+        raise ValueError(
+            "method='complex' takes no vertical component (the single-ODE formulation of "
+            "[001] has gravity constant); use method='nonlinear', 'linear', 'scipy' or 'auto', "
+            "or simulate Record(motion.acceleration, time=motion.time) for the horizontal alone"
         )
     rtol = _validate.rtol(rtol)
     max_steps = _validate.max_steps(max_steps)

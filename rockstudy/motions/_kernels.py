@@ -1,6 +1,6 @@
 """Numba kernels that evaluate a ground motion from its kernel encoding (private).
 
-A motion reaches the solvers as ``(kind, params, times, samples)``:
+A motion reaches the solvers as ``(kind, params, times, samples, vsamples)``:
 
 - ``KIND_TRIG``: ``a sin(omega t + phase)`` for ``0 <= t <= duration``;
   params = (a, omega, phase, duration).
@@ -8,6 +8,11 @@ A motion reaches the solvers as ``(kind, params, times, samples)``:
   ``0 <= t <= duration``; params = (a, f, t0, duration).
 - ``KIND_RECORD``: ``scale`` times the linear interpolation of ``samples`` at ``times``;
   params = (scale, 0, 0, duration).
+
+``vsamples`` is the vertical component [m/s^2, positive upwards] of a record on the same
+``times``, multiplied by ``|scale|`` (mirroring the horizontal direction does not turn the
+vertical upside down); an empty array for a motion without one (every pulse). It is always
+passed, empty or not, so that each kernel has one numba signature.
 
 The acceleration is zero outside ``[0, duration]``. Units: m/s^2 and s.
 """
@@ -22,6 +27,9 @@ from numba import njit
 KIND_TRIG = 0
 KIND_RICKER = 1
 KIND_RECORD = 2
+
+#: ``vsamples`` of a motion without a vertical component (writable: one numba signature).
+NO_VERTICAL = np.empty(0)
 
 
 @njit(cache=True, inline="always")
@@ -68,6 +76,15 @@ def ground_acceleration(kind, params, times, samples, t, k):
     if kind == KIND_RICKER:
         return _ricker(params, t)
     return params[0] * _record(times, samples, t, k)
+
+
+@njit(cache=True, inline="always")
+def vertical_acceleration(kind, params, times, vsamples, t, k):
+    """Vertical ground acceleration u_v'' [m/s^2] (positive upwards) at time t [s]: 0.0 for a
+    motion without a vertical component (``vsamples`` empty) and outside the motion."""
+    if vsamples.shape[0] == 0 or t < 0.0 or t > params[3]:
+        return 0.0
+    return abs(params[0]) * _record(times, vsamples, t, k)
 
 
 @njit(cache=True)

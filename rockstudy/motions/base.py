@@ -24,7 +24,8 @@ class Motion:
         raise NotImplementedError
 
     def kernel_spec(self):
-        """``(kind, params, times, samples)``: the encoding the numba kernels read."""
+        """``(kind, params, times, samples, vsamples)``: the encoding the numba kernels read
+        (see :mod:`rockstudy.motions._kernels`; ``vsamples`` empty without a vertical)."""
         raise NotImplementedError
 
     def __call__(self, t):
@@ -39,7 +40,7 @@ class Motion:
         t : float or array_like
             Times measured from the start of the motion [s].
         """
-        kind, params, times, samples = self.kernel_spec()
+        kind, params, times, samples, _ = self.kernel_spec()
         tt = np.atleast_1d(np.asarray(t, dtype=float))
         out = _kernels.ground_acceleration_array(kind, params, times, samples, tt.ravel())
         return out.reshape(tt.shape) if np.ndim(t) else float(out[0])

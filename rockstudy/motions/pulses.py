@@ -58,7 +58,7 @@ class _TrigPulse(Motion):
 
     def kernel_spec(self):
         kind, rows = pulse_kernel_rows(_NAMES[type(self)], self.amplitude, self.period, self.cycles)
-        return kind, rows[0], _EMPTY, _EMPTY
+        return kind, rows[0], _EMPTY, _EMPTY, _kernels.NO_VERTICAL
 
 
 _EMPTY = np.zeros(2)
@@ -152,7 +152,7 @@ class RickerWavelet(Motion):
 
     def kernel_spec(self):
         kind, rows = pulse_kernel_rows("ricker", self.amplitude, self.period)
-        return kind, rows[0], _EMPTY, _EMPTY
+        return kind, rows[0], _EMPTY, _EMPTY, _kernels.NO_VERTICAL
 
 
 _NAMES = {
@@ -203,4 +203,5 @@ class NoMotion(Motion):
         return 0.0
 
     def kernel_spec(self):
-        return _kernels.KIND_TRIG, np.array([0.0, 1.0, 0.0, 0.0]), _EMPTY, _EMPTY
+        params = np.array([0.0, 1.0, 0.0, 0.0])
+        return _kernels.KIND_TRIG, params, _EMPTY, _EMPTY, _kernels.NO_VERTICAL

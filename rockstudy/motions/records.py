@@ -1,4 +1,4 @@
-"""Sampled ground-motion records: PEER NGA ``.AT2`` files and two-column text files."""
+"""Sampled ground-motion records: PEER NGA ``.AT2`` files and text files of columns."""
 
 from __future__ import annotations
 
@@ -20,6 +20,28 @@ from .pulse_extraction import VelocityPulse, extract_pulse
 MAX_RECORD_BYTES = 64 * 2**20
 
 _UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+
+#: Column names :meth:`Record.from_csv` reads.
+COLUMNS = ("time", "horizontal", "vertical")
+
+
+def _check_columns(columns, dt) -> tuple:
+    """The columns of a text record as a tuple of :data:`COLUMNS` names, or a ValueError."""
+    if isinstance(columns, str):
+        columns = (columns,)
+    columns = tuple(columns)
+    unknown = [c for c in columns if c not in COLUMNS]
+    if unknown or len(set(columns)) != len(columns) or "horizontal" not in columns:
+        raise ValueError(
+            f"columns must name each column once, from {COLUMNS}, with 'horizontal' among "
+            f"them, e.g. ('time', 'horizontal', 'vertical'); got {columns!r}"
+        )
+    if ("time" in columns) == (dt is not None):
+        raise ValueError(
+            f"columns={columns!r} with dt={dt!r}: give dt [s] exactly when there is no "
+            "'time' column"
+        )
+    return columns
 
 
 def _unit_factor(units: str) -> float:
@@ -265,7 +287,14 @@ class Record(Motion):
         params = np.array([1.0, 0.0, 0.0, self.duration])
         # writable copies: numba types read-only arrays apart, and one compiled signature per
         # kernel (the one ``rockstudy compile`` primes) must serve every record
-        return _kernels.KIND_RECORD, params, np.array(self._times), np.array(self.acceleration)
+        vsamples = _kernels.NO_VERTICAL if self.vertical is None else np.array(self.vertical)
+        return (
+            _kernels.KIND_RECORD,
+            params,
+            np.array(self._times),
+            np.array(self.acceleration),
+            vsamples,
+        )
 
     @classmethod
     def from_at2(cls, path, vertical=None) -> Record:
@@ -303,9 +332,15 @@ class Record(Motion):
 
     @classmethod
     def from_csv(
-        cls, path, units: str = "g", delimiter: str | None = None, vertical=None
+        cls,
+        path,
+        units: str = "g",
+        delimiter: str | None = None,
+        vertical=None,
+        columns=("time", "horizontal"),
+        dt: float | None = None,
     ) -> Record:
-        """Read a two-column text file of time [s] and acceleration in ``units``.
+        """Read a text file of columns: by default two, time [s] and acceleration in ``units``.
 
         Lines starting with ``#`` are skipped, and so is a first row of column names; columns
         may be separated by commas or blanks.
@@ -314,39 +349,79 @@ class Record(Motion):
         ----------
         path : path-like
         units : {"g", "m/s2", "cm/s2"}
-            Units of the acceleration column.
+            Units of the acceleration columns (horizontal and vertical alike).
         delimiter : str, optional
             Column separator; by default commas or white space.
         vertical : path-like, optional
-            A file of the same format and samples holding the vertical component.
+            A file of the same format and samples holding the vertical component (not with a
+            ``"vertical"`` column).
+        columns : sequence of {"time", "horizontal", "vertical"}
+            What the file's columns hold, in order; ``"horizontal"`` is required. An H/V
+            record in one file: ``("time", "horizontal", "vertical")``, or
+            ``("horizontal", "vertical")`` with ``dt``. The file must have exactly these
+            columns on every line.
+        dt : float, optional
+            Uniform time step [s], given exactly when there is no ``"time"`` column.
         """
         factor = _unit_factor(units)
+        columns = _check_columns(columns, dt)
+        if vertical is not None and "vertical" in columns:
+            raise ValueError(
+                "vertical: give the vertical component as a column or as a file, not both"
+            )
         path = Path(path)
         text = read_text_file(path)
         if delimiter is None:
             text = text.replace(",", " ")
         rows = [r for r in text.splitlines() if r.strip() and not r.lstrip().startswith("#")]
         names = 1 if rows and re.match(r"\s*[A-Za-z_\"']", rows[0]) else 0  # a header row
+        ncol = len(columns)
+        what = f"{ncol} numbers ({', '.join(columns)})"
+        bad, found = _first_bad_line(text.splitlines(), delimiter, names, ncol)
+        if bad:
+            got = (
+                f"has {found} columns, expected {ncol} columns ({', '.join(columns)})"
+                if found
+                else f"is not {what}"
+            )
+            raise ValueError(f"{path}: line {bad} {got}{_column_hint(columns)}")
         try:
             data = np.loadtxt(rows[names:], comments="#", delimiter=delimiter, ndmin=2)
         except ValueError:  # its message quotes the file: name the line instead
+            raise ValueError(f"{path}: the data are not {what} on every line") from None
+        if data.shape[1] != ncol:
             raise ValueError(
-                f"{path}: line {_first_bad_line(text.splitlines(), delimiter, names)} is not "
-                "two numbers (time, acceleration)"
-            ) from None
-        if data.shape[1] != 2:
-            raise ValueError(
-                f"{path}: expected 2 columns (time, acceleration), found {data.shape[1]}"
+                f"{path}: expected {ncol} columns ({', '.join(columns)}), found "
+                f"{data.shape[1]}{_column_hint(columns)}"
             )
-        record = _build(path, lambda: cls(data[:, 1] * factor, time=data[:, 0], name=path.stem))
+        col = {name: data[:, i] for i, name in enumerate(columns)}
+        vert = col["vertical"] * factor if "vertical" in col else None
+        timing = {"time": col["time"]} if "time" in col else {"dt": dt}
+        record = _build(
+            path,
+            lambda: cls(col["horizontal"] * factor, **timing, name=path.stem, vertical=vert),
+        )
         if vertical is None:
             return record
-        return record._with_vertical(cls.from_csv(vertical, units, delimiter), vertical)
+        return record._with_vertical(
+            cls.from_csv(vertical, units, delimiter, columns=columns, dt=dt), vertical
+        )
 
 
-def _first_bad_line(lines, delimiter, skip_names=0) -> int:
-    """1-based number of the first data line that is not two numbers (0 if none is); the
-    first ``skip_names`` non-blank rows (column names) are not data."""
+def _column_hint(columns) -> str:
+    """A hint for a file whose column count does not match ``columns``."""
+    if columns == ("time", "horizontal"):
+        return (
+            "; for time, horizontal and vertical columns pass "
+            "columns=('time', 'horizontal', 'vertical')"
+        )
+    return ""
+
+
+def _first_bad_line(lines, delimiter, skip_names=0, ncol=2) -> tuple:
+    """(1-based number, how many numbers it holds or 0) of the first data line that is not
+    ``ncol`` numbers, (0, 0) if none is; the first ``skip_names`` non-blank rows (column
+    names) are not data."""
     for i, line in enumerate(lines, 1):
         body = line.split("#", 1)[0]
         if skip_names and body.strip():
@@ -358,10 +433,10 @@ def _first_bad_line(lines, delimiter, skip_names=0) -> int:
         try:
             values = [float(x) for x in fields]
         except ValueError:
-            return i
-        if len(values) != 2:
-            return i
-    return 0
+            return i, 0
+        if len(values) != ncol:
+            return i, len(values)
+    return 0, 0
 
 
 def _build(path, make) -> Record:
@@ -412,9 +487,10 @@ def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
         return data.decode("latin-1")  # old headers; the numbers are ASCII either way
 
 
-def read_record(path, units: str = "g") -> Record:
-    """Read a record file: a PEER ``.AT2`` file (by its suffix), else two columns of time [s]
-    and acceleration in ``units``."""
+def read_record(path, units: str = "g", columns=("time", "horizontal"), dt=None) -> Record:
+    """Read a record file: a PEER ``.AT2`` file (by its suffix), else a text file of
+    ``columns`` (time [s] and acceleration in ``units`` by default; see
+    :meth:`Record.from_csv` for H/V columns)."""
     if str(path).lower().endswith(".at2"):
         return Record.from_at2(path)
-    return Record.from_csv(path, units=units)
+    return Record.from_csv(path, units=units, columns=columns, dt=dt)

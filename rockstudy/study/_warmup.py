@@ -93,8 +93,16 @@ class _CompileCounter:
             yield self
 
 
+def _with_vertical(record):
+    """``record`` with a small vertical component on its samples (a third of it, upwards)."""
+    from ..motions import Record
+
+    return Record(record.acceleration, dt=record.dt, vertical=record.acceleration / 3.0)
+
+
 def _simulate_calls():
-    """One small call of every method of :func:`rockstudy.simulate` on a pulse and a record."""
+    """One small call of every method of :func:`rockstudy.simulate` on a pulse and a record
+    (also one with a vertical component, on the same kernel signatures)."""
     from ..dynamics import simulate
     from ..motions import RickerWavelet, SinePulse, stochastic_record
     from ..structures import Block, PointMassStrut
@@ -108,7 +116,10 @@ def _simulate_calls():
         for method in ("nonlinear", "linear", "auto"):
             simulate(block, motion, method=method)
         simulate(block, motion, method="complex", initial_rotation=0.5 * alpha, t_max=0.05)
+    for method in ("nonlinear", "linear", "auto"):
+        simulate(block, _with_vertical(record), method=method)
     simulate(PointMassStrut(1.0, alpha), pulse)  # the mechanism (tabulated) kernel
+    simulate(PointMassStrut(1.0, alpha), _with_vertical(record))
 
 
 def _batch_calls(methods=("nonlinear", "linear", "auto")):
@@ -124,6 +135,7 @@ def _batch_calls(methods=("nonlinear", "linear", "auto")):
         for shape in ("sine", "ricker"):
             simulate_batch(pulse=shape, amplitude=peak, period=0.5, **common)
         simulate_batch(record=record, scale=peak, **common)
+        simulate_batch(record=_with_vertical(record), scale=peak, **common)
 
 
 def _closedform_calls():
