@@ -110,11 +110,13 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
     return [read_pair(h, v, units) for h, v in suite_pairs(source, vertical)]
 
 
-def suite_pairs(source, vertical=None, field: str = "source") -> list[tuple[Path, Path | None]]:
+def suite_pairs(
+    source, vertical=None, field: str = "source", vertical_field: str = "vertical"
+) -> list[tuple[Path, Path | None]]:
     """The (horizontal, vertical or None) files of a suite, without reading them.
 
-    ``source`` and ``vertical`` are as in :func:`load_suite`; ``field`` names the argument in
-    the messages (a study names ``motion.files``). Raises ValueError for a folder or glob
+    ``source`` and ``vertical`` are as in :func:`load_suite`; ``field`` and ``vertical_field``
+    name them in the messages (a study names ``motion.files`` and ``motion.vertical``). Raises ValueError for a folder or glob
     without record files, a missing file, a file named twice, or a broken pairing.
     """
     items = list(source) if isinstance(source, (list, tuple)) else [source]
@@ -130,7 +132,7 @@ def suite_pairs(source, vertical=None, field: str = "source") -> list[tuple[Path
         else:
             pairs.extend((p, None) for p in _expand(item, field))
     if rule is not None:
-        pairs = _pair_by_name(pairs, rule)
+        pairs = _pair_by_name(pairs, rule, vertical_field)
     seen = {}
     for h, _ in pairs:
         key = h.resolve()
@@ -157,7 +159,7 @@ def read_pair(
     return rec
 
 
-def _pair_by_name(pairs, rule):
+def _pair_by_name(pairs, rule, field="vertical"):
     """Attach to each horizontal file its vertical file by the (regex, replacement) rule."""
     pattern, replacement = rule
     out = []
@@ -174,11 +176,11 @@ def _pair_by_name(pairs, rule):
     for h, v in pairs:
         if v is None and not pattern.search(h.name) and h.resolve() not in verticals:
             raise ValueError(
-                f"vertical: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
+                f"{field}: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
                 "record's vertical component; every file must be one or the other"
             )
     out = [(h, v) for h, v in out if h.resolve() not in verticals]
     for h, v in out:
         if not v.is_file():
-            raise ValueError(f"vertical: the vertical file {str(v)!r} of {str(h)!r} is missing")
+            raise ValueError(f"{field}: the vertical file {str(v)!r} of {str(h)!r} is missing")
     return out

@@ -8,7 +8,10 @@ problem is one sentence naming the field, the quantity and what is allowed.
 from __future__ import annotations
 
 import os
+from functools import lru_cache
 from pathlib import Path
+
+import numpy as np
 
 from ..motions.suites import read_pair, suite_pairs
 
@@ -64,6 +67,9 @@ def problems(study, base_dir=None) -> list[str]:
         except ValueError as exc:
             return [*found, str(exc)]
         found += _record_problems(study, pairs)
+        refusal = None if all(v is None for _, _, v in pairs) else vertical_refusal()
+        if refusal:
+            found.append(f"motion.vertical: {refusal}; give horizontal records only")
         if study.design is not None:
             rows = study.samples() * len(pairs)
             need = rows * (_ROW_BYTES + 8 * (30 + len(study.design.periods)))
@@ -109,6 +115,22 @@ def _record_problems(study, pairs) -> list[str]:
     return found
 
 
+@lru_cache(maxsize=1)
+def vertical_refusal() -> str | None:
+    """Why the solvers refuse a record with a vertical component (None if they take it), as
+    the batch entry point answers for a record at rest."""
+    from ..dynamics import simulate_batch
+    from ..motions import Record
+
+    rest = Record(np.zeros(3), dt=0.01, vertical=np.zeros(3))
+    try:
+        simulate_batch(frequency_parameter=[2.0], slenderness=[0.2], restitution=[0.9],
+                       record=rest, scale=[1.0])  # fmt: skip
+    except NotImplementedError as exc:
+        return str(exc)
+    return None
+
+
 def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
     """The records of a record motion: ``(field, horizontal file, vertical file or None)``,
     in order (a folder and a glob sorted by name), paths resolved by :func:`record_path`.
@@ -121,7 +143,7 @@ def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
     if isinstance(files, str):
         source = str(record_path(files, base_dir))
         vertical = None if rule is None else (rule.match, rule.replace)
-        pairs = suite_pairs(source, vertical, "motion.files")
+        pairs = suite_pairs(source, vertical, "motion.files", "motion.vertical")
         return [("motion.files", h, v) for h, v in pairs]
     out = []
     for i, item in enumerate(files):
@@ -133,7 +155,9 @@ def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
             h, v = record_path(item.horizontal, base_dir), record_path(item.vertical, base_dir)
         out.append((field, h, v))
     if hasattr(rule, "match"):  # a { match, replace } rule over the listed files
-        pairs = suite_pairs([h for _, h, _ in out], (rule.match, rule.replace), "motion.files")
+        pairs = suite_pairs(
+            [h for _, h, _ in out], (rule.match, rule.replace), "motion.files", "motion.vertical"
+        )
         return [("motion.files", h, v) for h, v in pairs]
     return out  # a file listed twice is drawn twice as often by Monte Carlo rows
 

@@ -121,7 +121,7 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     coords = {"sample": np.arange(rec.size)}
     if study.design.kind == "stripes":
         coords["level"] = ("level", study.motion.scale_to.value.points())
-    coords["period"] = ("period", np.array(sorted(set(study.design.periods)), float))
+    coords["period"] = ("period", stored_periods(study))
     ds = xr.Dataset(data, coords=coords)
     names = [str(h) if v is None else [str(h), str(v)] for _, h, v in pairs]
     ds.attrs.update(
@@ -152,10 +152,21 @@ def load_record(motion_json: str, base_dir, index: int):
     return read_pair(h, v, units, field)
 
 
+def stored_periods(study) -> np.ndarray:
+    """Periods [s] of the stored ``sa``: ``design.periods`` and the period of a spectral target
+    (as :mod:`.records_designs` stores them), sorted."""
+    de, periods = study.design, set(study.design.periods)
+    if de.kind == "stripes" and study.motion.scale_to.period is not None:
+        periods.add(study.motion.scale_to.period)
+    if de.kind == "ida" and de.period is not None:
+        periods.add(de.period)
+    return np.array(sorted(periods), float)
+
+
 def _widths(study) -> dict:
     """Sizes of the extra dimensions of the outputs."""
     ida = study.design.kind == "ida"
-    return {"period": len(set(study.design.periods)), "step": ida_steps(study) if ida else 0}
+    return {"period": stored_periods(study).size, "step": ida_steps(study) if ida else 0}
 
 
 def empty_rows(study, n: int) -> dict:
@@ -268,6 +279,10 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     if kind == "stripes":
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)
+    if "error" in ds:  # zarr reads the empty message (its fill value) back as NaN
+        text = ds["error"].values
+        ds["error"] = (ds["error"].dims, np.where([isinstance(m, str) for m in text.ravel()],
+                                                  text.ravel(), "").reshape(text.shape).astype(object))  # fmt: skip
     ds["uplift_acceleration"] = ("structure", _uplift(ds))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
     de = study["design"]
@@ -286,8 +301,10 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
                      max_pga_ratio=o["max_pga_ratio"])  # fmt: skip
         attrs["n_simulations"] = int(np.nansum(np.where(ds["simulations"] >= 0,
                                                         ds["simulations"], 0)))  # fmt: skip
-        for k in ("censored", "resurrection"):
-            ds[k] = ds[k].where(ds[k] >= 0, -1)
+        for k in ("censored", "resurrection"):  # as the API: bool (a failed row: False,
+            ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
+        used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
+        ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
     else:
         attrs["n_simulations"] = n_rec * n_st
     ds.attrs = attrs

@@ -186,7 +186,8 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         elif mo.pga_ratio is not None:
             data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
         else:
-            data["target"] = cols.get("target", np.full(n, float(mo.scale_to.value or 0.0)))
+            value = mo.scale_to.value
+            data["target"] = cols["target"] if "target" in cols else np.full(n, float(value))
     else:
         data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
     data["cos_alpha"] = np.cos(alpha)

@@ -428,6 +428,7 @@ class ChunkWriter:
             sums = {
                 name: file_sha256(self.path / name / _chunk_file(self.group, name, k))
                 for name in names
+                if self.group[name].size  # an array of no values has no chunk files
             }
             target = self.path / CHECKSUMS / str(k)
             tmp = target.with_name(f"{k}.tmp")
@@ -444,6 +445,7 @@ def _chunk_intact(path, group, names, k) -> bool:
         return all(
             file_sha256(path / name / _chunk_file(group, name, k)) == sums[name]
             for name in names
+            if group[name].size
         )
     except (OSError, ValueError, KeyError, TypeError):
         return False
@@ -599,6 +601,8 @@ def export_netcdf(path, out_path) -> Path:
         from .record_studies import design_dataset
 
         ds = design_dataset(ds)
+        empty = [d for d, size in ds.sizes.items() if size == 0]  # netCDF3 has none
+        ds = ds.drop_dims(empty)
     ds.attrs["grid_dims"] = json.dumps(ds.attrs.get("grid_dims", []))
     ds.attrs = {k: _nc3_attr(v) for k, v in ds.attrs.items()}
     for name in list(ds.variables):
