@@ -154,7 +154,7 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
             values = raw[name]
         result[name][ok] = values[ok].astype(OUTPUTS[name][2])
     if study.motion.kind == "record":  # the record's measures and groups, per sample
-        for name in record_studies.sample_outputs(study):
+        for name in record_studies.sample_outputs(study):  # (not the design's columns)
             result[name] = np.where(ok, raw[name], np.nan)
     result["status"] = status
     result["error"] = error

@@ -86,7 +86,6 @@ def _record_problems(study, pairs) -> list[str]:
     """Every record must read, fit the step limit and, if it is scaled to a target, have a
     non-zero measure to scale (each problem names the field and the file)."""
     mo, max_steps, found = study.motion, study.run.max_steps, []
-    target = mo.target()
     for field, h, v in pairs:
         vfield = field.replace("files", "vertical") if isinstance(mo.vertical, list) else field
         try:
@@ -96,15 +95,8 @@ def _record_problems(study, pairs) -> list[str]:
             continue
         if rec.acceleration.size > max_steps:
             found.append(_too_long(field, rec.acceleration.size, max_steps))
-        ims = [target.im] if target is not None else []
-        if study.design is not None and study.design.kind == "ida":
-            ims = ["pga", study.design.ida_options()["im"]]
-        for im in ims:
+        for im, period, damping in _scaled_measures(study):
             base = {"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(im, im)
-            period = None if target is None else target.period
-            if study.design is not None and study.design.kind == "ida" and im != "pga":
-                period = study.design.period
-            damping = 0.05 if target is None else target.damping
             value = rec.intensity_measure(base, period=period, damping=damping)
             if not value > 0:
                 found.append(
@@ -129,6 +121,14 @@ def vertical_refusal() -> str | None:
     except NotImplementedError as exc:
         return str(exc)
     return None
+
+
+def _scaled_measures(study) -> list[tuple]:
+    """(im, period, damping) of every measure a study scales its records by."""
+    target, de = study.motion.target(), study.design
+    if de is not None and de.kind == "ida":  # brackets by PGA, reports in im
+        return [("pga", None, de.damping), (de.ida_options()["im"], de.period, de.damping)]
+    return [] if target is None else [(target.im, target.period, target.damping)]
 
 
 def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:

@@ -333,6 +333,8 @@ def sample_outputs(study) -> dict:
         out[k] = (f"{long_name} of the scaled record", units, "f8", np.nan, None)
     if study.motion.pga_ratio is not None:
         del out["pga_ratio"]  # a design column already
+    if study.motion.scale is not None:
+        del out["scale"]  # likewise
     return out
 
 
