@@ -197,9 +197,14 @@ class Gen:
                 m["pga_ratio"] = self.dist(0.5, 5.0)
             else:  # a target measure: dimensional (SI) or a group
                 im, low, high = r.choice(
-                    [("pga", 1.0, 8.0), ("pgv", 0.1, 1.0), ("sa", 1.0, 10.0),
-                     ("pga_ratio", 0.5, 5.0), ("pgv_ratio", 0.2, 2.0)]
-                )  # fmt: skip
+                    [
+                        ("pga", 1.0, 8.0),
+                        ("pgv", 0.1, 1.0),
+                        ("sa", 1.0, 10.0),
+                        ("pga_ratio", 0.5, 5.0),
+                        ("pgv_ratio", 0.2, 2.0),
+                    ]
+                )
                 m["scale_to"] = {"im": im, "value": self.dist(low, high)}
                 if im == "sa":
                     m["scale_to"]["period"] = r.choice([0.2, 0.5, 1.0])

@@ -39,8 +39,9 @@ def suite(tmp_path_factory):
     """A folder of three synthetic near-fault records: horizontal and vertical .AT2 files."""
     folder = tmp_path_factory.mktemp("records")
     for i, tp in enumerate((0.5, 0.8, 1.2)):
-        rec = synthetic_near_fault(pulse_period=tp, pga=3.0, seed=10 + i, duration=5.0,
-                                   vertical=True)  # fmt: skip
+        rec = synthetic_near_fault(
+            pulse_period=tp, pga=3.0, seed=10 + i, duration=5.0, vertical=True
+        )
         write_at2(folder / f"nf{i}_H.AT2", rec)
         write_at2(folder / f"nf{i}_UP.AT2", Record(rec.vertical, dt=rec.dt))
     return folder
@@ -100,8 +101,10 @@ def design_study(folder, kind, where, motion=MOTION):
 
 
 def python_api(kind, records, cube):
-    structures = {"half_diagonal": cube["half_diagonal"].values,
-                  "slenderness": cube["slenderness"].values}  # fmt: skip
+    structures = {
+        "half_diagonal": cube["half_diagonal"].values,
+        "slenderness": cube["slenderness"].values,
+    }
     if kind == "cloud":
         return rd.cloud(records, structures, periods=[0.3, 1.0])
     if kind == "stripes":
@@ -128,9 +131,13 @@ def test_design_study_cube_equals_the_python_design(suite, client, tmp_path, kin
         got = cube[name]
         assert got.dims == var.dims, name
         np.testing.assert_allclose(
-            np.asarray(got.values, float), np.asarray(var.values, float), rtol=1e-12, atol=0,
-            equal_nan=True, err_msg=name,
-        )  # fmt: skip
+            np.asarray(got.values, float),
+            np.asarray(var.values, float),
+            rtol=1e-12,
+            atol=0,
+            equal_nan=True,
+            err_msg=name,
+        )
     for key in ("design", "im", "im_period", "n_simulations", "damping", "tolerance"):
         if key in api.attrs:
             np.testing.assert_equal(cube.attrs[key], api.attrs[key], err_msg=key)
@@ -186,7 +193,7 @@ def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, clie
 
 
 def rows_study(folder, where, motion_extra, n=6):
-    text = HEAD.replace("kind = \"lhs\"\nn = 3", f'kind = "monte_carlo"\nn = {n}') + (
+    text = HEAD.replace('kind = "lhs"\nn = 3', f'kind = "monte_carlo"\nn = {n}') + (
         f'[motion]\nkind = "record"\nfiles = "{folder}/*_H.AT2"\n{motion_extra}\n'
         '[run]\noutputs = ["max_rotation", "overturned"]\n'
     )
@@ -208,9 +215,10 @@ def test_rows_scaled_to_sa_reach_it_by_an_independent_oscillator(suite, tmp_path
     """scale_to = Sa(0.5 s) of a distribution: each sample's record, scaled by the factor the
     run applied, has that Sa, by scipy's exact solution of the oscillator (lsim)."""
     study = rows_study(
-        suite, tmp_path,
+        suite,
+        tmp_path,
         'scale_to = { im = "sa", period = 0.5, value = { dist = "uniform", low = 2, high = 8 } }',
-    )  # fmt: skip
+    )
     design, out = run_rows(study, tmp_path)
     files = sorted(suite.glob("*_H.AT2"))
     w, zeta = 2.0 * np.pi / 0.5, 0.05
@@ -266,18 +274,30 @@ def test_bad_record_suites_are_refused_naming_the_field(suite, tmp_path):
     stripes = '[design]\nkind = "stripes"\n'
     grid = 'value = { dist = "grid", values = [1.0, 2.0] }'
     # a folder with no records
-    msg = refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{empty}"\n',
-                  '[design]\nkind = "cloud"\n', "motion.files")  # fmt: skip
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{empty}"\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files",
+    )
     assert "holds no record files" in msg
     # a glob with no match
-    msg = refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*.xyz"\n',
-                  '[design]\nkind = "cloud"\n', "motion.files")  # fmt: skip
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*.xyz"\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files",
+    )
     assert "matches no file" in msg
     # an unreadable file: its name in the message
     bad = tmp_path / "broken.AT2"
     bad.write_text("PEER\nx\nUNITS OF G\nNPTS= 10, DT= 0.01 SEC\n1 2 3\n")
-    msg = refused(tmp_path, f'[motion]\nkind = "record"\nfiles = ["{suite}/nf1_H.AT2", "{bad}"]\n',
-                  '[design]\nkind = "cloud"\n', "motion.files[1]")  # fmt: skip
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = ["{suite}/nf1_H.AT2", "{bad}"]\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files[1]",
+    )
     assert "broken.AT2" in msg
     # an H/V pair of different lengths
     short = tmp_path / "short_UP.AT2"
@@ -285,28 +305,56 @@ def test_bad_record_suites_are_refused_naming_the_field(suite, tmp_path):
     msg = refused(
         tmp_path,
         f'[motion]\nkind = "record"\nfiles = ["{suite}/nf1_H.AT2"]\nvertical = ["{short}"]\n',
-        '[design]\nkind = "cloud"\n', "motion.vertical[0]",
-    )  # fmt: skip
+        '[design]\nkind = "cloud"\n',
+        "motion.vertical[0]",
+    )
     assert "samples" in msg
     # an IM name that does not exist, as a scale target and as the IDA's measure
-    refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
-            f'scale_to = {{ im = "pgx", {grid} }}\n', stripes, "motion.scale_to.im")  # fmt: skip
-    refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n',
-            '[design]\nkind = "ida"\nim = "pgx"\n', "design.im")  # fmt: skip
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        f'scale_to = {{ im = "pgx", {grid} }}\n',
+        stripes,
+        "motion.scale_to.im",
+    )
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n',
+        '[design]\nkind = "ida"\nim = "pgx"\n',
+        "design.im",
+    )
     # sa without its period
-    refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
-            f'scale_to = {{ im = "sa", {grid} }}\n', stripes, "motion.scale_to.period")  # fmt: skip
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        f'scale_to = {{ im = "sa", {grid} }}\n',
+        stripes,
+        "motion.scale_to.period",
+    )
     # a scale target the record cannot reach: PGA 0
     zero = tmp_path / "zero.AT2"
     write_at2(zero, Record(np.zeros(100), dt=0.01))
-    msg = refused(tmp_path, f'[motion]\nkind = "record"\nfiles = ["{zero}"]\n'
-                  f'scale_to = {{ im = "pga", {grid} }}\n', stripes, "motion.files[0]")  # fmt: skip
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = ["{zero}"]\nscale_to = {{ im = "pga", {grid} }}\n',
+        stripes,
+        "motion.files[0]",
+    )
     assert "zero.AT2" in msg
     # stripes need their levels as a grid; a cloud takes no scale
-    refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
-            'scale_to = { im = "pga", value = 3.0 }\n', stripes, "motion.scale_to.value")  # fmt: skip
-    refused(tmp_path, f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\npga_ratio = 2.0\n',
-            '[design]\nkind = "cloud"\n', "motion.pga_ratio")  # fmt: skip
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        'scale_to = { im = "pga", value = 3.0 }\n',
+        stripes,
+        "motion.scale_to.value",
+    )
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\npga_ratio = 2.0\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.pga_ratio",
+    )
 
 
 def test_no_record_of_a_folder_is_skipped(suite, tmp_path):

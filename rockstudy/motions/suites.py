@@ -116,8 +116,9 @@ def suite_pairs(
     """The (horizontal, vertical or None) files of a suite, without reading them.
 
     ``source`` and ``vertical`` are as in :func:`load_suite`; ``field`` and ``vertical_field``
-    name them in the messages (a study names ``motion.files`` and ``motion.vertical``). Raises ValueError for a folder or glob
-    without record files, a missing file, a file named twice, or a broken pairing.
+    name them in the messages (a study names ``motion.files`` and ``motion.vertical``). Raises
+    ValueError for a folder or glob without record files, a missing file, a file named twice,
+    or a broken pairing.
     """
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     if not items:

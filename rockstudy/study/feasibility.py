@@ -116,8 +116,13 @@ def vertical_refusal() -> str | None:
 
     rest = Record(np.zeros(3), dt=0.01, vertical=np.zeros(3))
     try:
-        simulate_batch(frequency_parameter=[2.0], slenderness=[0.2], restitution=[0.9],
-                       record=rest, scale=[1.0])  # fmt: skip
+        simulate_batch(
+            frequency_parameter=[2.0],
+            slenderness=[0.2],
+            restitution=[0.9],
+            record=rest,
+            scale=[1.0],
+        )
     except NotImplementedError as exc:
         return str(exc)
     return None

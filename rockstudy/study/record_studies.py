@@ -59,7 +59,12 @@ _RUN = {
 }
 _IDA = {
     "capacity": ("overturning intensity, in the units of the design's im", "", "f8", np.nan),
-    "capacity_scale": ("lowest scale seen to overturn (upper end of the bracket)", "1", "f8", np.nan),
+    "capacity_scale": (
+        "lowest scale seen to overturn (upper end of the bracket)",
+        "1",
+        "f8",
+        np.nan,
+    ),
     "capacity_scale_lower": ("highest scale below it seen to survive", "1", "f8", np.nan),
     "censored": ("1 if still standing at max_pga_ratio", "1", "i1", -1),
     "resurrection": ("1 if a scan above the capacity found a survival", "1", "i1", -1),
@@ -78,8 +83,13 @@ def outputs(study) -> dict:
     dimension or None). ``kernel_status`` is the design's ``status`` (0 ok)."""
     de = study.design
     out = {k: (*_float(*v), None) for k, v in RECORD_VARIABLES.items()}
-    out["sa"] = ("pseudo-spectral acceleration Sa(T) of the unscaled record", "m s-2", "f8",
-                 np.nan, "period")  # fmt: skip
+    out["sa"] = (
+        "pseudo-spectral acceleration Sa(T) of the unscaled record",
+        "m s-2",
+        "f8",
+        np.nan,
+        "period",
+    )
     out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
     if de.kind == "ida":
         out.update({k: (*v, None) for k, v in _IDA.items()})
@@ -182,16 +192,17 @@ def _run_design(study, record, structures, levels):
     """The design function of :mod:`.records_designs` on one record."""
     de, run = study.design, study.run
     common = dict(
-        periods=de.periods, damping=de.damping, method=run.method, rtol=run.rtol,
+        periods=de.periods,
+        damping=de.damping,
+        method=run.method,
+        rtol=run.rtol,
         max_steps=run.max_steps,
-    )  # fmt: skip
+    )
     if de.kind == "cloud":
         return rd.cloud([record], structures, **common)
     if de.kind == "stripes":
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
-        return rd.multiple_stripes(
-            [record], structures, levels, im=t.im, period=t.period, **common
-        )
+        return rd.multiple_stripes([record], structures, levels, im=t.im, period=t.period, **common)
     return rd.incremental_dynamic_analysis([record], structures, **de.ida_options(), **common)
 
 
@@ -281,13 +292,18 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     ds = xr.Dataset(out, coords=coords)
     if "error" in ds:  # zarr reads the empty message (its fill value) back as NaN
         text = ds["error"].values
-        ds["error"] = (ds["error"].dims, np.where([isinstance(m, str) for m in text.ravel()],
-                                                  text.ravel(), "").reshape(text.shape).astype(object))  # fmt: skip
+        ds["error"] = (
+            ds["error"].dims,
+            np.where([isinstance(m, str) for m in text.ravel()], text.ravel(), "")
+            .reshape(text.shape)
+            .astype(object),
+        )
     ds["uplift_acceleration"] = ("structure", _uplift(ds))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
     de = study["design"]
-    attrs.update(design=kind, method=study["run"]["method"], rtol=study["run"]["rtol"],
-                 damping=de["damping"])  # fmt: skip
+    attrs.update(
+        design=kind, method=study["run"]["method"], rtol=study["run"]["rtol"], damping=de["damping"]
+    )
     if kind == "stripes":
         t = study["motion"]["scale_to"]
         attrs.update(im=t["im"], im_period=np.nan if t["period"] is None else t["period"])
@@ -296,11 +312,16 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         o = {k: de[k] for k in ("im", "period", "tolerance", "growth", "max_pga_ratio")}
         defaults = {"im": "pga", "tolerance": 0.01, "growth": 1.5, "max_pga_ratio": 30.0}
         o = {k: (defaults.get(k) if v is None else v) for k, v in o.items()}
-        attrs.update(im=o["im"], im_period=np.nan if o["period"] is None else o["period"],
-                     tolerance=o["tolerance"], growth=o["growth"],
-                     max_pga_ratio=o["max_pga_ratio"])  # fmt: skip
-        attrs["n_simulations"] = int(np.nansum(np.where(ds["simulations"] >= 0,
-                                                        ds["simulations"], 0)))  # fmt: skip
+        attrs.update(
+            im=o["im"],
+            im_period=np.nan if o["period"] is None else o["period"],
+            tolerance=o["tolerance"],
+            growth=o["growth"],
+            max_pga_ratio=o["max_pga_ratio"],
+        )
+        attrs["n_simulations"] = int(
+            np.nansum(np.where(ds["simulations"] >= 0, ds["simulations"], 0))
+        )
         for k in ("censored", "resurrection"):  # as the API: bool (a failed row: False,
             ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
         used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))

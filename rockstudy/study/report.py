@@ -456,8 +456,10 @@ def _study_file(page, study, ds=None):
         page.text("The study file, as read when the run started:")
         page.preformatted(str(text))
     else:
-        page.text("The study file's text was not stored with this result (a run of an older "
-                  "rockstudy, or a study given as an object).")  # fmt: skip
+        page.text(
+            "The study file's text was not stored with this result (a run of an older "
+            "rockstudy, or a study given as an object)."
+        )
     page.text("The study as stored in the result (defaults filled in):")
     page.preformatted(json.dumps(json.loads(study.normalized()), indent=2))
 

@@ -322,9 +322,7 @@ class RecordSpec(_Model):
     """
 
     kind: Literal["record"]
-    files: Annotated[str, Field(min_length=1)] | Annotated[
-        list[str | HVPair], Field(min_length=1)
-    ]
+    files: Annotated[str, Field(min_length=1)] | Annotated[list[str | HVPair], Field(min_length=1)]
     vertical: list[str] | VerticalRule | None = None
     units: Literal["g", "m/s2", "cm/s2"] = "g"
     scale: Param | None = None

@@ -99,9 +99,11 @@ def input_hashes(study: Study, base_dir=None) -> dict:
     out = {}
     for _, h, v in record_pairs(study.motion, base_dir):
         for path in (h, v) if v is not None else (h,):
-            key = os.path.relpath(path, base) if not path.is_absolute() or path.is_relative_to(
-                base
-            ) else str(path)
+            key = (
+                os.path.relpath(path, base)
+                if not path.is_absolute() or path.is_relative_to(base)
+                else str(path)
+            )
             out[key] = file_sha256(path)
     return out
 
