@@ -5,6 +5,7 @@ directly on the suite read by :func:`load_suite` (the study goes through spec ->
 dask tasks -> zarr store -> folding; the function through none of them).
 """
 
+import html
 import shutil
 
 import numpy as np
@@ -370,3 +371,37 @@ def test_no_record_of_a_folder_is_skipped(suite, tmp_path):
         "motion.vertical",
     )
     assert "stray.AT2" in msg
+
+
+def test_report_of_a_record_study_shows_its_file_and_target_units(suite, client, tmp_path):
+    """Monte Carlo rows scaled to a PGV distribution: the report renders in Chromium, names the
+    target in its units in the inputs table, and shows the study file as written."""
+    from test_report import chromium_figures
+
+    from rockstudy.study.report import make_report
+
+    study = rows_study(
+        suite,
+        tmp_path,
+        'scale_to = { im = "pgv", value = { dist = "uniform", low = 0.2, high = 0.8 } }',
+        n=40,
+    )
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    cube = open_result(out)
+    assert {"pgv", "pga_ratio", "pulse_frequency_ratio", "scale"} <= set(cube.data_vars)
+    # each sample's scaled record has the PGV it was drawn: target = PGV of record x scale
+    files = sorted(suite.glob("*_H.AT2"))
+    pgv = np.array([Record.from_at2(f).intensity_measures()["pgv"] for f in files])
+    np.testing.assert_allclose(
+        pgv[cube["record"].values] * np.abs(cube["scale"].values), cube["target"].values, rtol=1e-12
+    )
+    page = make_report(out, tmp_path / "report")
+    shown, total = chromium_figures(page)
+    assert total >= 1 and shown == total
+    inputs = (tmp_path / "report" / "inputs.csv").read_text()
+    assert "scale target pgv [m/s]" in inputs
+
+    text = page.read_text()
+    for line in (tmp_path / "rows.toml").read_text().splitlines():
+        assert html.escape(line) in text, line

@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..constants import G
 from . import analysis
-from .sampling import VARIABLES
+from .sampling import VARIABLES, target_attributes
 from .store import open_result
 
 
@@ -440,8 +440,12 @@ def _study_file(page, study, ds=None):
     for name, dist in study.parameters().items():
         spec = dist.model_dump(mode="json")
         kind = spec.pop("dist")
+        quantity = _units(name)
+        if name == "target":  # a record's scale target, in its measure's units
+            attrs = target_attributes(study.motion.scale_to)
+            quantity = f"{attrs['long_name']} [{attrs['units']}]"
         rows[name] = {
-            "quantity": _units(name),
+            "quantity": quantity,
             "distribution": kind,
             "parameters": ", ".join(f"{k} = {_shown(v)}" for k, v in spec.items()),
         }

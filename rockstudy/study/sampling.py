@@ -199,7 +199,18 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     for name, values in axes.items():
         ds.coords[f"{name}_grid"] = (f"{name}_grid", values)
     ds.attrs["grid_dims"] = list(axes)
-    return _attributes(ds)
+    ds = _attributes(ds)
+    if "target" in ds:  # in the units of the measure it targets
+        ds["target"].attrs.update(target_attributes(mo.scale_to))
+    return ds
+
+
+def target_attributes(scale_to) -> dict:
+    """long_name and units of a record scale target ``scale_to``."""
+    from ..motions.intensity import UNITS
+
+    what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
+    return {"long_name": f"scale target {what}", "units": UNITS.get(scale_to.im, "1")}
 
 
 def _attributes(ds):
