@@ -190,6 +190,29 @@ def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, clie
     assert np.isfinite(again["max_rotation"].values).all()
 
 
+def test_a_record_that_fails_in_its_task_fails_its_rows_and_is_counted(suite, client, tmp_path):
+    """A record spoiled after validation: its task fails, its rows are marked failed with the
+    reader's message (naming the file), the other records are kept, and the run raises
+    FailedSamplesError (max_failed is 0 by default)."""
+    from rockstudy.study.runner import FailedSamplesError
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for f in sorted(suite.glob("*_H.AT2")):
+        shutil.copy(f, folder / f.name)
+    study = design_study(folder, "cloud", tmp_path)
+    (folder / "nf1_H.AT2").write_text("PEER\nspoiled\nUNITS OF G\nNPTS= 9, DT= 0.01 SEC\n1 2\n")
+    out = tmp_path / "cube.zarr"
+    with pytest.raises(FailedSamplesError) as info:
+        run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    assert info.value.report.failed_samples == 3  # the record's three structures
+    assert any("nf1_H.AT2" in m for m in info.value.report.errors)
+    cube = open_result(out).load()
+    np.testing.assert_array_equal(cube["run_status"].values[:, 0], [1, 2, 1])
+    assert np.isnan(cube["max_rotation"].values[1]).all()
+    assert np.isfinite(cube["max_rotation"].values[[0, 2]]).all()
+
+
 # ---------------------------------------------------------------- Monte Carlo rows, targets
 
 

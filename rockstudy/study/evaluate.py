@@ -163,16 +163,19 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
 
 def _design_chunk(study, cols, base_dir) -> dict:
     """Outputs, ``status`` and ``error`` of rows of a record design (one record per chunk):
-    a design call that raises fails its rows, with its message."""
+    a design call that raises fails its rows, with its message; a row whose simulations hit
+    the step limit (the design's own status) fails too, its outputs kept."""
     n = cols["sample"].size
     try:
         result = record_studies.evaluate_rows(study, cols, base_dir)
-        status, message = STATUS_OK, ""
+        failed = result["kernel_status"] != 0
+        message = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
     except Exception as exc:  # recorded per row, never aborts the run
         result = record_studies.empty_rows(study, n)
-        status, message = STATUS_FAILED, f"{type(exc).__name__}: {exc}"
-    result["status"] = np.full(n, status, dtype=np.int8)
-    result["error"] = np.full(n, message, dtype=object)
+        failed = np.ones(n, bool)
+        message = f"{type(exc).__name__}: {exc}"
+    result["status"] = np.where(failed, STATUS_FAILED, STATUS_OK).astype(np.int8)
+    result["error"] = np.where(failed, message, "").astype(object)
     return result
 
 
