@@ -241,8 +241,17 @@ def _validate(args) -> int:
     for path in args.study:
         try:
             study = load_study(path)
+            size = f"{study.samples()} samples"
+            if study.design is not None:
+                from .study.feasibility import record_pairs
+
+                records = len(record_pairs(study.motion, Path(path).resolve().parent))
+                size = (
+                    f"{study.design.kind} design: {records} records x "
+                    f"{study.samples() // study.levels()} structures x {study.levels()} levels"
+                )
             print(
-                f"{path}: ok ({study.sampler.kind}, {study.samples()} samples, "
+                f"{path}: ok ({study.sampler.kind}, {size}, "
                 f"{len(study.parameters())} distributed parameters, sha256 {study.sha256()[:12]})"
             )
         except StudyError as exc:

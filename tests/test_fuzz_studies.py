@@ -187,11 +187,27 @@ class Gen:
             return m
         if kind == "record":
             files = r.sample(self.good_records, r.choice([1, 2]))
+            if r.random() < 0.3:  # a glob, relative to the study file
+                files = "records/good.*"
             m = {"kind": kind, "files": files, "units": "g"}
-            if r.random() < 0.5:
+            way = r.random()
+            if way < 0.35:
                 m["scale"] = self.dist(0.2, 3.0)
-            else:
+            elif way < 0.7:
                 m["pga_ratio"] = self.dist(0.5, 5.0)
+            else:  # a target measure: dimensional (SI) or a group
+                im, low, high = r.choice(
+                    [
+                        ("pga", 1.0, 8.0),
+                        ("pgv", 0.1, 1.0),
+                        ("sa", 1.0, 10.0),
+                        ("pga_ratio", 0.5, 5.0),
+                        ("pgv_ratio", 0.2, 2.0),
+                    ]
+                )
+                m["scale_to"] = {"im": im, "value": self.dist(low, high)}
+                if im == "sa":
+                    m["scale_to"]["period"] = r.choice([0.2, 0.5, 1.0])
             return m
         return {
             "kind": kind,
@@ -204,7 +220,10 @@ class Gen:
         r = self.r
         st, mo = self.structure(), self.motion()
         distributed = [
-            (part, k) for part in (st, mo) for k, v in part.items() if isinstance(v, dict)
+            (part, k)
+            for part in (st, mo, mo.get("scale_to", {}))
+            for k, v in part.items()
+            if isinstance(v, dict) and k != "scale_to"
         ]
         if not distributed:  # at least one distributed parameter (all-fixed: issue 12, h4)
             key = "half_diagonal" if "half_diagonal" in st else "frequency_parameter"
@@ -440,7 +459,7 @@ def time_limit(seconds, what):
 
 def run_in_process(study, base_dir):
     """Evaluate every row as the dask tasks would, chunk by chunk; return the failures."""
-    design = make_design(study)
+    design = make_design(study, base_dir)
     cols = {k: design[k].values for k in design.data_vars if design[k].dims == ("sample",)}
     cols["sample"] = design["sample"].values
     n = cols["sample"].size

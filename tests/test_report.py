@@ -161,7 +161,9 @@ def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
     (escaped), counts as integers, bins in three significant figures, no debug line."""
     import html as html_mod
 
-    study = validate_text(quickstart_text(600))
+    comment = "# a comment with <script>markup</script> & an ampersand, as typed"
+    study_text = quickstart_text(600) + comment + "\n"
+    study = validate_text(study_text)
     cube = tmp_path / "cube.zarr"
     run_study(study, cube, workers=1, progress=False)
     page = make_report(cube, tmp_path / "report")
@@ -173,7 +175,11 @@ def test_monte_carlo_report_reads_as_a_design_note(tmp_path):
     text = re.sub(r"<img[^>]*>", "", source)
     assert "figures rendered" not in text
     assert "<b>under</b>" not in text and html_mod.escape("<b>under</b>") in text
-    assert "&quot;amplitude_ratio&quot;" in text  # the study file itself
+    assert "&quot;amplitude_ratio&quot;" in text  # the study as stored (defaults filled in)
+    # the study file itself, as read when the run started: every line, comments too, escaped
+    assert "<script>markup" not in text
+    for line in study_text.splitlines():
+        assert html_mod.escape(line) in text, line
     inputs = (tmp_path / "report" / "inputs.csv").read_text()
     assert "loguniform" in inputs and "pulse period T_p [s]" in inputs
     assert "<td>600</td>" in text and not re.search(r"<td>\d(\.\d+)?e\+\d+</td>", text)

@@ -21,25 +21,25 @@ def _is_glob(text: str) -> bool:
     return any(c in text for c in "*?[")
 
 
-def _expand(item) -> list[Path]:
+def _expand(item, field: str = "source") -> list[Path]:
     """The record files named by one source item: a file, a folder or a glob."""
     text = str(item)
     if _is_glob(text):
         paths = sorted(Path(p) for p in glob.glob(text) if Path(p).is_file())
         if not paths:
-            raise ValueError(f"source: the glob {text!r} matches no file")
+            raise ValueError(f"{field}: the glob {text!r} matches no file")
         return paths
     path = Path(item)
     if path.is_dir():
         paths = sorted(p for p in path.iterdir() if p.is_file() and _suffix_ok(p))
         if not paths:
             raise ValueError(
-                f"source: the folder {str(path)!r} holds no record files "
+                f"{field}: the folder {str(path)!r} holds no record files "
                 f"(suffixes {', '.join(RECORD_SUFFIXES)}, any case)"
             )
         return paths
     if not path.is_file():
-        raise ValueError(f"source: {text!r} is neither a file, a folder nor a glob that matches")
+        raise ValueError(f"{field}: {text!r} is neither a file, a folder nor a glob that matches")
     return [path]
 
 
@@ -107,36 +107,60 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
         record files, a file that cannot be read, a file listed twice, a missing vertical
         file, or an H/V pair of different lengths or steps.
     """
+    return [read_pair(h, v, units) for h, v in suite_pairs(source, vertical)]
+
+
+def suite_pairs(
+    source, vertical=None, field: str = "source", vertical_field: str = "vertical"
+) -> list[tuple[Path, Path | None]]:
+    """The (horizontal, vertical or None) files of a suite, without reading them.
+
+    ``source`` and ``vertical`` are as in :func:`load_suite`; ``field`` and ``vertical_field``
+    name them in the messages (a study names ``motion.files`` and ``motion.vertical``). Raises
+    ValueError for a folder or glob without record files, a missing file, a file named twice,
+    or a broken pairing.
+    """
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     if not items:
-        raise ValueError("source: an empty list names no record")
+        raise ValueError(f"{field}: an empty list names no record")
     rule = _vertical_rule(vertical)
     pairs: list[tuple[Path, Path | None]] = []
     for item in items:
         if isinstance(item, tuple):
             if len(item) != 2:
-                raise ValueError(f"source: a pair must be (horizontal, vertical), got {item!r}")
+                raise ValueError(f"{field}: a pair must be (horizontal, vertical), got {item!r}")
             pairs.append((Path(item[0]), Path(item[1])))
         else:
-            pairs.extend((p, None) for p in _expand(item))
+            pairs.extend((p, None) for p in _expand(item, field))
     if rule is not None:
-        pairs = _pair_by_name(pairs, rule)
+        pairs = _pair_by_name(pairs, rule, vertical_field)
     seen = {}
     for h, _ in pairs:
         key = h.resolve()
         if key in seen:
-            raise ValueError(f"source: the file {str(h)!r} is named twice")
+            raise ValueError(f"{field}: the file {str(h)!r} is named twice")
         seen[key] = h
-    records = []
-    for h, v in pairs:
-        rec = _read(h, units, "source")
-        if v is not None:
-            rec = rec._with_vertical(_read(v, units, "vertical"), v)
-        records.append(rec)
-    return records
+    return pairs
 
 
-def _pair_by_name(pairs, rule):
+def read_pair(
+    horizontal, vertical=None, units: str = "g", field: str = "source", vertical_field="vertical"
+) -> Record:
+    """One record from its horizontal file and, optionally, its vertical file (same samples);
+    any failure is a ValueError naming the field (``field``, ``vertical_field``) and the file."""
+    rec = _read(Path(horizontal), units, field)
+    if vertical is not None:
+        try:
+            rec = rec._with_vertical(_read(Path(vertical), units, vertical_field), vertical)
+        except ValueError as exc:
+            text = str(exc)
+            raise ValueError(
+                text if text.startswith(vertical_field) else f"{vertical_field}: {text}"
+            ) from None
+    return rec
+
+
+def _pair_by_name(pairs, rule, field="vertical"):
     """Attach to each horizontal file its vertical file by the (regex, replacement) rule."""
     pattern, replacement = rule
     out = []
@@ -153,11 +177,11 @@ def _pair_by_name(pairs, rule):
     for h, v in pairs:
         if v is None and not pattern.search(h.name) and h.resolve() not in verticals:
             raise ValueError(
-                f"vertical: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
+                f"{field}: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
                 "record's vertical component; every file must be one or the other"
             )
     out = [(h, v) for h, v in out if h.resolve() not in verticals]
     for h, v in out:
         if not v.is_file():
-            raise ValueError(f"vertical: the vertical file {str(v)!r} of {str(h)!r} is missing")
+            raise ValueError(f"{field}: the vertical file {str(v)!r} of {str(h)!r} is missing")
     return out

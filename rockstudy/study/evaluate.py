@@ -9,7 +9,6 @@ one by one) is recorded as failed; overturning is an outcome, not a failure.
 from __future__ import annotations
 
 import json
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,8 @@ import numpy as np
 from ..constants import G
 from ..dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ..dynamics.batch import simulate_batch
-from ..motions import Record, stochastic_record
-from ..motions.records import read_record
+from ..motions import stochastic_record
+from . import record_studies
 from .feasibility import record_path
 from .spec import Study
 
@@ -45,11 +44,6 @@ OUTPUTS = {
 def resolve_file(name: str, base_dir) -> Path:
     """A record path as written in a study: see :func:`rockstudy.study.feasibility.record_path`."""
     return record_path(name, base_dir)
-
-
-@lru_cache(maxsize=32)
-def _load_record(path: str, units: str) -> Record:
-    return read_record(path, units)
 
 
 def engine_outputs(study: Study) -> tuple:
@@ -83,21 +77,23 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
     if mo.kind == "record":
         out = {}
         rec_idx = cols["record"][idx]
+        motion_json = mo.model_dump_json()
         for r in np.unique(rec_idx):
             sel = rec_idx == r
-            rec = _load_record(str(resolve_file(mo.files[r], base_dir)), mo.units)
-            scale = (
-                cols["scale"][idx][sel]
-                if "scale" in cols
-                else cols["pga_ratio"][idx][sel] * uplift[sel] / rec.peak
-            )
+            rec = record_studies.load_record(motion_json, base_dir, int(r))
+            scale = record_studies.scale_factors(study, rec, cols, idx[sel])
             part = simulate_batch(
                 record=rec,
                 scale=scale,
                 **{k: (v[sel] if isinstance(v, np.ndarray) else v) for k, v in common.items()},
             )
+            part.update(
+                record_studies.sample_measures(
+                    rec, scale, common["frequency_parameter"][sel], uplift[sel]
+                )
+            )
             for k, v in part.items():
-                out.setdefault(k, np.empty(idx.size, v.dtype))[sel] = v
+                out.setdefault(k, np.empty(idx.size, np.asarray(v).dtype))[sel] = v
         return out
     out = {}
     for j, i in enumerate(idx):  # stochastic: one seeded record per sample
@@ -134,6 +130,8 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
 
     numba.set_num_threads(1)  # one task per core: no nested threading
     study = Study.model_validate(json.loads(study_json))
+    if study.design is not None:
+        return _design_chunk(study, cols, base_dir)
     n = cols["sample"].size
     wanted = study.run.outputs
     result = {name: np.full(n, OUTPUTS[name][3], dtype=OUTPUTS[name][2]) for name in wanted}
@@ -155,14 +153,38 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
         else:
             values = raw[name]
         result[name][ok] = values[ok].astype(OUTPUTS[name][2])
+    if study.motion.kind == "record":  # the record's measures and groups, per sample
+        for name in record_studies.sample_outputs(study):  # (not the design's columns)
+            result[name] = np.where(ok, raw[name], np.nan)
     result["status"] = status
     result["error"] = error
     return result
 
 
+def _design_chunk(study, cols, base_dir) -> dict:
+    """Outputs, ``status`` and ``error`` of rows of a record design (one record per chunk):
+    a design call that raises fails its rows, with its message; a row whose simulations hit
+    the step limit (the design's own status) fails too, its outputs kept."""
+    n = cols["sample"].size
+    try:
+        result = record_studies.evaluate_rows(study, cols, base_dir)
+        failed = result["kernel_status"] != 0
+        message = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
+    except Exception as exc:  # recorded per row, never aborts the run
+        result = record_studies.empty_rows(study, n)
+        failed = np.ones(n, bool)
+        message = f"{type(exc).__name__}: {exc}"
+    result["status"] = np.where(failed, STATUS_FAILED, STATUS_OK).astype(np.int8)
+    result["error"] = np.where(failed, message, "").astype(object)
+    return result
+
+
 def _rows_one_by_one(study, cols, base_dir, error):
     n = cols["sample"].size
-    raw = {k: np.zeros(n) for k in engine_outputs(study)}
+    names = engine_outputs(study)
+    if study.motion.kind == "record":
+        names += tuple(record_studies.sample_outputs(study))
+    raw = {k: np.zeros(n) for k in names}
     failed = np.zeros(n, bool)
     for i in range(n):
         try:

@@ -8,9 +8,12 @@ problem is one sentence naming the field, the quantity and what is allowed.
 from __future__ import annotations
 
 import os
+from functools import lru_cache
 from pathlib import Path
 
-from ..motions.records import read_record
+import numpy as np
+
+from ..motions.suites import read_pair, suite_pairs
 
 GIB = 2.0**30
 #: Bytes per design row: the ~20 design columns, the unit samples and the outputs (8 bytes
@@ -59,22 +62,109 @@ def problems(study, base_dir=None) -> list[str]:
         elif points > max_steps:
             found.append(_too_long("motion.duration", points, max_steps))
     elif mo.kind == "record":
-        for i, name in enumerate(mo.files):
-            field = f"motion.files[{i}]"
-            path = record_path(name, base_dir)
-            try:
-                rec = read_record(path, mo.units)
-            except (OSError, ValueError) as exc:
-                found.append(f"{field}: {_reason(exc, path)}")
-                continue
-            if rec.acceleration.size > max_steps:
-                found.append(_too_long(field, rec.acceleration.size, max_steps))
-            if mo.pga_ratio is not None and not rec.peak > 0:
+        try:
+            pairs = record_pairs(mo, base_dir)
+        except ValueError as exc:
+            return [*found, str(exc)]
+        found += _record_problems(study, pairs)
+        refusal = None if all(v is None for _, _, v in pairs) else vertical_refusal()
+        if refusal:
+            found.append(f"motion.vertical: {refusal}; give horizontal records only")
+        if study.design is not None:
+            rows = study.samples() * len(pairs)
+            need = rows * (_ROW_BYTES + 8 * (30 + len(study.design.periods)))
+            if need > DESIGN_SHARE * memory:
                 found.append(
-                    f"{field}: {path} is zero everywhere; pga_ratio cannot scale it "
-                    "(give scale, or another record)"
+                    f"sampler.n: the design has {len(pairs)} records x {study.samples():.4g} "
+                    f"structures and levels, about {need / GIB:.3g} GiB in memory, more than "
+                    f"{DESIGN_SHARE:.0%} of this machine's {memory / GIB:.3g} GiB; reduce it"
                 )
     return found
+
+
+def _record_problems(study, pairs) -> list[str]:
+    """Every record must read, fit the step limit and, if it is scaled to a target, have a
+    non-zero measure to scale (each problem names the field and the file)."""
+    mo, max_steps, found = study.motion, study.run.max_steps, []
+    for field, h, v in pairs:
+        vfield = field.replace("files", "vertical") if isinstance(mo.vertical, list) else field
+        try:
+            rec = read_pair(h, v, mo.units, field, vfield)
+        except (OSError, ValueError) as exc:
+            found.append(_reason(exc, h) if isinstance(exc, OSError) else str(exc))
+            continue
+        if rec.acceleration.size > max_steps:
+            found.append(_too_long(field, rec.acceleration.size, max_steps))
+        for im, period, damping in _scaled_measures(study):
+            base = {"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(im, im)
+            value = rec.intensity_measure(base, period=period, damping=damping)
+            if not value > 0:
+                found.append(
+                    f"{field}: {h} has {base} = {value:g}; no scale factor brings it to a "
+                    f"target {im} (give another record, or another measure)"
+                )
+                break
+    return found
+
+
+@lru_cache(maxsize=1)
+def vertical_refusal() -> str | None:
+    """Why the solvers refuse a record with a vertical component (None if they take it), as
+    the batch entry point answers for a record at rest."""
+    from ..dynamics import simulate_batch
+    from ..motions import Record
+
+    rest = Record(np.zeros(3), dt=0.01, vertical=np.zeros(3))
+    try:
+        simulate_batch(
+            frequency_parameter=[2.0],
+            slenderness=[0.2],
+            restitution=[0.9],
+            record=rest,
+            scale=[1.0],
+        )
+    except NotImplementedError as exc:
+        return str(exc)
+    return None
+
+
+def _scaled_measures(study) -> list[tuple]:
+    """(im, period, damping) of every measure a study scales its records by."""
+    target, de = study.motion.target(), study.design
+    if de is not None and de.kind == "ida":  # brackets by PGA, reports in im
+        return [("pga", None, de.damping), (de.ida_options()["im"], de.period, de.damping)]
+    return [] if target is None else [(target.im, target.period, target.damping)]
+
+
+def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
+    """The records of a record motion: ``(field, horizontal file, vertical file or None)``,
+    in order (a folder and a glob sorted by name), paths resolved by :func:`record_path`.
+
+    Raises ValueError naming ``motion.files`` (or ``motion.vertical``) for a folder without
+    record files, a glob without a match, a missing file or a file named twice.
+    """
+    files = motion.files
+    rule = motion.vertical
+    if isinstance(files, str):
+        source = str(record_path(files, base_dir))
+        vertical = None if rule is None else (rule.match, rule.replace)
+        pairs = suite_pairs(source, vertical, "motion.files", "motion.vertical")
+        return [("motion.files", h, v) for h, v in pairs]
+    out = []
+    for i, item in enumerate(files):
+        field = f"motion.files[{i}]"
+        if isinstance(item, str):
+            h = record_path(item, base_dir)
+            v = record_path(rule[i], base_dir) if isinstance(rule, list) else None
+        else:
+            h, v = record_path(item.horizontal, base_dir), record_path(item.vertical, base_dir)
+        out.append((field, h, v))
+    if hasattr(rule, "match"):  # a { match, replace } rule over the listed files
+        pairs = suite_pairs(
+            [h for _, h, _ in out], (rule.match, rule.replace), "motion.files", "motion.vertical"
+        )
+        return [("motion.files", h, v) for h, v in pairs]
+    return out  # a file listed twice is drawn twice as often by Monte Carlo rows
 
 
 def _reason(exc, path) -> str:

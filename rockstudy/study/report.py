@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..constants import G
 from . import analysis
-from .sampling import VARIABLES
+from .sampling import VARIABLES, target_attributes
 from .store import open_result
 
 
@@ -433,14 +433,19 @@ def _plain_log_ticks(ax):
     ax.tick_params(axis="x", which="minor", labelsize=7)
 
 
-def _study_file(page, study):
-    """The input distributions as a table, and the study itself as the cube stores it."""
+def _study_file(page, study, ds=None):
+    """The input distributions as a table, the study file as read when the run started (its
+    text, stored with the run), and the study as the cube stores it (defaults filled in)."""
     rows = {}
     for name, dist in study.parameters().items():
         spec = dist.model_dump(mode="json")
         kind = spec.pop("dist")
+        quantity = _units(name)
+        if name == "target":  # a record's scale target, in its measure's units
+            attrs = target_attributes(study.motion.scale_to)
+            quantity = f"{attrs['long_name']} [{attrs['units']}]"
         rows[name] = {
-            "quantity": _units(name),
+            "quantity": quantity,
             "distribution": kind,
             "parameters": ", ".join(f"{k} = {_shown(v)}" for k, v in spec.items()),
         }
@@ -449,6 +454,15 @@ def _study_file(page, study):
             pd.DataFrame(rows).T.rename_axis("parameter"),
             "inputs",
             "Input distributions of the sampled parameters",
+        )
+    text = None if ds is None else ds.attrs.get("study_text")
+    if text:
+        page.text("The study file, as read when the run started:")
+        page.preformatted(str(text))
+    else:
+        page.text(
+            "The study file's text was not stored with this result (a run of an older "
+            "rockstudy, or a study given as an object)."
         )
     page.text("The study as stored in the result (defaults filled in):")
     page.preformatted(json.dumps(json.loads(study.normalized()), indent=2))
@@ -661,7 +675,7 @@ def make_report(result, out=None) -> Path:
         page.heading("Self-similarity")
         _similarity(page, ds, study)
     page.heading("Study")
-    _study_file(page, study)
+    _study_file(page, study, ds)
     meta = (
         f"<p>{html.escape(study.description)}</p><p class='cap'>study sha256 "
         f"{html.escape(str(ds.attrs.get('study_sha256', ''))[:16])}, seed {study.seed}, "

@@ -244,9 +244,9 @@ def run_study(
     nc = out.with_suffix(".nc") if netcdf else None
     if nc == out:
         raise ValueError(f"out: {out} ends in .nc, the name of its netCDF export; use .zarr")
-    design = make_design(study)
+    design = make_design(study, base_dir)
     n = design.sizes["sample"]
-    bounds = store.chunk_bounds(n, study.chunk_size)
+    bounds = store.chunk_bounds(n, study.rows_per_chunk())
     inputs = store.input_hashes(study, base_dir)
     if nc is not None and not resume:  # refused before the folder is even created
         store.check_export_target(nc, study.sha256(), overwrite)
@@ -295,7 +295,7 @@ def _failure_message(report, max_failed) -> str:
 def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress, client, where):
     """The run proper, while the store's lock is held."""
     if complete:
-        pending, damaged = store.chunks_to_compute(out, design, study.chunk_size)
+        pending, damaged = store.chunks_to_compute(out, design, study.rows_per_chunk())
         todo, template = sorted(pending + damaged), None
         if damaged:
             sys.stderr.write(

@@ -38,6 +38,9 @@ VARIABLES = {
     "uplift_ratio": ("g tan(alpha) / a_g, eqs. (5.3), (6.1) of [000]", "1"),
     "cos_alpha": ("cos(alpha), eq. (5.3) of [000]", "1"),
     "group_point": ("index of the group point (replicated designs)", "1"),
+    "target": ("scale target of the record, in the units of motion.scale_to.im", "1"),
+    "structure": ("index of the structure (record designs)", "1"),
+    "level_index": ("index of the intensity level (stripes designs)", "1"),
 }
 
 
@@ -100,12 +103,15 @@ def _value(cols, spec, name, n):
     return np.full(n, float(getattr(spec, name)))
 
 
-def make_design(study: Study) -> xr.Dataset:
+def make_design(study: Study, base_dir=None) -> xr.Dataset:
     """All inputs of a study on the ``sample`` dimension, with the derived rocking parameters
     (p, alpha, eta), the motion in SI units and the dimensionless groups of [000].
 
     For grid studies the grid axes are kept as coordinates ``<name>_grid`` and the attribute
-    ``grid_dims`` lists them, so :func:`rockstudy.study.store.open_result` can unstack.
+    ``grid_dims`` lists them, so :func:`rockstudy.study.store.open_result` can unstack. A study
+    with a ``[design]`` gets the rows (record, structure[, level]) of
+    :func:`.record_studies.design_rows`; ``base_dir`` is where its relative record paths are
+    (the study file's folder), and a suite given as a folder or glob is listed there.
     """
     cols, axes = _inputs(study)
     # no distributed parameter: the fixed values, once on a grid, else the sampler's n times
@@ -140,6 +146,10 @@ def make_design(study: Study) -> xr.Dataset:
             frequency_parameter=p,
             critical_rotation=alpha,
         )
+    if study.design is not None:
+        from .record_studies import design_rows
+
+        return _attributes(design_rows(study, data, base_dir))
     uplift = G * np.tan(alpha)
     if mo.kind == "pulse":
         if mo.amplitude is not None:
@@ -170,11 +180,14 @@ def make_design(study: Study) -> xr.Dataset:
         )
     elif mo.kind == "record":
         rng = np.random.default_rng(np.random.SeedSequence([study.seed, 1]))
-        data["record"] = rng.integers(0, len(mo.files), n).astype(np.int64)
+        data["record"] = rng.integers(0, _suite_size(mo, base_dir), n).astype(np.int64)
         if mo.scale is not None:
             data["scale"] = _value(cols, mo, "scale", n)
-        else:
+        elif mo.pga_ratio is not None:
             data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
+        else:
+            value = mo.scale_to.value
+            data["target"] = cols["target"] if "target" in cols else np.full(n, float(value))
     else:
         data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
     data["cos_alpha"] = np.cos(alpha)
@@ -186,8 +199,33 @@ def make_design(study: Study) -> xr.Dataset:
     for name, values in axes.items():
         ds.coords[f"{name}_grid"] = (f"{name}_grid", values)
     ds.attrs["grid_dims"] = list(axes)
+    ds = _attributes(ds)
+    if "target" in ds:  # in the units of the measure it targets
+        ds["target"].attrs.update(target_attributes(mo.scale_to))
+    return ds
+
+
+def target_attributes(scale_to) -> dict:
+    """long_name and units of a record scale target ``scale_to``."""
+    from ..motions.intensity import UNITS
+
+    what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
+    return {"long_name": f"scale target {what}", "units": UNITS.get(scale_to.im, "1")}
+
+
+def _attributes(ds):
+    """CF-style attributes of the design variables."""
     for name, var in ds.data_vars.items():
         long_name, units = VARIABLES[name]
         var.attrs.update(long_name=long_name, units=units)
     ds["sample"].attrs.update(long_name="sample index", units="1")
     return ds
+
+
+def _suite_size(motion, base_dir) -> int:
+    """Records of a record motion: its list of files, or those its folder or glob names."""
+    if isinstance(motion.files, list) and not hasattr(motion.vertical, "match"):
+        return len(motion.files)
+    from .feasibility import record_pairs
+
+    return len(record_pairs(motion, base_dir))

@@ -51,6 +51,7 @@ from pydantic import (
     ConfigDict,
     Discriminator,
     Field,
+    PrivateAttr,
     Tag,
     ValidationError,
     field_validator,
@@ -241,39 +242,179 @@ class PulseSpec(_Model):
         return self
 
 
-class RecordSpec(_Model):
-    """Recorded motions, each sample picking one of ``files`` (uniformly) and scaling it,
-    either by ``scale`` (a factor != 0; negative mirrors) or to a peak ground acceleration
-    ``pga_ratio`` x g tan(alpha).
+#: Intensity measures a record can be scaled to (see :meth:`rockstudy.motions.Record.scaled_to`)
+#: and the dimensionless targets ``pga_ratio`` = PGA / (g tan alpha) and ``pgv_ratio`` =
+#: PGV p / (g tan alpha); ``sa``, ``psv`` and ``sd`` need a ``period``.
+ScaleIM = Literal[
+    "pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd",
+    "pga_ratio", "pgv_ratio",
+]  # fmt: skip
+_SPECTRAL_IMS = ("sa", "psv", "sd")
+#: The damping ratio of ``sa``, ``psv``, ``sd`` and the spectrum intensity in record studies.
+_Damping = Annotated[float, Field(ge=0.0, lt=1.0)]
+_Period = Annotated[float, Field(gt=0.0)]
 
-    A file path is absolute as written, or relative to the study file's folder (never to the
+
+def _check_period(im, period, field):
+    """``period`` [s] is required by the spectral measures and refused by the others."""
+    if im in _SPECTRAL_IMS and period is None:
+        raise FieldError(field, f"im = {im!r} needs a period [s]")
+    if im not in _SPECTRAL_IMS and period is not None:
+        raise FieldError(field, f"applies to im = 'sa', 'psv' or 'sd' only, not {im!r}")
+
+
+class ScaleTo(_Model):
+    """Scale each record so that its measure ``im`` equals ``value`` (in the units of ``im``:
+    ``pga``, ``sa`` [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and
+    ``pgv_ratio``). ``value`` is a number or a distribution (Monte Carlo rows), or a grid (the
+    levels of a stripes design)."""
+
+    im: ScaleIM
+    period: _Period | None = None
+    damping: _Damping = 0.05
+    value: Param | None = None
+
+    @model_validator(mode="after")
+    def _ranges(self):
+        _check_period(self.im, self.period, "period")
+        _check_positive("value", self.value)
+        return self
+
+
+class HVPair(_Model):
+    """One record as a horizontal and a vertical file on the same samples."""
+
+    horizontal: str = Field(min_length=1)
+    vertical: str = Field(min_length=1)
+
+
+class VerticalRule(_Model):
+    """H/V pairing of a folder or glob: the vertical file of each horizontal file is in the same
+    folder, named by ``re.sub(match, replace, name)`` (files that are some record's vertical
+    component are not read as horizontal records)."""
+
+    match: str = Field(min_length=1)
+    replace: str
+
+    @field_validator("match")
+    @classmethod
+    def _regex(cls, value):
+        try:
+            re.compile(value)
+        except re.error as exc:
+            raise ValueError(f"must be a regular expression ({exc})") from None
+        return value
+
+
+class RecordSpec(_Model):
+    """Recorded motions: a suite of record files, each scaled, or left unscaled in a design.
+
+    ``files`` is a folder (its ``.AT2``, ``.dat``, ``.txt`` and ``.csv`` files), a glob, or a
+    list of files and ``{ horizontal = ..., vertical = ... }`` pairs. ``vertical`` gives the
+    vertical components: a list as long as ``files`` (of plain files), or ``{ match, replace }``
+    naming each vertical file after its horizontal one. Monte Carlo rows pick one record per
+    sample (uniformly) and scale it, either by ``scale`` (a factor != 0; negative mirrors), to
+    ``pga_ratio`` x g tan(alpha), or to ``scale_to``; a ``[design]`` runs every record.
+
+    A path is absolute as written, or relative to the study file's folder (never to the
     working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
-    are read.
+    are read. No record is skipped: every file named, matched or found must read.
     """
 
     kind: Literal["record"]
-    files: list[str] = Field(min_length=1)
+    files: Annotated[str, Field(min_length=1)] | Annotated[list[str | HVPair], Field(min_length=1)]
+    vertical: list[str] | VerticalRule | None = None
     units: Literal["g", "m/s2", "cm/s2"] = "g"
     scale: Param | None = None
     pga_ratio: Param | None = None
+    scale_to: ScaleTo | None = None
 
     @field_validator("files")
     @classmethod
     def _paths(cls, files):
-        for i, name in enumerate(files):
-            if not name.strip() or "\0" in name:
-                raise ValueError(f"files[{i}] must be a path (not empty, no NUL character)")
+        names = [files] if isinstance(files, str) else files
+        for i, item in enumerate(names):
+            for name in (item.horizontal, item.vertical) if isinstance(item, HVPair) else (item,):
+                if not name.strip() or "\0" in name:
+                    where = "files" if isinstance(files, str) else f"files[{i}]"
+                    raise ValueError(f"{where} must be a path (not empty, no NUL character)")
         return files
 
     @model_validator(mode="after")
     def _one(self):
-        if (self.scale is None) == (self.pga_ratio is None):
-            raise ValueError("give exactly one of scale or pga_ratio")
+        given = [x is not None for x in (self.scale, self.pga_ratio, self.scale_to)]
+        if sum(given) > 1:
+            raise ValueError("give at most one of scale, pga_ratio or scale_to")
         if self.pga_ratio is not None:
             _check_positive("pga_ratio", self.pga_ratio)
-        else:
+        elif self.scale is not None:
             _nonzero("scale", self.scale)
+        if isinstance(self.vertical, list):
+            if isinstance(self.files, str):
+                raise FieldError(
+                    "vertical",
+                    "a list pairs with a list of files; for a folder or glob give "
+                    "vertical = { match = '<regex>', replace = '<replacement>' }",
+                )
+            if len(self.vertical) != len(self.files):
+                raise FieldError(
+                    "vertical",
+                    f"lists {len(self.vertical)} files but files lists {len(self.files)}; "
+                    "give one vertical file per record",
+                )
+            if any(isinstance(f, HVPair) for f in self.files):
+                raise FieldError("vertical", "give pairs either in files or in vertical, not both")
         return self
+
+    def target(self) -> ScaleTo | None:
+        """The scaling target, with ``pga_ratio`` read as ``scale_to = { im = "pga_ratio" }``."""
+        if self.pga_ratio is not None:
+            return ScaleTo(im="pga_ratio", value=self.pga_ratio)
+        return self.scale_to
+
+
+class DesignSpec(_Model):
+    """A record design over records x structures (``sampler.n`` structures drawn by the
+    sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
+    each level of ``motion.scale_to.value``, a grid), or ``ida`` (the overturning intensity of
+    each structure under each record in ``im``, by bracketing and bisection to ``tolerance``;
+    see :func:`rockstudy.study.records_designs.incremental_dynamic_analysis` for ``growth``,
+    ``max_pga_ratio`` and ``scan``). ``periods`` [s] are those of the spectral accelerations
+    ``sa`` stored for every record, ``damping`` their damping ratio."""
+
+    kind: Literal["cloud", "stripes", "ida"]
+    periods: list[_Period] = []
+    damping: _Damping = 0.05
+    im: ScaleIM | None = None
+    period: _Period | None = None
+    tolerance: float | None = Field(default=None, gt=0.0, lt=1.0)
+    growth: float | None = Field(default=None, gt=1.0, le=100.0)
+    max_pga_ratio: float | None = Field(default=None, gt=1.0, le=1e4)
+    scan: int | None = Field(default=None, ge=0, le=100)
+
+    @model_validator(mode="after")
+    def _ida_keys(self):
+        ida = ("im", "period", "tolerance", "growth", "max_pga_ratio", "scan")
+        if self.kind != "ida":
+            for name in ida:
+                if getattr(self, name) is not None:
+                    raise FieldError(name, f"applies to kind = 'ida' only, not {self.kind!r}")
+            return self
+        _check_period(self.im or "pga", self.period, "period")
+        if not self.ida_options()["growth"] > 1.0 + self.ida_options()["tolerance"]:
+            raise FieldError("growth", "must be > 1 + tolerance")
+        return self
+
+    def ida_options(self) -> dict:
+        """Keyword arguments of the IDA (defaults filled in)."""
+        return {
+            "im": self.im or "pga",
+            "period": self.period,
+            "tolerance": 0.01 if self.tolerance is None else self.tolerance,
+            "growth": 1.5 if self.growth is None else self.growth,
+            "max_pga_ratio": 30.0 if self.max_pga_ratio is None else self.max_pga_ratio,
+            "scan": 4 if self.scan is None else self.scan,
+        }
 
 
 class StochasticSpec(_Model):
@@ -382,7 +523,71 @@ class Study(_Model):
     sampler: SamplerSpec
     structure: Structure
     motion: MotionSpec
+    design: DesignSpec | None = None
     run: RunSpec = RunSpec()
+    #: The study file's text as read (None for a study not read from text).
+    _text: str | None = PrivateAttr(default=None)
+
+    @property
+    def source_text(self) -> str | None:
+        """The TOML text the study was validated from, as read (stored with its run)."""
+        return self._text
+
+    @model_validator(mode="after")
+    def _design(self):
+        mo, de = self.motion, self.design
+        if de is None:
+            if mo.kind == "record":
+                if mo.scale is None and mo.target() is None:
+                    raise FieldError(
+                        "motion.scale",
+                        "give one of scale, pga_ratio or scale_to (or a [design] table)",
+                    )
+                if mo.scale_to is not None and mo.scale_to.value is None:
+                    raise FieldError("motion.scale_to.value", "is required (the target value)")
+            return self
+        if mo.kind != "record":
+            raise FieldError("design", f"needs [motion] kind = 'record', not {mo.kind!r}")
+        if self.sampler.kind not in ("monte_carlo", "lhs", "grid"):
+            raise FieldError(
+                "sampler.kind",
+                "a [design] draws its structures with monte_carlo, lhs or grid, not "
+                f"{self.sampler.kind!r}",
+            )
+        if mo.scale is not None or mo.pga_ratio is not None:
+            which = "scale" if mo.scale is not None else "pga_ratio"
+            raise FieldError(
+                f"motion.{which}",
+                f"does not apply to a [design] (kind = {de.kind!r}); "
+                + (
+                    "give motion.scale_to with a grid of levels"
+                    if de.kind == "stripes"
+                    else "remove it"
+                ),
+            )
+        if de.kind == "stripes":
+            if mo.scale_to is not None and mo.scale_to.damping != de.damping:
+                raise FieldError(
+                    "motion.scale_to.damping",
+                    f"a stripes design scales with design.damping = {de.damping:g}; give the "
+                    "same value or leave it out",
+                )
+            value = None if mo.scale_to is None else mo.scale_to.value
+            if value is None or getattr(value, "dist", None) != "grid":
+                raise FieldError(
+                    "motion.scale_to.value",
+                    "a stripes design needs the levels as a grid: "
+                    "scale_to = { im = ..., value = { dist = 'grid', values = [...] } }",
+                )
+        elif mo.scale_to is not None:
+            raise FieldError(
+                "motion.scale_to",
+                f"does not apply to a {de.kind!r} design"
+                + ("; give the IDA's measure as design.im" if de.kind == "ida" else ""),
+            )
+        if self.sampler.replicates > 1:
+            raise FieldError("sampler.replicates", "does not apply to a [design]")
+        return self
 
     @model_validator(mode="after")
     def _grid(self):
@@ -436,9 +641,32 @@ class Study(_Model):
             )
         return self
 
+    def largest_critical_rotation(self) -> float:
+        """The largest critical rotation theta_cr [rad] the structures can have."""
+        st = self.structure
+        if st.kind == "equivalent_block":
+            return _largest(st.critical_rotation)
+        return (2.0 if st.kind == "rocking_wall" else 1.0) * _largest(st.slenderness)
+
+    def levels(self) -> int:
+        """Intensity levels of each record and structure of a design (1 but for stripes)."""
+        if self.design is not None and self.design.kind == "stripes":
+            return self.motion.scale_to.value.size()
+        return 1
+
+    def rows_per_chunk(self) -> int:
+        """Rows of each stored chunk: ``chunk_size``, or for a ``[design]`` one record's rows
+        (its structures times levels: one record per task)."""
+        return self.chunk_size if self.design is None else self.samples()
+
     def samples(self) -> int:
-        """Number of rows of the design (without making it)."""
+        """Number of rows of the design (without making it); for a ``[design]``, the number of
+        structures times :meth:`levels` (each record adds as many)."""
         s, params = self.sampler, self.parameters()
+        if self.design is not None and s.kind != "grid":
+            return s.n * self.levels()
+        if self.design is not None:
+            return math.prod(d.size() for d in params.values()) * self.levels()
         if s.kind == "grid":
             return math.prod(d.size() for d in params.values())
         if s.kind == "sobol":  # Saltelli layout: N (D + 2), or N (2 D + 2) with second order
@@ -452,13 +680,18 @@ class Study(_Model):
         return [n for n in self.parameters() if n in names]
 
     def parameters(self) -> dict[str, Distribution]:
-        """The distributed parameters, in design order (structure, then motion)."""
+        """The distributed parameters, in design order (structure, then motion); a distributed
+        ``motion.scale_to.value`` is the parameter ``target`` (the levels of a stripes design are
+        no parameter: they are its ``level`` dimension)."""
         out = {}
         for part in (self.structure, self.motion):
             for name in type(part).model_fields:
                 value = getattr(part, name)
                 if isinstance(value, BaseModel) and hasattr(value, "dist"):
                     out[name] = value
+        target = getattr(self.motion, "scale_to", None)
+        if self.design is None and target is not None and hasattr(target.value, "dist"):
+            out["target"] = target.value
         return out
 
     def normalized(self) -> str:
@@ -651,9 +884,14 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     except ValidationError as exc:
         raise StudyError(source, _format_errors(exc, data)) from None
 
+    if study.design is not None and "chunk_size" in data:
+        raise StudyError(
+            source, ["chunk_size: does not apply to a [design], whose chunks are its records"]
+        )
     found = problems(study, base_dir)
     if found:
         raise StudyError(source, found)
+    study._text = text
     return study
 
 

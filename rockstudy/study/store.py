@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .evaluate import OUTPUTS, STATUS_FAILED, STATUS_OK, STATUS_PENDING, resolve_file
+from .evaluate import OUTPUTS, STATUS_FAILED, STATUS_OK, STATUS_PENDING
 from .spec import Study
 
 _INT32 = np.iinfo(np.int32)
@@ -89,13 +89,23 @@ def file_sha256(path) -> str:
 
 
 def input_hashes(study: Study, base_dir=None) -> dict:
-    """The sha256 of every input file of a study (its records), keyed as the study names them."""
+    """The sha256 of every input file of a study (its records, H and V), keyed by their path
+    relative to ``base_dir`` (absolute if outside it)."""
     if study.motion.kind != "record":
         return {}
-    return {
-        name: file_sha256(resolve_file(name, base_dir))
-        for name in dict.fromkeys(study.motion.files)
-    }
+    from .feasibility import record_pairs
+
+    base = Path(Path.cwd() if base_dir is None else base_dir)
+    out = {}
+    for _, h, v in record_pairs(study.motion, base_dir):
+        for path in (h, v) if v is not None else (h,):
+            key = (
+                os.path.relpath(path, base)
+                if not path.is_absolute() or path.is_relative_to(base)
+                else str(path)
+            )
+            out[key] = file_sha256(path)
+    return out
 
 
 def read_marker(path) -> dict | None:
@@ -305,15 +315,17 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
 
     clear_template(path)
     n = design.sizes["sample"]
-    size = min(study.chunk_size, n)
+    size = min(study.rows_per_chunk(), n)
     ds = design.copy()
 
-    def lazy(fill, dtype):  # written chunk by chunk: the template never sits in memory
-        return ("sample", da.full(n, fill, dtype=dtype, chunks=size))
+    def lazy(fill, dtype, extra=None):  # written chunk by chunk: never whole in memory
+        if extra is None:
+            return ("sample", da.full(n, fill, dtype=dtype, chunks=size))
+        width = ds.attrs["ida_steps"] if extra == "step" else ds.sizes[extra]
+        return (("sample", extra), da.full((n, width), fill, dtype=dtype, chunks=(size, width)))
 
-    for name in study.run.outputs:
-        long_name, units, dtype, fill = OUTPUTS[name]
-        ds[name] = lazy(fill, dtype)
+    for name, (long_name, units, dtype, fill, extra) in output_table(study).items():
+        ds[name] = lazy(fill, dtype, extra)
         ds[name].attrs.update(long_name=long_name, units=units)
     ds["status"] = lazy(STATUS_PENDING, np.int8)
     ds["status"].attrs.update(long_name="0 pending, 1 ok, 2 failed", units="1")
@@ -322,13 +334,16 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         study_sha256=study.sha256(),
         inputs_sha256=json.dumps(inputs or {}),
         study_name=study.name,
+        study_text=study.source_text or "",
         seed=study.seed,
         chunk_size=study.chunk_size,
         versions=json.dumps(package_versions()),
         Conventions="CF-1.8",
     )
     chunks = {
-        name: {"chunks": (size,)} for name, var in ds.data_vars.items() if var.dims == ("sample",)
+        name: {"chunks": (size,) + var.shape[1:]}
+        for name, var in ds.data_vars.items()
+        if var.dims[:1] == ("sample",)
     }
     with dask.config.set(scheduler="threads"), _quiet_about_our_files():
         ds.to_zarr(Path(path), mode="a", encoding=chunks, zarr_format=2, consolidated=False)
@@ -340,6 +355,26 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         group.attrs["template_complete"] = 1
         zarr.consolidate_metadata(str(path), zarr_format=2)
     write_marker(path, template_complete=True)
+
+
+def output_table(study: Study) -> dict:
+    """The per-sample outputs of a study: name -> (long_name, units, dtype, fill, extra
+    dimension or None)."""
+    if study.design is not None:
+        from .record_studies import outputs
+
+        return outputs(study)
+    out = {name: (*OUTPUTS[name], None) for name in study.run.outputs}
+    if study.motion.kind == "record":
+        from .record_studies import sample_outputs
+
+        out.update(sample_outputs(study))
+    return out
+
+
+def _chunk_file(group, name, k) -> str:
+    """The file of zarr chunk ``k`` (along ``sample``) of the array ``name``."""
+    return str(k) + ".0" * (group[name].ndim - 1)
 
 
 @contextlib.contextmanager
@@ -392,7 +427,11 @@ class ChunkWriter:
             for name in names:
                 self.group[name][start:stop] = result[name]
             k = start // self.size
-            sums = {name: file_sha256(self.path / name / str(k)) for name in names}
+            sums = {
+                name: file_sha256(self.path / name / _chunk_file(self.group, name, k))
+                for name in names
+                if self.group[name].size  # an array of no values has no chunk files
+            }
             target = self.path / CHECKSUMS / str(k)
             tmp = target.with_name(f"{k}.tmp")
             tmp.write_text(json.dumps(sums))
@@ -400,12 +439,16 @@ class ChunkWriter:
             self.group["status"][start:stop] = result["status"]
 
 
-def _chunk_intact(path, names, k) -> bool:
+def _chunk_intact(path, group, names, k) -> bool:
     """Whether chunk ``k`` of every variable in ``names`` still has the checksum it was
     written with."""
     try:
         sums = json.loads((path / CHECKSUMS / str(k)).read_text())
-        return all(file_sha256(path / name / str(k)) == sums[name] for name in names)
+        return all(
+            file_sha256(path / name / _chunk_file(group, name, k)) == sums[name]
+            for name in names
+            if group[name].size
+        )
     except (OSError, ValueError, KeyError, TypeError):
         return False
 
@@ -471,11 +514,11 @@ def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
             status = np.full(b - a, -1)
         if np.all(status == STATUS_PENDING):
             pending.append((a, b))
-        elif not (np.all(np.isin(status, DONE)) and _chunk_intact(path, outputs, k)):
+        elif not (np.all(np.isin(status, DONE)) and _chunk_intact(path, group, outputs, k)):
             damaged.append((a, b))
             (path / CHECKSUMS / str(k)).unlink(missing_ok=True)
             for name in results:  # never merged into: a damaged file may not decode
-                (path / name / str(k)).unlink(missing_ok=True)
+                (path / name / _chunk_file(group, name, k)).unlink(missing_ok=True)
             group["status"][a:b] = np.full(b - a, STATUS_PENDING, np.int8)
     return pending, damaged
 
@@ -487,6 +530,10 @@ def open_result(path) -> xr.Dataset:
         ds = xr.open_dataset(path)
     else:
         ds = xr.open_zarr(path, consolidated=True)
+    if "record_design" in ds.attrs and "sample" in ds.dims:
+        from .record_studies import design_dataset
+
+        return design_dataset(ds)
     grid = ds.attrs.get("grid_dims")
     if isinstance(grid, str):
         grid = json.loads(grid)
@@ -552,6 +599,12 @@ def export_netcdf(path, out_path) -> Path:
 
     out_path = Path(out_path)
     ds = xr.open_zarr(Path(path), consolidated=True)  # lazy: written chunk by chunk
+    if "record_design" in ds.attrs:  # a record design is exported in its own layout
+        from .record_studies import design_dataset
+
+        ds = design_dataset(ds)
+        empty = [d for d, size in ds.sizes.items() if size == 0]  # netCDF3 has none
+        ds = ds.drop_dims(empty)
     ds.attrs["grid_dims"] = json.dumps(ds.attrs.get("grid_dims", []))
     ds.attrs = {k: _nc3_attr(v) for k, v in ds.attrs.items()}
     for name in list(ds.variables):

@@ -1,0 +1,404 @@
+"""Record designs in study files: cloud, stripes and IDA run on the study runner and store.
+
+A study with a ``[design]`` table runs every record of its suite against every structure the
+sampler draws (``sampler.n`` of them) [at every level of ``motion.scale_to.value``]. Its rows
+on the store's ``sample`` dimension are (record, structure[, level]) in C order, and each
+record is one chunk: one dask task, stored and hashed as any chunk, so an interrupted run
+resumes at the records not yet done. A task calls the Python design functions of
+:mod:`.records_designs` on its record and structures (no second pipeline), and
+:func:`design_dataset` folds the rows back into their layout: dims ``record``,
+``structure`` [, ``level``] [, ``step``, ``period``], with each record's intensity measures,
+pulse and groups, as :mod:`.records_designs` returns them.
+
+The store's per-row ``status`` (1 ok, 2 failed: the task raised) is ``run_status`` there, and
+``status`` is the design's own (0 ok; else a simulation hit the step limit), as in the API.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ..motions.intensity import UNITS
+from ..motions.suites import read_pair
+from . import records_designs as rd
+from .feasibility import record_pairs
+
+#: Per-record variables of the design Dataset: (long_name, units).
+RECORD_VARIABLES = {
+    **{k: (k.replace("_", " "), UNITS[k]) for k in UNITS if k not in ("sa", "psv", "sd")},
+    "pulse_period": ("period T_p of the extracted velocity pulse", "s"),
+    "pulse_amplitude": ("amplitude of the extracted velocity pulse", "m s-1"),
+    "pulse_indicator": ("pulse indicator (Baker 2007)", "1"),
+}
+#: (record, structure) groups of the unscaled record (:func:`rockstudy.similarity.record_groups`).
+GROUP_VARIABLES = {
+    "pga_ratio": ("PGA / (g tan alpha)", "1"),
+    "pgv_ratio": ("PGV p / (g tan alpha)", "1"),
+    "pulse_frequency_ratio": ("omega_p / p = 2 pi / (T_p p)", "1"),
+    "pulse_amplitude_ratio": ("pulse amplitude omega_p v_p / (g tan alpha)", "1"),
+}
+#: Per-structure variables taken from the design (not the chunks).
+STRUCTURE_VARIABLES = (
+    "half_diagonal",
+    "slenderness",
+    "restitution",
+    "frequency_parameter",
+    "critical_rotation",
+)
+_RUN = {
+    "max_rotation": ("max |theta| (pi/2 if overturned)", "rad", "f8", np.nan),
+    "overturned": ("overturned (1) or survived (0); -1 if failed", "1", "i1", -1),
+    "n_impacts": ("impacts until rest; -1 if failed", "1", "i8", -1),
+    "overturn_time": ("time at which |theta| reached pi/2 (NaN if it survived)", "s", "f8", np.nan),
+}
+_IDA = {
+    "capacity": ("overturning intensity, in the units of the design's im", "", "f8", np.nan),
+    "capacity_scale": (
+        "lowest scale seen to overturn (upper end of the bracket)",
+        "1",
+        "f8",
+        np.nan,
+    ),
+    "capacity_scale_lower": ("highest scale below it seen to survive", "1", "f8", np.nan),
+    "censored": ("1 if still standing at max_pga_ratio", "1", "i1", -1),
+    "resurrection": ("1 if a scan above the capacity found a survival", "1", "i1", -1),
+    "resurrection_scale": ("lowest surviving scan scale above the capacity", "1", "f8", np.nan),
+    "simulations": ("simulations run", "1", "i8", -1),
+}
+_STEPS = ("step_scale", "step_max_rotation", "step_overturned")
+
+
+def _float(long_name, units):
+    return (long_name, units, "f8", np.nan)
+
+
+def outputs(study) -> dict:
+    """The per-row outputs of a design study: name -> (long_name, units, dtype, fill, extra
+    dimension or None). ``kernel_status`` is the design's ``status`` (0 ok)."""
+    de = study.design
+    out = {k: (*_float(*v), None) for k, v in RECORD_VARIABLES.items()}
+    out["sa"] = (
+        "pseudo-spectral acceleration Sa(T) of the unscaled record",
+        "m s-2",
+        "f8",
+        np.nan,
+        "period",
+    )
+    out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
+    if de.kind == "ida":
+        out.update({k: (*v, None) for k, v in _IDA.items()})
+        unit = UNITS.get(de.ida_options()["im"], "1")
+        out["capacity"] = (_IDA["capacity"][0], unit, "f8", np.nan, None)
+        for k in _STEPS:
+            out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
+    else:
+        out.update({k: (*v, None) for k, v in _RUN.items()})
+        if de.kind == "stripes":
+            out["scale"] = ("factor applied to the record", "1", "f8", np.nan, None)
+    out["kernel_status"] = ("0 ok; else a simulation hit the step limit", "1", "i8", -1, None)
+    return out
+
+
+def ida_steps(study) -> int:
+    """Most simulations one structure of the study can take in the IDA: the bracket (from
+    g alpha to max_pga_ratio g tan alpha in steps of ``growth``), the bisection (from ``growth``
+    down to ``1 + tolerance``) and the scan."""
+    o = study.design.ida_options()
+    alpha = study.largest_critical_rotation()
+    span = o["max_pga_ratio"] * math.tan(alpha) / alpha
+    bracket = math.ceil(math.log(span) / math.log(o["growth"])) + 1
+    bisect = math.ceil(math.log2(math.log(o["growth"]) / math.log1p(o["tolerance"]))) + 1
+    return bracket + bisect + o["scan"]
+
+
+def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
+    """The rows (record, structure[, level]) of a design study on ``sample``, in C order.
+
+    ``structures`` holds the sampler's structure columns (``sampler.n`` of each). The record
+    files (named in the attribute ``record_files``) are listed, not read.
+    """
+    pairs = record_pairs(study.motion, base_dir)
+    n_rec, n_st, n_lev = len(pairs), len(structures["critical_rotation"]), study.levels()
+    rec, st, lev = (a.ravel() for a in np.indices((n_rec, n_st, n_lev)))
+    data = {k: ("sample", np.asarray(v)[st]) for k, v in structures.items()}
+    data.update(record=("sample", rec), structure=("sample", st), level_index=("sample", lev))
+    coords = {"sample": np.arange(rec.size)}
+    if study.design.kind == "stripes":
+        coords["level"] = ("level", study.motion.scale_to.value.points())
+    coords["period"] = ("period", stored_periods(study))
+    ds = xr.Dataset(data, coords=coords)
+    names = [str(h) if v is None else [str(h), str(v)] for _, h, v in pairs]
+    ds.attrs.update(
+        record_files=json.dumps(names),
+        record_names=json.dumps([Path(h).stem for _, h, _ in pairs]),
+        record_design=study.design.kind,
+        structures=n_st,
+    )
+    if study.design.kind == "ida":
+        ds.attrs["ida_steps"] = ida_steps(study)
+    return ds
+
+
+@lru_cache(maxsize=8)
+def _suite(motion_json: str, base_dir) -> tuple:
+    from .spec import RecordSpec
+
+    return tuple(record_pairs(RecordSpec.model_validate(json.loads(motion_json)), base_dir))
+
+
+@lru_cache(maxsize=32)
+def load_record(motion_json: str, base_dir, index: int):
+    """Record ``index`` of a study's suite (read once per process)."""
+    from .spec import RecordSpec
+
+    units = RecordSpec.model_validate(json.loads(motion_json)).units
+    field, h, v = _suite(motion_json, base_dir)[index]
+    return read_pair(h, v, units, field)
+
+
+def stored_periods(study) -> np.ndarray:
+    """Periods [s] of the stored ``sa``: ``design.periods`` and the period of a spectral target
+    (as :mod:`.records_designs` stores them), sorted."""
+    de, periods = study.design, set(study.design.periods)
+    if de.kind == "stripes" and study.motion.scale_to.period is not None:
+        periods.add(study.motion.scale_to.period)
+    if de.kind == "ida" and de.period is not None:
+        periods.add(de.period)
+    return np.array(sorted(periods), float)
+
+
+def _widths(study) -> dict:
+    """Sizes of the extra dimensions of the outputs."""
+    ida = study.design.kind == "ida"
+    return {"period": stored_periods(study).size, "step": ida_steps(study) if ida else 0}
+
+
+def empty_rows(study, n: int) -> dict:
+    """The outputs of ``n`` rows, each at its fill value."""
+    width = _widths(study)
+    return {
+        name: np.full((n,) if extra is None else (n, width[extra]), fill, dtype=dtype)
+        for name, (_, _, dtype, fill, extra) in outputs(study).items()
+    }
+
+
+def _run_design(study, record, structures, levels):
+    """The design function of :mod:`.records_designs` on one record."""
+    de, run = study.design, study.run
+    common = dict(
+        periods=de.periods,
+        damping=de.damping,
+        method=run.method,
+        rtol=run.rtol,
+        max_steps=run.max_steps,
+    )
+    if de.kind == "cloud":
+        return rd.cloud([record], structures, **common)
+    if de.kind == "stripes":
+        t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
+        return rd.multiple_stripes([record], structures, levels, im=t.im, period=t.period, **common)
+    return rd.incremental_dynamic_analysis([record], structures, **de.ida_options(), **common)
+
+
+def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
+    """Outputs of design rows (any subset of one or more records' rows): one design call per
+    record on the structures and levels the rows name. Raises if a design call does."""
+    outs = outputs(study)
+    width = _widths(study)
+    result = empty_rows(study, cols["sample"].size)
+    motion_json = study.motion.model_dump_json()
+    levels_all = (
+        study.motion.scale_to.value.points() if study.design.kind == "stripes" else np.ones(1)
+    )
+    for r in np.unique(cols["record"]):
+        rows = np.flatnonzero(cols["record"] == r)
+        rec = load_record(motion_json, base_dir, int(r))
+        st_ids, st_pos = np.unique(cols["structure"][rows], return_inverse=True)
+        first = rows[np.unique(st_pos, return_index=True)[1]]
+        structures = {
+            "frequency_parameter": cols["frequency_parameter"][first],
+            "slenderness": cols["critical_rotation"][first],
+            "restitution": cols["restitution"][first],
+        }
+        lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
+        ds = _run_design(study, rec, structures, levels_all[lev_ids])
+        _fill(result, outs, ds, rows, st_pos, lev_pos, width)
+    return result
+
+
+def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
+    """Copy a one-record design Dataset into the rows ``rows`` of ``result``."""
+    for name, (*_, extra) in outs.items():
+        src = "status" if name == "kernel_status" else name
+        var = ds[src].isel(record=0) if "record" in ds[src].dims else ds[src]
+        if "structure" in var.dims:
+            var = var.isel(structure=xr.DataArray(st_pos, dims="row"))
+        if "level" in var.dims:
+            var = var.isel(level=xr.DataArray(lev_pos, dims="row"))
+        values = np.asarray(var.values)
+        if extra is None:
+            result[name][rows] = np.broadcast_to(values, rows.shape).astype(result[name].dtype)
+        elif extra == "period":
+            result[name][rows] = np.broadcast_to(values, (rows.size, width["period"]))
+        else:  # IDA steps: (row, step), padded with NaN to the study's bound
+            k = values.shape[-1]
+            if k > width["step"]:
+                raise RuntimeError(
+                    f"the IDA took {k} simulations for one structure, more than the bound "
+                    f"{width['step']} of ida_steps(); this is a bug of rockstudy"
+                )
+            result[name][rows, :k] = values
+
+
+def design_dataset(cube: xr.Dataset) -> xr.Dataset:
+    """Fold a design study's rows (the store's cube) into the layout of :mod:`.records_designs`:
+    ``record`` x ``structure`` [x ``level``], per-record and per-structure tables, attributes.
+    """
+    kind = cube.attrs["record_design"]
+    names = json.loads(cube.attrs["record_names"])
+    n_rec, n_st = len(names), int(cube.attrs["structures"])
+    n_lev = cube.sizes.get("level", 1) if kind == "stripes" else 1
+    shape = (n_rec, n_st, n_lev)
+    study = json.loads(cube.attrs["study"])
+    out = {}
+    for name, var in cube.data_vars.items():
+        if var.dims[:1] != ("sample",) or name in ("record", "structure", "level_index"):
+            continue
+        values = np.asarray(var.values).reshape(shape + var.shape[1:])
+        new = "status" if name == "kernel_status" else "run_status" if name == "status" else name
+        extra = var.dims[1:]
+        if name in STRUCTURE_VARIABLES:
+            out[new] = (("structure",), values[0, :, 0], var.attrs)
+        elif name in RECORD_VARIABLES or name == "sa":
+            out[new] = (("record",) + extra, values[:, 0, 0], var.attrs)
+        elif name in GROUP_VARIABLES or kind != "stripes":
+            out[new] = (("record", "structure") + extra, values[:, :, 0], var.attrs)
+        else:
+            out[new] = (("record", "structure", "level"), values, var.attrs)
+    coords = {
+        "record": np.arange(n_rec),
+        "structure": np.arange(n_st),
+        "period": cube["period"].values,
+        "record_name": ("record", np.array(names, dtype=object)),
+    }
+    if kind == "stripes":
+        coords["level"] = cube["level"].values
+    ds = xr.Dataset(out, coords=coords)
+    if "error" in ds:  # zarr reads the empty message (its fill value) back as NaN
+        text = ds["error"].values
+        ds["error"] = (
+            ds["error"].dims,
+            np.where([isinstance(m, str) for m in text.ravel()], text.ravel(), "")
+            .reshape(text.shape)
+            .astype(object),
+        )
+    ds["uplift_acceleration"] = ("structure", _uplift(ds))
+    attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
+    de = study["design"]
+    attrs.update(
+        design=kind, method=study["run"]["method"], rtol=study["run"]["rtol"], damping=de["damping"]
+    )
+    if kind == "stripes":
+        t = study["motion"]["scale_to"]
+        attrs.update(im=t["im"], im_period=np.nan if t["period"] is None else t["period"])
+        attrs["n_simulations"] = n_rec * n_st * n_lev
+    elif kind == "ida":
+        o = {k: de[k] for k in ("im", "period", "tolerance", "growth", "max_pga_ratio")}
+        defaults = {"im": "pga", "tolerance": 0.01, "growth": 1.5, "max_pga_ratio": 30.0}
+        o = {k: (defaults.get(k) if v is None else v) for k, v in o.items()}
+        attrs.update(
+            im=o["im"],
+            im_period=np.nan if o["period"] is None else o["period"],
+            tolerance=o["tolerance"],
+            growth=o["growth"],
+            max_pga_ratio=o["max_pga_ratio"],
+        )
+        attrs["n_simulations"] = int(
+            np.nansum(np.where(ds["simulations"] >= 0, ds["simulations"], 0))
+        )
+        for k in ("censored", "resurrection"):  # as the API: bool (a failed row: False,
+            ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
+        used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
+        ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
+    else:
+        attrs["n_simulations"] = n_rec * n_st
+    ds.attrs = attrs
+    return ds
+
+
+def _uplift(ds):
+    """g tan(theta_cr) [m/s^2] of each structure, as :mod:`.records_designs` forms it."""
+    from ..constants import G
+
+    return G * np.tan(ds["critical_rotation"].values)
+
+
+# ------------------------------------------------------------------ Monte Carlo rows
+
+
+#: Measures that scale as |scale| (the others: Arias as scale^2; durations and periods not).
+_LINEAR = ("pga", "pgv", "pgd", "cav", "spectrum_intensity", "pulse_amplitude")
+
+
+def sample_outputs(study) -> dict:
+    """Per-sample record outputs of a Monte Carlo record study: the factor applied, the
+    measures of the scaled record and its groups (see :func:`sample_measures`)."""
+    out = {"scale": ("factor applied to the record", "1", "f8", np.nan, None)}
+    for k, (long_name, units) in {**RECORD_VARIABLES, **GROUP_VARIABLES}.items():
+        out[k] = (f"{long_name} of the scaled record", units, "f8", np.nan, None)
+    if study.motion.pga_ratio is not None:
+        del out["pga_ratio"]  # a design column already
+    if study.motion.scale is not None:
+        del out["scale"]  # likewise
+    return out
+
+
+def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
+    """Measures and groups of ``record`` scaled by ``scale`` (arrays over samples), from the
+    unscaled record's (cached) measures: linear ones times |scale|, Arias intensity times
+    scale^2, durations, periods and the pulse indicator unchanged; groups as in
+    :func:`rockstudy.similarity.record_groups` (PGA / (g tan alpha), PGV p / (g tan alpha),
+    omega_p / p and omega_p v_p / (g tan alpha), eqs. of issue 13 section 3)."""
+    ims = dict(record.intensity_measures())
+    ims.pop("sa")
+    pulse = record.pulse()
+    ims.update(
+        pulse_period=pulse.period, pulse_amplitude=pulse.amplitude, pulse_indicator=pulse.indicator
+    )
+    s = np.abs(np.asarray(scale, float))
+    out = {}
+    for k, v in ims.items():
+        factor = s if k in _LINEAR else s * s if k == "arias" else np.ones_like(s)
+        out[k] = float(v) * factor
+    w_p = 2.0 * np.pi / pulse.period if pulse.amplitude > 0 else np.nan
+    out["pga_ratio"] = out["pga"] / uplift
+    out["pgv_ratio"] = out["pgv"] * frequency_parameter / uplift
+    out["pulse_frequency_ratio"] = w_p / frequency_parameter
+    out["pulse_amplitude_ratio"] = w_p * out["pulse_amplitude"] / uplift
+    out["scale"] = np.asarray(scale, float)
+    return out
+
+
+def scale_factors(study, record, cols, idx) -> np.ndarray:
+    """The factor on ``record`` of the rows ``idx``: ``scale``; or the factor that brings
+    its PGA to ``pga_ratio`` g tan(alpha); or its ``scale_to.im`` to ``target``."""
+    alpha = cols["critical_rotation"][idx]
+    uplift = rd.G * np.tan(alpha)
+    if "scale" in cols:
+        return cols["scale"][idx]
+    if "pga_ratio" in cols:
+        return cols["pga_ratio"][idx] * uplift / record.peak
+    t = study.motion.scale_to
+    structures = {
+        "slenderness": alpha,
+        "frequency_parameter": cols["frequency_parameter"][idx],
+        "uplift_acceleration": uplift,
+    }
+    measure = rd._record_measure(record, t.im, t.period, t.damping, structures)
+    return rd._scale_for(cols["target"][idx], measure, t.im)

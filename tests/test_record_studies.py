@@ -1,0 +1,430 @@
+"""Record suites in study files: designs on the runner and store, scale targets, bad input.
+
+The oracle of a design study is the Python design function of :mod:`records_designs` called
+directly on the suite read by :func:`load_suite` (the study goes through spec -> design rows ->
+dask tasks -> zarr store -> folding; the function through none of them).
+"""
+
+import html
+import shutil
+
+import numpy as np
+import pytest
+import scipy.signal
+from distributed import Client, LocalCluster
+
+from rockstudy.constants import G
+from rockstudy.motions import Record, load_suite, synthetic_near_fault
+from rockstudy.study import StudyError, load_study, run_study
+from rockstudy.study import records_designs as rd
+from rockstudy.study.evaluate import STATUS_OK, evaluate_chunk
+from rockstudy.study.sampling import make_design
+from rockstudy.study.store import open_result
+
+
+def write_at2(path, record):
+    """A PEER .AT2 file of ``record`` (in g)."""
+    values = record.acceleration / G
+    lines = [
+        "PEER STRONG MOTION DATABASE RECORD",
+        "synthetic near-fault record for the tests",
+        "ACCELERATION TIME SERIES IN UNITS OF G",
+        f"NPTS= {values.size}, DT= {record.dt:.4f} SEC",
+    ]
+    lines += [" ".join(f"{v:.9e}" for v in values[i : i + 5]) for i in range(0, values.size, 5)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.fixture(scope="module")
+def suite(tmp_path_factory):
+    """A folder of three synthetic near-fault records: horizontal and vertical .AT2 files."""
+    folder = tmp_path_factory.mktemp("records")
+    for i, tp in enumerate((0.5, 0.8, 1.2)):
+        rec = synthetic_near_fault(
+            pulse_period=tp, pga=3.0, seed=10 + i, duration=5.0, vertical=True
+        )
+        write_at2(folder / f"nf{i}_H.AT2", rec)
+        write_at2(folder / f"nf{i}_UP.AT2", Record(rec.vertical, dt=rec.dt))
+    return folder
+
+
+@pytest.fixture(scope="module")
+def client():
+    with (
+        LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as c,
+    ):
+        yield c
+
+
+HEAD = """
+name = "designs"
+seed = 5
+[sampler]
+kind = "lhs"
+n = 3
+[structure]
+kind = "block"
+half_diagonal = { dist = "uniform", low = 0.3, high = 1.2 }
+slenderness = { dist = "uniform", low = 0.15, high = 0.25 }
+"""
+
+MOTION = """
+[motion]
+kind = "record"
+files = "RECORDS/*_H.AT2"
+"""
+HV = """
+[motion]
+kind = "record"
+files = "RECORDS"
+vertical = { match = '_H\\.AT2$', replace = "_UP.AT2" }
+"""
+
+DESIGNS = {
+    "cloud": '[design]\nkind = "cloud"\nperiods = [0.3, 1.0]\n',
+    "stripes": (
+        'scale_to = { im = "sa", period = 0.5, value = { dist = "grid", values = [2.0, 6.0] } }\n'
+        '[design]\nkind = "stripes"\nperiods = [1.0]\n'
+    ),
+    "ida": '[design]\nkind = "ida"\nim = "pgv"\ntolerance = 0.02\nscan = 2\n',
+}
+
+
+def design_study(folder, kind, where, motion=MOTION):
+    text = HEAD + motion.replace("RECORDS", str(folder)) + DESIGNS[kind]
+    text += '[run]\noutputs = ["max_rotation", "overturned"]\n'
+    path = where / f"{kind}.toml"
+    path.write_text(text)
+    return load_study(path)
+
+
+def python_api(kind, records, cube):
+    structures = {
+        "half_diagonal": cube["half_diagonal"].values,
+        "slenderness": cube["slenderness"].values,
+    }
+    if kind == "cloud":
+        return rd.cloud(records, structures, periods=[0.3, 1.0])
+    if kind == "stripes":
+        return rd.multiple_stripes(
+            records, structures, [2.0, 6.0], im="sa", period=0.5, periods=[1.0]
+        )
+    return rd.incremental_dynamic_analysis(records, structures, im="pgv", tolerance=0.02, scan=2)
+
+
+@pytest.mark.parametrize("kind", ["cloud", "stripes", "ida"])
+def test_design_study_cube_equals_the_python_design(suite, client, tmp_path, kind):
+    study = design_study(suite, kind, tmp_path)
+    out = tmp_path / "cube.zarr"
+    report = run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    assert report.failed_samples == 0 and report.chunks_total == 3  # one record per chunk
+    cube = open_result(out).load()
+    records = load_suite(str(suite / "*_H.AT2"))
+    api = python_api(kind, records, cube)
+    assert dict(cube.sizes) == dict(api.sizes)
+    assert list(cube["record_name"].values) == [r.name for r in records]
+    for name, var in api.variables.items():
+        if var.dtype.kind in "OU":
+            continue
+        got = cube[name]
+        assert got.dims == var.dims, name
+        np.testing.assert_allclose(
+            np.asarray(got.values, float),
+            np.asarray(var.values, float),
+            rtol=1e-12,
+            atol=0,
+            equal_nan=True,
+            err_msg=name,
+        )
+    for key in ("design", "im", "im_period", "n_simulations", "damping", "tolerance"):
+        if key in api.attrs:
+            np.testing.assert_equal(cube.attrs[key], api.attrs[key], err_msg=key)
+    assert np.all(cube["run_status"].values == STATUS_OK)
+    nc = open_result(out.with_suffix(".nc")).load()  # the export has the same layout
+    assert dict(nc.sizes) == {d: n for d, n in api.sizes.items() if n}  # netCDF3: no empty dims
+    for name in ("max_rotation", "capacity", "scale"):
+        if name in api:
+            np.testing.assert_allclose(nc[name], api[name], rtol=1e-12, equal_nan=True)
+
+
+def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, client, tmp_path):
+    """A folder of H/V pairs: each record is read with its vertical file; if the solvers take
+    vertical shaking the cube equals the Python design on the same pairs, else the study is
+    refused by validation (never run without its vertical)."""
+    from rockstudy.study.feasibility import vertical_refusal
+
+    if vertical_refusal() is not None:
+        with pytest.raises(StudyError, match="motion.vertical"):
+            design_study(suite, "cloud", tmp_path, HV)
+        return
+    study = design_study(suite, "cloud", tmp_path, HV)
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    cube = open_result(out).load()
+    records = load_suite(suite, vertical=(r"_H\.AT2$", "_UP.AT2"))
+    assert all(r.vertical is not None for r in records) and len(records) == 3
+    api = python_api("cloud", records, cube)
+    np.testing.assert_allclose(cube["max_rotation"], api["max_rotation"], rtol=1e-12)
+
+
+def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, client, tmp_path):
+    import zarr
+
+    study = design_study(suite, "stripes", tmp_path)
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    full = open_result(out).load()
+    group = zarr.open_group(str(out), mode="r+", zarr_format=2)
+    rows = group["status"].shape[0] // 3
+    group["status"][rows : 2 * rows] = 0  # record 1 as a killed run leaves it: pending
+    group["max_rotation"][rows : 2 * rows] = np.nan
+    report = run_study(
+        study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False, resume=True
+    )
+    assert report.chunks_computed == [(rows, 2 * rows)]
+    again = open_result(out).load()
+    np.testing.assert_array_equal(again["max_rotation"].values, full["max_rotation"].values)
+    assert np.isfinite(again["max_rotation"].values).all()
+
+
+def test_a_record_that_fails_in_its_task_fails_its_rows_and_is_counted(suite, client, tmp_path):
+    """A record spoiled after validation: its task fails, its rows are marked failed with the
+    reader's message (naming the file), the other records are kept, and the run raises
+    FailedSamplesError (max_failed is 0 by default)."""
+    from rockstudy.study.runner import FailedSamplesError
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for f in sorted(suite.glob("*_H.AT2")):
+        shutil.copy(f, folder / f.name)
+    study = design_study(folder, "cloud", tmp_path)
+    (folder / "nf1_H.AT2").write_text("PEER\nspoiled\nUNITS OF G\nNPTS= 9, DT= 0.01 SEC\n1 2\n")
+    out = tmp_path / "cube.zarr"
+    with pytest.raises(FailedSamplesError) as info:
+        run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    assert info.value.report.failed_samples == 3  # the record's three structures
+    assert any("nf1_H.AT2" in m for m in info.value.report.errors)
+    cube = open_result(out).load()
+    np.testing.assert_array_equal(cube["run_status"].values[:, 0], [1, 2, 1])
+    assert np.isnan(cube["max_rotation"].values[1]).all()
+    assert np.isfinite(cube["max_rotation"].values[[0, 2]]).all()
+
+
+# ---------------------------------------------------------------- Monte Carlo rows, targets
+
+
+def rows_study(folder, where, motion_extra, n=6):
+    text = HEAD.replace('kind = "lhs"\nn = 3', f'kind = "monte_carlo"\nn = {n}') + (
+        f'[motion]\nkind = "record"\nfiles = "{folder}/*_H.AT2"\n{motion_extra}\n'
+        '[run]\noutputs = ["max_rotation", "overturned"]\n'
+    )
+    path = where / "rows.toml"
+    path.write_text(text)
+    return load_study(path)
+
+
+def run_rows(study, where):
+    design = make_design(study, where)
+    cols = {k: v.values for k, v in design.data_vars.items() if v.dims == ("sample",)}
+    cols["sample"] = design["sample"].values
+    out = evaluate_chunk(study.normalized(), cols, where)
+    assert np.all(out["status"] == STATUS_OK), out["error"]
+    return design, out
+
+
+def test_rows_scaled_to_sa_reach_it_by_an_independent_oscillator(suite, tmp_path):
+    """scale_to = Sa(0.5 s) of a distribution: each sample's record, scaled by the factor the
+    run applied, has that Sa, by scipy's exact solution of the oscillator (lsim)."""
+    study = rows_study(
+        suite,
+        tmp_path,
+        'scale_to = { im = "sa", period = 0.5, value = { dist = "uniform", low = 2, high = 8 } }',
+    )
+    design, out = run_rows(study, tmp_path)
+    files = sorted(suite.glob("*_H.AT2"))
+    w, zeta = 2.0 * np.pi / 0.5, 0.05
+    system = scipy.signal.lti([-1.0], [1.0, 2.0 * zeta * w, w * w])
+    for i in range(3):
+        rec = Record.from_at2(files[design["record"].values[i]])
+        t = rec.dt * np.arange(rec.acceleration.size + 400)  # and free vibration after it
+        acc = np.concatenate([rec.acceleration * out["scale"][i], np.zeros(400)])
+        _, u, _ = scipy.signal.lsim(system, acc, t, interp=True)
+        sa = w * w * np.max(np.abs(u))
+        assert sa == pytest.approx(design["target"].values[i], rel=2e-3)
+        # the cube's groups are those of the scaled record
+        alpha = design["critical_rotation"].values[i]
+        assert out["pga_ratio"][i] == pytest.approx(
+            np.max(np.abs(acc)) / (G * np.tan(alpha)), rel=1e-12
+        )
+
+
+def test_pga_ratio_is_scale_to_pga_ratio(suite, tmp_path):
+    """The legacy pga_ratio and scale_to = { im = "pga_ratio" } apply the same factors, and the
+    scaled record's peak is pga_ratio g tan(alpha)."""
+    old = rows_study(suite, tmp_path, "pga_ratio = 2.5")
+    new = rows_study(suite, tmp_path, 'scale_to = { im = "pga_ratio", value = 2.5 }')
+    d_old, o_old = run_rows(old, tmp_path)
+    _, o_new = run_rows(new, tmp_path)
+    np.testing.assert_allclose(o_new["scale"], o_old["scale"], rtol=1e-14)
+    np.testing.assert_array_equal(o_new["max_rotation"], o_old["max_rotation"])
+    files = sorted(suite.glob("*_H.AT2"))
+    peaks = np.array([Record.from_at2(files[r]).peak for r in d_old["record"].values])
+    uplift = G * np.tan(d_old["critical_rotation"].values)
+    np.testing.assert_allclose(peaks * o_old["scale"], 2.5 * uplift, rtol=1e-12)
+
+
+# ---------------------------------------------------------------- bad input, before the run
+
+
+def refused(tmp_path, motion, design="", field=None):
+    text = HEAD + motion + design + '[run]\noutputs = ["max_rotation"]\n'
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(StudyError) as info:
+        load_study(path)
+    message = str(info.value)
+    if field is not None:
+        assert field in message, message
+    return message
+
+
+def test_bad_record_suites_are_refused_naming_the_field(suite, tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "notes.md").write_text("no records here")
+    stripes = '[design]\nkind = "stripes"\n'
+    grid = 'value = { dist = "grid", values = [1.0, 2.0] }'
+    # a folder with no records
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{empty}"\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files",
+    )
+    assert "holds no record files" in msg
+    # a glob with no match
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*.xyz"\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files",
+    )
+    assert "matches no file" in msg
+    # an unreadable file: its name in the message
+    bad = tmp_path / "broken.AT2"
+    bad.write_text("PEER\nx\nUNITS OF G\nNPTS= 10, DT= 0.01 SEC\n1 2 3\n")
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = ["{suite}/nf1_H.AT2", "{bad}"]\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.files[1]",
+    )
+    assert "broken.AT2" in msg
+    # an H/V pair of different lengths
+    short = tmp_path / "short_UP.AT2"
+    write_at2(short, Record(np.ones(50), dt=0.005))
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = ["{suite}/nf1_H.AT2"]\nvertical = ["{short}"]\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.vertical[0]",
+    )
+    assert "samples" in msg
+    # an IM name that does not exist, as a scale target and as the IDA's measure
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        f'scale_to = {{ im = "pgx", {grid} }}\n',
+        stripes,
+        "motion.scale_to.im",
+    )
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n',
+        '[design]\nkind = "ida"\nim = "pgx"\n',
+        "design.im",
+    )
+    # sa without its period
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        f'scale_to = {{ im = "sa", {grid} }}\n',
+        stripes,
+        "motion.scale_to.period",
+    )
+    # a scale target the record cannot reach: PGA 0
+    zero = tmp_path / "zero.AT2"
+    write_at2(zero, Record(np.zeros(100), dt=0.01))
+    msg = refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = ["{zero}"]\nscale_to = {{ im = "pga", {grid} }}\n',
+        stripes,
+        "motion.files[0]",
+    )
+    assert "zero.AT2" in msg
+    # stripes need their levels as a grid; a cloud takes no scale
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\n'
+        'scale_to = { im = "pga", value = 3.0 }\n',
+        stripes,
+        "motion.scale_to.value",
+    )
+    refused(
+        tmp_path,
+        f'[motion]\nkind = "record"\nfiles = "{suite}/*_H.AT2"\npga_ratio = 2.0\n',
+        '[design]\nkind = "cloud"\n',
+        "motion.pga_ratio",
+    )
+
+
+def test_no_record_of_a_folder_is_skipped(suite, tmp_path):
+    """A folder's files that are neither a horizontal record nor its vertical are refused by
+    an H/V rule, not skipped."""
+    folder = tmp_path / "mixed"
+    shutil.copytree(suite, folder)
+    shutil.copy(folder / "nf1_H.AT2", folder / "stray.AT2")
+    msg = refused(
+        tmp_path,
+        HV.replace("RECORDS", str(folder)),
+        '[design]\nkind = "cloud"\n',
+        "motion.vertical",
+    )
+    assert "stray.AT2" in msg
+
+
+def test_report_of_a_record_study_shows_its_file_and_target_units(suite, client, tmp_path):
+    """Monte Carlo rows scaled to a PGV distribution: the report renders in Chromium, names the
+    target in its units in the inputs table, and shows the study file as written."""
+    from test_report import chromium_figures
+
+    from rockstudy.study.report import make_report
+
+    study = rows_study(
+        suite,
+        tmp_path,
+        'scale_to = { im = "pgv", value = { dist = "uniform", low = 0.2, high = 0.8 } }',
+        n=40,
+    )
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False, netcdf=False)
+    cube = open_result(out)
+    assert {"pgv", "pga_ratio", "pulse_frequency_ratio", "scale"} <= set(cube.data_vars)
+    # each sample's scaled record has the PGV it was drawn: target = PGV of record x scale
+    files = sorted(suite.glob("*_H.AT2"))
+    pgv = np.array([Record.from_at2(f).intensity_measures()["pgv"] for f in files])
+    np.testing.assert_allclose(
+        pgv[cube["record"].values] * np.abs(cube["scale"].values), cube["target"].values, rtol=1e-12
+    )
+    page = make_report(out, tmp_path / "report")
+    shown, total = chromium_figures(page)  # the page loads; its figures (if any) decode
+    assert shown == total
+    inputs = (tmp_path / "report" / "inputs.csv").read_text()
+    assert "scale target pgv [m/s]" in inputs
+
+    text = page.read_text()
+    for line in (tmp_path / "rows.toml").read_text().splitlines():
+        assert html.escape(line) in text, line
