@@ -30,8 +30,8 @@ from .records_fragility import QUOTED_UNITS, fit_binomial, fit_capacities, inten
 FREQUENCY_GROUP = "pulse_frequency_ratio"
 
 
-def size_classes(ds: xr.Dataset, size_bins=3) -> dict:
-    """{label: boolean mask over ``structure``}: blocks binned by half-diagonal R [m].
+def size_edges(ds: xr.Dataset, size_bins=3) -> np.ndarray:
+    """Edges [m] of the size classes of the blocks by half-diagonal R.
 
     Parameters
     ----------
@@ -58,15 +58,27 @@ def size_classes(ds: xr.Dataset, size_bins=3) -> dict:
             )
         edges = np.quantile(R, np.linspace(0.0, 1.0, k + 1))
         edges[-1] = np.nextafter(edges[-1], np.inf)
-    else:
-        edges = np.asarray(size_bins, float)
-        if edges.ndim != 1 or edges.size < 3 or np.any(np.diff(edges) <= 0):
-            raise ValueError(
-                f"size_bins: edges must be increasing, at least 3 of them, got {size_bins!r}"
-            )
-    idx = np.digitize(R, edges)
+        return edges
+    edges = np.asarray(size_bins, float)
+    if edges.ndim != 1 or edges.size < 3 or np.any(np.diff(edges) <= 0):
+        raise ValueError(
+            f"size_bins: edges must be increasing, at least 3 of them, got {size_bins!r}"
+        )
+    return edges
+
+
+def size_label(low: float, high: float) -> str:
+    """The name of a size class in words: 'R 0.3 to 0.776 m'."""
+    return f"R {low:.3g} to {high:.3g} m"
+
+
+def size_classes(ds: xr.Dataset, size_bins=3) -> dict:
+    """{label: boolean mask over ``structure``}: blocks binned by half-diagonal R [m]
+    (:func:`size_edges`); empty classes are left out."""
+    edges = size_edges(ds, size_bins)
+    idx = np.digitize(np.asarray(ds["half_diagonal"].values, float), edges)
     return {
-        f"R {edges[i - 1]:.3g} to {edges[i]:.3g} m": idx == i
+        size_label(edges[i - 1], edges[i]): idx == i
         for i in range(1, edges.size)
         if np.any(idx == i)
     }

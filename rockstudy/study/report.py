@@ -636,6 +636,10 @@ def make_report(result, out=None) -> Path:
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     out.mkdir(parents=True, exist_ok=True)
     ds = open_result(result).load()
+    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
+        from .report_records import record_report
+
+        return record_report(ds, out, title=result.stem)
     study = analysis.study_of(ds)
     page = _Page(out)
     page.heading("Summary")
