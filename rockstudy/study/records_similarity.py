@@ -123,7 +123,7 @@ def _median_fitter(ds, im, period):
         rs = ("record", "structure")
         cap = intensity(ds, im, period, scale="capacity_scale").transpose(*rs).values
         top = intensity(ds, im, period, scale="capacity_scale_lower").transpose(*rs).values
-        cens = ds["censored"].transpose(*rs).values
+        cens = ds["censored"].transpose(*rs).values == 1  # bool, or -1 where a run failed
         x = np.where(cens, top, cap)  # capacities, and the censoring levels
         ok = (ds["status"].transpose(*rs).values == 0) & np.isfinite(x) & (x > 0)
 

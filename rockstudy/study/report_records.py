@@ -144,8 +144,12 @@ def _summary(page, ds):
         rows["levels"] = int(ds.sizes["level"])
     if design == "ida":
         rows["bisection tolerance (relative)"] = float(ds.attrs.get("tolerance", np.nan))
-        rows["capacities censored (standing at the top of the range)"] = int(ds["censored"].sum())
-        rows["resurrections found by the scan above the capacity"] = int(ds["resurrection"].sum())
+        rows["capacities censored (standing at the top of the range)"] = int(
+            (ds["censored"].values == 1).sum()
+        )
+        rows["resurrections found by the scan above the capacity"] = int(
+            (ds["resurrection"].values == 1).sum()
+        )
     else:
         rows["overturned points"] = int(ds["overturned"].values.sum())
     page.table(pd.Series(rows, dtype=object).to_frame("value"), "summary", "The design")
@@ -373,9 +377,9 @@ def _per_record(page, ds):
             row["lowest capacity, PGA [g]"] = (
                 float(np.nanmin(cap)) if np.isfinite(cap).any() else np.nan
             )
-            row["censored blocks"] = int(ds["censored"].values[i].sum())
+            row["censored blocks"] = int((ds["censored"].values[i] == 1).sum())
             row["blocks that resurrect above their capacity"] = int(
-                ds["resurrection"].values[i].sum()
+                (ds["resurrection"].values[i] == 1).sum()
             )
         else:
             over = ds["overturned"].values[i]
