@@ -18,10 +18,11 @@ import pandas as pd
 import xarray as xr
 
 from ..constants import G
+from ..motions import intensity as _im
 from . import records_fragility as rf
 from . import records_similarity as rsim
+from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
 from .analysis import fragility_curve
-from .report import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
@@ -156,20 +157,8 @@ def _summary(page, ds):
 
 
 def _record_list(page, ds):
-    cols = {
-        im: ds[im].values * (1.0 / G if im == "pga" else 1.0)
-        for im in (
-            "pga",
-            "pgv",
-            "pgd",
-            "arias",
-            "cav",
-            "significant_duration",
-            "mean_period",
-            "spectrum_intensity",
-        )
-        if im in ds
-    }
+    scalars = [k for k in _im.UNITS if k not in _im.SPECTRAL and k in ds]
+    cols = {k: ds[k].values * (1.0 / G if k == "pga" else 1.0) for k in scalars}
     table = pd.DataFrame({IM_NAMES[k]: v for k, v in cols.items()}, index=_names(ds))
     for k, t in enumerate(np.asarray(ds["period"].values, float) if "period" in ds.coords else []):
         table[im_label("sa", t)] = ds["sa"].values[:, k] / G
