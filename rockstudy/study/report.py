@@ -8,9 +8,7 @@ the collapse metric, and the eta^2 law of [000] eq. 4.16 for the linear model).
 
 from __future__ import annotations
 
-import base64
 import html
-import io
 import json
 import textwrap
 from pathlib import Path
@@ -20,86 +18,17 @@ import pandas as pd
 
 from ..constants import G
 from . import analysis
+from ._page import (  # noqa: F401 (the page machinery, also reached as report.<name>)
+    _FRAGILITY_NAMES,
+    BELOW_RANGE,
+    NOT_REACHED,
+    _capacities_as_measured,
+    _Page,
+    _plt,
+    _shown,
+)
 from .sampling import VARIABLES, target_attributes
 from .store import open_result
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _shown(value):
-    """A table cell as the page shows it: counts as integers, other numbers with three
-    significant figures, text as it is."""
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        return "" if np.isnan(value) else f"{value:.3g}"
-    return value
-
-
-class _Page:
-    def __init__(self, out: Path):
-        self.out = out
-        self.parts = []
-        self.figures = 0
-
-    def heading(self, text):
-        self.parts.append(f"<h2>{html.escape(text)}</h2>")
-
-    def text(self, text):
-        self.parts.append(f"<p>{html.escape(text)}</p>")
-
-    def preformatted(self, text):
-        self.parts.append(f"<pre>{html.escape(text)}</pre>")
-
-    def table(self, frame: pd.DataFrame, name: str, caption: str):
-        frame.to_csv(self.out / f"{name}.csv")
-        self.parts.append(
-            f"<p class='cap'>{html.escape(caption)} (<a href='{name}.csv'>{name}.csv</a>)</p>"
-        )
-        shown = frame.map(_shown).rename(index=_shown, columns=_shown)
-        self.parts.append(shown.to_html(classes="t"))  # to_html escapes every cell
-
-    def figure(self, fig, name: str, caption: str):
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=100)
-        fig.savefig(self.out / f"{name}.png", dpi=100)
-        _plt().close(fig)
-        data = base64.b64encode(buf.getvalue()).decode()
-        self.figures += 1
-        self.parts.append(
-            f"<figure><img alt='{html.escape(name)}' "
-            f"src='data:image/png;base64,{data}'>"
-            f"<figcaption>{html.escape(caption)}</figcaption></figure>"
-        )
-
-    def write(self, title, meta):
-        head = (
-            f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
-            "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
-            "img{max-width:100%}table.t{border-collapse:collapse;font-size:12px}"
-            "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
-            ".cap{color:#555}</style></head><body>"
-        )
-        # a check for headless browsers, invisible to the reader: the count of decoded figures
-        # goes into the body's data-figures attribute ("shown/total")
-        check = (
-            "<script>window.addEventListener('load',()=>{const im=[...document.images];"
-            "const ok=im.filter(i=>i.complete&&i.naturalWidth>0).length;"
-            "document.body.dataset.figures=ok+'/'+im.length;});</script>"
-        )
-        body = f"<h1>{html.escape(title)}</h1>{meta}" + "".join(self.parts) + check
-        path = self.out / "index.html"
-        path.write_text(head + body + "</body></html>")
-        return path
 
 
 def _summary(page, ds):
@@ -152,39 +81,6 @@ def _middle_third(values):
     """Samples in the middle third of a variable's range (quantiles 1/3 to 2/3)."""
     lo, hi = np.quantile(values, [1 / 3, 2 / 3])
     return (values >= lo) & (values <= hi)
-
-
-NOT_REACHED = "not reached within the sampled range"
-BELOW_RANGE = "below the sampled range"
-
-
-def _capacities_as_measured(table: pd.DataFrame) -> pd.DataFrame:
-    """The fragility table as the report shows it: a median capacity or band limit outside
-    the group's observed intensities (``im_min``-``im_max``) is an extrapolation of the
-    lognormal shape, so it is shown as text, not as a number."""
-    shown = table.astype(object)
-    for col in ("theta", "theta_lo", "theta_hi"):
-        value = table[col].to_numpy(float)
-        shown[col] = [
-            NOT_REACHED if v > hi else BELOW_RANGE if v < lo else v
-            for v, lo, hi in zip(value, table["im_min"], table["im_max"], strict=True)
-        ]
-    return shown
-
-
-_FRAGILITY_NAMES = {
-    "theta": "median capacity",
-    "theta_lo": "median capacity, lower",
-    "theta_hi": "median capacity, upper",
-    "beta_lo": "beta, lower",
-    "beta_hi": "beta, upper",
-    "n": "samples",
-    "im_min": "lowest intensity",
-    "im_max": "highest intensity",
-    "theta_in_range": "median within the samples",
-    "band_in_range": "band within the samples",
-    "band": "subset of the samples",
-}
 
 
 _BANDS = {
@@ -650,6 +546,18 @@ def make_report(result, out=None) -> Path:
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     out.mkdir(parents=True, exist_ok=True)
     ds = open_result(result).load()
+    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
+        from .report_records import record_report
+
+        study = analysis.study_of(ds)
+
+        def study_section(page):
+            page.heading("Study")
+            _study_file(page, study, ds)
+
+        return record_report(
+            ds, out, title=study.name, description=study.description, appendix=study_section
+        )
     study = analysis.study_of(ds)
     page = _Page(out)
     page.heading("Summary")

@@ -1,0 +1,123 @@
+"""The HTML page shared by the reports (:mod:`.report`, :mod:`.report_records`): sections,
+escaped text, tables as the page shows them (CSV beside), and figures embedded as PNG."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _shown(value):
+    """A table cell as the page shows it: counts as integers, other numbers with three
+    significant figures, text as it is."""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return "" if np.isnan(value) else f"{value:.3g}"
+    return value
+
+
+class _Page:
+    def __init__(self, out: Path):
+        self.out = out
+        self.parts = []
+        self.figures = 0
+
+    def heading(self, text):
+        self.parts.append(f"<h2>{html.escape(text)}</h2>")
+
+    def text(self, text):
+        self.parts.append(f"<p>{html.escape(text)}</p>")
+
+    def preformatted(self, text):
+        self.parts.append(f"<pre>{html.escape(text)}</pre>")
+
+    def table(self, frame: pd.DataFrame, name: str, caption: str):
+        frame.to_csv(self.out / f"{name}.csv")
+        self.parts.append(
+            f"<p class='cap'>{html.escape(caption)} (<a href='{name}.csv'>{name}.csv</a>)</p>"
+        )
+        shown = frame.map(_shown).rename(index=_shown, columns=_shown)
+        self.parts.append(shown.to_html(classes="t"))  # to_html escapes every cell
+
+    def figure(self, fig, name: str, caption: str):
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=100)
+        fig.savefig(self.out / f"{name}.png", dpi=100)
+        _plt().close(fig)
+        data = base64.b64encode(buf.getvalue()).decode()
+        self.figures += 1
+        self.parts.append(
+            f"<figure><img alt='{html.escape(name)}' "
+            f"src='data:image/png;base64,{data}'>"
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+        )
+
+    def write(self, title, meta):
+        head = (
+            f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
+            "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
+            "img{max-width:100%}table.t{border-collapse:collapse;font-size:12px}"
+            "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
+            ".cap{color:#555}</style></head><body>"
+        )
+        # a check for headless browsers, invisible to the reader: the count of decoded figures
+        # goes into the body's data-figures attribute ("shown/total")
+        check = (
+            "<script>window.addEventListener('load',()=>{const im=[...document.images];"
+            "const ok=im.filter(i=>i.complete&&i.naturalWidth>0).length;"
+            "document.body.dataset.figures=ok+'/'+im.length;});</script>"
+        )
+        body = f"<h1>{html.escape(title)}</h1>{meta}" + "".join(self.parts) + check
+        path = self.out / "index.html"
+        path.write_text(head + body + "</body></html>")
+        return path
+
+
+NOT_REACHED = "not reached within the sampled range"
+BELOW_RANGE = "below the sampled range"
+
+
+def _capacities_as_measured(table: pd.DataFrame) -> pd.DataFrame:
+    """The fragility table as the report shows it: a median capacity or band limit outside
+    the group's observed intensities (``im_min``-``im_max``) is an extrapolation of the
+    lognormal shape, so it is shown as text, not as a number."""
+    shown = table.astype(object)
+    for col in ("theta", "theta_lo", "theta_hi"):
+        value = table[col].to_numpy(float)
+        shown[col] = [
+            NOT_REACHED if v > hi else BELOW_RANGE if v < lo else v
+            for v, lo, hi in zip(value, table["im_min"], table["im_max"], strict=True)
+        ]
+    return shown
+
+
+_FRAGILITY_NAMES = {
+    "theta": "median capacity",
+    "theta_lo": "median capacity, lower",
+    "theta_hi": "median capacity, upper",
+    "beta_lo": "beta, lower",
+    "beta_hi": "beta, upper",
+    "n": "samples",
+    "im_min": "lowest intensity",
+    "im_max": "highest intensity",
+    "theta_in_range": "median within the samples",
+    "band_in_range": "band within the samples",
+    "band": "subset of the samples",
+}

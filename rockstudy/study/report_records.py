@@ -1,0 +1,526 @@
+"""The report of a record design (cloud, multiple stripes or IDA; issue 13 section 8).
+
+From a dataset of :mod:`rockstudy.study.records_designs` (or a result cube of the same layout):
+the record list with each record's intensity measures and pulse period; fragility curves with
+bands against PGA [g], PGV [m/s], Sa(T) [g], PGA / (g tan alpha) and PGV p / (g tan alpha), by
+block size; the efficiency of the intensity measures; IDA curves, stripe points or the cloud;
+a per-record breakdown; and, when the blocks span sizes, the self-similarity of the fragility
+on records (:mod:`rockstudy.study.records_similarity`).
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from ..constants import G
+from ..motions import intensity as _im
+from . import records_fragility as rf
+from . import records_similarity as rsim
+from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
+from .analysis import fragility_curve
+
+#: Designs this report reads (``ds.attrs["design"]``).
+DESIGNS = ("cloud", "stripes", "ida")
+
+#: Intensity measures in words, with the units of the tables and figures.
+IM_NAMES = {
+    "pga": "PGA [g]",
+    "pgv": "PGV [m/s]",
+    "pgd": "PGD [m]",
+    "arias": "Arias intensity [m/s]",
+    "cav": "CAV [m/s]",
+    "significant_duration": "significant duration 5-95 % [s]",
+    "mean_period": "mean period T_m [s]",
+    "spectrum_intensity": "spectrum intensity [m]",
+    "sa": "Sa [g]",
+    "psv": "PSV [m/s]",
+    "sd": "Sd [m]",
+    "pga_ratio": "PGA / (g tan alpha) [-]",
+    "pgv_ratio": "PGV p / (g tan alpha) [-]",
+    "pulse_amplitude_ratio": "pulse amplitude omega_p A_p / (g tan alpha) [-]",
+}
+_DESIGN_NAMES = {
+    "cloud": "cloud (records unscaled)",
+    "stripes": "multiple-stripe analysis",
+    "ida": "incremental dynamic analysis (bracket and bisection)",
+}
+#: Frequency bins of omega_p / p (of equal count) within which PGA / (g tan alpha) is compared.
+FREQUENCY_BINS = 3
+
+
+def im_label(im: str, period=None) -> str:
+    """An intensity measure's name in words with its units, e.g. 'Sa(T = 0.5 s) [g]'."""
+    name = IM_NAMES.get(im, im)
+    if period is None:
+        return name
+    head, unit = name.split(" [")
+    return f"{head}(T = {float(period):.3g} s) [{unit}"
+
+
+def _names(ds) -> list[str]:
+    """Record names as text (a cube may store them as bytes)."""
+    values = ds["record_name"].values if "record_name" in ds.coords else ds["record"].values
+    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in values]
+
+
+def _log_ticks(ax, axis="x"):
+    """Plain-number labels (0.2, 1, 5) on a logarithmic axis; minor ones (2 and 5 of each
+    decade) only where the axis spans under 1.5 decades. Call it after plotting."""
+    from matplotlib.ticker import FuncFormatter
+
+    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
+    few = hi > lo > 0 and np.log10(hi / lo) < 1.5
+
+    def minor(v, _):
+        mantissa = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
+        return f"{v:g}" if few and np.isclose(mantissa, [2.0, 5.0]).any() else ""
+
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    target.set_minor_formatter(FuncFormatter(minor))
+    ax.tick_params(axis=axis, which="minor", labelsize=7)
+
+
+def _mpl_text(text: str) -> str:
+    """Text for a matplotlib label: a '$' from a file must not start mathtext."""
+    return text.replace("$", r"\$")
+
+
+def _measures(ds) -> list[tuple[str, float | None]]:
+    """The measures of the fragility section: PGA, PGV, Sa at the design's (or the first
+    stored) period, and the two dimensionless groups."""
+    out = [("pga", None), ("pgv", None)]
+    periods = np.asarray(ds["period"].values, float) if "period" in ds.coords else np.zeros(0)
+    if periods.size:
+        t = ds.attrs.get("im_period", np.nan)
+        out.append(("sa", float(t) if np.isfinite(t) else float(periods[0])))
+    return out + [("pga_ratio", None), ("pgv_ratio", None)]
+
+
+def _sizes(ds):
+    """Size-class edges [m] of the blocks, or None when they do not span three sizes."""
+    R = ds["half_diagonal"].values if "half_diagonal" in ds else np.zeros(0)
+    if not (R.size and np.all(np.isfinite(R)) and np.unique(R).size >= 3):
+        return None
+    return rsim.size_edges(ds, 3)
+
+
+def _fit(ds, im, period, edges, n_boot):
+    """The design's fragility table against ``im``, by size class when there are sizes."""
+    fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
+    by = None if edges is None else "half_diagonal"
+    table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
+    if edges is not None:  # analysis labels bins "lo-hi" in %g: name them in words
+        table.index = [
+            rsim.size_label(lo, hi)
+            for lo, hi in (map(float, g.split("-")) for g in table.index.astype(str))
+        ]
+    table.index.name = "block size" if edges is not None else "blocks"
+    return table
+
+
+# ------------------------------------------------------------------------------ sections
+
+
+def _summary(page, ds):
+    design = ds.attrs.get("design")
+    rows = {
+        "design": _DESIGN_NAMES.get(design, str(design)),
+        "records": int(ds.sizes["record"]),
+        "structures": int(ds.sizes["structure"]),
+        "simulations": int(ds.attrs.get("n_simulations", 0)),
+        "points that failed (step limit)": int((ds["status"].values != 0).sum()),
+    }
+    if design in ("stripes", "ida"):
+        rows["scaling measure"] = im_label(
+            ds.attrs.get("im", "pga"),
+            ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
+        )
+    if design == "stripes":
+        rows["levels"] = int(ds.sizes["level"])
+    if design == "ida":
+        rows["bisection tolerance (relative)"] = float(ds.attrs.get("tolerance", np.nan))
+        rows["capacities censored (standing at the top of the range)"] = int(
+            (ds["censored"].values == 1).sum()
+        )
+        rows["resurrections found by the scan above the capacity"] = int(
+            (ds["resurrection"].values == 1).sum()
+        )
+    else:
+        rows["overturned points"] = int(ds["overturned"].values.sum())
+    page.table(pd.Series(rows, dtype=object).to_frame("value"), "summary", "The design")
+
+
+def _record_list(page, ds):
+    scalars = [k for k in _im.UNITS if k not in _im.SPECTRAL and k in ds]
+    cols = {k: ds[k].values * (1.0 / G if k == "pga" else 1.0) for k in scalars}
+    table = pd.DataFrame({IM_NAMES[k]: v for k, v in cols.items()}, index=_names(ds))
+    for k, t in enumerate(np.asarray(ds["period"].values, float) if "period" in ds.coords else []):
+        table[im_label("sa", t)] = ds["sa"].values[:, k] / G
+    table["pulse period T_p [s]"] = ds["pulse_period"].values
+    table["pulse amplitude A_p [m/s]"] = ds["pulse_amplitude"].values
+    table["pulse indicator (Baker 2007) [-]"] = ds["pulse_indicator"].values
+    table["pulse-like (indicator > 0.85)"] = ds["pulse_indicator"].values > 0.85
+    table.index.name = "record"
+    page.table(
+        table,
+        "records",
+        "The records (unscaled): intensity measures (Sa at the damping "
+        f"{float(ds.attrs.get('damping', 0.05)):.3g}) and the dominant velocity pulse "
+        "(Mavroeidis-Papageorgiou fit)",
+    )
+
+
+def _fragility(page, ds, edges, n_boot):
+    measures = _measures(ds)
+    plt = _plt()
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+    axes = axes.ravel()
+    tables = []
+    for ax, (im, period) in zip(axes, measures, strict=False):
+        try:
+            t = _fit(ds, im, period, edges, n_boot)
+        except ValueError as err:
+            page.text(f"Fragility against {im_label(im, period)}: {err}")
+            ax.set_visible(False)
+            continue
+        low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
+        if not (np.isfinite(low) and np.isfinite(high) and high > low > 0):
+            ax.set_visible(False)
+            continue
+        grid = np.geomspace(low, high, 200)
+        curve = fragility_curve(t, grid)
+        for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
+            c = curve.sel(group=g)
+            note = "" if inside else " (median outside the data)"
+            ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
+            ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
+        ax.set(xscale="log", xlabel=im_label(im, period), ylabel="probability of overturning")
+        _log_ticks(ax)
+        ax.legend(fontsize=7)
+        t.insert(0, "intensity", im_label(im, period))
+        tables.append(t)
+    for ax in axes[len(measures) :]:
+        ax.set_visible(False)
+    if not tables:
+        plt.close(fig)
+        return
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "record_fragility",
+        "Lognormal fragility curves with 90 % bands"
+        + (" by block size" if edges is not None else "")
+        + (
+            ": the fit of the IDA capacities (first overturning levels)"
+            if ds.attrs.get("design") == "ida"
+            else ": the binomial maximum-likelihood fit (Baker 2015)"
+        )
+        + "; dashed: the median lies outside the observed intensities",
+    )
+    fit = pd.concat(tables)
+    fit.to_csv(page.out / "record_fragility_fit.csv")
+    page.table(
+        _capacities_as_measured(fit).drop(columns="unit").rename(columns=_FRAGILITY_NAMES),
+        "record_fragility",
+        "Fragility parameters in each measure's units: median capacity, its 90 % band and "
+        "the log-standard deviation beta (the fitted numbers and flags are in "
+        "record_fragility_fit.csv)",
+    )
+
+
+def _efficiency(page, ds, n_boot):
+    table = rf.im_efficiency(ds, n_boot=n_boot)
+    rows = []
+    for (label, _), r in table.iterrows():
+        name, _, rest = label.partition("(T=")
+        period = float(rest.rstrip(" s)")) if rest else None
+        rows.append(
+            {
+                "intensity measure": im_label(name, period),
+                "dispersion beta [-]": r["beta"],
+                "beta, lower": r["beta_lo"],
+                "beta, upper": r["beta_hi"],
+                "median capacity": r["theta"],
+                "points": int(r["n"]),
+                "dimensionless": bool(r["dimensionless"]),
+            }
+        )
+    page.table(
+        pd.DataFrame(rows).set_index("intensity measure"),
+        "im_efficiency",
+        "Which measure predicts overturning best: the dispersion beta of the fragility "
+        "against each measure, pooled over all blocks (smaller is better; 90 % bands), "
+        "dimensional and dimensionless",
+    )
+
+
+def _representatives(ds, k=3) -> list[int]:
+    """Up to k structures spanning the sizes (or the order) of the design."""
+    key = ds["half_diagonal"].values if "half_diagonal" in ds else np.arange(ds.sizes["structure"])
+    key = np.where(np.isfinite(key), key, np.arange(key.size))
+    order = np.argsort(key, kind="stable")
+    picks = np.unique(np.round(np.linspace(0, order.size - 1, min(k, order.size))).astype(int))
+    return [int(order[i]) for i in picks]
+
+
+def _structure_title(ds, j) -> str:
+    alpha = float(ds["slenderness"].values[j])
+    R = float(ds["half_diagonal"].values[j]) if "half_diagonal" in ds else np.nan
+    size = f"R = {R:.3g} m, " if np.isfinite(R) else ""
+    return f"block {j}: {size}alpha = {alpha:.3g} rad"
+
+
+def _responses(page, ds):
+    """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes."""
+    design = ds.attrs.get("design")
+    names = _names(ds)
+    picks = _representatives(ds)
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(picks), figsize=(4.4 * len(picks), 4), squeeze=False)
+    pga_g = ds["pga"].values / G
+    for ax, j in zip(axes[0], picks, strict=True):
+        alpha = float(ds["slenderness"].values[j])
+        for i, name in enumerate(names):
+            if design == "ida":
+                s = ds["step_scale"].values[i, j]
+                cap = ds["capacity_scale"].values[i, j]
+                ok = np.isfinite(s)
+                order = np.argsort(s[ok])
+                s = s[ok][order]
+                x = (ds["step_max_rotation"].values[i, j][ok] / alpha)[order]
+                over = ds["step_overturned"].values[i, j][ok][order] == 1
+                x = np.where(over, 1.0, np.minimum(x, 1.0))
+                upto = ~(s > cap)  # the curve up to the first overturning (all if censored)
+                (line,) = ax.plot(x[upto], s[upto] * pga_g[i], "-", lw=1, label=_mpl_text(name))
+                ax.plot(x[over], s[over] * pga_g[i], "x", color=line.get_color(), ms=5)
+                above = (s > cap) & ~over  # survived above the capacity: resurrection
+                ax.plot(x[above], s[above] * pga_g[i], "o", mfc="none", color=line.get_color())
+            else:
+                y = pga_g[i] * (ds["scale"].values[i, j] if design == "stripes" else 1.0)
+                x = ds["max_rotation"].values[i, j] / alpha
+                over = ds["overturned"].values[i, j] == 1
+                x = np.where(over, 1.0, np.minimum(x, 1.0))
+                (line,) = ax.plot(
+                    np.atleast_1d(x)[~np.atleast_1d(over)],
+                    np.atleast_1d(y)[~np.atleast_1d(over)],
+                    "o",
+                    ms=4,
+                    label=_mpl_text(name),
+                )
+                ax.plot(
+                    np.atleast_1d(x)[np.atleast_1d(over)],
+                    np.atleast_1d(y)[np.atleast_1d(over)],
+                    "x",
+                    color=line.get_color(),
+                    ms=6,
+                )
+        ax.set(
+            xlabel="peak rotation / slenderness, theta_max / alpha [-]",
+            ylabel="PGA of the scaled record [g]",
+            yscale="log",
+            xlim=(0, 1.05),
+            title=_structure_title(ds, j),
+        )
+        _log_ticks(ax, "y")
+        if len(names) <= 15:
+            ax.legend(fontsize=6)
+    fig.tight_layout()
+    what = {
+        "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
+        "stripes": "Stripe points: each record scaled to each level",
+        "cloud": "The cloud: each record unscaled",
+    }.get(design, "Responses")
+    page.figure(
+        fig,
+        f"{design}_points",
+        f"{what}, for blocks spanning the design's sizes; crosses: overturned (drawn at "
+        "theta_max / alpha = 1)"
+        + (
+            "; the line ends at the first overturning, open circles mark survival above it "
+            "(resurrection)"
+            if design == "ida"
+            else ""
+        ),
+    )
+
+
+def _per_record(page, ds):
+    names = _names(ds)
+    design = ds.attrs.get("design")
+    rows = {}
+    for i, name in enumerate(names):
+        row = {"simulations": None, "failed points": int((ds["status"].values[i] != 0).sum())}
+        if design == "ida":
+            cap = rf.intensity(ds.isel(record=[i]), "pga", scale="capacity_scale").values[0]
+            ratio = rf.intensity(ds.isel(record=[i]), "pga_ratio", scale="capacity_scale")
+            ratio = ratio.values[0]
+            row["simulations"] = int(ds["simulations"].values[i].sum())
+            row["median capacity, PGA [g]"] = _median(cap)
+            row["median capacity, PGA / (g tan alpha) [-]"] = _median(ratio)
+            row["lowest capacity, PGA [g]"] = (
+                float(np.nanmin(cap)) if np.isfinite(cap).any() else np.nan
+            )
+            row["censored blocks"] = int((ds["censored"].values[i] == 1).sum())
+            row["blocks that resurrect above their capacity"] = int(
+                (ds["resurrection"].values[i] == 1).sum()
+            )
+        else:
+            over = ds["overturned"].values[i]
+            row["simulations"] = int(over.size)
+            row["overturned"] = int(over.sum())
+            row["overturned share [-]"] = float(over.mean())
+            surv = ds["max_rotation"].values[i] / np.broadcast_to(
+                ds["slenderness"].values.reshape((-1,) + (1,) * (over.ndim - 1)), over.shape
+            )
+            surv = surv[over == 0]
+            row["median theta_max / alpha of the survivors [-]"] = _median(surv)
+        rows[name] = row
+    table = pd.DataFrame(rows).T
+    table.index.name = "record"
+    page.table(table, "per_record", "Per-record breakdown over all blocks")
+
+
+def _median(values) -> float:
+    values = np.asarray(values, float)
+    values = values[np.isfinite(values)]
+    return float(np.median(values)) if values.size else np.nan
+
+
+def _self_similarity(page, ds, edges, n_boot):
+    """Medians of the size classes against PGA [g] (pooled), PGA / (g tan alpha) within bins
+    of omega_p / p, and PGV p / (g tan alpha) (pooled), and their spread."""
+    cases = [
+        ("pga", None),
+        ("pga_ratio", FREQUENCY_BINS if np.isfinite(ds["pulse_frequency_ratio"]).any() else None),
+        ("pgv_ratio", None),
+    ]
+    spreads, medians = [], []
+    for im, bins in cases:
+        try:
+            m, s = rsim.size_class_medians(
+                ds, im, size_bins=edges, frequency_bins=bins, n_boot=n_boot
+            )
+        except ValueError as err:
+            page.text(f"Self-similarity against {im_label(im)}: {err}")
+            continue
+        for frame in (m, s):
+            frame.insert(0, "intensity", im_label(im))
+        medians.append(m)
+        spreads.append(s)
+    if not spreads:
+        return
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(medians), figsize=(4.4 * len(medians), 3.8), squeeze=False)
+    mids = np.sqrt(edges[:-1] * edges[1:])
+    for ax, m in zip(axes[0], medians, strict=True):
+        for band, sub in m.groupby(level="band", sort=False):
+            theta = sub["theta"].to_numpy(float)
+            x = mids[: theta.size]
+            ok = np.isfinite(theta) & (theta > 0)
+            if not ok.any():
+                continue
+            lo = np.where(ok, sub["theta_lo"].to_numpy(float), np.nan)
+            hi = np.where(ok, sub["theta_hi"].to_numpy(float), np.nan)
+            (line,) = ax.plot(x[ok], theta[ok], "o-", label=str(band))
+            ax.fill_between(x[ok], lo[ok], hi[ok], alpha=0.2, color=line.get_color())
+        ax.set(
+            xscale="log",
+            yscale="log",
+            xlabel="block size, geometric middle of the class R [m]",
+            ylabel=f"median capacity, {m['intensity'].iloc[0]}",
+        )
+        _log_ticks(ax)
+        _log_ticks(ax, "y")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "size_collapse",
+        "Median overturning intensity of each size class (90 % bands by resampling the "
+        "records): against PGA in g the sizes spread apart; in the record groups a flat line "
+        "is a complete collapse",
+    )
+    table = pd.concat(spreads).rename(
+        columns={
+            "ratio": "largest / smallest median",
+            "ratio_lo": "ratio, lower",
+            "ratio_hi": "ratio, upper",
+            "log_std": "std of ln median",
+            "log_std_lo": "std of ln median, lower",
+            "log_std_hi": "std of ln median, upper",
+            "classes": "size classes with a median in range",
+            "unit": "units",
+        }
+    )
+    table.index.name = "records"
+    page.table(
+        table,
+        "size_collapse",
+        "Spread of the median capacity across the size classes (1 and 0: a complete "
+        "collapse), with 90 % bands by resampling the records",
+    )
+    pd.concat(medians).to_csv(page.out / "size_class_medians.csv")
+
+
+# ------------------------------------------------------------------------------ page
+
+
+def record_report(
+    ds: xr.Dataset,
+    out,
+    title: str = "Record design",
+    description: str = "",
+    n_boot: int = 50,
+    appendix=None,
+) -> Path:
+    """Write the report of a record design into the folder ``out``; return its index.html.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`~rockstudy.study.records_designs.cloud`,
+        :func:`~rockstudy.study.records_designs.multiple_stripes` or
+        :func:`~rockstudy.study.records_designs.incremental_dynamic_analysis` (``design`` in its
+        attributes), or a result cube of the same layout.
+    out : path-like
+        Folder of the page, its PNG figures and CSV tables (created if missing).
+    title, description : str
+        Shown (escaped) at the top of the page.
+    n_boot : int
+        Resamples of the records for the bootstrapped bands.
+    appendix : callable, optional
+        Called with the page last, to add sections (a study's report adds its study file).
+    """
+    design = ds.attrs.get("design")
+    if design not in DESIGNS:
+        raise ValueError(f"ds: attrs['design'] must be one of {DESIGNS}, got {design!r}")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    page = _Page(out)
+    edges = _sizes(ds)
+    page.heading("Summary")
+    _summary(page, ds)
+    page.heading("Records")
+    _record_list(page, ds)
+    page.heading("Fragility")
+    _fragility(page, ds, edges, n_boot)
+    page.heading("Intensity-measure efficiency")
+    _efficiency(page, ds, n_boot)
+    page.heading({"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[design])
+    _responses(page, ds)
+    page.heading("Per-record breakdown")
+    _per_record(page, ds)
+    if edges is not None:
+        page.heading("Self-similarity on records")
+        _self_similarity(page, ds, edges, n_boot)
+    if appendix is not None:
+        appendix(page)
+    meta = f"<p>{html.escape(description)}</p>" if description else ""
+    return page.write(f"rockstudy report: {title}", meta)
