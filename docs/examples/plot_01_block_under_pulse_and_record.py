@@ -47,7 +47,8 @@ res = rs.simulate(block, pulse, dt_out=0.005)
 res_rec = rs.simulate(block, record, dt_out=0.005)
 largest = np.abs(res_rec.peak_rotations).argmax()
 print(f"record: {res_rec.peak_times.size} peaks, the largest "
-      f"{res_rec.peak_rotations[largest] / alpha:.3f} alpha at {res_rec.peak_times[largest]:.2f} s")
+      f"{res_rec.peak_rotations[largest] / alpha:.3f} alpha at {res_rec.peak_times[largest]:.2f} s "
+      f"(overturned: {res_rec.overturned}; a fall is not a peak)")
 
 fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=False)
 for ax, r, name in ((axes[0], res, "sine pulse"), (axes[1], res_rec, "synthetic record")):
