@@ -588,11 +588,11 @@ def _free_map_table(u, v, eta, tab, other, omega_rest):
 def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0, om0, fall, tab):
     """Rock one block (or tabulated mechanism) through one motion, from rest or (th0, om0).
 
-    mot = (kind, mp, times, samples); log = (hist, imps, peaks, dense): arrays of history
-    rows (t, theta, theta_dot), impact times and peaks (t, theta) to fill, and requested
-    times dense[:, 0] (sorted) whose states the integration writes into dense[:, 1:3] (rows
-    it does not reach keep their values: fill them with 0, the state at rest); all of
-    shape (0, ...) for none. For
+    mot = (kind, mp, times, samples); log = (hist, imps, peaks, dense): arrays to fill with
+    history rows (t, theta, theta_dot), impact times and peaks (t, theta, the maxima of
+    |theta|), and the requested times dense[:, 0] (sorted), whose states the integration
+    writes into dense[:, 1:3] (the rows it does not reach, in a rest or after a fall, keep
+    their values: fill them with 0, the state at rest); each of length 0 for none. For
     MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
     table and ``fall`` the amplitude at which it is taken to have collapsed.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
