@@ -83,6 +83,16 @@ def test_free_rocking_peaks_are_the_energy_map():
     assert np.max(np.abs(r.peak_rotations)) == pytest.approx(r.max_rotation, rel=1e-12)
 
 
+def test_history_has_points_inside_every_half_cycle():
+    # late in free rocking a whole half-cycle fits in one DOP853 step: the history must still
+    # sample its inside (it held only the two impacts, theta = 0, and drew a flat line there)
+    r = rs.simulate(BLOCK, NoMotion(), initial_rotation=THETA0)
+    inside = np.searchsorted(r.t, r.impact_times[1:], "left") - np.searchsorted(
+        r.t, r.impact_times[:-1], "right"
+    )
+    assert r.n_impacts > 50 and np.all(inside >= 3)
+
+
 @pytest.mark.filterwarnings("ignore::rockstudy.LinearizationWarning")
 @pytest.mark.parametrize("motion", ["pulse solver", "kernel"])
 def test_linearized_free_rocking_peaks_and_times_are_the_closed_form(motion):

@@ -256,12 +256,18 @@ def _push(hist, ta, t, th, om):
 
 
 @njit(cache=True)
-def _record_step(hist, ta, args, t, h, th, om, f0, th1, om1, kx, kv):
-    """Append states at 1/4, 1/2 and 3/4 of an accepted step, each by a DOP853 step from its
-    start (as accurate as the step itself), and the end of the step."""
+def _record_inside(hist, ta, args, t, h, th, om, f0, kx, kv):
+    """Append states at 1/4, 1/2 and 3/4 of [t, t + h] within an accepted step, each by a
+    DOP853 step from its start (as accurate as the step itself)."""
     for j in range(1, 4):
         x, v = _step(args, t, th, om, f0, 0.25 * j * h, kx, kv)
         _push(hist, ta, t + 0.25 * j * h, x, v)
+
+
+@njit(cache=True)
+def _record_step(hist, ta, args, t, h, th, om, f0, th1, om1, kx, kv):
+    """Append the states inside an accepted step (:func:`_record_inside`) and at its end."""
+    _record_inside(hist, ta, args, t, h, th, om, f0, kx, kv)
     _push(hist, ta, t + h, th1, om1)
 
 
@@ -390,6 +396,8 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if s_imp > 1.0 and s * th1 >= fall:
             s_ot = _root_hermite(s * fall, -s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0)
             _dense(dense, ta, args, t, t + s_ot * hs, th, om, f0, kx, kv)
+            if rec:
+                _record_inside(hist, ta, args, t, s_ot * hs, th, om, f0, kx, kv)
             om = hermite5(s_ot, hs, th, om, f0, th1, om1, f1)[1]
             t = t + s_ot * hs
             th = s * fall
@@ -416,6 +424,8 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
                 continue
             dl = min(max(s_imp * hs + dl, 0.0), hs) - s_imp * hs
         _dense(dense, ta, args, t, t + s_imp * hs + dl, th, om, f0, kx, kv)
+        if rec:  # a whole half-cycle can fit in this step: its inside, up to the impact
+            _record_inside(hist, ta, args, t, s_imp * hs + dl, th, om, f0, kx, kv)
         t = t + s_imp * hs + dl
         om_pre = v + a * dl
         om = eta * om_pre  # eq. (2.3) of [000], once per impact
