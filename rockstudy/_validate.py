@@ -78,3 +78,35 @@ def max_steps(value) -> int:
     if not (math.isfinite(value) and value == int(value) and 1 <= value <= MAX_STEPS_MAX):
         raise ValueError(f"max_steps must be a whole number in [1, 1e12], got {value!r}")
     return int(value)
+
+
+def output_times(t_eval, dt_out, t_max) -> np.ndarray | None:
+    """Return the requested output times of a simulation as a sorted float array (None for
+    none), or raise: ``t_eval`` must be finite, >= 0, non-decreasing and at most ``t_max``
+    [s] when that is given; ``dt_out`` [s] > 0 asks for the uniform grid 0, dt_out, ...
+    up to ``t_max`` (or, without it, to the end of the response, which the caller finds)."""
+    if t_eval is not None and dt_out is not None:
+        raise ValueError("give t_eval or dt_out, not both")
+    if dt_out is not None:
+        dt_out = positive("dt_out", dt_out)
+        return None if t_max is None else uniform_times(dt_out, t_max)
+    if t_eval is None:
+        return None
+    arr = finite_array("t_eval", t_eval)
+    if arr[0] < 0.0:
+        raise ValueError(f"t_eval must be >= 0 (the motion starts at t = 0), got {arr[0]!r}")
+    down = np.flatnonzero(np.diff(arr) < 0.0)
+    if down.size:
+        raise ValueError(
+            f"t_eval must be sorted (non-decreasing); it decreases at index {down[0] + 1}"
+        )
+    if t_max is not None and arr[-1] > t_max:
+        raise ValueError(
+            f"t_eval reaches {arr[-1]!r} s, beyond the simulated end t_max = {t_max!r} s"
+        )
+    return arr
+
+
+def uniform_times(dt_out: float, end: float) -> np.ndarray:
+    """The times k dt_out [s] in [0, end]."""
+    return np.minimum(dt_out * np.arange(int(math.floor(end / dt_out)) + 1), end)

@@ -59,6 +59,7 @@ def _simulate(args) -> int:
         rtol=args.rtol,
         initial_rotation=args.initial_rotation,
         initial_velocity=args.initial_velocity,
+        dt_out=args.dt_out,
     )
     if args.out:
         _write_history(res, Path(args.out))
@@ -70,6 +71,7 @@ def _simulate(args) -> int:
         "first": float(impacts[0]) if impacts.size else None,
         "last": float(impacts[-1]) if impacts.size else None,
     }
+    summary["peaks"] = _peaks_summary(res)
     inputs = {
         "half_diagonal": block.half_diagonal,
         "slenderness": block.slenderness,
@@ -81,6 +83,7 @@ def _simulate(args) -> int:
         "rtol": args.rtol,
         "initial_rotation": args.initial_rotation,
         "initial_velocity": args.initial_velocity,
+        "dt_out": args.dt_out,
     }
     if args.json:
         print(json.dumps({"inputs": inputs, "result": summary}, indent=2))
@@ -90,6 +93,19 @@ def _simulate(args) -> int:
         if args.out:
             print(f"wrote {args.out}")
     return 0
+
+
+def _peaks_summary(res) -> dict:
+    """The count of the peaks and the largest (by |theta|), with its time."""
+    peaks = res.peak_rotations
+    if peaks is None or not peaks.size:
+        return {"count": 0, "largest_rotation": None, "largest_time": None}
+    k = int(abs(peaks).argmax())
+    return {
+        "count": int(peaks.size),
+        "largest_rotation": float(peaks[k]),
+        "largest_time": float(res.peak_times[k]),
+    }
 
 
 def _positive_int(text: str) -> int:
@@ -326,7 +342,17 @@ def main(argv=None) -> int:
         help="the model and solver",
     )
     sim.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance")
-    sim.add_argument("--out", help="write the history to this .csv or .nc (netCDF) file")
+    sim.add_argument(
+        "--out",
+        help="write the history to this .csv or .nc file (netCDF: with the peaks, and the "
+        "--dt-out grid beside the history; CSV: the --dt-out grid instead of the history)",
+    )
+    sim.add_argument(
+        "--dt-out",
+        type=float,
+        help="also give the state on the uniform grid 0, dt, 2 dt, ... [s] to the end of the "
+        "response, each point as accurate as the integrator's steps (default: none)",
+    )
     sim.add_argument(
         "--json", action="store_true", help="print the inputs and the outcomes as JSON"
     )

@@ -134,11 +134,17 @@ def _next_break(x, r0):
     return base + math.pi + r0
 
 
+#: Kind (last column) of a row of the phase log: a phase (ending in an impact or not), a peak.
+ROW_PHASE, ROW_IMPACT, ROW_PEAK = 0.0, 1.0, 2.0
+
+
 @njit(cache=True, inline="always")
 def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
-    """Append a row (tau0, tau1, A, B, s, q, ends in an impact) to the phase log, if it has room.
+    """Append a row (tau0, tau1, A, B, s, q, kind) to the phase log, if it has room: kind
+    ROW_IMPACT (1) for a phase that ends in an impact, ROW_PHASE (0) for one that does not,
+    ROW_PEAK (2) for a peak (tau, theta in the first two columns).
 
-    Row 0 holds the number of phases (also those that did not fit).
+    Row 0 holds the number of rows (also those that did not fit).
     """
     n = int(rec[0, 0])
     if n + 1 < rec.shape[0]:
@@ -199,7 +205,10 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
             end = s_imp if s_imp >= 0.0 else sb
             if va >= 0.0 and _u(1, A, B, c, W, x0, alpha, s, end) <= 0.0:
                 s_pk = _root(1, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, end)
-                ta[_MAXU] = max(ta[_MAXU], _u(0, A, B, c, W, x0, alpha, s, s_pk))
+                u_pk = _u(0, A, B, c, W, x0, alpha, s, s_pk)
+                ta[_MAXU] = max(ta[_MAXU], u_pk)
+                if log:
+                    _log_phase(rec, tau0 + s_pk, s * u_pk, 0.0, 0.0, s, q, ROW_PEAK)
             if s_imp >= 0.0:
                 break
             if ub >= FALL_ROTATION:
@@ -286,8 +295,8 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
 
     With ``use_map`` the free rocking after the pulse is mapped, otherwise it is followed in
     closed form until rest, overturning or ``t_tail`` [s]. ``rec`` is the phase log of
-    :func:`_trig_phase`. Returns (status, max rotation, overturned, impacts, overturning time
-    [s], first impact time [s]).
+    :func:`_trig_phase` (with its peaks). Returns (status, max rotation, overturned, impacts,
+    overturning time [s], first impact time [s]).
     """
     a_g, w, ph, dur = mp[0], mp[1], mp[2], mp[3]
     q = a_g / G
@@ -364,26 +373,65 @@ def trig_batch(p, alpha, eta, mp):
     return out
 
 
+def _phase_state(row, sig, p, alpha, W, phase):
+    """theta [rad] and theta_dot [rad/s] at sigma = tau - tau0 in a logged phase (eq. 3.4 of
+    [000], the closed form of the module docstring)."""
+    tau0, _, A, B, s, q, _ = row
+    c = q / (1.0 + W * W)
+    x = (W * tau0 + phase if q != 0.0 else 0.0) + W * sig
+    em, ep = np.exp(-sig), np.exp(sig)
+    return alpha * s + c * np.sin(x) + A * em + B * ep, p * (c * W * np.cos(x) - A * em + B * ep)
+
+
+def _phases(rec):
+    """The phase rows of a log (without the peaks)."""
+    rows = rec[1 : int(rec[0, 0]) + 1]
+    return rows[rows[:, 6] != ROW_PEAK]
+
+
 def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40):
     """Evaluate a phase log on a dense grid: (t [s], theta [rad], theta_dot [rad/s], impacts [s]).
 
     Each phase is sampled at ``points_per_unit`` points per unit of tau = p t (at least 8), and
     at both ends, so impacts appear twice (before and after the jump of theta_dot).
     """
-    n = int(rec[0, 0])
     ts, ths, oms = [np.zeros(1)], [np.full(1, x0[0])], [np.full(1, x0[1])]
     W = omega / p
-    for tau0, tau1, A, B, s, q, _ in rec[1 : n + 1]:
+    phases = _phases(rec)
+    for row in phases:
+        tau0, tau1 = row[0], row[1]
         m = max(8, int(np.ceil((tau1 - tau0) * points_per_unit)))
         sig = np.linspace(0.0, tau1 - tau0, m + 1)
-        c = q / (1.0 + W * W)
-        x = (W * tau0 + phase if q != 0.0 else 0.0) + W * sig
-        em, ep = np.exp(-sig), np.exp(sig)
+        th, om = _phase_state(row, sig, p, alpha, W, phase)
         ts.append((tau0 + sig) / p)
-        ths.append(alpha * s + c * np.sin(x) + A * em + B * ep)
-        oms.append(p * (c * W * np.cos(x) - A * em + B * ep))
-    impacts = rec[1 : n + 1][rec[1 : n + 1, 6] == 1.0, 1] / p
+        ths.append(th)
+        oms.append(om)
+    impacts = phases[phases[:, 6] == ROW_IMPACT, 1] / p
     return np.concatenate(ts), np.concatenate(ths), np.concatenate(oms), impacts
+
+
+def phase_peaks(rec, p):
+    """The peaks of a phase log: (times [s], signed rotations [rad])."""
+    rows = rec[1 : int(rec[0, 0]) + 1]
+    peaks = rows[rows[:, 6] == ROW_PEAK]
+    return peaks[:, 0] / p, peaks[:, 1].copy()
+
+
+def phase_states(rec, p, alpha, omega, phase, t_eval, x0=(0.0, 0.0)):
+    """The state at the times ``t_eval`` [s] from a phase log, by the closed form: (theta
+    [rad], theta_dot [rad/s]). A time on an impact gets the state just before it; a time that
+    no phase covers falls in a rest, (0, 0) (the caller marks those after an overturning)."""
+    theta, theta_dot = np.zeros(t_eval.size), np.zeros(t_eval.size)
+    start = t_eval == 0.0
+    theta[start], theta_dot[start] = x0
+    W = omega / p
+    tau = p * t_eval
+    for row in _phases(rec)[::-1]:  # backwards: on a shared end the earlier phase wins
+        inside = (tau >= row[0]) & (tau <= row[1])
+        theta[inside], theta_dot[inside] = _phase_state(
+            row, tau[inside] - row[0], p, alpha, W, phase
+        )
+    return theta, theta_dot
 
 
 # ------------------------------------------------- records: piecewise-linear ground acceleration

@@ -269,8 +269,9 @@ def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
 
 # Per-scene work arrays: the rocking state ...
 T, TH, OM, SIDE, H = 0, 1, 2, 3, 4
-# ... and the running tallies (counts are stored as floats)
-MAXU, NIMP, WORK, NH, NI, FIRST = 0, 1, 2, 3, 4, 5
+# ... and the running tallies (counts are stored as floats): max u, impacts, DOP853 steps,
+# history rows, impact times, first impact time, peaks, next requested time (dense output)
+MAXU, NIMP, WORK, NH, NI, FIRST, NP, NE = 0, 1, 2, 3, 4, 5, 6, 7
 
 
 @njit(cache=True)
@@ -285,13 +286,50 @@ def _push(hist, ta, t, th, om):
 
 
 @njit(cache=True)
-def _record_step(hist, ta, args, t, h, th, om, f0, th1, om1, kx, kv):
-    """Append states at 1/4, 1/2 and 3/4 of an accepted step, each by a DOP853 step from its
-    start (as accurate as the step itself), and the end of the step."""
+def _record_inside(hist, ta, args, t, h, th, om, f0, kx, kv):
+    """Append states at 1/4, 1/2 and 3/4 of [t, t + h] within an accepted step, each by a
+    DOP853 step from its start (as accurate as the step itself)."""
     for j in range(1, 4):
         x, v = _step(args, t, th, om, f0, 0.25 * j * h, kx, kv)
         _push(hist, ta, t + 0.25 * j * h, x, v)
+
+
+@njit(cache=True)
+def _record_step(hist, ta, args, t, h, th, om, f0, th1, om1, kx, kv):
+    """Append the states inside an accepted step (:func:`_record_inside`) and at its end."""
+    _record_inside(hist, ta, args, t, h, th, om, f0, kx, kv)
     _push(hist, ta, t + h, th1, om1)
+
+
+@njit(cache=True)
+def _peak(peaks, ta, t_lo, t_hi, t, th, om, acc):
+    r"""The peak near (t, theta, theta_dot, theta_ddot) by one Newton step on theta_dot = 0:
+    :math:`t_p = t - \dot\theta / \ddot\theta` (kept in [t_lo, t_hi], its step) and
+    :math:`\theta_p = \theta - \dot\theta^2 / (2 \ddot\theta)`. Appends (t_p, theta_p) to
+    ``peaks`` if there is room (always counted, so overflow is detectable); returns theta_p."""
+    if acc != 0.0:
+        t = min(max(t - om / acc, t_lo), t_hi)
+        th = th - 0.5 * om * om / acc
+    n = int(ta[NP])
+    if n < peaks.shape[0]:
+        peaks[n, 0] = t
+        peaks[n, 1] = th
+    ta[NP] = n + 1
+    return th
+
+
+@njit(cache=True)
+def _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv):
+    """Dense output on an accepted step from (t, theta, theta_dot) to t_end: the state at
+    each requested time dense[j, 0] in [t, t_end] not yet served, by one DOP853 step from t
+    (as accurate as the step), into dense[j, 1:3]. Requested times before t fall in a rest
+    and keep the (0, 0) they hold; a time on an impact gets the state just before it."""
+    j = int(ta[NE])
+    while j < dense.shape[0] and dense[j, 0] <= t_end:
+        if dense[j, 0] >= t:
+            dense[j, 1], dense[j, 2] = _step(args, t, th, om, f0, dense[j, 0] - t, kx, kv)
+        j += 1
+    ta[NE] = j
 
 
 @njit(cache=True)
@@ -336,14 +374,15 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
     blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
-    mot = (kind, mp, times, samples, vsamples), log = (hist, imps) (empty arrays: no history).
+    mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
+    :func:`scene`).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact).
     """
     p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
     kind, mp, times, samples, vsamples = mot
-    hist, imps = log
+    hist, imps, peaks, dense = log
     rec = hist.shape[0] > 0
     t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
     dur = mp[3]
@@ -394,9 +433,12 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if s_pk >= 0.0:  # peak: theta_peak = theta - theta_dot^2 / (2 theta_ddot), one Newton
             ta[WORK] += 1
             x, v, a = _true_state(args, t, th, om, f0, s_pk * hs, kx, kv)
-            ta[MAXU] = max(ta[MAXU], s * (x - 0.5 * v * v / a) if a != 0.0 else s * x)
+            ta[MAXU] = max(ta[MAXU], s * _peak(peaks, ta, t, t1, t + s_pk * hs, x, v, a))
         if s_imp > 1.0 and s * th1 >= fall:
             s_ot = _root_hermite(s * fall, -s, False, hs, th, om, f0, th1, om1, f1, 0.0, 1.0)
+            _dense(dense, ta, args, t, t + s_ot * hs, th, om, f0, kx, kv)
+            if rec:
+                _record_inside(hist, ta, args, t, s_ot * hs, th, om, f0, kx, kv)
             om = hermite5(s_ot, hs, th, om, f0, th1, om1, f1)[1]
             t = t + s_ot * hs
             th = s * fall
@@ -407,6 +449,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             break
         if s_imp > 1.0:
             ta[MAXU] = max(ta[MAXU], s * th1)
+            _dense(dense, ta, args, t, t1, th, om, f0, kx, kv)
             if rec:
                 _record_step(hist, ta, args, t, hs, th, om, f0, th1, om1, kx, kv)
             t, th, om, f0 = t1, th1, om1, f1
@@ -421,6 +464,9 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
                 h = 0.25 * hs  # retry with a shorter step
                 continue
             dl = min(max(s_imp * hs + dl, 0.0), hs) - s_imp * hs
+        _dense(dense, ta, args, t, t + s_imp * hs + dl, th, om, f0, kx, kv)
+        if rec:  # a whole half-cycle can fit in this step: its inside, up to the impact
+            _record_inside(hist, ta, args, t, s_imp * hs + dl, th, om, f0, kx, kv)
         t = t + s_imp * hs + dl
         om_pre = v + a * dl
         om = eta * om_pre  # eq. (2.3) of [000], once per impact
@@ -595,11 +641,15 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     """Rock one block (or tabulated mechanism) through one motion, from rest or (th0, om0).
 
     mot = (kind, mp, times, samples, vsamples) (see :mod:`rockstudy.motions._kernels`);
-    log = (hist, imps), empty arrays for no history. For
+    log = (hist, imps, peaks, dense): arrays to fill with
+    history rows (t, theta, theta_dot), impact times and peaks (t, theta, the maxima of
+    |theta|), and the requested times dense[:, 0] (sorted), whose states the integration
+    writes into dense[:, 1:3] (the rows it does not reach, in a rest or after a fall, keep
+    their values: fill them with 0, the state at rest); each of length 0 for none. For
     MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
     table and ``fall`` the amplitude at which it is taken to have collapsed.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
-    impact times recorded, DOP853 steps, first impact time).
+    impact times recorded, DOP853 steps, first impact time, peaks logged).
     """
     kind, mp, times, samples, vsamples = mot
     omega_rest = REST_FRACTION * p * alpha
@@ -609,7 +659,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     dur = mp[3]
     at_rest = th0 == 0.0 and om0 == 0.0
     st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
-    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan])
+    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END
@@ -655,8 +705,8 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
     over = code == PH_OVER
     t_ot = st[T] if over else np.nan
-    nh, ni = int(ta[NH]), int(ta[NI])
-    return status, ta[MAXU], over, int(ta[NIMP]), t_ot, nh, ni, int(ta[WORK]), ta[FIRST]
+    nh, ni, n_pk = int(ta[NH]), int(ta[NI]), int(ta[NP])
+    return status, ta[MAXU], over, int(ta[NIMP]), t_ot, nh, ni, int(ta[WORK]), ta[FIRST], n_pk
 
 
 #: Columns of the batch output array.
@@ -679,7 +729,7 @@ def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, 
     Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
     """
     out = np.empty((p.shape[0], 7))
-    no_log = (np.empty((0, 3)), np.empty(0))
+    no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
     for i in prange(p.shape[0]):
         mot = (kind, mp[i], times, samples, vsamples)
         r = scene(

@@ -70,6 +70,7 @@ def simulate_reference(
     initial_state=(0.0, 0.0),
     free_map=False,
     max_impacts=20000,
+    t_eval=None,
 ):
     """Integrate one scene with ``solve_ivp`` and events.
 
@@ -94,11 +95,20 @@ def simulate_reference(
         After the motion ends, use the closed-form free-rocking map of the kernels instead of
         integrating (integrating on only if the block overturns). This is the scipy path with
         the same algorithm as the kernels, for a like-for-like timing.
+    t_eval : ndarray, optional
+        Sorted times [s] at which to return the state, from ``solve_ivp``'s dense output
+        (not with ``free_map``): (0, 0) at rest, the state just before an impact at its time,
+        NaN after an overturning.
 
     Returns
     -------
-    dict with keys t, theta, theta_dot, max_rotation, overturned, impact_times, overturn_time.
+    dict with keys t, theta, theta_dot, max_rotation, overturned, impact_times, overturn_time,
+    peak_times and peak_rotations (the maxima of |theta|, by scipy's event location), and
+    with ``t_eval`` also t_eval, theta_eval and theta_dot_eval.
     """
+    if free_map and t_eval is not None:
+        raise ValueError("t_eval needs the free rocking integrated: free_map=False")
+    dense = _Dense(t_eval)
     acc = _scalar_acceleration(motion)
     _, mp, _, _, vsamples = motion.kernel_spec()
     refuse_free_fall(vsamples, mp[0])
@@ -126,7 +136,7 @@ def simulate_reference(
         return [y[1], -p * p * (gv * math.sin(x) + a * math.cos(x))]
 
     th, om = (float(x) for x in initial_state)
-    ts, ths, oms, impacts = [0.0], [th], [om], []
+    ts, ths, oms, impacts, peaks = [0.0], [th], [om], [], []
     max_u = abs(th)
     t = 0.0
     at_rest = th == 0.0 and om == 0.0
@@ -146,7 +156,7 @@ def simulate_reference(
             over, peak, n_post = free_rocking_map(s * th, s * om, p, alpha, eta, model, omega_rest)
             if not over:
                 impacts.extend([math.nan] * n_post)
-                return _pack(ts, ths, oms, max(max_u, peak), False, impacts, math.nan)
+                return _pack(ts, ths, oms, max(max_u, peak), False, impacts, math.nan, peaks)
         if t < dur:  # records: stop at every sample, where u_g'' has a kink
             stop = dur if breaks is None else breaks[np.searchsorted(breaks, t, side="right")]
         else:
@@ -175,17 +185,20 @@ def simulate_reference(
             rtol=rtol,
             atol=atol,
             events=(impact, fall, peak),
+            dense_output=dense.wanted,
         )
         if sol.status < 0:
             raise RuntimeError(f"solve_ivp failed: {sol.message}")
         end = -1 if sol.status == 1 else None  # the event row is added below, exactly
         ts.extend(sol.t[1:end]), ths.extend(sol.y[0, 1:end]), oms.extend(sol.y[1, 1:end])
+        dense.fill(sol.sol, t, float(sol.t[-1]))  # (a terminal event's time, if one came)
         if sol.y_events[2].size:
             max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
+            peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
         if sol.t_events[1].size:
             t_ot = float(sol.t_events[1][0])
             ts.append(t_ot), ths.append(s * FALL_ROTATION), oms.append(sol.y_events[1][0, 1])
-            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, t_ot)
+            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, t_ot, peaks, dense)
         if sol.t_events[0].size:
             t = float(sol.t_events[0][0])
             om_pre = float(sol.y_events[0][0, 1])
@@ -209,11 +222,45 @@ def simulate_reference(
         max_u = max(max_u, s * th)
         if t >= t_end:
             break
-    return _pack(ts, ths, oms, max_u, False, impacts, math.nan)
+    return _pack(ts, ths, oms, max_u, False, impacts, math.nan, peaks, dense)
 
 
-def _pack(ts, ths, oms, max_u, over, impacts, t_ot):
+class _Dense:
+    """Dense output of the reference: the requested times, the states found so far ((0, 0)
+    for those in a rest) and the next time to serve."""
+
+    def __init__(self, t_eval):
+        self.wanted = t_eval is not None
+        self.t = np.asarray(t_eval if self.wanted else [], dtype=float)
+        self.y = np.zeros((2, self.t.size))
+        self.next = 0
+
+    def fill(self, sol, t0, t1):
+        """The requested times in [t0, t1] not yet served, from the interpolant ``sol``."""
+        stop = int(np.searchsorted(self.t, t1, side="right"))
+        if stop <= self.next:
+            return
+        inside = np.arange(self.next, stop)
+        inside = inside[self.t[inside] >= t0]
+        if inside.size:
+            self.y[:, inside] = sol(self.t[inside])
+        self.next = stop
+
+    def fields(self, t_ot):
+        """The dense-output keys of the result; NaN after an overturning at ``t_ot``."""
+        if not self.wanted:
+            return {}
+        y = self.y.copy()
+        y[:, self.t > t_ot] = np.nan
+        return {"t_eval": self.t, "theta_eval": y[0], "theta_dot_eval": y[1]}
+
+
+def _pack(ts, ths, oms, max_u, over, impacts, t_ot, peaks, dense=None):
+    peaks = np.array(peaks, dtype=float).reshape(-1, 2)
     return {
+        "peak_times": peaks[:, 0],
+        "peak_rotations": peaks[:, 1],
+        **(dense.fields(t_ot) if dense is not None else {}),
         "t": np.asarray(ts),
         "theta": np.asarray(ths),
         "theta_dot": np.asarray(oms),

@@ -6,6 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+#: The optional arrays of a result (peaks and dense output), in field order.
+_OPTIONAL_ARRAYS = ("peak_times", "peak_rotations", "t_eval", "theta_eval", "theta_dot_eval")
+
 
 @dataclass(frozen=True)
 class RockingResult:
@@ -42,6 +45,21 @@ class RockingResult:
         what ran (``frequency_parameter`` p [rad/s], ``critical_rotation`` [rad]: alpha for a
         block, theta_cr for a structure, ``restitution``), ``motion`` (a description),
         ``rtol_requested`` and the initial conditions.
+    peak_times, peak_rotations : ndarray or None
+        The peaks of the response: every local maximum of |theta| (theta_dot = 0 with the
+        block swinging back towards its pivot), during the motion and in the free rocking
+        after it, as its time [s] and its signed rotation theta [rad] (positive on the
+        positive pivot), in time order, each located by the method itself (see
+        :func:`rockstudy.simulate`), not read off the history. A rotation at t = 0 counts
+        as a peak when the block is released there at rest (theta_dot = 0). Not listed:
+        the minima of |theta| (impacts, or rarely a dip under forcing without one) and
+        the fall of a block that overturns. ``None`` when the producer did not locate
+        peaks.
+    t_eval, theta_eval, theta_dot_eval : ndarray or None
+        Dense output, when asked for (``simulate(..., t_eval=...)`` or ``dt_out=``): the
+        requested times [s] and the state there [rad, rad/s], as accurate as the method's
+        own steps. At rest the state is (0, 0); at an impact, the state just before it;
+        after an overturning, NaN (the model ends there).
     """
 
     t: np.ndarray
@@ -53,6 +71,11 @@ class RockingResult:
     overturn_time: float
     method: str
     info: dict = field(default_factory=dict)
+    peak_times: np.ndarray | None = None
+    peak_rotations: np.ndarray | None = None
+    t_eval: np.ndarray | None = None
+    theta_eval: np.ndarray | None = None
+    theta_dot_eval: np.ndarray | None = None
 
     @property
     def n_impacts(self) -> int:
@@ -72,6 +95,7 @@ class RockingResult:
             r["overturn_time"],
             method,
             info or {},
+            *(r.get(k) for k in _OPTIONAL_ARRAYS),
         )
 
     def __repr__(self) -> str:
@@ -111,6 +135,7 @@ class RockingResult:
         coordinate = self.info.get("coordinate", "rotation of the block")
         ds = xr.Dataset(
             {
+                **self._peaks_and_dense(coordinate),
                 "theta": ("time", self.theta, {"units": "rad", "long_name": coordinate}),
                 "theta_dot": (
                     "time",
@@ -128,16 +153,75 @@ class RockingResult:
         )
         return ds
 
-    def to_dataframe(self):
-        """The history as a :class:`pandas.DataFrame`: columns ``t`` [s], ``theta`` [rad] and
-        ``theta_dot`` [rad/s] (an impact's time appears twice: before and after it)."""
+    def _peaks_and_dense(self, coordinate) -> dict:
+        """The peaks (on a ``peak`` dimension) and the dense output (on ``time_eval``) as
+        Dataset variables, those the result has."""
+        out = {}
+        if self.peak_times is not None:
+            out["peak_time"] = (
+                "peak",
+                self.peak_times,
+                {"units": "s", "long_name": "time of a peak"},
+            )
+            out["peak_rotation"] = (
+                "peak",
+                self.peak_rotations,
+                {"units": "rad", "long_name": f"{coordinate} at a peak (signed)"},
+            )
+        if self.t_eval is not None:
+            te = {"units": "s", "long_name": "requested time (dense output)"}
+            out["theta_eval"] = (
+                "time_eval",
+                self.theta_eval,
+                {"units": "rad", "long_name": f"{coordinate} at the requested times"},
+            )
+            out["theta_dot_eval"] = (
+                "time_eval",
+                self.theta_dot_eval,
+                {
+                    "units": "rad s-1",
+                    "long_name": f"rate of the {coordinate} at the requested times",
+                },
+            )
+            out["time_eval"] = ("time_eval", self.t_eval, te)
+        return out
+
+    def to_dataframe(self, part=None):
+        """A :class:`pandas.DataFrame` of one part of the result.
+
+        Parameters
+        ----------
+        part : {"history", "dense", "peaks"}, optional
+            ``"history"``: columns ``t`` [s], ``theta`` [rad] and ``theta_dot`` [rad/s] (an
+            impact's time appears twice: before and after it). ``"dense"``: the same columns
+            at the requested times of ``simulate(..., t_eval=)``. ``"peaks"``: columns ``t``
+            [s] and ``theta`` [rad] of the peaks. Default: ``"dense"`` when the result has a
+            dense output, else ``"history"``.
+        """
         import pandas as pd
 
-        return pd.DataFrame({"t": self.t, "theta": self.theta, "theta_dot": self.theta_dot})
+        if part is None:
+            part = "history" if self.t_eval is None else "dense"
+        if part == "history":
+            return pd.DataFrame({"t": self.t, "theta": self.theta, "theta_dot": self.theta_dot})
+        if part == "dense" and self.t_eval is not None:
+            return pd.DataFrame(
+                {"t": self.t_eval, "theta": self.theta_eval, "theta_dot": self.theta_dot_eval}
+            )
+        if part == "peaks" and self.peak_times is not None:
+            return pd.DataFrame({"t": self.peak_times, "theta": self.peak_rotations})
+        if part in ("dense", "peaks"):
+            raise ValueError(
+                f"part={part!r}: this result has no "
+                + ("dense output (simulate(..., t_eval=...))" if part == "dense" else "peaks")
+            )
+        raise ValueError(f"part must be 'history', 'dense' or 'peaks', got {part!r}")
 
     def plot(self, ax=None):
         """Draw theta / theta_cr against t, the impacts as dotted verticals and the
-        overturning as a cross; return the matplotlib axes. Without ``info
+        overturning as a cross; return the matplotlib axes. The curve passes through the
+        exact peaks and the dense output, smooth between the history's points (their cubic
+        Hermite interpolant in theta and theta_dot). Without ``info
         ["critical_rotation"]`` theta is drawn in rad."""
         if ax is None:
             import matplotlib.pyplot as plt
@@ -145,7 +229,8 @@ class RockingResult:
             ax = plt.figure().add_subplot()
         crit = self.info.get("critical_rotation")
         scale = crit if crit else 1.0
-        ax.plot(self.t, self.theta / scale, lw=1, label="rotation")
+        t, theta = self._curve()
+        ax.plot(t, theta / scale, lw=1, label="rotation")
         for k, ti in enumerate(self.impact_times):
             ax.axvline(ti, color="0.6", ls=":", lw=0.8, label="impacts" if k == 0 else None)
         if self.overturned and np.isfinite(self.overturn_time):
@@ -162,6 +247,39 @@ class RockingResult:
         )
         ax.legend(fontsize=8)
         return ax
+
+    def _curve(self, per_interval=8):
+        """(t, theta) to draw: the history with the exact peaks and the dense output merged
+        in, in time order, and ``per_interval`` points between each two of them on the cubic
+        Hermite interpolant of (theta, theta_dot). The drawn curve passes through the true
+        peaks, with no corners (the history alone is sampled at a quarter of each step, up to
+        0.03 s apart in free rocking, and cuts the peaks)."""
+        parts = [(self.t, self.theta, self.theta_dot)]
+        if self.peak_times is not None:  # theta_dot = 0 there
+            parts.insert(0, (self.peak_times, self.peak_rotations, 0.0 * self.peak_times))
+        if self.t_eval is not None:
+            ok = np.isfinite(self.theta_eval)
+            parts.insert(0, (self.t_eval[ok], self.theta_eval[ok], self.theta_dot_eval[ok]))
+        # a stable sort with the history last: at an impact its two rows (before and after the
+        # jump of theta_dot) stay together, after any other point at that time
+        t, y, d = (np.concatenate(c) for c in zip(*parts, strict=True))
+        order = np.argsort(t, kind="stable")
+        t, y, d = t[order], y[order], d[order]
+        h = np.diff(t)[:, None]
+        s = np.linspace(0.0, 1.0, per_interval + 2)[1:-1][None, :]
+        between = (
+            (2 * s**3 - 3 * s**2 + 1) * y[:-1, None]
+            + (s**3 - 2 * s**2 + s) * h * d[:-1, None]
+            + (3 * s**2 - 2 * s**3) * y[1:, None]
+            + (s**3 - s**2) * h * d[1:, None]
+        )
+        t_all = np.concatenate([t[:-1, None], t[:-1, None] + s * h], axis=1)
+        y_all = np.concatenate([y[:-1, None], between], axis=1)
+        keep = np.concatenate([np.ones((h.size, 1), bool), np.repeat(h > 0, s.size, 1)], axis=1)
+        return (
+            np.append(t_all[keep], t[-1:]),
+            np.append(y_all[keep], y[-1:]),
+        )
 
     def summary(self) -> dict:
         """The scalar outcomes as a JSON-ready dict."""

@@ -47,14 +47,20 @@ def _kernel(
     x0,
     fall=FALL_ROTATION,
     tab=_rocking.NO_TABLE,
+    t_eval=None,
 ):
     kind, mp, times, samples, vsamples = motion.kernel_spec()
     t_tail = _tail_end(p, eta, motion, t_max)
+    _check_end(t_eval, t_tail)
     cap = 4096
     while True:
         hist = np.empty((cap, 3))
         imps = np.empty(cap)
-        status, max_rot, over, n_imp, t_ot, nh, ni, work, _ = _rocking.scene(
+        peaks = np.empty((cap, 2))
+        dense = np.zeros((0 if t_eval is None else t_eval.size, 3))  # (0, 0): at rest
+        if t_eval is not None:
+            dense[:, 0] = t_eval
+        status, max_rot, over, n_imp, t_ot, nh, ni, work, _, n_pk = _rocking.scene(
             p,
             alpha,
             eta,
@@ -63,14 +69,14 @@ def _kernel(
             rtol,
             False,
             t_tail,
-            (hist, imps),
+            (hist, imps, peaks, dense),
             max_steps,
             x0[0],
             x0[1],
             fall,
             tab,
         )
-        if nh <= cap and ni <= cap:
+        if nh <= cap and ni <= cap and n_pk <= cap:
             break
         cap *= 4
     if status == _rocking.STATUS_MAX_STEPS:
@@ -85,16 +91,43 @@ def _kernel(
         float(t_ot),
         method,
         {"dop853_steps": int(work)},
+        peaks[:n_pk, 0].copy(),
+        peaks[:n_pk, 1].copy(),
+        **_dense_fields(t_eval, dense[:, 1], dense[:, 2], over, t_ot),
     )
 
 
-def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+def _check_end(t_eval, end):
+    """Refuse requested times beyond the end of the history ``end`` [s] (before the run)."""
+    if t_eval is not None and t_eval.size and t_eval[-1] > end:
+        raise ValueError(
+            f"t_eval reaches {t_eval[-1]!r} s, beyond the simulated end {end!r} s (a block "
+            "that never comes to rest, restitution 1, is followed for 100 / p after the "
+            "motion: give t_max to follow it longer)"
+        )
+
+
+def _dense_fields(t_eval, theta, theta_dot, over, t_ot) -> dict:
+    """The dense-output fields of a RockingResult: none without ``t_eval``; NaN after an
+    overturning at ``t_ot`` [s] (the model ends there)."""
+    if t_eval is None:
+        return {}
+    theta, theta_dot = np.array(theta, dtype=float), np.array(theta_dot, dtype=float)
+    if over:
+        theta[t_eval > t_ot] = np.nan
+        theta_dot[t_eval > t_ot] = np.nan
+    return {"t_eval": t_eval, "theta_eval": theta, "theta_dot_eval": theta_dot}
+
+
+def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, t_eval=None):
     """Exact piecewise solution for trigonometric pulses; the kernel for other motions (also
     for a record with a vertical component, which the constant-coefficient closed forms
-    cannot take: said in ``info["solver"]``)."""
+    cannot take: said in ``info["solver"]``). Peaks and the dense output are the closed
+    form's (eq. 3.4 of [000])."""
     kind, mp, _, _, vsamples = motion.kernel_spec()
     if kind != mk.KIND_TRIG:
-        r = _kernel(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        args = (p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        r = _kernel(*args, t_eval=t_eval)
         if vsamples.size:
             r.info["solver"] = (
                 "DOP853 kernel of the linearized eq. (3.1) of [000] with gravity g + u_v'' "
@@ -102,6 +135,7 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
             )
         return r
     t_tail = _tail_end(p, eta, motion, t_max)
+    _check_end(t_eval, t_tail)
     cap = 1024
     while True:
         rec = np.zeros((cap, 7))
@@ -112,6 +146,10 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
             break
         cap *= 4
     t, th, om, impacts = _linear.phase_history(rec, p, alpha, mp[1], mp[2], x0)
+    dense = {}
+    if t_eval is not None:
+        th_e, om_e = _linear.phase_states(rec, p, alpha, mp[1], mp[2], t_eval, x0)
+        dense = _dense_fields(t_eval, th_e, om_e, over, t_ot)
     return RockingResult(
         t,
         th,
@@ -122,6 +160,8 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
         float(t_ot),
         method,
         {"solver": "exact piecewise (eq. 3.4 of [000])"},
+        *_linear.phase_peaks(rec, p),
+        **dense,
     )
 
 
@@ -132,10 +172,10 @@ def _tail_end(p, eta, motion, t_max):
     return _rocking.free_tail_end(p, eta, motion.duration)
 
 
-def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l=1e-4):
+def _complex(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, l=1e-4, t_eval=None):
     from .complex import simulate_complex
 
-    r = simulate_complex(p, alpha, eta, motion, l=l, rtol=rtol, t_end=t_max, x0=x0)
+    r = simulate_complex(p, alpha, eta, motion, l=l, rtol=rtol, t_end=t_max, x0=x0, t_eval=t_eval)
     return RockingResult.from_dict(r, method, {"l": l, "rk45_steps": r["steps"]})
 
 
@@ -192,7 +232,7 @@ def _auto_kernel(run, rtol, critical):
     return r, k_rtol
 
 
-def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, t_eval=None):
     """The cheapest method whose error bound meets ``rtol`` (see :mod:`._auto`). With a full
     history the exact linear solver is not cheaper than the kernel (it evaluates its phases on
     a dense grid in Python: 0.70 ms against 0.15-0.6 ms per work-precision scene), so here the
@@ -200,15 +240,18 @@ def _auto_method(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x
     psi, bound, _ = _linearization_bound(p, alpha, eta, motion, x0)
     rest = x0 == (0.0, 0.0) and psi < 1.0
     args = (p, alpha, eta, motion, _rocking.MODEL_NONLINEAR)
-    r, k_rtol = _auto_kernel(lambda k: _kernel(*args, k, t_max, max_steps, method, x0), rtol, alpha)
+    r, k_rtol = _auto_kernel(
+        lambda k: _kernel(*args, k, t_max, max_steps, method, x0, t_eval=t_eval), rtol, alpha
+    )
     chosen = _auto.MODEL_REST if rest else _auto.MODEL_NONLINEAR
     r.info.update(model=_auto.MODEL_NAMES[chosen], linearization_bound=bound, rtol=k_rtol)
     return r
 
 
-def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0):
+def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, t_eval=None):
+    _check_end(t_eval, _tail_end(p, eta, motion, t_max))
     r = simulate_reference(
-        p, alpha, eta, motion, model=model, rtol=rtol, t_max=t_max, initial_state=x0
+        p, alpha, eta, motion, model, rtol, t_max=t_max, initial_state=x0, t_eval=t_eval
     )
     return RockingResult.from_dict(r, method)
 
@@ -234,6 +277,8 @@ def simulate(
     initial_velocity: float = 0.0,
     max_steps: int = 10_000_000,
     l: float = 1e-4,
+    t_eval=None,
+    dt_out: float | None = None,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -285,10 +330,28 @@ def simulate(
         Safety cap on the integrator steps in one rocking phase, a whole number in [1, 1e12].
     l : float
         The complex formulation's l (method ``"complex"`` only), in (0, 0.1).
+    t_eval : array_like, optional
+        Times [s] at which to return the state (dense output, ``result.t_eval``,
+        ``theta_eval``, ``theta_dot_eval``): finite, >= 0, sorted, and within the simulated
+        end (``t_max`` when given; a block with restitution 1 is followed for 100 / p after
+        the motion). Each state is as accurate as the steps: one DOP853 step from the start
+        of the accepted step that contains the time (kernel methods), the closed form
+        (``"linear"`` on a pulse), scipy's dense output (``"scipy"``) or the cubic Hermite
+        interpolant of the steps (``"complex"``). At rest (0, 0); at an impact, the state
+        just before it; after an overturning NaN.
+    dt_out : float, optional
+        Instead of ``t_eval``: the uniform grid 0, dt_out, 2 dt_out, ... [s] up to ``t_max``
+        or, without it, up to the end of the history (rest or overturning; the scene then
+        runs twice, once to find that end).
 
     Returns
     -------
     RockingResult
+        With the peaks (``peak_times``, ``peak_rotations``: every local maximum of |theta|)
+        located by each method on its own solution: on the DOP853 step's interpolant and one
+        Newton step on a true step (the kernels), on the closed form (``"linear"`` on a
+        pulse), by scipy's event location (``"scipy"``) or on the cubic Hermite interpolant
+        of the steps (``"complex"``).
     """
     try:
         runner, model = _METHODS[method]
@@ -322,11 +385,17 @@ def simulate(
     if method in ("nonlinear", "mechanism"):
         _auto.warn_loose_tolerance(rtol)
     x0 = (th0, om0)
+    t_eval = _validate.output_times(t_eval, dt_out, t_max)
+    run_args = (motion, method, rtol, t_max, int(max_steps), x0, l)
     if hasattr(structure, "mechanism"):
-        r = _simulate_structure(structure, motion, method, rtol, t_max, int(max_steps), x0, l)
+        run, run_args = _simulate_structure, (structure, *run_args)
     else:
-        p, alpha, eta = block_parameters(structure)
-        r = _simulate_block(p, alpha, eta, motion, method, rtol, t_max, int(max_steps), x0, l)
+        run, run_args = _simulate_block, (*block_parameters(structure), *run_args)
+    if dt_out is not None and t_max is None:  # the grid runs to the end of the response
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            t_eval = _validate.uniform_times(float(dt_out), float(run(*run_args).t[-1]))
+    r = run(*run_args, t_eval=t_eval)
     r.info.update(
         motion=_describe(motion),
         rtol_requested=rtol,
@@ -348,15 +417,16 @@ def _describe(motion) -> str:
     return type(motion).__name__
 
 
-def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l):
+def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l, t_eval=None):
     """A block (p, alpha, eta) through ``method``."""
     runner, model = _METHODS[method]
     if method in ("linear", "scipy-linear"):
         _warn_linearization(p, alpha, eta, motion, x0)
+    args = (p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
     if method == "complex":
-        r = _complex(p, alpha, eta, motion, None, rtol, t_max, max_steps, method, x0, l)
+        r = _complex(*args, l, t_eval=t_eval)
     else:
-        r = runner(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
+        r = runner(*args, t_eval=t_eval)
     _record_parameters(r, p, alpha, eta)
     return r
 
@@ -369,18 +439,18 @@ def _record_parameters(r, p, alpha, eta):
     )
 
 
-def _simulate_structure(structure, motion, method, rtol, t_max, max_steps, x0, l):
+def _simulate_structure(structure, motion, method, rtol, t_max, max_steps, x0, l, t_eval=None):
     """A structure with a ``mechanism()``: the mechanism, eq. (8) of [003], for "nonlinear",
     "mechanism" and "auto" (the exact equivalent block for the Table I structures under
     "auto"); the kappa_1 equivalent block for the other methods, said in ``result.info`` and
     in an :class:`EquivalentBlockWarning` unless the block is exact."""
     exact = isinstance(structure, EXACT_EQUIVALENTS)
     if method in ("nonlinear", "mechanism"):
-        return _mechanism(structure, motion, rtol, t_max, max_steps, x0, method)
+        return _mechanism(structure, motion, rtol, t_max, max_steps, x0, method, t_eval)
     if method == "auto" and not exact:
         params = _structure_parameters(structure)
         r, k_rtol = _auto_kernel(
-            lambda k: _mechanism(structure, motion, k, t_max, max_steps, x0, method),
+            lambda k: _mechanism(structure, motion, k, t_max, max_steps, x0, method, t_eval),
             rtol,
             params.critical_rotation,
         )
@@ -403,7 +473,7 @@ def _simulate_structure(structure, motion, method, rtol, t_max, max_steps, x0, l
             EquivalentBlockWarning,
             stacklevel=3,
         )
-    r = _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l)
+    r = _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l, t_eval)
     r.info.update(structure_model=model, coordinate=coordinate)
     return r
 
@@ -416,7 +486,7 @@ def _structure_parameters(structure):
     return params[0] if isinstance(params, tuple) else params
 
 
-def _mechanism(structure, motion, rtol, t_max, max_steps, x0, method="mechanism"):
+def _mechanism(structure, motion, rtol, t_max, max_steps, x0, method="mechanism", t_eval=None):
     """The full mechanism, eq. (8) of [003], through the tabulated kernel. An overturned
     structure reports max_rotation = pi/2, as a block does (its history ends at
     ``info["fall_rotation"]``, where the mechanism collapses or its kinematics end)."""
@@ -439,6 +509,7 @@ def _mechanism(structure, motion, rtol, t_max, max_steps, x0, method="mechanism"
         x0,
         fall,
         tab,
+        t_eval,
     )
     if result.overturned:
         result = dataclasses.replace(result, max_rotation=FALL_ROTATION)
