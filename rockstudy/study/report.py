@@ -549,6 +549,8 @@ def make_report(result, out=None) -> Path:
     if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
         from .report_records import record_report
 
+        if "study" not in ds.attrs:  # a design run from Python and saved: no study file
+            return record_report(ds, out, title=result.stem)
         study = analysis.study_of(ds)
 
         def study_section(page):
