@@ -6,9 +6,13 @@ oscillator inside a step) is located by :func:`newton_bisect`: Newton steps from
 that every iterate shrinks, with a bisection wherever Newton would leave it. It converges
 quadratically near a simple root and never leaves the bracket.
 
-``fdf`` is a numba-jitted function ``fdf(x, args) -> (f, f')`` and ``args`` a tuple of its
-parameters (numba specialises :func:`newton_bisect` on each ``fdf``, so the call costs what an
-inlined loop does). From Python, with a Python ``fdf``, call ``newton_bisect.py_func``.
+``fdf`` is a module-level numba-jitted function ``fdf(x, args) -> (f, f')`` and ``args`` a
+tuple of its parameters. :func:`newton_bisect` is inlined into each caller at numba's IR level
+(``inline="always"``), so ``fdf`` becomes a direct call: the loop costs what a hand-written copy
+does, and the caller stays in numba's on-disk cache (a jitted function passed to a separately
+compiled function is typed by its address, which makes the caller uncachable and recompiles it
+in every process; numba issues 2956 and 6972). From Python, with a Python ``fdf``, call
+``newton_bisect.py_func``.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from __future__ import annotations
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):
     """The root in [lo, hi] of f, where f changes sign, by Newton steps kept in the bracket.
 
