@@ -147,7 +147,7 @@ def _velocity2(a, w, tau):
     return _f21(A, B, C, _psi(a), w, tau)[1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _f21_fdf(x, args):
     """2 theta / alpha - 2 of eq. (3.21) of [000] at tau = x and its tau-derivative."""
     A, B, C, psi, w = args

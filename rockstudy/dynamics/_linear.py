@@ -110,7 +110,7 @@ def _u(k, A, B, c, W, x0, alpha, s, sig):
     return s * (-c * W * W * math.sin(x) + A * em + B * ep)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _u_fdf(x, args):
     """u^(k) - target and its derivative at sigma = x (:func:`_u`), for :func:`newton_bisect`."""
     k, target, A, B, c, W, x0, alpha, s = args
@@ -453,7 +453,7 @@ def _seg_turning_points(th0, v0, g0, f1, length, e_length):
     return min(s1, s2), max(s1, s2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _seg_fdf(x, args):
     """s theta - target and its derivative at sigma = x on a record segment (:func:`_seg_state`)."""
     target, th0, v0, g0, f1, s = args

@@ -213,7 +213,7 @@ def next_uplift(kind, mp, times, samples, p, alpha, model, tab, t0):
     return np.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _hermite_fdf(x, args):
     """The Hermite value (or derivative) minus target at unit step time x, and its x-derivative."""
     target, deriv, h, y0, d0, a0, y1, d1, a1 = args

@@ -58,14 +58,14 @@ def _advance(q, u, v, f0, f1):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _state_inside(tau, args):
     """(u, v) at tau inside a step from (u, v) with the force linear from f0 to f1 over h."""
     omega, zeta, h, u, v, f0, f1 = args
     return _advance(step_coefficients(omega, zeta, tau), u, v, f0, f0 + (f1 - f0) * tau / h)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _velocity_fdf(tau, args):
     """v(tau) and v'(tau) = f - 2 zeta omega v - omega^2 u inside a step (:func:`_state_inside`)."""
     omega, zeta, h, u, v, f0, f1 = args
