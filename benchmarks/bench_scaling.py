@@ -2,14 +2,14 @@
 
 One run measures, on one core unless said otherwise:
 
-1. cost per scene against record length: Kanai-Tajimi records (``stochastic_record``, dt
+1. cost per scene (CPU time) against record length: Kanai-Tajimi records (``stochastic_record``, dt
    0.01 s, the envelope stretched with the duration) of 5 to 80 s, nonlinear kernel at rtol
    1e-8 and the exact linear solver (``simulate_batch``, one thread);
 2. cost per scene against the number of scenes per ``simulate_batch`` call (1 ... 1000, or
    10^4 with ``--big``), on sine pulses and on a 20 s record: the fixed cost of a call;
 3. throughput of a pulse study and a record study run by the study runner
    (``run_study`` on a started local dask cluster of 1 and 2 single-threaded workers) against
-   the bare kernel on the same scenes (one thread), with the overheads separated: design,
+   the bare kernel on the same scenes (one thread, CPU time), with the overheads separated: design,
    template and chunk writes (timed in the client), the work of each task outside the kernel
    (dask's task stream), the workers' start and kernel load (first task on fresh workers), and
    what is left (scheduling and idle workers); plus the round trip and throughput of empty
@@ -17,7 +17,9 @@ One run measures, on one core unless said otherwise:
 
 The blocks are those of issue 14: R 0.5-3 m, alpha 0.1-0.3, peak ground acceleration
 0.8-6 g tan(alpha). From the measured per-task overheads it prints what 64 workers need: the
-chunk size for 90 % parallel efficiency. Writes benchmarks/results/scaling.json.
+chunk size for 90 % parallel efficiency. The study parts are wall times, and grow with the
+machine's load (printed): on a shared machine the dask overheads are upper bounds.
+Writes benchmarks/results/scaling.json.
 
     python benchmarks/bench_scaling.py [--scenes 200] [--durations 5 10 20 40 80]
         [--study-pulse 20000] [--study-record 2000] [--workers 1 2] [--big]
@@ -41,7 +43,7 @@ import numpy as np
 from rockstudy.constants import G
 from rockstudy.dynamics.batch import simulate_batch
 from rockstudy.motions import stochastic_record
-from rockstudy.study import make_design, run_study, store, validate_text
+from rockstudy.study import make_design, run_study, runner, store, validate_text
 from rockstudy.study.evaluate import _run_rows, evaluate_chunk
 
 OUT = Path(__file__).parent / "results"
@@ -88,17 +90,19 @@ def blocks(n, seed=14):
     return rng.uniform(0.5, 3.0, n), rng.uniform(0.1, 0.3, n), rng.uniform(0.8, 6.0, n)
 
 
-def median_seconds(fn, min_total=0.3, min_repeat=3, max_repeat=200):
-    """Median wall time of fn() over repeats (at least min_repeat, and min_total seconds)."""
+def cpu_seconds(fn, min_total=0.3, min_repeat=3, max_repeat=200):
+    """Least CPU time of this process over repeats of fn() (at least min_repeat, and min_total
+    seconds): numba runs on one thread here, and CPU time hardly moves with the machine's load,
+    where wall time does (the machine is shared)."""
     times = []
     t_start = time.perf_counter()
     while len(times) < max_repeat and (
         len(times) < min_repeat or time.perf_counter() - t_start < min_total
     ):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+        times.append(time.process_time() - t0)
+    return float(np.min(times))
 
 
 def record_call(rec, R, alpha, ratio, method="nonlinear", n=None):
@@ -135,8 +139,8 @@ def record_length_curve(durations, n):
         record_call(rec, R, alpha, ratio, n=2)
         record_call(rec, R, alpha, ratio, "linear", n=2)
         out = record_call(rec, R, alpha, ratio)
-        t_nl = median_seconds(lambda rec=rec: record_call(rec, R, alpha, ratio), min_repeat=1)
-        t_lin = median_seconds(lambda rec=rec: record_call(rec, R, alpha, ratio, "linear"))
+        t_nl = cpu_seconds(lambda rec=rec: record_call(rec, R, alpha, ratio), min_repeat=1)
+        t_lin = cpu_seconds(lambda rec=rec: record_call(rec, R, alpha, ratio, "linear"))
         rows.append(
             {
                 "duration_s": d,
@@ -168,8 +172,8 @@ def batch_size_curve(sizes):
     record_call(rec, R, alpha, ratio, n=2)
     rows = []
     for n in sizes:
-        t_p = median_seconds(lambda n=n: pulse_call(R, alpha, ratio, period, n))
-        t_r = median_seconds(
+        t_p = cpu_seconds(lambda n=n: pulse_call(R, alpha, ratio, period, n))
+        t_r = cpu_seconds(
             lambda n=n: record_call(rec, R, alpha, ratio, n=n), min_repeat=3 if n < 1000 else 1
         )
         rows.append(
@@ -203,28 +207,40 @@ def dask_floor(client, n_tasks=400):
     }
 
 
+def _timed_chunk(study_json, cols, base_dir=None):
+    """evaluate_chunk, with the CPU time of the task in its result (taken out before the write;
+    this function travels to the workers by value)."""
+    t0 = time.process_time()
+    result = evaluate_chunk(study_json, cols, base_dir)
+    result["_task_cpu_s"] = time.process_time() - t0
+    return result
+
+
 class _ClientTimers:
-    """Wall time the client spends creating the store template and writing finished chunks."""
+    """Time the client spends creating the store template (CPU) and writing finished chunks
+    (wall), and the CPU time the tasks report."""
 
     def __init__(self):
-        self.template = self.writes = 0.0
+        self.template = self.writes = self.task_cpu = 0.0
         self.chunks = 0
 
     def __enter__(self):
         self._create, self._write = store.create_store, store.ChunkWriter.write
+        self._task, runner.evaluate_chunk = runner.evaluate_chunk, _timed_chunk
         timers = self
 
         def create(*a, **k):
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             try:
                 return timers._create(*a, **k)
             finally:
-                timers.template += time.perf_counter() - t0
+                timers.template += time.process_time() - t0
 
-        def write(writer, *a, **k):
+        def write(writer, start, stop, result):
+            timers.task_cpu += result.pop("_task_cpu_s")
             t0 = time.perf_counter()
             try:
-                return timers._write(writer, *a, **k)
+                return timers._write(writer, start, stop, result)
             finally:
                 timers.writes += time.perf_counter() - t0
                 timers.chunks += 1
@@ -234,6 +250,7 @@ class _ClientTimers:
 
     def __exit__(self, *exc):
         store.create_store, store.ChunkWriter.write = self._create, self._write
+        runner.evaluate_chunk = self._task
 
 
 def bare_kernel_seconds(study, base_dir):
@@ -243,20 +260,20 @@ def bare_kernel_seconds(study, base_dir):
     cols["sample"] = design["sample"].values
     n = cols["sample"].size
     _run_rows(study, cols, np.arange(min(n, 4)), base_dir)
-    return median_seconds(lambda: _run_rows(study, cols, np.arange(n), base_dir), min_total=0.0)
+    return cpu_seconds(lambda: _run_rows(study, cols, np.arange(n), base_dir), min_total=0.0)
 
 
 def study_run(client, study, out, base_dir):
     """run_study on a started cluster, its parts separated (seconds)."""
     from distributed import get_task_stream
 
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     make_design(study)
-    design = time.perf_counter() - t0
+    design = time.process_time() - t0  # CPU, as the client's time below
     with _ClientTimers() as timers, get_task_stream(client) as ts:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         rep = run_study(study, out, client=client, base_dir=base_dir, progress=False, netcdf=False)
-        wall = time.perf_counter() - t0
+        wall, client_cpu = time.perf_counter() - t0, time.process_time() - c0
     tasks = [t for t in ts.data if str(t["key"]).startswith("rockstudy-chunk")]
     busy = sum(
         s["stop"] - s["start"] for t in tasks for s in t["startstops"] if s["action"] == "compute"
@@ -270,6 +287,10 @@ def study_run(client, study, out, base_dir):
         "template_s": timers.template,
         "chunk_writes_s": timers.writes,
         "task_compute_s": busy,
+        "task_cpu_s": timers.task_cpu,
+        # the client process also runs the local scheduler: its CPU time per chunk (without the
+        # design and the template, made once) is the serial cost that bounds the chunk rate
+        "client_cpu_s": client_cpu,
     }
 
 
@@ -325,7 +346,7 @@ def study_section(args, tmp):
         "record": study_of("record", args.study_record, chunk_r, path),
     }
     kernel = {k: bare_kernel_seconds(s, tmp) for k, s in studies.items()}
-    res = {"kernel_1_thread_s": kernel, "runs": {}, "dask_floor": {}}
+    res = {"kernel_cpu_s": kernel, "runs": {}, "dask_floor": {}}
     for w in args.workers:
         cluster, client, start = worker_start(w, studies["record"], tmp)
         try:
@@ -334,10 +355,13 @@ def study_section(args, tmp):
                 r = study_run(client, st, tmp / f"{name}-{w}.zarr", tmp)
                 r.update(start)
                 r["workers"], r["study"] = w, name
-                r["kernel_1_thread_s"] = kernel[name]
+                r["kernel_cpu_s"] = kernel[name]
                 r["parallel_efficiency"] = kernel[name] / (w * r["wall_s"])
                 r["scenes_per_s"] = r["scenes"] / r["wall_s"]
-                r["task_overhead_ms"] = 1e3 * (r["task_compute_s"] - kernel[name]) / r["chunks"]
+                r["task_overhead_ms"] = 1e3 * (r["task_cpu_s"] - kernel[name]) / r["chunks"]
+                r["client_cpu_ms_per_chunk"] = (
+                    1e3 * (r["client_cpu_s"] - r["design_s"] - r["template_s"]) / r["chunks"]
+                )
                 r["idle_worker_s"] = w * r["wall_s"] - r["task_compute_s"]
                 res["runs"][f"{name}_{w}"] = r
             if w == max(args.workers):
@@ -363,22 +387,21 @@ def study_section(args, tmp):
 
 
 def implications(res, workers=64, target=0.9):
-    """Chunk sizes for ``target`` parallel efficiency on ``workers`` workers (see the module).
+    """Chunk sizes for ``target`` parallel efficiency on ``workers`` workers.
 
-    A chunk of c scenes costs c t + o_w on its worker (t: kernel per scene; o_w: the task's
-    work outside the kernel, from the task stream) and o_s in the client and scheduler, which
-    handle the chunks one at a time (round trip of an empty task, plus the chunk write). The
-    efficiency is c t / max(c t + o_w, W o_s): at least ``target`` when c t >= o_w target /
-    (1 - target) and c t >= target W o_s.
+    A chunk of c scenes costs c t + o_w on its worker (t: kernel CPU per scene; o_w: the task's
+    CPU outside the kernel) and o_s in the client and its scheduler, which handle the chunks one
+    at a time (client CPU per chunk, without the design and the template). The efficiency is
+    c t / max(c t + o_w, W o_s): at least ``target`` when c t >= o_w target / (1 - target) and
+    c t >= target W o_s. CPU times, so that the machine's load does not inflate them.
     """
     w = max(int(k.split("_")[1]) for k in res["runs"])
     out = {}
-    floor = res["dask_floor"][w]
     for name in ("pulse", "record"):
         r = res["runs"][f"{name}_{w}"]
-        t = r["kernel_1_thread_s"] / r["scenes"]
-        o_w = max(r["task_compute_s"] - r["kernel_1_thread_s"], 0.0) / r["chunks"]
-        o_s = 1.0 / floor["empty_tasks_per_s"] + r["chunk_writes_s"] / r["chunks"]
+        t = r["kernel_cpu_s"] / r["scenes"]
+        o_w = max(r["task_cpu_s"] - r["kernel_cpu_s"], 0.0) / r["chunks"]
+        o_s = max(r["client_cpu_s"] - r["design_s"] - r["template_s"], 0.0) / r["chunks"]
         c_worker = o_w * target / (1.0 - target) / t
         c_serial = target * workers * o_s / t
         out[name] = {
@@ -387,7 +410,7 @@ def implications(res, workers=64, target=0.9):
             "serial_per_chunk_s": o_s,
             "chunk_for_target_scenes": int(np.ceil(max(c_worker, c_serial))),
             "chunk_compute_for_target_s": max(c_worker, c_serial) * t,
-            "max_chunks_per_s_serial": 1.0 / o_s,
+            "max_chunks_per_s_serial": 1.0 / o_s if o_s > 0 else float("inf"),
         }
     return {"workers": workers, "target_efficiency": target, **out}
 
@@ -477,15 +500,16 @@ def report(r):
     s = r["studies"]
     print("\n3. study runner on a started local cluster against the bare kernel (one thread)")
     print(
-        f"{'study':>10} {'W':>2} {'scenes':>7} {'chunks':>6} {'wall s':>7} {'kernel s':>8} "
-        f"{'eff':>5} {'task ovh ms':>11} {'writes s':>8} {'idle s':>7}"
+        f"{'study':>10} {'W':>2} {'scenes':>7} {'chunks':>6} {'wall s':>7} {'kernel cpu':>10} "
+        f"{'eff':>5} {'task ovh ms':>11} {'client ms/chunk':>15} {'writes s':>8} {'idle s':>7}"
     )
     for x in s["runs"].values():
         print(
             f"{x['study']:>10} {x['workers']:2d} {x['scenes']:7d} {x['chunks']:6d} "
             f"{x['wall_s']:7.2f} "
-            f"{x['kernel_1_thread_s']:8.2f} {x['parallel_efficiency']:5.2f} "
-            f"{x['task_overhead_ms']:11.1f} {x['chunk_writes_s']:8.2f} {x['idle_worker_s']:7.2f}"
+            f"{x['kernel_cpu_s']:10.2f} {x['parallel_efficiency']:5.2f} "
+            f"{x['task_overhead_ms']:11.1f} {x['client_cpu_ms_per_chunk']:15.1f} "
+            f"{x['chunk_writes_s']:8.2f} {x['idle_worker_s']:7.2f}"
         )
     for w, x in s["dask_floor"].items():
         print(
