@@ -46,6 +46,7 @@ bench: $(KERNELS)
 	$(BIN)/python benchmarks/bench_engine.py
 	$(BIN)/python benchmarks/bench_closedform.py
 	$(BIN)/python benchmarks/bench_study.py
+	$(BIN)/python benchmarks/bench_scaling.py
 	$(BIN)/python benchmarks/bench_structures.py
 	$(BIN)/python benchmarks/bench_report.py
 	$(BIN)/python -W ignore benchmarks/bench_work_precision.py

@@ -17,6 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rockstudy"
 LAYER = {
     "constants": 0,
     "_validate": 0,
+    "_roots": 0,  # the one Newton-bisection root finder, shared from motions up to closedform
     "_warnings": 0,
     "data": 0,
     "motions": 1,

@@ -22,6 +22,7 @@ import warnings
 import numpy as np
 from numba import float64, int8, njit, vectorize
 
+from .._roots import newton_bisect
 from .._warnings import ClosedFormValidityWarning
 
 _F2 = [float64(float64, float64)]
@@ -146,6 +147,23 @@ def _velocity2(a, w, tau):
     return _f21(A, B, C, _psi(a), w, tau)[1]
 
 
+@njit(cache=True, inline="always")
+def _f21_fdf(x, args):
+    """2 theta / alpha - 2 of eq. (3.21) of [000] at tau = x and its tau-derivative."""
+    A, B, C, psi, w = args
+    ep = math.exp(x)
+    sn, cs = math.sin(w * x + psi), math.cos(w * x + psi)
+    return A / ep + B * ep + C * sn - 2.0, B * ep - A / ep + C * w * cs
+
+
+# tau_i1 to 1e-13 (relative above 1): the closed forms are compared with the exact solver at
+# 1e-10, and the second impact starts from this one.
+FIRST_IMPACT_TOL = 1e-13
+# Newton from the secant converges in 3-6 steps; bisection alone of a grid cell of at most 0.25
+# would need about 42.
+FIRST_IMPACT_MAX_ITER = 100
+
+
 @njit(cache=True)
 def _first_impact(A, B, C, psi, w, te):
     """First root of eq. (3.21) of [000] in (0, p T_ex]: (tau_i1, 2 theta_dot / (p alpha),
@@ -169,32 +187,15 @@ def _first_impact(A, B, C, psi, w, te):
             f_hi = _f21(A, B, C, psi, w, te)[0]
         else:
             f_hi = A * em + B * ep + C * sn - 2.0
-        if f_hi >= 0.0:
-            # Newton from the secant, safeguarded by the Illinois false position on [lo, hi]
-            x = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo < 0.0 else hi
-            side = 0
-            for _ in range(100):
-                ep = math.exp(x)
-                sn, cs = math.sin(w * x + psi), math.cos(w * x + psi)
-                f = A / ep + B * ep + C * sn - 2.0
-                df = B * ep - A / ep + C * w * cs
-                if f >= 0.0:
-                    hi, f_hi = x, f
-                    if side == 1:
-                        f_lo *= 0.5
-                    side = 1
-                else:
-                    lo, f_lo = x, f
-                    if side == -1:
-                        f_hi *= 0.5
-                    side = -1
-                xn = x - f / df if df != 0.0 else lo
-                if not lo < xn < hi:  # (theta = 0 at uplift: bisect while lo is still 0)
-                    xn = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo < 0.0 else 0.5 * (lo + hi)
-                if abs(xn - x) <= 1e-13 * max(1.0, x) or hi - lo <= 1e-13 * max(1.0, x):
-                    break
-                x = xn
-            return x, df, sn, cs, ep
+        if f_hi >= 0.0:  # Newton from the secant (from hi while theta = 0 at lo, at uplift)
+            x0 = lo + (hi - lo) * f_lo / (f_lo - f_hi) if f_lo < 0.0 else hi
+            args = (A, B, C, psi, w)
+            x = newton_bisect(
+                _f21_fdf, args, lo, hi, x0, -1.0, FIRST_IMPACT_TOL, FIRST_IMPACT_MAX_ITER
+            )
+            ep = math.exp(x)
+            sn, cs = math.sin(w * x + psi), math.cos(w * x + psi)
+            return x, B * ep - A / ep + C * w * cs, sn, cs, ep
         lo, f_lo = hi, f_hi
     return np.nan, np.nan, np.nan, np.nan, np.nan
 

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .._roots import newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, KIND_TRIG, ground_acceleration, segment_index
 from ._rocking import (
@@ -46,6 +47,13 @@ from ._rocking import (
 )
 
 _NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record; no vertical
+
+# Impacts, peaks and falls are located to rounding: sigma is a time inside one phase, and the
+# root is the next phase's initial state, so its error would carry on through the history.
+ROOT_TOL = 1e-16
+# Bisection alone halves a bracket of up to a few units of tau to 1e-16 in about 55 steps;
+# Newton converges in about 5 near a simple root. The cap is never the stopping rule.
+ROOT_MAX_ITER = 100
 
 
 @njit(cache=True)
@@ -101,24 +109,19 @@ def _u(k, A, B, c, W, x0, alpha, s, sig):
     return s * (-c * W * W * math.sin(x) + A * em + B * ep)
 
 
+@njit(cache=True, inline="always")
+def _u_fdf(x, args):
+    """u^(k) - target and its derivative at sigma = x (:func:`_u`), for :func:`newton_bisect`."""
+    k, target, A, B, c, W, x0, alpha, s = args
+    f = _u(k, A, B, c, W, x0, alpha, s, x) - target
+    return f, (_u(k + 1, A, B, c, W, x0, alpha, s, x) if k < 2 else 0.0)
+
+
 @njit(cache=True)
 def _root(k, target, sgn, A, B, c, W, x0, alpha, s, lo, hi):
     """sigma in [lo, hi] where sgn * (u^(k) - target) turns from >= 0 to < 0 (Newton-bisection)."""
-    x = 0.5 * (lo + hi)
-    for _ in range(100):
-        f = _u(k, A, B, c, W, x0, alpha, s, x) - target
-        if sgn * f >= 0.0:
-            lo = x
-        else:
-            hi = x
-        df = _u(k + 1, A, B, c, W, x0, alpha, s, x) if k < 2 else 0.0
-        xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
-        if not lo < xn < hi:
-            xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= 1e-16 * max(1.0, abs(x)) or hi - lo <= 1e-16 * max(1.0, hi):
-            return xn
-        x = xn
-    return x
+    args = (k, target, A, B, c, W, x0, alpha, s)
+    return newton_bisect(_u_fdf, args, lo, hi, 0.5 * (lo + hi), sgn, ROOT_TOL, ROOT_MAX_ITER)
 
 
 @njit(cache=True)
@@ -506,26 +509,21 @@ def _seg_turning_points(th0, v0, g0, f1, length, e_length):
     return min(s1, s2), max(s1, s2)
 
 
+@njit(cache=True, inline="always")
+def _seg_fdf(x, args):
+    """s theta - target and its derivative at sigma = x on a record segment (:func:`_seg_state`)."""
+    target, th0, v0, g0, f1, s = args
+    th, v = _seg_state(th0, v0, g0, f1, x)
+    return s * th - target, s * v
+
+
 @njit(cache=True)
 def _seg_root(target, th0, v0, g0, f1, s, lo, hi):
     """sigma in [lo, hi] where s theta - target changes sign, theta monotone on [lo, hi]
     (Newton steps safeguarded by bisection, to rounding)."""
-    u_lo = s * _seg_state(th0, v0, g0, f1, lo)[0] - target
-    x = 0.5 * (lo + hi)
-    for _ in range(200):
-        th, v = _seg_state(th0, v0, g0, f1, x)
-        f = s * th - target
-        if (f >= 0.0) == (u_lo >= 0.0):
-            lo = x
-        else:
-            hi = x
-        xn = x - f / (s * v) if v != 0.0 else 0.5 * (lo + hi)
-        if not lo < xn < hi:
-            xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= 1e-16 * max(1.0, abs(x)) or hi - lo <= 1e-16 * max(1.0, hi):
-            return xn
-        x = xn
-    return x
+    sign_lo = 1.0 if s * _seg_state(th0, v0, g0, f1, lo)[0] - target >= 0.0 else -1.0
+    args = (target, th0, v0, g0, f1, s)
+    return newton_bisect(_seg_fdf, args, lo, hi, 0.5 * (lo + hi), sign_lo, ROOT_TOL, ROOT_MAX_ITER)
 
 
 @njit(cache=True)

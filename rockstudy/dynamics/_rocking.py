@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .._roots import newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import (
     KIND_RECORD,
@@ -242,29 +243,32 @@ def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
     return np.inf
 
 
+@njit(cache=True, inline="always")
+def _hermite_fdf(x, args):
+    """The Hermite value (or derivative) minus target at unit step time x, and its x-derivative."""
+    target, deriv, h, y0, d0, a0, y1, d1, a1 = args
+    v, dv, av = hermite5(x, h, y0, d0, a0, y1, d1, a1)
+    return (dv - target, av * h) if deriv else (v - target, dv * h)
+
+
+# Event times on the interpolant, in units of the step: to 1e-14 of it, near rounding of a
+# unit interval (the event is then refined on a true step where it matters).
+HERMITE_ROOT_TOL = 1e-14
+# Bisection alone reaches 1e-14 of the step in 47 halvings; Newton needs about 5.
+HERMITE_ROOT_MAX_ITER = 100
+
+
 @njit(cache=True)
 def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
     """Root in [lo, hi] (unit step time) of the Hermite value (deriv=False) or derivative.
 
     Finds where sgn * (q(s) - target) changes from >= 0 at lo to < 0 at hi, by Newton steps
-    safeguarded by bisection of the bracket, to 1e-14 of the step.
+    safeguarded by bisection of the bracket (:func:`newton_bisect`), to 1e-14 of the step.
     """
-    s = 0.5 * (lo + hi)
-    for _ in range(100):
-        v, dv, av = hermite5(s, h, y0, d0, a0, y1, d1, a1)
-        q, dq = (dv, av * h) if deriv else (v, dv * h)
-        f = q - target
-        if sgn * f >= 0.0:
-            lo = s
-        else:
-            hi = s
-        sn = s - f / dq if dq != 0.0 else 0.5 * (lo + hi)
-        if not lo < sn < hi:
-            sn = 0.5 * (lo + hi)
-        if abs(sn - s) <= 1e-14 or hi - lo <= 1e-14:
-            return sn
-        s = sn
-    return s
+    args = (target, deriv, h, y0, d0, a0, y1, d1, a1)
+    return newton_bisect(
+        _hermite_fdf, args, lo, hi, 0.5 * (lo + hi), sgn, HERMITE_ROOT_TOL, HERMITE_ROOT_MAX_ITER
+    )
 
 
 # Per-scene work arrays: the rocking state ...

@@ -27,6 +27,12 @@ from .. import _validate
 from ..constants import G
 from ._jet import Jet
 
+# phi_cr to rounding [rad]: every rocking parameter of the equivalent block is read at it.
+CRITICAL_ROTATION_TOL = 1e-15
+# The bracket is one step of a 2001-point grid; Newton converges in about 5 evaluations of the
+# kinematics, bisection alone in about 40 (each evaluation is a Python call on the linkage).
+CRITICAL_MAX_ITER = 50
+
 
 @dataclass(frozen=True)
 class RockingParameters:
@@ -173,21 +179,16 @@ class Mechanism:
         if sign.size == 0:
             raise ValueError("no unstable equilibrium within the kinematic range")
         lo, hi = grid[sign[0]], grid[sign[0] + 1]
-        x = 0.5 * (lo + hi)
-        for _ in range(50):  # Newton on G with its exact derivative, kept in the bracket
+        from .._roots import newton_bisect  # here: importing the structures loads no numba
+
+        def g_and_slope(x, _):
             t = self.terms(np.array([x]))
-            gx, dg = float(t["G"][0]), float(t["dG"][0])
-            if gx < 0:
-                lo = x
-            else:
-                hi = x
-            xn = x - gx / dg if dg != 0 else 0.5 * (lo + hi)
-            if not lo < xn < hi:
-                xn = 0.5 * (lo + hi)
-            if abs(xn - x) <= 1e-15 * max(1.0, x):
-                return xn
-            x = xn
-        return x
+            return float(t["G"][0]), float(t["dG"][0])
+
+        # Newton on G with its exact derivative, kept in the bracket (G < 0 below phi_cr)
+        return newton_bisect.py_func(
+            g_and_slope, (), lo, hi, 0.5 * (lo + hi), -1.0, CRITICAL_ROTATION_TOL, CRITICAL_MAX_ITER
+        )
 
     def rocking_parameters(self, restitution: float) -> RockingParameters:
         """The rocking parameters of this direction (eqs. 9-20 of [003])."""
