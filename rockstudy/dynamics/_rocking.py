@@ -445,12 +445,12 @@ def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
 
 
 @njit(cache=True)
-def _record_poly(hist, ta, c, n, t, hs):
-    """Append states at 1/4, 1/2, 3/4 and the end of an accepted Taylor step (its polynomial
-    is the solution within the step's tolerance)."""
+def _record_poly(hist, ta, c, n, t, hs, t1):
+    """Append states at 1/4, 1/2 and 3/4 of an accepted Taylor step (its polynomial is the
+    solution within the step's tolerance), and at its end t1."""
     for j in range(1, 5):
         x, d, _ = poly_value(c, n, 0.25 * j)
-        _push(hist, ta, t + 0.25 * j * hs, x, d / hs)
+        _push(hist, ta, t + 0.25 * j * hs if j < 4 else t1, x, d / hs)
 
 
 @njit(cache=True)
@@ -510,7 +510,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
         if ev == EV_NONE:
             ta[MAXU] = max(ta[MAXU], s * th1)
             if rec and taylor:
-                _record_poly(hist, ta, w[0], order, t, hs)
+                _record_poly(hist, ta, w[0], order, t, hs, t1)
             elif rec:
                 _record_step(hist, ta, args, t, hs, th, om, f0, th1, om1, kx, kv)
             t, th, om, f0 = t1, th1, om1, f1
