@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
+from test_records_rocking import FILES, load
 
 import rockstudy as rs
 from rockstudy.constants import G
@@ -138,22 +139,6 @@ def test_step_cap_counts_taylor_steps():
     # one Taylor step per sample segment while rocking, at most: a few more at impacts
     rocking_samples = rec.duration / 0.01
     assert 50 < full["steps"][0] < 2 * rocking_samples
-
-
-FILES = [
-    "RSN126_GAZLI_GAZ000.AT2",
-    "RSN183_IMPVALL.H_H-E08140.AT2",
-    "RSN948_NORTHR_CAM009.AT2",
-    "RSN982_NORTHR_JEN292.AT2",
-    "elcentro_NS.dat",
-]
-
-
-def load(records_dir, name):
-    path = records_dir / name
-    if name.endswith(".AT2"):
-        return rs.motions.Record.from_at2(path)
-    return rs.motions.Record.from_csv(path, units="g")
 
 
 @pytest.mark.parametrize("name", FILES)
