@@ -15,7 +15,7 @@ the machine is shared, and wall time measures the neighbours). Printed per recor
     1e-4)), for this checkout and the old kernel.
 Writes benchmarks/results/records.json.
 
-    python benchmarks/bench_records.py [--rtol 1e-6] [--ref-scenes 40] [--old-rev a5019f7]
+    python benchmarks/bench_records.py [--rtol 1e-6] [--ref-scenes 20] [--old-rev a5019f7]
 """
 
 from __future__ import annotations
@@ -172,7 +172,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rtol", type=float, default=1e-6)
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--ref-scenes", type=int, default=40, help="scenes per record vs rtol 1e-12")
+    ap.add_argument("--ref-scenes", type=int, default=20, help="scenes per record vs rtol 1e-12")
     ap.add_argument("--scipy-scenes", type=int, default=5, help="scenes per record timed in scipy")
     ap.add_argument("--old-rev", default="a5019f7", help="git revision of the old kernel")
     args = ap.parse_args()
