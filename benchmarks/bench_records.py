@@ -181,7 +181,8 @@ def main():
     old = old_kernel(args.old_rev, args.rtol, args.repeat) if args.old_rev else {}
     rows = np.arange(min(args.ref_scenes, N_BLOCKS))
     results = {}
-    head = f"{'record':32s} {'new /s':>8s} {'old /s':>8s} {'x old':>6s} {'scipy /s':>9s} {'x scipy':>8s}"
+    head = f"{'record':32s} {'new /s':>8s} {'old /s':>8s} {'x old':>6s}"
+    head += f" {'scipy /s':>9s} {'x scipy':>8s}"
     print(f"rtol {args.rtol:g}, {N_BLOCKS} blocks per record, one core (CPU time)")
     print(head + "  p99 err (new/old), disagreements robust/all (new/old)")
     for name in FILES:
@@ -225,7 +226,8 @@ def main():
         "wall_s": time.perf_counter() - t_start,
     }
     print(
-        f"min {summary['min_new_scenes_per_s']:.0f} scenes/s/core, x{summary['geomean_speedup_vs_old']:.1f} "
+        f"min {summary['min_new_scenes_per_s']:.0f} scenes/s/core, "
+        f"x{summary['geomean_speedup_vs_old']:.1f} "
         f"on the old kernel (geometric mean), p99 error <= {summary['p99_rel_error_max']:.1e}, "
         f"robust disagreements {summary['robust_disagreements']}, {summary['wall_s']:.0f} s"
     )
