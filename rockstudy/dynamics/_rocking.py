@@ -700,7 +700,8 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
     table and ``fall`` the amplitude at which it is taken to have collapsed.
     Returns (status, max rotation, overturned, impacts, overturning time, history rows,
-    impact times recorded, DOP853 steps, first impact time).
+    impact times recorded, integrator steps (DOP853, or Taylor inside a record), first impact
+    time).
     """
     kind, mp, times, samples = mot
     omega_rest = REST_FRACTION * p * alpha
