@@ -27,6 +27,7 @@ from ..motions._kernels import (
     segment_index,
 )
 from ._dop853 import dop853_error, hermite5, make_dop853_step
+from ._roots import newton_bisect_update
 from ._taylor import (
     MAX_ORDER,
     poly_root,
@@ -276,15 +277,8 @@ def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
     for _ in range(100):
         v, dv, av = hermite5(s, h, y0, d0, a0, y1, d1, a1)
         q, dq = (dv, av * h) if deriv else (v, dv * h)
-        f = q - target
-        if sgn * f >= 0.0:
-            lo = s
-        else:
-            hi = s
-        sn = s - f / dq if dq != 0.0 else 0.5 * (lo + hi)
-        if not lo < sn < hi:
-            sn = 0.5 * (lo + hi)
-        if abs(sn - s) <= 1e-14 or hi - lo <= 1e-14:
+        sn, lo, hi, done = newton_bisect_update(s, q - target, dq, sgn, lo, hi, 1e-14)
+        if done:
             return sn
         s = sn
     return s

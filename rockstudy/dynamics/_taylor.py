@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from ..constants import G
+from ._roots import newton_bisect_update
 
 #: Highest order tried before a step is rejected (p h <~ 1 converges well below it).
 MAX_ORDER = 24
@@ -142,14 +143,8 @@ def poly_root(c, n, target, sgn, deriv, lo, hi):
     for _ in range(ROOT_ITERATIONS):
         v, d, dd = poly_value(c, n, x)
         f, df = (d - target, dd) if deriv else (v - target, d)
-        if sgn * f >= 0.0:
-            lo = x
-        else:
-            hi = x
-        xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
-        if not lo < xn < hi:
-            xn = 0.5 * (lo + hi)
-        if abs(xn - x) <= ROOT_TOL or hi - lo <= ROOT_TOL:
+        xn, lo, hi, done = newton_bisect_update(x, f, df, sgn, lo, hi, ROOT_TOL)
+        if done:
             return xn
         x = xn
     return x
