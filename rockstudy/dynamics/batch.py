@@ -158,9 +158,10 @@ def simulate_batch(
         (until rest; with restitution 1 the block never rests, and the impacts are counted up
         to duration + 100/p, the end of :func:`rockstudy.simulate`'s default history),
         ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s] (NaN if none),
-        ``status`` (0 ok, 1 step limit reached), ``steps`` (DOP853 steps
-        taken; 0 for the exact solver), ``model`` (0 rest without integration, 1 linear,
-        2 nonlinear: what each row ran); only those of ``outputs`` (and ``status``) if given.
+        ``status`` (0 ok, 1 step limit reached), ``steps`` (integrator steps taken: DOP853,
+        or Taylor steps inside a record; 0 for the exact solver), ``model`` (0 rest without
+        integration, 1 linear, 2 nonlinear: what each row ran); only those of ``outputs`` (and
+        ``status``) if given.
     """
     wanted = _requested_outputs(outputs)
     try:
@@ -249,7 +250,7 @@ _BATCH_UNITS = {
     "overturn_time": ("time of overturning", "s"),
     "first_impact_time": ("time of the first impact", "s"),
     "status": ("0 ok, 1 step limit reached", "1"),
-    "steps": ("DOP853 steps", "1"),
+    "steps": ("integrator steps (DOP853, or Taylor inside a record)", "1"),
     "model": ("0 rest, 1 linear, 2 nonlinear", "1"),
 }
 

@@ -1,0 +1,197 @@
+"""Taylor-series step for rocking under a sampled record (private numba kernels).
+
+Between two samples of a record the ground acceleration is linear in t, and so is a vertical
+component sampled on the same grid. On one side s of Housner's block, eq. (2.2) of [000]
+with a vertical acceleration v(t) reads
+
+.. math:: \\ddot\\theta = -p^2 [(1 + v/g) \\sin x + (a/g) \\cos x], \\quad x = \\alpha s - \\theta
+
+(linearized, eq. (3.1): sin x -> x, cos x -> 1). Its Taylor series about the start of a step
+follows from the recurrences of the series of S = sin x and C = cos x (Moore, *Interval
+Analysis*, 1966; Jorba & Zou, *Exp. Math.* 14, 2005):
+
+.. math:: k S_k = \\sum_{j=1}^{k} j x_j C_{k-j}, \\qquad k C_k = -\\sum_{j=1}^{k} j x_j S_{k-j},
+
+one sine and one cosine per step and O(N^2) flops for order N. The coefficients are kept
+scaled by the step, c_k = theta_k h^k, so the step is the polynomial sum_k c_k sigma^k on
+sigma in [0, 1]: an exact dense output (within the tolerance of the step), on which impacts,
+peaks and overturning are located by a safeguarded Newton-bisection.
+
+The order is chosen step by step: terms are added until the last two are below the error
+scale of theta (and, times their order, of h theta_dot). Those two terms bound the
+truncation error conservatively: the series decreases roughly like (p h)^k / k!, so the
+remainder is far below its last retained term. A step whose series has not converged at
+:data:`MAX_ORDER` is rejected and retried shorter.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..constants import G
+from .._roots import newton_bisect
+
+#: Highest order tried before a step is rejected (p h <~ 1 converges well below it).
+MAX_ORDER = 24
+#: Lowest order accepted: below it the last two terms could both vanish by symmetry
+#: (theta_dot = 0 and a symmetric forcing) and hide the true error.
+MIN_ORDER = 4
+#: Iteration cap and tolerance (unit step time) of the root finder on the step polynomial.
+ROOT_ITERATIONS = 100
+ROOT_TOL = 1e-14
+
+MODEL_NONLINEAR = 0
+MODEL_LINEAR = 1
+
+
+def work_arrays():
+    """Coefficient work space of :func:`taylor_coefficients`: rows c, j x_j, S, C."""
+    return np.empty((4, MAX_ORDER + 1))
+
+
+#: 1/k and 1/(k (k-1)), read by the recurrences (constants: no division in the loops).
+_INV = np.array([0.0] + [1.0 / k for k in range(1, MAX_ORDER + 1)])
+_INV2 = np.array([0.0, 0.0] + [1.0 / (k * (k - 1)) for k in range(2, MAX_ORDER + 1)])
+
+
+@njit(cache=True, inline="always")
+def _sin_cos_next(jx, sn, cs, k):
+    """S_k and C_k of the series of sin x and cos x, from j x_j (jx) and S, C up to k-1
+    (the recurrences of the module docstring)."""
+    sk = 0.0
+    ck = 0.0
+    for j in range(1, k + 1):
+        sk += jx[j] * cs[k - j]
+        ck -= jx[j] * sn[k - j]
+    return sk * _INV[k], ck * _INV[k]
+
+
+@njit(cache=True)
+def taylor_coefficients(w, th, om, s, p, alpha, model, h, a0, a1, v0, v1, sc_x, sc_v):
+    """Scaled Taylor coefficients c_k = theta_k h^k of one step of length h [s] into w[0].
+
+    th, om: theta [rad] and theta_dot [rad/s] at the start; s: the side (+1 or -1);
+    a0, a1 (v0, v1): horizontal (vertical) ground acceleration [m/s^2] at the start and the
+    end of the step, linear between. sc_x, sc_v: error scales of theta [rad] and theta_dot
+    [rad/s]. Returns (order n, error ratio): the step is sum_{k<=n} c_k sigma^k, accepted if
+    the ratio of its truncation-error bound to the scales is <= 1.
+    """
+    c, jx, sn, cs = w[0], w[1], w[2], w[3]
+    q = -((p * h) ** 2)
+    ah0 = q * a0 / G
+    ah1 = q * (a1 - a0) / G
+    vh0 = q * (1.0 + v0 / G)
+    vh1 = q * (v1 - v0) / G
+    x0 = alpha * s - th
+    c[0] = th
+    c[1] = om * h
+    jx[1] = -c[1]
+    if model == MODEL_LINEAR:
+        sn[0], cs[0] = x0, 1.0
+    else:
+        sn[0], cs[0] = math.sin(x0), math.cos(x0)
+    tol_v = sc_v * h
+    n = MAX_ORDER
+    for m in range(2, MAX_ORDER + 1):
+        k = m - 2
+        if k >= 1:
+            if model == MODEL_LINEAR:
+                sn[k], cs[k] = -c[k], 0.0
+            else:
+                sn[k], cs[k] = _sin_cos_next(jx, sn, cs, k)
+            rhs = vh0 * sn[k] + ah0 * cs[k] + vh1 * sn[k - 1] + ah1 * cs[k - 1]
+        else:
+            rhs = vh0 * sn[0] + ah0 * cs[0]
+        cm = rhs * _INV2[m]
+        c[m] = cm
+        jx[m] = -m * cm
+        if m >= MIN_ORDER:
+            b = abs(c[m - 1])
+            e = abs(cm)
+            if b + e <= sc_x and (m - 1) * b + m * e <= tol_v:
+                n = m
+                break
+    b = abs(c[n - 1])
+    e = abs(c[n])
+    return n, max((b + e) / sc_x, ((n - 1) * b + n * e) / tol_v)
+
+
+@njit(cache=True, inline="always")
+def poly_value(c, n, x):
+    """Value, first and second derivative (in unit step time) of sum_{k<=n} c_k x^k."""
+    v = c[n]
+    d = 0.0
+    dd = 0.0
+    for k in range(n - 1, -1, -1):
+        dd = dd * x + 2.0 * d
+        d = d * x + v
+        v = v * x + c[k]
+    return v, d, dd
+
+
+@njit(cache=True, inline="always")
+def _poly_fdf(x, args):
+    """The polynomial's value (or derivative) minus target at x, and its x-derivative."""
+    c, n, target, deriv = args
+    v, d, dd = poly_value(c, n, x)
+    return (d - target, dd) if deriv else (v - target, d)
+
+
+@njit(cache=True)
+def poly_root(c, n, target, sgn, deriv, lo, hi):
+    """Root in [lo, hi] of the polynomial's value (deriv=False) or derivative, minus target.
+
+    Finds where sgn * (q(x) - target) changes from >= 0 at lo to < 0 at hi, by Newton steps
+    safeguarded by bisection of the bracket (:func:`rockstudy._roots.newton_bisect`), to
+    :data:`ROOT_TOL` of the step.
+    """
+    args = (c, n, target, deriv)
+    return newton_bisect(_poly_fdf, args, lo, hi, 0.5 * (lo + hi), sgn, ROOT_TOL, ROOT_ITERATIONS)
+
+
+@njit(cache=True, inline="always")
+def _rises_throughout(c, n, s):
+    """Whether u = s theta (u(0) >= 0, u'(0) >= 0) surely stays >= 0 on the step: u'' is at
+    least m = 2 s c_2 - sum_{k>=3} k (k-1) |c_k| there, so u >= u(0) + u'(0) x + m x^2 / 2,
+    a parabola whose minimum on [0, 1] is at an end when m < 0."""
+    m = 2.0 * s * c[2]
+    for k in range(3, n + 1):
+        m -= k * (k - 1) * abs(c[k])
+    return m >= 0.0 or s * (c[0] + c[1]) + 0.5 * m >= 0.0
+
+
+@njit(cache=True)
+def step_impact(c, n, s, u1, du1):
+    """First root of theta in the step, in unit step time (2.0 if none), for a block on side
+    s; u1 = s theta and du1 = s dtheta/dx at the end of the step.
+
+    Beyond a sign change at the end, a dip through zero between two rises is looked for at
+    the minimum of s theta, and, unless a bound on the curvature rules it out, a short hop
+    (up, down through zero, up again) at the quarter points.
+    """
+    if u1 < 0.0:
+        return poly_root(c, n, 0.0, s, False, 0.0, 1.0)
+    if s * c[1] < 0.0:
+        if du1 > 0.0:
+            x_min = poly_root(c, n, 0.0, -s, True, 0.0, 1.0)
+            if s * poly_value(c, n, x_min)[0] < 0.0:
+                return poly_root(c, n, 0.0, s, False, 0.0, x_min)
+        return 2.0
+    if _rises_throughout(c, n, s):
+        return 2.0
+    for j in range(1, 4):
+        if s * poly_value(c, n, 0.25 * j)[0] < 0.0:
+            return poly_root(c, n, 0.0, s, False, 0.25 * (j - 1), 0.25 * j)
+    return 2.0
+
+
+@njit(cache=True)
+def step_peak(c, n, s, x_end, du_end):
+    """Unit step time of the peak of u = s theta in [0, x_end] (-1.0 if none): where
+    u' turns from >= 0 to <= 0; du_end = u'(x_end)."""
+    if s * c[1] >= 0.0 and du_end <= 0.0:
+        return poly_root(c, n, 0.0, s, True, 0.0, x_end)
+    return -1.0
