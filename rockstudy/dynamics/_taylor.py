@@ -31,8 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..constants import G
 from .._roots import newton_bisect
+from ..constants import G
 
 #: Highest order tried before a step is rejected (p h <~ 1 converges well below it).
 MAX_ORDER = 24

@@ -138,6 +138,16 @@ def _batch_calls(methods=("nonlinear", "linear", "auto")):
         simulate_batch(record=_with_vertical(record), scale=peak, **common)
 
 
+def _record_measure_calls():
+    """Intensity measures, spectrum and pulse of a record (studies store them per record)."""
+    from ..motions import synthetic_near_fault
+
+    record = synthetic_near_fault(pulse_period=1.0, pga=3.0, seed=0, duration=4.0)
+    record.intensity_measures(periods=[0.5, 1.0])
+    record.response_spectrum([0.5, 1.0])
+    record.pulse()
+
+
 def _closedform_calls():
     """Every ufunc of :mod:`rockstudy.closedform.sine`, and the boundary-curve kernel."""
     from ..closedform import overturning_boundary, sine
@@ -169,6 +179,7 @@ def compile_kernels(on_first_compile=None) -> dict:
         warnings.simplefilter("ignore")
         _simulate_calls()
         _batch_calls()
+        _record_measure_calls()
         _closedform_calls()
     return {"compiled": counter.count, "seconds": time.perf_counter() - t0}
 
