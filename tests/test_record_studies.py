@@ -269,7 +269,8 @@ def test_pga_ratio_is_scale_to_pga_ratio(suite, tmp_path):
     d_old, o_old = run_rows(old, tmp_path)
     _, o_new = run_rows(new, tmp_path)
     np.testing.assert_allclose(o_new["scale"], o_old["scale"], rtol=1e-14)
-    np.testing.assert_array_equal(o_new["max_rotation"], o_old["max_rotation"])
+    # the factors agree to rounding (two orders of the same arithmetic), the responses to 1e-12
+    np.testing.assert_allclose(o_new["max_rotation"], o_old["max_rotation"], rtol=1e-12)
     files = sorted(suite.glob("*_H.AT2"))
     peaks = np.array([Record.from_at2(files[r]).peak for r in d_old["record"].values])
     uplift = G * np.tan(d_old["critical_rotation"].values)
