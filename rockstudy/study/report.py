@@ -18,9 +18,8 @@ import pandas as pd
 
 from ..constants import G
 from . import analysis
-from ._page import (  # noqa: F401 (the page machinery, also reached as report.<name>)
+from ._page import (
     _FRAGILITY_NAMES,
-    BELOW_RANGE,
     NOT_REACHED,
     _capacities_as_measured,
     _Page,
