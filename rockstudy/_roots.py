@@ -54,6 +54,8 @@ def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):
         else:
             hi = x
         xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
+        if abs(xn - x) <= tol * max(1.0, abs(x)):  # converged (also a step below the ulp,
+            return min(max(xn, lo), hi)  # which would fail the bracket test: x is an end)
         if not lo < xn < hi:
             xn = 0.5 * (lo + hi)
         if abs(xn - x) <= tol * max(1.0, abs(x)) or hi - lo <= tol * max(1.0, abs(hi)):

@@ -9,10 +9,11 @@ import pytest
 
 import rockstudy as rs
 from rockstudy.constants import G
-from rockstudy.dynamics import _linear
+from rockstudy.dynamics import _linear_record
 from rockstudy.motions import Record, stochastic_record
 from rockstudy.structures import block_parameters
 
+NO_LOG = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
 RNG = np.random.default_rng(14)
 SCENES = [
     (RNG.uniform(0.5, 3.0), RNG.uniform(0.1, 0.3), RNG.uniform(0.8, 6.0), seed)
@@ -23,7 +24,7 @@ SCENES = [
 def exact(block, record, use_map=False, scale=1.0):
     p, alpha, eta = block_parameters(block)
     times, samples = record.kernel_spec()[2:4]
-    return _linear.record_scene(p, alpha, eta, scale, times, samples, use_map, np.inf)
+    return _linear_record.record_scene(p, alpha, eta, scale, times, samples, _linear_record.loud_table(samples), use_map, np.inf, NO_LOG, np.empty((0, 7)))[:6]
 
 
 @pytest.mark.parametrize("R, alpha, pga_ratio, seed", SCENES)
@@ -42,7 +43,7 @@ def test_exact_linear_record_matches_the_reference(R, alpha, pga_ratio, seed):
     # the batch form maps the free rocking after the record instead of following it
     p, a, eta = block_parameters(block)
     times, samples = record.kernel_spec()[2:4]
-    row = _linear.record_batch(
+    row = _linear_record.record_batch(
         np.array([p]), np.array([a]), np.array([eta]), np.ones(1), times, samples
     )[0]
     np.testing.assert_allclose(row[1], ref.max_rotation, rtol=1e-10)

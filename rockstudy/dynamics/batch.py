@@ -17,7 +17,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES, pulse_kernel_rows
 from ..structures.block import frequency_parameter as _p_of_R
 from ..structures.block import restitution_housner
-from . import _auto, _linear, _rocking
+from . import _auto, _linear, _linear_record, _rocking
 from ._vertical import refuse_free_fall, uplift_ratio
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
@@ -293,7 +293,7 @@ def _run(rows, idx, model, rtol, max_steps):
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
         return _linear.trig_batch(*args, mp[idx])
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD and not vsamples.size:
-        return _linear.record_batch(*args, mp[idx, 0], times, samples)
+        return _linear_record.record_batch(*args, mp[idx, 0], times, samples)
     return _rocking.scene_batch(
         *args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps
     )

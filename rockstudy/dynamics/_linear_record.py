@@ -1,0 +1,482 @@
+"""Exact solution of the linearized rocking block under sampled records (private).
+
+On a record segment the ground term of eq. (3.1) of [000] is linear in tau = p t,
+F = f0 + f1 sigma (F = u_g'' / g, sigma = tau - tau_k), so theta'' = theta - g0 - f1 sigma with
+g0 = alpha s + f0 has the closed form, from theta0 and v0 = theta'(0),
+
+    theta(sigma) = theta0 + v0 sinh + (theta0 - g0)(cosh - 1) - f1 (sinh - sigma),
+
+written so that no large terms cancel where theta is small (near impacts). Nothing is
+integrated: each segment is a 2 x 2 exponential recursion of (theta, theta').
+
+Events on a segment. theta = g0 + f1 sigma + A e^-sigma + B e^sigma, so theta'' = A e^-sigma
++ B e^sigma has at most one zero: where theta'' has one strict sign at both ends of the segment,
+theta' is monotone, and theta' has a zero inside only if it changes sign. On such a segment
+(almost every one) theta is monotone, and the only test is whether s theta ends below 0 (an
+impact) or above FALL_ROTATION (the fall). Elsewhere theta' = 0 where x = e^sigma solves
+B x^2 + f1 x - A = 0: at most two turning points (the peaks), between which theta is monotone,
+so an impact or the fall is the single root of a bracketed monotone function.
+
+Costs. The functions of sigma are Taylor polynomials below 0.25 (a record segment is p dt ~
+0.005-0.1), computed once per scene for the record's step (a uniform record: once; else
+whenever the length changes) and once per impact for the rest of the segment. A block at
+rest skips the samples below the uplift level g alpha by a table of block maxima of |u_g''|
+shared by every row of a batch (:func:`loud_table`), and the exact lift-off time is found on
+the first segment that can lift, by the kernel's own test (``_rocking._lift``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .._roots import newton_bisect
+from ..constants import FALL_ROTATION, G
+from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ._linear import _FIRST, _MAXU, _NIMP, ROOT_MAX_ITER, ROOT_TOL, _impact_tally, trig_scene
+from ._rocking import (
+    MODEL_LINEAR,
+    NO_TABLE,
+    PH_END,
+    PH_OVER,
+    PH_REST,
+    QUIET_MARGIN,
+    REST_FRACTION,
+    STATUS_OK,
+    _lift,
+)
+
+#: Below this |sigma| the segment functions are Taylor polynomials: the first term left out
+#: is below 1e-18 of the sum (sinh - sigma to sigma^13, cosh - 1 to sigma^12).
+SERIES_LIMIT = 0.25
+#: Samples per entry of the table of |u_g''| maxima that a block at rest skips by.
+LOUD_BLOCK = 64
+#: Relative change of the segment length below which the cached segment functions are reused
+#: (the sample times of a uniform record differ from k dt by rounding).
+SAME_LENGTH = 1e-13
+
+# log counters of a scene (after _MAXU, _NIMP, _FIRST): history rows, impacts, peaks, dense
+_NH, _NI, _NP, _ND = 3, 4, 5, 6
+
+
+@njit(cache=True, inline="always")
+def _seg_functions(sig):
+    """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation."""
+    if abs(sig) >= SERIES_LIMIT:
+        half = math.sinh(0.5 * sig)
+        sh = math.sinh(sig)
+        return sh, 2.0 * half * half, sh - sig
+    x2 = sig * sig
+    smx = x2 * (1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (1.0 / 39916800.0)))
+    smx = sig * x2 * (1.0 / 6.0 + x2 * (1.0 / 120.0 + smx + x2 * x2 * x2 * x2 / 6227020800.0))
+    cm1 = x2 * (1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (1.0 / 3628800.0)))
+    cm1 = x2 * (0.5 + x2 * (1.0 / 24.0 + cm1 + x2 * x2 * x2 * x2 / 479001600.0))
+    return sig + smx, cm1, smx
+
+
+@njit(cache=True, inline="always")
+def _seg_advance(th0, v0, g0, f1, sh, cm1, smx):
+    """theta and theta' after sigma on a record segment, given :func:`_seg_functions` of sigma."""
+    return th0 + v0 * sh + (th0 - g0) * cm1 - f1 * smx, v0 + (th0 - g0) * sh + (v0 - f1) * cm1
+
+
+@njit(cache=True, inline="always")
+def _seg_state(th0, v0, g0, f1, sig):
+    """theta [rad] and theta' = d theta / d tau at sigma on a record segment (closed form of
+    the module docstring, eq. 3.1 of [000] under a linear ground)."""
+    sh, cm1, smx = _seg_functions(sig)
+    return _seg_advance(th0, v0, g0, f1, sh, cm1, smx)
+
+
+@njit(cache=True)
+def _seg_turning_points(th0, v0, g0, f1, length, e_length):
+    """The sigma in (0, length) where theta' = 0 (B x^2 + f1 x - A = 0, x = e^sigma), in order;
+    inf where there is none. ``e_length`` is e^length (no logarithm unless a root is inside)."""
+    A = 0.5 * ((th0 - g0) - (v0 - f1))
+    B = 0.5 * ((th0 - g0) + (v0 - f1))
+    r1 = r2 = np.inf
+    if B == 0.0:
+        if f1 != 0.0:
+            r1 = A / f1
+    else:
+        disc = f1 * f1 + 4.0 * A * B
+        if disc < 0.0:
+            return np.inf, np.inf
+        qq = -0.5 * (f1 + math.copysign(math.sqrt(disc), f1))
+        r1 = qq / B
+        r2 = -A / qq if qq != 0.0 else np.inf
+    s1 = math.log(r1) if 1.0 < r1 < e_length else np.inf
+    s2 = math.log(r2) if 1.0 < r2 < e_length else np.inf
+    s1 = s1 if s1 < length else np.inf
+    s2 = s2 if s2 < length else np.inf
+    return min(s1, s2), max(s1, s2)
+
+
+@njit(cache=True, inline="always")
+def _seg_fdf(x, args):
+    """f = s theta - target at sigma = x on a record segment (:func:`_seg_state`), and the
+    slope that makes a Newton step of :func:`newton_bisect` a Halley step, f' - f f'' / 2 f'
+    (cubic convergence; theta'' = theta - g0 - f1 sigma comes free with the state)."""
+    target, th0, v0, g0, f1, s = args
+    th, v = _seg_state(th0, v0, g0, f1, x)
+    f = s * th - target
+    df = s * v
+    return f, (df - 0.5 * f * s * (th - g0 - f1 * x) / df if df != 0.0 else 0.0)
+
+
+@njit(cache=True)
+def _seg_root(target, th0, v0, g0, f1, s, lo, hi, u_lo, u_hi):
+    """sigma in [lo, hi] where s theta - target changes sign, theta monotone on [lo, hi] with
+    s theta = u_lo, u_hi at the ends (Newton steps from the secant guess, safeguarded by
+    bisection, to rounding)."""
+    sign_lo = 1.0 if u_lo - target >= 0.0 else -1.0
+    x0 = lo + (hi - lo) * (u_lo - target) / (u_lo - u_hi) if u_lo != u_hi else 0.5 * (lo + hi)
+    x0 = min(max(x0, lo), hi)
+    args = (target, th0, v0, g0, f1, s)
+    return newton_bisect(_seg_fdf, args, lo, hi, x0, sign_lo, ROOT_TOL, ROOT_MAX_ITER)
+
+
+@njit(cache=True, inline="always")
+def _push(hist, ta, t, theta, theta_dot):
+    """Append the row (t, theta, theta_dot) to the history, if it has room; count it."""
+    n = int(ta[_NH])
+    if n < hist.shape[0]:
+        hist[n, 0], hist[n, 1], hist[n, 2] = t, theta, theta_dot
+    ta[_NH] = n + 1
+
+
+@njit(cache=True, inline="always")
+def _push_event(times, ta, counter, t, theta):
+    """Append an impact (``times`` 1-D: t) or a peak (2-D: t, theta) to its log; count it."""
+    n = int(ta[counter])
+    if n < times.shape[0]:
+        times.ravel()[n * times.ndim] = t
+        if times.ndim == 2:
+            times.ravel()[n * times.ndim + 1] = theta
+    ta[counter] = n + 1
+
+
+@njit(cache=True)
+def _dense_piece(dense, ta, p, tau_a, tau_b, th, v, g0, f1):
+    """Write the states at the requested times in (tau_a, tau_b] (tau units, sorted, from
+    ``ta[_ND]`` on) from the closed form of the segment piece starting at tau_a in (th, v);
+    requested times before tau_a fall in a rest and keep (0, 0)."""
+    i = int(ta[_ND])
+    while i < dense.shape[0] and p * dense[i, 0] <= tau_b:
+        if p * dense[i, 0] >= tau_a:
+            th_i, v_i = _seg_state(th, v, g0, f1, p * dense[i, 0] - tau_a)
+            dense[i, 1] = th_i
+            dense[i, 2] = p * v_i
+        i += 1
+    ta[_ND] = i
+
+
+@njit(cache=True, inline="always")
+def _monotone(v, v_end, d0, d1, length):
+    """Whether theta is monotone on a segment: theta' keeps one strict sign. theta'' = A e^-sigma
+    + B e^sigma is monotone or of one sign, so it has its extremes d0, d1 at the ends: where
+    they have one strict sign theta' is monotone too, and otherwise |theta''| <= M = max(|d0|,
+    |d1|) keeps theta' >= (|v| + |v_end| - M length) / 2 > 0 in magnitude."""
+    if v * v_end <= 0.0:
+        return False
+    return d0 * d1 > 0.0 or abs(v) + abs(v_end) > max(abs(d0), abs(d1)) * length
+
+
+@njit(cache=True, inline="always")
+def _below(u0, du0, ddu0, ddu1, length, level):
+    """Whether u = s theta stays at or below ``level`` on a segment where it starts at u0 with
+    u' = du0 and u'' = ddu0 ... ddu1 at the ends (u'' has its maximum at an end, as theta''):
+    u <= u0 + max(u', 0) length + max(u'', 0) length^2 / 2."""
+    top = u0 + max(du0, 0.0) * length + 0.5 * max(ddu0, ddu1, 0.0) * length * length
+    return top <= level
+
+
+@njit(cache=True)
+def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
+    """A segment on which theta may turn: split at its turning points (the peaks, logged),
+    on each monotone piece look for an impact (s theta reaching 0) or the fall (FALL_ROTATION).
+    Returns (sigma of the event or -1, whether it is the fall)."""
+    c1, c2 = _seg_turning_points(th, v, g0, f1, length, 1.0 + sh + cm1)
+    lo = 0.0
+    u_lo = s * th
+    for hi in (c1, c2, length):
+        if hi == np.inf or hi < lo:
+            continue
+        th_hi = th_end if hi == length else _seg_state(th, v, g0, f1, hi)[0]
+        u_hi = s * th_hi
+        if u_lo > 0.0 and u_hi <= 0.0:
+            return _seg_root(0.0, th, v, g0, f1, s, lo, hi, u_lo, u_hi), False
+        if u_hi >= FALL_ROTATION:
+            return _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi, u_lo, u_hi), True
+        if hi < length and u_hi > 0.0 and u_hi - s * (g0 + f1 * hi) < 0.0:  # u'' < 0: a peak
+            _push_event(log[2], ta, _NP, (tau + hi) / p, th_hi)
+        ta[_MAXU] = max(ta[_MAXU], u_hi)
+        lo, u_lo = hi, u_hi
+    return -1.0, False
+
+
+@njit(cache=True, inline="always")
+def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log):
+    """The first impact or fall on a segment: (sigma or -1, whether it is the fall), with the
+    max rotation (``ta[_MAXU]``) and the peaks updated. Most segments are decided without a
+    root: theta monotone (:func:`_monotone`), or, when no peak is logged, a single turning
+    point that cannot raise the max rotation so far (:func:`_below`)."""
+    u0, u_end = s * th, s * th_end
+    d0 = th - g0  # theta'' at both ends
+    d1 = th_end - g0 - f1 * length
+    if _monotone(v, v_end, d0, d1, length):
+        if 0.0 < u_end < FALL_ROTATION:
+            ta[_MAXU] = max(ta[_MAXU], u_end)
+            return -1.0, False
+        if u_end >= FALL_ROTATION:
+            return _seg_root(FALL_ROTATION, th, v, g0, f1, s, 0.0, length, u0, u_end), True
+        if u0 > 0.0:
+            return _seg_root(0.0, th, v, g0, f1, s, 0.0, length, u0, u_end), False
+    elif (
+        log[2].shape[0] == 0
+        and s * v > 0.0 > s * v_end
+        and u_end > 0.0
+        and _below(u0, s * v, s * d0, s * d1, length, ta[_MAXU])
+    ):
+        return -1.0, False  # one turning point, a maximum: no impact, and not a new max
+    return _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log)
+
+
+@njit(cache=True)
+def _record_phase(alpha, eta, p, c, times, samples, k, tau, th, v, s, ta, log):
+    """Rock exactly from (tau, theta, theta', side) on record segment k until rest, overturning
+    or the end of the record (eq. 3.1 of [000] with u_g''/g = c samples; impacts with
+    restitution eta; rest when the speed after an impact is below REST_FRACTION alpha, the
+    caller deciding by the kernel's lift test whether the block rises again). ``log`` =
+    (history, impacts, peaks, dense) (arrays of length 0 for none), counted in ``ta``. Returns
+    (code, k, tau, theta, theta', side)."""
+    n = times.shape[0]
+    rest_v = REST_FRACTION * alpha
+    logging = log[0].shape[0] > 0
+    dense = log[3].shape[0] > 0
+    known = -1.0  # the segment length whose functions are in (sh_l, cm1_l, smx_l, inv_l)
+    sh_l = cm1_l = smx_l = inv_l = 0.0
+    t_lo = p * times[k]
+    while k < n - 1:
+        t_hi = p * times[k + 1]
+        seg = t_hi - t_lo
+        if abs(seg - known) > SAME_LENGTH * seg:
+            known = seg
+            sh_l, cm1_l, smx_l = _seg_functions(seg)
+            inv_l = 1.0 / seg
+        F0 = c * samples[k]
+        f1 = (c * samples[k + 1] - F0) * inv_l
+        length = t_hi - tau
+        if tau == t_lo:
+            g0 = alpha * s + F0
+            sh, cm1, smx = sh_l, cm1_l, smx_l
+        else:  # the rest of a segment, after an impact or a lift-off inside it
+            g0 = alpha * s + F0 + f1 * (tau - t_lo)
+            sh, cm1, smx = _seg_functions(length)
+        th_end, v_end = _seg_advance(th, v, g0, f1, sh, cm1, smx)
+        hit, fall = _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log)
+        if dense:
+            _dense_piece(log[3], ta, p, tau, t_hi if hit < 0.0 else tau + hit, th, v, g0, f1)
+        if hit < 0.0:  # on to the next segment
+            th, v, tau, t_lo = th_end, v_end, t_hi, t_hi
+            k += 1
+            if logging:
+                _push(log[0], ta, times[k], th, p * v)
+            continue
+        th_hit, v_hit = _seg_state(th, v, g0, f1, hit)
+        tau += hit
+        if fall:
+            ta[_MAXU] = FALL_ROTATION
+            if logging:
+                _push(log[0], ta, tau / p, s * FALL_ROTATION, p * v_hit)
+            return PH_OVER, k, tau, s * FALL_ROTATION, 0.0, s
+        v_post = eta * v_hit
+        _impact_tally(ta, tau)
+        th = 0.0
+        if logging:
+            _push(log[0], ta, tau / p, 0.0, p * v_hit)
+            _push_event(log[1], ta, _NI, tau / p, 0.0)
+        if abs(v_post) < rest_v:
+            if logging:
+                _push(log[0], ta, tau / p, 0.0, 0.0)
+            return PH_REST, k, tau, 0.0, 0.0, s
+        s = -s
+        v = v_post
+        if logging:
+            _push(log[0], ta, tau / p, 0.0, p * v)
+    return PH_END, n - 1, tau, th, v, s
+
+
+@njit(cache=True)
+def loud_table(samples):
+    """max |samples| over blocks of LOUD_BLOCK samples: a block at rest skips a whole block
+    whose maximum is below the uplift level (one table per record, shared by every row)."""
+    out = np.zeros((samples.shape[0] + LOUD_BLOCK - 1) // LOUD_BLOCK)
+    for i in range(samples.shape[0]):
+        out[i // LOUD_BLOCK] = max(out[i // LOUD_BLOCK], abs(samples[i]))
+    return out
+
+
+@njit(cache=True)
+def _first_loud(samples, loud, level, j):
+    """The first sample index >= j (below the last) with |sample| >= level, or the last."""
+    n = samples.shape[0]
+    while j < n - 1:
+        if j % LOUD_BLOCK == 0 and loud[j // LOUD_BLOCK] < level:
+            j += LOUD_BLOCK
+        elif abs(samples[j]) >= level:
+            return j
+        else:
+            j += 1
+    return n - 1
+
+
+@njit(cache=True, inline="always")
+def _lifts(p, alpha, mp, times, samples, t, k):
+    """Whether the ground at t [s] (segment k) lifts a block at rest (``_rocking._lift``)."""
+    a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t, k)
+    return _lift(a_g, 0.0, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
+
+
+@njit(cache=True)
+def _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, lifts_hi):
+    """The time in (lo, hi] on segment k where the lift test turns to ``lifts_hi``, to the ulp."""
+    for _ in range(2000):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if _lifts(p, alpha, mp, times, samples, mid, k) == lifts_hi:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(cache=True)
+def _record_uplift(p, alpha, mp, times, samples, loud, t, k):
+    """First time >= t [s] (on segment k) at which the record lifts a block at rest, and its
+    segment; (inf, k) if none. The samples below the uplift level (less QUIET_MARGIN) are
+    skipped by the block table ``loud``; on a segment the ground is linear, so the lift test is
+    monotone on each side of its zero and needs checking at the segment's end only
+    (``_rocking.next_uplift``)."""
+    n = times.shape[0]
+    if _lifts(p, alpha, mp, times, samples, t, k):
+        return t, k
+    level = G * alpha * (1.0 - QUIET_MARGIN) / abs(mp[0]) if mp[0] != 0.0 else np.inf
+    lo = t
+    while k < n - 1:
+        j = _first_loud(samples, loud, level, k + 1)
+        if j - 1 > k:
+            k = j - 1
+            lo = times[k]
+        hi = times[k + 1]
+        if _lifts(p, alpha, mp, times, samples, hi, min(k + 1, n - 2)):
+            return _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, True), k
+        lo = hi
+        k += 1
+    return np.inf, k
+
+
+@njit(cache=True)
+def _record_lift_end(p, alpha, mp, times, samples, t, k):
+    """First time >= t [s] (segment k) at which the ground stops lifting a block at rest, or
+    the end of the record (``_linear._lift_ends``: a block lifted from rest cannot come back
+    before it; when the closed form brings it back earlier, it is left at rest until here)."""
+    n = times.shape[0]
+    lo = t
+    while k < n - 1:
+        hi = times[k + 1]
+        if hi >= mp[3] or not _lifts(p, alpha, mp, times, samples, hi, k):
+            return _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, False)
+        lo = hi
+        k += 1
+    return mp[3]
+
+
+@njit(cache=True)
+def record_scene(
+    p, alpha, eta, scale, times, samples, loud, use_map, t_tail, log, tail_log, th0=0.0, om0=0.0
+):
+    """Linearized block under a sampled record (linear between samples), exactly.
+
+    Nothing is integrated: every record segment is the closed form of :func:`_seg_state`. The
+    block lifts off where |scale samples| first exceeds g alpha (eq. 3.1 of [000]), by the
+    kernel's test (``_rocking._lift``), also after a Zeno rest. ``loud`` is
+    :func:`loud_table` of the samples. After the record the free rocking is mapped
+    (``use_map``) or followed in closed form until rest, overturning or ``t_tail`` [s]
+    (``_linear.trig_scene``, logged in ``tail_log``, its times from the record's end).
+    ``log`` = (history (t, theta, theta_dot), impact times, peaks (t, theta), dense (t,
+    theta, theta_dot)) inside the record, each of length 0 for none.
+
+    Returns (status, max rotation [rad], overturned, impacts, overturning time [s], first
+    impact time [s], (history rows, impacts, peaks) logged), as ``_linear.trig_scene`` with
+    the log counts.
+
+    Horizontal only: the closed form needs constant coefficients, which a vertical
+    component (p^2 (1 + u_v''/g) in time) breaks; the callers run the kernel with
+    MODEL_LINEAR for a record that has one.
+    """
+    dur = times[-1]
+    mp = np.array([scale, 0.0, 0.0, dur])
+    ta = np.array([abs(th0), 0.0, np.nan, 0.0, 0.0, 0.0, 0.0])
+    logging = log[0].shape[0] > 0
+    if logging:
+        _push(log[0], ta, 0.0, th0, om0)
+    rocking = th0 != 0.0 or om0 != 0.0
+    tau, th, v = 0.0, th0, om0 / p
+    s = math.copysign(1.0, th0 if th0 != 0.0 else om0)
+    k = 0
+    code = PH_END
+    while True:
+        lifted = not rocking  # this phase starts from rest
+        if not rocking:
+            t_up, k = _record_uplift(p, alpha, mp, times, samples, loud, tau / p, k)
+            k_up = k
+            if t_up >= dur:
+                if logging:
+                    _push(log[0], ta, dur, 0.0, 0.0)
+                n_log = int(ta[_NH]), int(ta[_NI]), int(ta[_NP])
+                return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p, n_log
+            a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t_up, k)
+            s = -1.0 if a_g > 0.0 else 1.0
+            tau, th, v = p * t_up, 0.0, 0.0
+            if logging:
+                _push(log[0], ta, t_up, 0.0, 0.0)
+        rocking = False
+        code, k, tau, th, v, s = _record_phase(
+            alpha, eta, p, scale / G, times, samples, k, tau, th, v, s, ta, log
+        )
+        if code != PH_REST:
+            break
+        if lifted:
+            tau = max(tau, p * _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
+        k = segment_index(times, tau / p, k)
+    n_log = int(ta[_NH]), int(ta[_NI]), int(ta[_NP])
+    if code == PH_OVER:
+        return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p, n_log
+    # the free rocking after the record: trig_scene under a motion of zero length, from here
+    tail = trig_scene(
+        p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_tail - dur, tail_log, th, v * p
+    )
+    first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
+    peak = max(ta[_MAXU], tail[1])
+    return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first, n_log
+
+
+@njit(cache=True, parallel=True)
+def record_batch(p, alpha, eta, scale, times, samples):
+    """:func:`record_scene` over rows (one record, scaled row by row), in parallel; an (n, 7)
+    array of ``BATCH_COLUMNS``."""
+    out = np.empty((p.shape[0], 7))
+    loud = loud_table(samples)
+    no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
+    no_tail = np.empty((0, 7))
+    for i in prange(p.shape[0]):
+        r = record_scene(
+            p[i], alpha[i], eta[i], scale[i], times, samples, loud, True, np.inf, no_log, no_tail
+        )
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
+        out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
+    return out
