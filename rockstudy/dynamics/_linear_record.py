@@ -457,9 +457,8 @@ def record_scene(
     if code == PH_OVER:
         return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p, n_log
     # the free rocking after the record: trig_scene under a motion of zero length, from here
-    tail = trig_scene(
-        p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_tail - dur, tail_log, th, v * p
-    )
+    t_free = max(t_tail - dur, 0.0)
+    tail = trig_scene(p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_free, tail_log, th, v * p)
     first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
     peak = max(ta[_MAXU], tail[1])
     return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first, n_log

@@ -129,7 +129,10 @@ def simulate_batch(
         linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
         ``max_rotation`` and ``overturned`` are asked for (see ``outputs``), and the
         nonlinear kernel at 0.05 ``rtol`` (5e-6 at most, for the overturning decisions)
-        otherwise.
+        otherwise. Under a record ``"auto"`` never runs the linear model: no bound on its
+        error is known there (the table is measured on one-cycle pulses; under a record the
+        error depends on the whole history, and the two models part for good once one of
+        them crosses an overturning boundary or a rest that the other does not).
     rtol : float
         Relative tolerance of the integrator, in [1e-12, 1). For ``"auto"``: the relative
         accuracy of ``max_rotation``, with the overturning decision of Housner's model;

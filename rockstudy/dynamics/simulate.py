@@ -17,7 +17,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
-from . import _auto, _linear, _rocking
+from . import _auto, _linear, _linear_record, _rocking
 from ._vertical import refuse_free_fall, uplift_ratio
 from .reference import simulate_reference
 from .result import RockingResult
@@ -120,11 +120,14 @@ def _dense_fields(t_eval, theta, theta_dot, over, t_ot) -> dict:
 
 
 def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, t_eval=None):
-    """Exact piecewise solution for trigonometric pulses; the kernel for other motions (also
-    for a record with a vertical component, which the constant-coefficient closed forms
+    """Exact piecewise solution for trigonometric pulses (eq. 3.4 of [000]) and for records
+    without a vertical component (:func:`_linear_record_exact`); the kernel for other motions
+    (also for a record with a vertical component, which the constant-coefficient closed forms
     cannot take: said in ``info["solver"]``). Peaks and the dense output are the closed
-    form's (eq. 3.4 of [000])."""
+    form's."""
     kind, mp, _, _, vsamples = motion.kernel_spec()
+    if kind == mk.KIND_RECORD and not vsamples.size:
+        return _linear_record_exact(p, alpha, eta, motion, t_max, method, x0, t_eval)
     if kind != mk.KIND_TRIG:
         args = (p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)
         r = _kernel(*args, t_eval=t_eval)
@@ -161,6 +164,61 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
         method,
         {"solver": "exact piecewise (eq. 3.4 of [000])"},
         *_linear.phase_peaks(rec, p),
+        **dense,
+    )
+
+
+def _linear_record_exact(p, alpha, eta, motion, t_max, method, x0, t_eval=None):
+    """The linearized block under a record, in closed form on each record segment
+    (``_linear_record.record_scene``): the history holds the uplifts, the impacts (before and
+    after), the rests and every segment end, then the free rocking after the record in closed
+    form (``_linear.trig_scene``); peaks at the closed-form turning points; the dense output
+    from the closed form of the segment (or free-rocking phase) that holds each time."""
+    _, mp, times, samples, _ = motion.kernel_spec()
+    t_tail = _tail_end(p, eta, motion, t_max)
+    _check_end(t_eval, t_tail)
+    dur = float(times[-1])
+    t_in = np.empty(0) if t_eval is None else t_eval[t_eval <= dur]
+    loud = _linear_record.loud_table(samples)
+    cap = 4096
+    while True:
+        log = (np.empty((cap, 3)), np.empty(cap), np.empty((cap, 2)), np.zeros((t_in.size, 3)))
+        log[3][:, 0] = t_in
+        tail = np.zeros((cap, 7))
+        args = (p, alpha, eta, mp[0], times, samples, loud, False, t_tail, log, tail)
+        _, max_rot, over, _, t_ot, _, counts = _linear_record.record_scene(*args, *x0)
+        if max(counts) <= cap and tail[0, 0] < cap - 1:
+            break
+        cap *= 4
+    nh, ni, npk = counts
+    t_free, th_free, om_free, imp_free = _linear.phase_history(tail, p, alpha, 1.0, 0.0)
+    peak_t, peak_th = _linear.phase_peaks(tail, p)
+    hist = log[0][:nh]
+    peaks = log[2][:npk]
+    if x0[0] != 0.0 and x0[1] == 0.0:  # released at rest: t = 0 is a peak, as for pulses
+        peaks = np.vstack([[0.0, x0[0]], peaks])
+    dense = {}
+    if t_eval is not None:
+        after = t_eval[t_eval > dur] - dur
+        th_after, om_after = _linear.phase_states(tail, p, alpha, 1.0, 0.0, after)
+        theta = np.concatenate([log[3][:, 1], th_after])
+        theta_dot = np.concatenate([log[3][:, 2], om_after])
+        dense = _dense_fields(t_eval, theta, theta_dot, over, t_ot)
+    return RockingResult(
+        np.concatenate([hist[:, 0], t_free[1:] + dur]),
+        np.concatenate([hist[:, 1], th_free[1:]]),
+        np.concatenate([hist[:, 2], om_free[1:]]),
+        float(max_rot),
+        bool(over),
+        np.concatenate([log[1][:ni], imp_free + dur]),
+        float(t_ot),
+        method,
+        {
+            "solver": "exact piecewise: eq. (3.1) of [000] in closed form on each record segment",
+            "dop853_steps": 0,
+        },
+        np.concatenate([peaks[:, 0], peak_t + dur]),
+        np.concatenate([peaks[:, 1], peak_th]),
         **dense,
     )
 
@@ -295,7 +353,9 @@ def simulate(
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
         ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven DOP853 kernel.
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
-        trigonometric pulses, the same kernel otherwise.
+        trigonometric pulses and for records (closed form on each sample segment, nothing
+        integrated: ``info["dop853_steps"]`` = 0), the same kernel otherwise (a record with a
+        vertical component, a Ricker wavelet; ``info["solver"]`` says which ran).
         ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
         ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
         (Housner's model as l -> 0; steps below l / 10 make it slow).
@@ -303,7 +363,9 @@ def simulate(
         where the ground never reaches g tan(alpha), otherwise the nonlinear kernel at
         0.05 ``rtol``, 5e-6 at most (tighter again for responses below 0.1 alpha, where
         chattering makes its error absolute). With a history to build the exact linear
-        solver is not cheaper, so only :func:`rockstudy.simulate_batch` chooses it.
+        solver is not cheaper, so only :func:`rockstudy.simulate_batch` chooses it, and only
+        under one-cycle pulses, where a tabulated bound covers its error; under records no
+        such bound is known, and ``"auto"`` runs rest or the nonlinear kernel.
         ``result.info`` holds the model, the kernel's rtol and the scene's linearization
         bound.
         On a structure with a ``mechanism()``: ``"nonlinear"``, ``"mechanism"`` and
@@ -336,7 +398,7 @@ def simulate(
         end (``t_max`` when given; a block with restitution 1 is followed for 100 / p after
         the motion). Each state is as accurate as the steps: one DOP853 step from the start
         of the accepted step that contains the time (kernel methods), the closed form
-        (``"linear"`` on a pulse), scipy's dense output (``"scipy"``) or the cubic Hermite
+        (``"linear"`` on a pulse or a record), scipy's dense output (``"scipy"``) or the cubic Hermite
         interpolant of the steps (``"complex"``). At rest (0, 0); at an impact, the state
         just before it; after an overturning NaN.
     dt_out : float, optional
@@ -350,7 +412,7 @@ def simulate(
         With the peaks (``peak_times``, ``peak_rotations``: every local maximum of |theta|)
         located by each method on its own solution: on the DOP853 step's interpolant and one
         Newton step on a true step (the kernels), on the closed form (``"linear"`` on a
-        pulse), by scipy's event location (``"scipy"``) or on the cubic Hermite interpolant
+        pulse or a record), by scipy's event location (``"scipy"``) or on the cubic Hermite interpolant
         of the steps (``"complex"``).
     """
     try:
