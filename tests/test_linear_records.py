@@ -26,7 +26,19 @@ SCENES = [
 def exact(block, record, use_map=False, scale=1.0):
     p, alpha, eta = block_parameters(block)
     times, samples = record.kernel_spec()[2:4]
-    return _linear_record.record_scene(p, alpha, eta, scale, times, samples, _linear_record.loud_table(samples), use_map, np.inf, NO_LOG, np.empty((0, 7)))[:6]
+    return _linear_record.record_scene(
+        p,
+        alpha,
+        eta,
+        scale,
+        times,
+        samples,
+        _linear_record.loud_table(samples),
+        use_map,
+        np.inf,
+        NO_LOG,
+        np.empty((0, 7)),
+    )[:6]
 
 
 @pytest.mark.parametrize("R, alpha, pga_ratio, seed", SCENES)
@@ -93,9 +105,7 @@ def _assert_matches_reference(r, ref, alpha, p):
     np.testing.assert_allclose(r.peak_times, ref.peak_times, rtol=0, atol=1e-8)
     np.testing.assert_allclose(r.peak_rotations, ref.peak_rotations, rtol=0, atol=1e-10 * alpha)
     np.testing.assert_allclose(r.theta_eval, ref.theta_eval, rtol=0, atol=1e-10 * alpha)
-    np.testing.assert_allclose(
-        r.theta_dot_eval, ref.theta_dot_eval, rtol=0, atol=1e-8 * p * alpha
-    )
+    np.testing.assert_allclose(r.theta_dot_eval, ref.theta_dot_eval, rtol=0, atol=1e-8 * p * alpha)
 
 
 @pytest.mark.parametrize(
@@ -170,8 +180,8 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
     through many impacts amplifies the reference's error: on one of these scenes its max
     rotation moves by 1.4e-8 between rtol 1e-12 and 3e-13; the exact solver must lie within
     that spread (and within 1e-10 where the reference has converged)."""
-    from rockstudy.dynamics.reference import simulate_reference
     from rockstudy.dynamics._rocking import MODEL_LINEAR
+    from rockstudy.dynamics.reference import simulate_reference
 
     records = [
         Record.from_at2(records_dir / "RSN126_GAZLI_GAZ000.AT2"),
@@ -189,7 +199,12 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
         for i in range(R.size):
             ref, finer = (
                 simulate_reference(
-                    p[i], alpha[i], eta[i], record.scaled(scale[i]), MODEL_LINEAR, rtol,
+                    p[i],
+                    alpha[i],
+                    eta[i],
+                    record.scaled(scale[i]),
+                    MODEL_LINEAR,
+                    rtol,
                     free_map=True,
                 )
                 for rtol in (1e-12, 3e-13)

@@ -406,6 +406,8 @@ def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40
         m = max(8, int(np.ceil((tau1 - tau0) * points_per_unit)))
         sig = np.linspace(0.0, tau1 - tau0, m + 1)
         th, om = _phase_state(row, sig, p, alpha, W, phase)
+        if row[6] == ROW_IMPACT:  # the closed form at the located impact: 0 up to rounding
+            th[-1] = 0.0
         ts.append((tau0 + sig) / p)
         ths.append(th)
         oms.append(om)

@@ -55,7 +55,7 @@ SERIES_LIMIT = 0.25
 LOUD_BLOCK = 64
 #: Relative change of the segment length below which the cached segment functions are reused
 #: (the sample times of a uniform record differ from k dt by rounding).
-SAME_LENGTH = 1e-13
+SAME_LENGTH = 1e-9
 
 # log counters of a scene (after _MAXU, _NIMP, _FIRST): history rows, impacts, peaks, dense
 _NH, _NI, _NP, _ND = 3, 4, 5, 6
@@ -276,7 +276,9 @@ def _record_phase(alpha, eta, p, c, times, samples, k, tau, th, v, s, ta, log):
             g0 = alpha * s + F0 + f1 * (tau - t_lo)
             sh, cm1, smx = _seg_functions(length)
         th_end, v_end = _seg_advance(th, v, g0, f1, sh, cm1, smx)
-        hit, fall = _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log)
+        hit, fall = _segment_event(
+            th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log
+        )
         if dense:
             _dense_piece(log[3], ta, p, tau, t_hi if hit < 0.0 else tau + hit, th, v, g0, f1)
         if hit < 0.0:  # on to the next segment
@@ -340,9 +342,33 @@ def _lifts(p, alpha, mp, times, samples, t, k):
     return _lift(a_g, 0.0, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
 
 
+#: Steps of one ulp from the crossing of the uplift level before the switch is bisected for.
+ULP_STEPS = 16
+
+
 @njit(cache=True)
 def _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, lifts_hi):
-    """The time in (lo, hi] on segment k where the lift test turns to ``lifts_hi``, to the ulp."""
+    """The time in (lo, hi] on segment k where the lift test turns to ``lifts_hi``, to the ulp.
+
+    The ground is linear on the segment, so the switch is where |u_g''| crosses g alpha; the
+    test itself (``_rocking._lift``, other arithmetic) is then checked one ulp either side of
+    that time, and bisected for on [lo, hi] only if it is more than ULP_STEPS ulps away.
+    """
+    a_lo = ground_acceleration(KIND_RECORD, mp, times, samples, lo, k)
+    a_hi = ground_acceleration(KIND_RECORD, mp, times, samples, hi, k)
+    level = math.copysign(G * alpha, a_hi if lifts_hi else a_lo)
+    t = lo + (hi - lo) * (level - a_lo) / (a_hi - a_lo) if a_hi != a_lo else hi
+    t = min(max(t, np.nextafter(lo, hi)), hi)
+    for _ in range(ULP_STEPS):
+        if _lifts(p, alpha, mp, times, samples, t, k) != lifts_hi:
+            if t >= hi:
+                break
+            t = np.nextafter(t, hi)
+        else:
+            before = np.nextafter(t, lo)
+            if before <= lo or _lifts(p, alpha, mp, times, samples, before, k) != lifts_hi:
+                return t
+            t = before
     for _ in range(2000):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
@@ -458,7 +484,9 @@ def record_scene(
         return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p, n_log
     # the free rocking after the record: trig_scene under a motion of zero length, from here
     t_free = max(t_tail - dur, 0.0)
-    tail = trig_scene(p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_free, tail_log, th, v * p)
+    tail = trig_scene(
+        p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_free, tail_log, th, v * p
+    )
     first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
     peak = max(ta[_MAXU], tail[1])
     return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first, n_log

@@ -398,9 +398,9 @@ def simulate(
         end (``t_max`` when given; a block with restitution 1 is followed for 100 / p after
         the motion). Each state is as accurate as the steps: one DOP853 step from the start
         of the accepted step that contains the time (kernel methods), the closed form
-        (``"linear"`` on a pulse or a record), scipy's dense output (``"scipy"``) or the cubic Hermite
-        interpolant of the steps (``"complex"``). At rest (0, 0); at an impact, the state
-        just before it; after an overturning NaN.
+        (``"linear"`` on a pulse or a record), scipy's dense output (``"scipy"``) or the
+        cubic Hermite interpolant of the steps (``"complex"``). At rest (0, 0); at an
+        impact, the state just before it; after an overturning NaN.
     dt_out : float, optional
         Instead of ``t_eval``: the uniform grid 0, dt_out, 2 dt_out, ... [s] up to ``t_max``
         or, without it, up to the end of the history (rest or overturning; the scene then
@@ -412,8 +412,8 @@ def simulate(
         With the peaks (``peak_times``, ``peak_rotations``: every local maximum of |theta|)
         located by each method on its own solution: on the DOP853 step's interpolant and one
         Newton step on a true step (the kernels), on the closed form (``"linear"`` on a
-        pulse or a record), by scipy's event location (``"scipy"``) or on the cubic Hermite interpolant
-        of the steps (``"complex"``).
+        pulse or a record), by scipy's event location (``"scipy"``) or on the cubic Hermite
+        interpolant of the steps (``"complex"``).
     """
     try:
         runner, model = _METHODS[method]
