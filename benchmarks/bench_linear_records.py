@@ -12,7 +12,7 @@ Centro: 200 random blocks, R 0.5-3 m, alpha 0.1-0.3, PGA 0.8-6 x g tan alpha), t
     where neither overturns, max first-impact time error, overturning disagreements.
 Writes benchmarks/results/linear_records.json.
 
-    python benchmarks/bench_linear_records.py [--ref-scenes 20] [--old-rev 85ac0e1]
+    python benchmarks/bench_linear_records.py [--ref-scenes 10] [--old-rev 85ac0e1]
 """
 
 from __future__ import annotations
@@ -133,7 +133,7 @@ def accuracy(res, rows, ref):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--ref-scenes", type=int, default=20, help="scenes per record vs rtol 1e-12")
+    ap.add_argument("--ref-scenes", type=int, default=10, help="scenes per record vs rtol 1e-12")
     ap.add_argument("--old-rev", default="85ac0e1", help="git revision to compare with ('' none)")
     args = ap.parse_args()
     t_start = time.perf_counter()
