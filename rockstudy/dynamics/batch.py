@@ -304,7 +304,9 @@ def _run(rows, idx, model, rtol, max_steps):
 
 def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
     """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`); the
-    linear model only if ``linear_ok`` (no output outside its bound was asked for)."""
+    linear model only if ``linear_ok`` (no output outside its bound was asked for), and only
+    under one-cycle trigonometric pulses, the one case its error table covers (none is known
+    under records: see :func:`simulate_batch`)."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
     n = p.size
     if pulse is not None:
