@@ -242,7 +242,11 @@ def compile_kernels(on_first_compile=None, processes=None) -> dict:
 
         nonlinear = functools.partial(_batch_calls, ("nonlinear",))
         compiled = _count_compiled(nonlinear, first_compile)
-        compiled += sum(job.result() for job in apart)
+        for job in apart:
+            try:
+                compiled += job.result()
+            except concurrent.futures.process.BrokenProcessPool:
+                pass  # the second process died (e.g. out of memory): the pass below compiles
     compiled += _count_compiled(_all_calls, None if compiled else on_first_compile)
     return {"compiled": compiled, "seconds": time.perf_counter() - t0}
 
