@@ -353,12 +353,16 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
         priming = _start_prime(study_json, columns, base_dir, progress)
         if own:  # the workers start, and import the study's modules, while the client compiles
             client, cluster = _client(*where)
-            client.run(_imported)
-        priming.join()  # only then do the workers get a chunk: they load the kernels
-        if priming.error is not None:
+        try:
+            if own:
+                client.run(_imported)
+            priming.join()  # only then do the workers get a chunk: they load the kernels
+            if priming.error is not None:
+                raise priming.error
+        except BaseException:  # also Ctrl-C while the client compiles
             if own:
                 _close(client, cluster)
-            raise priming.error
+            raise
     bar = _Progress(len(todo), progress)
     try:
         if todo:
