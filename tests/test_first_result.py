@@ -43,12 +43,15 @@ numba.core.caching.Cache.load_overload = load_overload
 """
 
 
-def run(args, cwd=ROOT):
-    """Run ``python args`` in a fresh interpreter; return its standard output."""
+def run(args, cwd=ROOT, env=ENV, stderr=None):
+    """Run ``python args`` in a fresh interpreter; return its standard output (and append its
+    standard error to the list ``stderr``, if given)."""
     proc = subprocess.run(
-        [sys.executable, *args], env=ENV, cwd=cwd, capture_output=True, text=True, timeout=1800
+        [sys.executable, *args], env=env, cwd=cwd, capture_output=True, text=True, timeout=1800
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
+    if stderr is not None:
+        stderr.append(proc.stderr)
     return proc.stdout
 
 
@@ -201,6 +204,14 @@ print(json.dumps(counts))
     assert {k: v for k, v in out["signatures"].items() if v > 1} == {}
 
 
+#: (name, cache hits, cache misses) of every kernel of a process (its dispatchers' own stats)
+DISPATCHER_STATS = (
+    "[(n, d.stats.cache_hits, d.stats.cache_misses) for m in list(__import__('sys').modules"
+    ".values()) if (m.__name__ or '').startswith('rockstudy') for n, d in vars(m).items() "
+    "if type(d).__name__ == 'CPUDispatcher']"
+)
+
+
 def test_dask_workers_load_the_kernels_the_client_primed(tmp_path):
     """``run_study`` primes the cache in the client; its workers then compile nothing."""
     from distributed import Client, LocalCluster
@@ -209,11 +220,6 @@ def test_dask_workers_load_the_kernels_the_client_primed(tmp_path):
 
     text = (ROOT / "studies" / "quickstart.toml").read_text()
     study = validate_text(text.replace("n = 20000", "n = 40").replace("= 2500", "= 20"))
-    stats = (
-        "[(n, d.stats.cache_hits, d.stats.cache_misses) for m in list(__import__('sys').modules"
-        ".values()) if (m.__name__ or '').startswith('rockstudy') for n, d in vars(m).items() "
-        "if type(d).__name__ == 'CPUDispatcher']"
-    )
     with (
         LocalCluster(
             n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
@@ -221,11 +227,49 @@ def test_dask_workers_load_the_kernels_the_client_primed(tmp_path):
         Client(cluster) as client,
     ):
         run_study(study, tmp_path / "q.zarr", client=client, progress=False, netcdf=False)
-        (rows,) = client.run(eval, stats, {}).values()
+        (rows,) = client.run(eval, DISPATCHER_STATS, {}).values()
     hits = {name: sum(h.values()) for name, h, _ in rows}
     misses = {name: sum(m.values()) for name, _, m in rows if m}
     assert misses == {}
     assert hits["scene_batch"] >= 1
+
+
+def test_a_cold_run_compiles_in_the_client_only(tmp_path):
+    """From an empty numba cache, ``run_study`` compiles the study's kernels once, in the
+    client, saying so, before any worker gets a chunk: every worker loads them and compiles
+    nothing. (The quickstart's study with the linear method: its kernel graph is the smallest,
+    which keeps this test short.)"""
+    text = (ROOT / "studies" / "quickstart.toml").read_text()
+    text = text.replace("n = 20000", "n = 40").replace("= 2500", "= 10")
+    text = text.replace('method = "nonlinear"', 'method = "linear"')
+    assert 'method = "linear"' in text
+    code = f"""
+import json
+from distributed import Client, LocalCluster
+from rockstudy.study import run_study, validate_text
+from rockstudy.study._warmup import _CompileCounter
+
+study = validate_text({text!r})
+with (
+    LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    as cluster,
+    Client(cluster) as client,
+):
+    with _CompileCounter().listening() as counter:
+        run_study(study, {str(tmp_path / "q.zarr")!r}, client=client, netcdf=False)
+    stats = client.run(eval, {DISPATCHER_STATS!r}, {{}}).values()
+workers = [[(n, sum(h.values()), sum(m.values())) for n, h, m in rows] for rows in stats]
+print(json.dumps({{"client": counter.count, "workers": workers}}))
+"""
+    env = dict(ENV, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"), NUMBA_NUM_THREADS="1")
+    err = []
+    out = json.loads(run(["-c", code], tmp_path, env, err).strip().splitlines()[-1])
+    assert len(out["workers"]) == 2
+    for rows in out["workers"]:
+        assert {name: misses for name, _, misses in rows if misses} == {}
+    assert sum(hits for rows in out["workers"] for name, hits, _ in rows if name == "trig_batch")
+    assert out["client"] > 0  # the cache was cold: the client compiled, and said so
+    assert "compiling the numba kernels" in err[0]
 
 
 def test_run_says_when_it_compiles(monkeypatch, capsys):
@@ -286,3 +330,11 @@ def test_compile_counter_sees_compilation_and_not_cache_hits():
     with _CompileCounter(lambda: calls.append(1)).listening() as counter:
         twice(2.5)  # already compiled for float64
     assert counter.count == 0 and calls == [1]
+
+
+def test_compile_kernels_refuses_a_process_count_it_cannot_use():
+    from rockstudy.study._warmup import compile_kernels
+
+    for bad in (0, 3, 1.5):
+        with pytest.raises(ValueError, match="processes"):
+            compile_kernels(processes=bad)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -58,6 +59,39 @@ class _Progress:
         if self.done == self.total:
             sys.stderr.write("\n")
         sys.stderr.flush()
+
+
+def _imported() -> None:
+    """Nothing: a worker that runs it has imported this module and the engine's (no kernel)."""
+
+
+def _close(client, cluster):
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+class _Priming(threading.Thread):
+    """:func:`_prime` in a thread (a daemon: Ctrl-C need not wait for the compiler); its
+    exception, if any, in ``error``."""
+
+    def __init__(self, *args):
+        super().__init__(daemon=True, name="rockstudy-prime")
+        self.args, self.error = args, None
+
+    def run(self):
+        try:
+            _prime(*self.args)
+        except BaseException as exc:  # noqa: BLE001 - raised again in the calling thread
+            self.error = exc
+
+
+def _start_prime(study_json, columns, base_dir, progress) -> _Priming:
+    """Start compiling the study's kernels in a thread of this process (see :func:`_prime`),
+    so that the local cluster can start meanwhile on the other core."""
+    thread = _Priming(study_json, columns, base_dir, progress)
+    thread.start()
+    return thread
 
 
 def _prime(study_json, columns, base_dir, progress):
@@ -316,9 +350,19 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
     own = client is None
     cluster = None
     if todo:
-        _prime(study_json, columns, base_dir, progress)
-    if own and todo:
-        client, cluster = _client(*where)
+        priming = _start_prime(study_json, columns, base_dir, progress)
+        if own:  # the workers start, and import the study's modules, while the client compiles
+            client, cluster = _client(*where)
+        try:
+            if own:
+                client.run(_imported)
+            priming.join()  # only then do the workers get a chunk: they load the kernels
+            if priming.error is not None:
+                raise priming.error
+        except BaseException:  # also Ctrl-C while the client compiles
+            if own:
+                _close(client, cluster)
+            raise
     bar = _Progress(len(todo), progress)
     try:
         if todo:
@@ -327,9 +371,7 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
             template()
     finally:
         if own and client is not None:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            _close(client, cluster)
     status = store.read_status(out)
     report.failed_samples = int(np.count_nonzero(status == STATUS_FAILED))
     report.errors = error_summary(out) if report.failed_samples else {}
