@@ -93,7 +93,7 @@ def _sin_cos_next(w, k):
     return sk * _INV[k], ck * _INV[k]
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"contract"})  # fused multiply-adds: shorter chains, +3 %
 def taylor_coefficients(w, th, om, s, p, alpha, model, h, a0, a1, v0, v1, sc_x, sc_v):
     """Scaled Taylor coefficients c_k = theta_k h^k of one step of length h [s] into w[0].
 
