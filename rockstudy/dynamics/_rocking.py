@@ -34,6 +34,7 @@ from ..motions._kernels import (
 )
 from ._dop853 import dop853_error, hermite5, make_dop853_step
 from ._taylor import (
+    FMA,
     MAX_ORDER,
     NO_REFCOUNT,
     poly_end,
@@ -497,7 +498,7 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
     return EV_IMPACT, h, hs, t1, th1, om1, f1, t + s_imp * hs + dl, v + a * dl, u_pk, t_pk, work, 0
 
 
-@njit(cache=True, **NO_REFCOUNT)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _taylor_attempt(w, p, alpha, model, fall, tol, mp, times, samples, vsamples, t, th, om, h, t_next, s, k):
     """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next.
 
