@@ -499,17 +499,16 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _taylor_attempt(w, p, alpha, model, fall, tol, mp, times, samples, vsamples, t, th, om, h, t_next, s, k):
+def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
     """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next.
 
-    Both ground components are linear on the step. p, alpha, model, fall and tol as in
-    ``blk`` of :func:`_phase` (the step's error target is TAYLOR_TOL_FRACTION * tol), and
-    mp, times, samples, vsamples as in ``mot``. Returns the tuple of :func:`_dop853_attempt`,
-    with the events located on the step polynomial (the order of that polynomial last; its
-    coefficients stay in w[0]). The arrays come one by one, not in ``blk`` and ``mot``: numba
-    counts a reference for every array unpacked from a tuple, twice per array and step.
+    Both ground components are linear on the step. Returns
+    the tuple of :func:`_dop853_attempt`, with the events located on the step polynomial
+    (the order of that polynomial last; its coefficients stay in w[0]).
     """
-    tol = TAYLOR_TOL_FRACTION * tol
+    p, alpha, model, fall = blk[0], blk[1], blk[3], blk[7]
+    tol = TAYLOR_TOL_FRACTION * blk[5]
+    kind, mp, times, samples, vsamples = mot
     last = h >= t_next - t
     hs = t_next - t if last else h
     t1 = t_next if last else t + hs
@@ -517,8 +516,8 @@ def _taylor_attempt(w, p, alpha, model, fall, tol, mp, times, samples, vsamples,
     a1 = _record_acceleration(mp, times, samples, t1, k)
     v0 = v1 = 0.0
     if vsamples.shape[0] > 0:
-        v0 = vertical_acceleration(KIND_RECORD, mp, times, vsamples, t, k)
-        v1 = vertical_acceleration(KIND_RECORD, mp, times, vsamples, t1, k)
+        v0 = vertical_acceleration(kind, mp, times, vsamples, t, k)
+        v1 = vertical_acceleration(kind, mp, times, vsamples, t1, k)
     sc_x = tol * (ATOL_FRACTION * alpha + abs(th) + abs(om) * hs)
     sc_v = tol * (ATOL_FRACTION * p * alpha + abs(om) + abs(th) * p * p * hs)
     n, err = taylor_coefficients(w, th, om, s, p, alpha, model, hs, a0, a1, v0, v1, sc_x, sc_v)
@@ -606,9 +605,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             t_next = min(t_next, times[k + 1])
         taylor = in_record and model != MODEL_TABLE
         if taylor:
-            out = _taylor_attempt(
-                w, p, alpha, model, fall, tol, mp, times, samples, vsamples, t, th, om, h, t_next, s, k
-            )
+            out = _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k)
         else:
             args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
             out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
