@@ -34,7 +34,10 @@ from ..motions._kernels import (
 )
 from ._dop853 import dop853_error, hermite5, make_dop853_step
 from ._taylor import (
+    FMA,
     MAX_ORDER,
+    NO_REFCOUNT,
+    poly_end,
     poly_root,
     poly_value,
     step_impact,
@@ -387,14 +390,14 @@ def _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv):
     ta[NE] = j
 
 
-@njit(cache=True)
-def _dense_poly(dense, ta, c, n, t, hs, t_end):
-    """:func:`_dense` on an accepted Taylor step of length hs from t, by its polynomial c of
-    order n (the solution within the step's tolerance), up to t_end."""
+@njit(cache=True, **NO_REFCOUNT)
+def _dense_poly(dense, ta, w, n, t, hs, t_end):
+    """:func:`_dense` on an accepted Taylor step of length hs from t, by its polynomial w[0]
+    of order n (the solution within the step's tolerance), up to t_end."""
     j = int(ta[NE])
     while j < dense.shape[0] and dense[j, 0] <= t_end:
         if dense[j, 0] >= t:
-            x, d, _ = poly_value(c, n, (dense[j, 0] - t) / hs)
+            x, d, _ = poly_value(w[0], n, (dense[j, 0] - t) / hs)
             dense[j, 1], dense[j, 2] = x, d / hs
         j += 1
     ta[NE] = j
@@ -495,7 +498,7 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
     return EV_IMPACT, h, hs, t1, th1, om1, f1, t + s_imp * hs + dl, v + a * dl, u_pk, t_pk, work, 0
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
     """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next.
 
@@ -511,33 +514,37 @@ def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
     t1 = t_next if last else t + hs
     a0 = _record_acceleration(mp, times, samples, t, k)
     a1 = _record_acceleration(mp, times, samples, t1, k)
-    v0 = vertical_acceleration(kind, mp, times, vsamples, t, k)
-    v1 = vertical_acceleration(kind, mp, times, vsamples, t1, k)
-    c = w[0]
+    v0 = v1 = 0.0
+    if vsamples.shape[0] > 0:
+        v0 = vertical_acceleration(kind, mp, times, vsamples, t, k)
+        v1 = vertical_acceleration(kind, mp, times, vsamples, t1, k)
     sc_x = tol * (ATOL_FRACTION * alpha + abs(th) + abs(om) * hs)
     sc_v = tol * (ATOL_FRACTION * p * alpha + abs(om) + abs(th) * p * p * hs)
     n, err = taylor_coefficients(w, th, om, s, p, alpha, model, hs, a0, a1, v0, v1, sc_x, sc_v)
     if not err <= 1.0:  # rejected (or NaN)
         return EV_REJECT, 0.5 * hs, hs, t, th, om, np.nan, t, om, -1.0, np.nan, 0, 0
     h = max(h, 2.0 * hs) if last else 2.0 * hs
-    th1, dth1, ddth1 = poly_value(c, n, 1.0)
+    c = w[0]
+    th1, dth1, ddth1 = poly_end(c, n)
     om1 = dth1 / hs
     f1 = ddth1 / (hs * hs)
     s_imp = step_impact(c, n, s, s * th1, s * dth1)
     if s_imp > 1.0:
         s_pk = step_peak(c, n, s, 1.0, s * dth1)
-    else:
-        s_pk = step_peak(c, n, s, s_imp, s * poly_value(c, n, s_imp)[1])
+        u_pk = -1.0
+        if s_pk >= 0.0:
+            u_pk = s * poly_value(c, n, s_pk)[0]
+        t_pk = t + s_pk * hs
+        if s * th1 >= fall:
+            s_ot = poly_root(c, n, s * fall, -s, False, 0.0, 1.0)
+            om_ot = poly_value(c, n, s_ot)[1] / hs
+            return EV_OVER, h, hs, t1, th1, om1, f1, t + s_ot * hs, om_ot, u_pk, t_pk, 0, n
+        return EV_NONE, h, hs, t1, th1, om1, f1, t1, om1, u_pk, t_pk, 0, n
+    th_imp, dth_imp, _ = poly_value(c, n, s_imp)
+    s_pk = step_peak(c, n, s, s_imp, s * dth_imp)
     u_pk = s * poly_value(c, n, s_pk)[0] if s_pk >= 0.0 else -1.0
     t_pk = t + s_pk * hs
-    if s_imp > 1.0 and s * th1 >= fall:
-        s_ot = poly_root(c, n, s * fall, -s, False, 0.0, 1.0)
-        om_ot = poly_value(c, n, s_ot)[1] / hs
-        return EV_OVER, h, hs, t1, th1, om1, f1, t + s_ot * hs, om_ot, u_pk, t_pk, 0, n
-    if s_imp > 1.0:
-        return EV_NONE, h, hs, t1, th1, om1, f1, t1, om1, u_pk, t_pk, 0, n
-    om_imp = poly_value(c, n, s_imp)[1] / hs
-    return EV_IMPACT, h, hs, t1, th1, om1, f1, t + s_imp * hs, om_imp, u_pk, t_pk, 0, n
+    return EV_IMPACT, h, hs, t1, th1, om1, f1, t + s_imp * hs, dth_imp / hs, u_pk, t_pk, 0, n
 
 
 @njit(cache=True)
@@ -597,10 +604,10 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             k = segment_index(times, t, k)
             t_next = min(t_next, times[k + 1])
         taylor = in_record and model != MODEL_TABLE
-        args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
         if taylor:
             out = _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k)
         else:
+            args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
             out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
         ev, h, hs, t1, th1, om1, f1, t_ev, om_ev, u_pk, t_pk, work, order = out
         ta[WORK] += work
@@ -611,10 +618,12 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
             _log_peak(peaks, ta, t_pk, s * u_pk)
         t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
         if taylor:
-            _dense_poly(dense, ta, w[0], order, t, hs, t_end)
+            if dense.shape[0] > 0:
+                _dense_poly(dense, ta, w, order, t, hs, t_end)
             if rec:
                 _record_poly(hist, ta, w[0], order, t, hs, t_end)
         else:
+            args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
             _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv)
             if rec:
                 _record_inside(hist, ta, args, t, t_end - t, th, om, f0, kx, kv)
