@@ -598,12 +598,23 @@ def _record_poly(hist, ta, c, n, t, hs, t_end):
 
 
 @njit(cache=True)
-def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
+def _work_arrays(kind):
+    """Work arrays of one scene, allocated once and passed down to every phase: the DOP853
+    stage derivatives of theta and theta_dot (13 each), and the Taylor coefficients
+    (4, MAX_ORDER + 1) of :mod:`._taylor` for a record (a (4, 1) stub for a pulse, whose
+    steps are DOP853 only)."""
+    w = np.empty((4, MAX_ORDER + 1 if kind == KIND_RECORD else 1))
+    return np.empty(13), np.empty(13), w
+
+
+@njit(cache=True)
+def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
     blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
     mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
     :func:`scene`).
+    wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact). Inside a record the block model steps by Taylor series
@@ -615,9 +626,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     rec = hist.shape[0] > 0
     t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
     dur = mp[3]
-    kx = np.empty(13)
-    kv = np.empty(13)
-    w = np.empty((4, MAX_ORDER + 1))
+    kx, kv, w = wk
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
     f0 = _accel(
         _ground_after(kind, mp, times, samples, t, k),
@@ -874,6 +883,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     at_rest = th0 == 0.0 and om0 == 0.0
     st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
     ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
+    wk = _work_arrays(kind)
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END
@@ -893,12 +903,12 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             at_rest = False
             if rec:
                 _push(hist, ta, t_up, 0.0, 0.0)
-        code = _phase(blk, mot, log, st, ta, dur)
+        code = _phase(blk, mot, log, st, ta, wk, dur)
         if code != PH_END and code != PH_REST:
             break
         at_rest = code == PH_REST
     if use_map and code == PH_END and not at_rest and ta[NIMP] == 0:
-        code = _phase(blk, mot, log, st, ta, t_tail, 1)  # integrate on to time the first impact
+        code = _phase(blk, mot, log, st, ta, wk, t_tail, 1)  # integrate on to time the first impact
         at_rest = code == PH_REST
     if at_rest:
         if rec:
@@ -915,7 +925,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             ta[NIMP] += n_post
         else:  # integrate the free rocking: for the history, to time the overturning, or to
             # count the impacts of a block that never rests (eta = 1) up to t_tail
-            code = _phase(blk, mot, log, st, ta, t_tail)
+            code = _phase(blk, mot, log, st, ta, wk, t_tail)
     status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
     over = code == PH_OVER
     t_ot = st[T] if over else np.nan
