@@ -283,17 +283,17 @@ def _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi):
     d = TRIG_BRACKET * (abs(tc) + 1.0 / w)
     while d < hi - lo:
         a, b = max(lo, tc - d), min(hi, tc + d)
-        if (
-            a == lo
-            or not _lift_at(
-                KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, a, 0
-            )
+        lift_a = (
+            a > lo
+            and _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, a, 0)
             > 0.0
-        ) and (
+        )
+        lift_b = (
             b == hi
             or _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, b, 0)
             > 0.0
-        ):
+        )
+        if not lift_a and lift_b:
             return a, b
         d *= 64.0
     return lo, hi
