@@ -5,11 +5,16 @@ One run times, on the same random set of sine-pulse scenes:
     after the pulse ("scipy full"), and with the kernels' closed-form map instead ("scipy+map",
     the like-for-like comparison);
   - the numba nonlinear kernel at rtol 1e-8 (batch entry point, one thread = one core);
-  - the exact linear solver (batch entry point, one thread).
-Errors are measured against solve_ivp DOP853 at rtol 1e-12. Prints a table and writes
+  - the exact linear solver (batch entry point, one thread);
+  - both of these again for the source tree of ``--old-rev`` (extracted by ``git archive``,
+    timed in a subprocess on the same scenes), with the ratios and whether the outputs are
+    bit-identical.
+The kernels are timed in CPU seconds of their process (``time.process_time``, best of
+repeats: the machine is shared, and wall time measures the neighbours). Errors are measured
+against solve_ivp DOP853 at rtol 1e-12. Prints a table and writes
 benchmarks/results/engine.json.
 
-    python benchmarks/bench_engine.py [--scenes 1000] [--scipy-scenes 1000]
+    python benchmarks/bench_engine.py [--scenes 1000] [--scipy-scenes 1000] [--old-rev 85ac0e1]
 """
 
 from __future__ import annotations
@@ -22,13 +27,15 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from bench_records import run_at_rev
 
 import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.dynamics.batch import simulate_batch
 from rockstudy.dynamics.reference import simulate_reference
 
-OUT = Path(__file__).parent / "results"
+HERE = Path(__file__).resolve().parent
+OUT = HERE / "results"
 
 
 def scene_set(n, seed=20261121):
@@ -42,12 +49,41 @@ def scene_set(n, seed=20261121):
 
 
 def timed(fn, repeat):
-    times = []
+    """(output, best CPU seconds of ``repeat`` calls)."""
+    best = np.inf
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         out = fn()
-        times.append(time.perf_counter() - t0)
-    return out, float(np.median(times))
+        best = min(best, time.process_time() - t0)
+    return out, best
+
+
+def time_kernels(n, repeat=10):
+    """Scenes/s/core of the importable rockstudy's nonlinear kernel (rtol 1e-8) and exact
+    linear solver through ``simulate_batch`` on one thread, and their outputs."""
+    numba.set_num_threads(1)
+    R, alpha, amp, period = scene_set(n)
+    kw = dict(half_diagonal=R, slenderness=alpha, pulse="sine", amplitude=amp, period=period)
+    few = {k: v[:2] if isinstance(v, np.ndarray) else v for k, v in kw.items()}
+    simulate_batch(**few)  # warm up (compile or load the cache)
+    simulate_batch(method="linear", **few)
+    ker, t_ker = timed(lambda: simulate_batch(rtol=1e-8, **kw), repeat)
+    lin, t_lin = timed(lambda: simulate_batch(method="linear", **kw), 3 * repeat)
+    return {
+        "nonlinear_kernel": n / t_ker,
+        "linear_exact": n / t_lin,
+        "median_steps": float(np.median(ker["steps"])),
+        "nonlinear": {k: np.asarray(v, float).tolist() for k, v in ker.items()},
+        "linear": {k: np.asarray(v, float).tolist() for k, v in lin.items()},
+    }
+
+
+def same_outputs(a, b):
+    """Whether two output dicts are bit-identical (NaN equal to NaN), and the largest
+    relative difference of max_rotation."""
+    same = all(np.array_equal(np.asarray(a[k]), np.asarray(b[k]), equal_nan=True) for k in a)
+    x, y = np.asarray(a["max_rotation"]), np.asarray(b["max_rotation"])
+    return same, float(np.max(np.abs(x - y) / np.maximum(np.abs(y), 1e-300)))
 
 
 def main():
@@ -56,22 +92,18 @@ def main():
     ap.add_argument(
         "--scipy-scenes", type=int, default=1000, help="scenes timed through scipy (the slow part)"
     )
+    ap.add_argument("--old-rev", default="85ac0e1", help="the kernel to compare with")
+    ap.add_argument("--repeat", type=int, default=10, help="timing repeats (best is kept)")
     args = ap.parse_args()
     n = args.scenes
     R, alpha, amp, period = scene_set(n)
     p = np.sqrt(3 * G / (4 * R))
     eta = 1 - 1.5 * np.sin(alpha) ** 2
-    numba.set_num_threads(1)
-    kw = dict(half_diagonal=R, slenderness=alpha, pulse="sine", amplitude=amp, period=period)
-
-    # warm up (compile), then time: median of repeats
-    simulate_batch(**{k: v[:2] if isinstance(v, np.ndarray) else v for k, v in kw.items()})
-    simulate_batch(
-        method="linear", **{k: v[:2] if isinstance(v, np.ndarray) else v for k, v in kw.items()}
-    )
-    ker, t_ker = timed(lambda: simulate_batch(rtol=1e-8, **kw), 5)
-    lin_reps = max(5, int(2e5 // n))
-    lin, t_lin = timed(lambda: simulate_batch(method="linear", **kw), lin_reps)
+    print(f"timing {n} scenes: this checkout, then {args.old_rev} ...", flush=True)
+    new = time_kernels(n, args.repeat)
+    old = run_at_rev(args.old_rev, "bench_engine", f"time_kernels({n}, {args.repeat})")
+    ker = {k: np.asarray(v) for k, v in new["nonlinear"].items()}
+    ker["overturned"] = ker["overturned"].astype(bool)
 
     # reference, rtol 1e-12, full integration
     print(f"reference: {n} scenes through solve_ivp DOP853 at rtol 1e-12 ...", flush=True)
@@ -140,14 +172,27 @@ def main():
     rate = {
         "scipy_full": m / float(np.sum(sc_times["full"])),
         "scipy_map": m / float(np.sum(sc_times["map"])),
-        "nonlinear_kernel": n / t_ker,
-        "linear_exact": n / t_lin,
+        "nonlinear_kernel": new["nonlinear_kernel"],
+        "linear_exact": new["linear_exact"],
+        f"nonlinear_kernel_{args.old_rev}": old["nonlinear_kernel"],
+        f"linear_exact_{args.old_rev}": old["linear_exact"],
+    }
+    versus_old = {
+        path: {
+            "ratio": new[path] / old[path],
+            "bit_identical": same_outputs(new[key], old[key])[0],
+            "max_rotation_max_rel_difference": same_outputs(new[key], old[key])[1],
+        }
+        for path, key in (("nonlinear_kernel", "nonlinear"), ("linear_exact", "linear"))
     }
     result = {
         "scenes": n,
         "scipy_scenes": m,
         "machine": platform.processor() or platform.machine(),
         "scenes_per_second_per_core": rate,
+        "old_rev": args.old_rev,
+        "versus_old_rev": versus_old,
+        "median_steps": new["median_steps"],
         "ratio_kernel_vs_scipy_full": rate["nonlinear_kernel"] / rate["scipy_full"],
         "ratio_kernel_vs_scipy_map": rate["nonlinear_kernel"] / rate["scipy_map"],
         "ratio_linear_vs_scipy_map": rate["linear_exact"] / rate["scipy_map"],
@@ -177,6 +222,15 @@ def main():
     print(f"{'path':22s} {'scenes/s/core':>14s} {'vs scipy full':>14s} {'vs scipy+map':>13s}")
     for key, v in rate.items():
         print(f"{key:22s} {v:14.1f} {v / rate['scipy_full']:14.1f} {v / rate['scipy_map']:13.1f}")
+    for path, v in versus_old.items():
+        print(
+            f"{path}: {v['ratio']:.2f} x {args.old_rev}; outputs "
+            + (
+                "bit-identical"
+                if v["bit_identical"]
+                else f"differ (max_rotation by {v['max_rotation_max_rel_difference']:.1e} rel.)"
+            )
+        )
     e = result["kernel_max_rotation_rel_error"]
     print(
         f"kernel max-rotation rel. error vs rtol 1e-12: max {e['max']:.2e}, "

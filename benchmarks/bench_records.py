@@ -96,9 +96,10 @@ def time_kernel(rtol, repeat):
     return out
 
 
-def old_kernel(rev, rtol, repeat):
-    """:func:`time_kernel` of the source tree at ``rev``, in a subprocess (its own numba
-    cache under the temp folder, kept between runs)."""
+def run_at_rev(rev, module, call):
+    """``module.call`` (a call of a benchmark module, returning JSON data) evaluated in a
+    subprocess on the source tree of ``rev``, extracted by ``git archive`` (with its own numba
+    cache under the temp folder, kept between runs), on one thread."""
     src = Path(tempfile.gettempdir()) / f"rockstudy-bench-{rev}"
     if not (src / "rockstudy").is_dir():
         src.mkdir(parents=True, exist_ok=True)
@@ -108,13 +109,18 @@ def old_kernel(rev, rtol, repeat):
         subprocess.run(["tar", "-x", "-C", str(src)], input=archive, check=True)
     env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
     code = (
-        f"import sys, json; sys.path.insert(0, {str(HERE)!r}); import bench_records as b; "
-        f"print(json.dumps(b.time_kernel({rtol!r}, {repeat})))"
+        f"import sys, json; sys.path.insert(0, {str(HERE)!r}); import {module} as b; "
+        f"print(json.dumps(b.{call}))"
     )
     run = subprocess.run(
         [sys.executable, "-c", code], env=env, cwd=src, check=True, capture_output=True, text=True
     )
     return json.loads(run.stdout.strip().splitlines()[-1])
+
+
+def old_kernel(rev, rtol, repeat):
+    """:func:`time_kernel` of the source tree at ``rev`` (:func:`run_at_rev`)."""
+    return run_at_rev(rev, "bench_records", f"time_kernel({rtol!r}, {repeat})")
 
 
 def reference(name, rows, rtol, scale_factor=1.0, free_map=True):

@@ -257,6 +257,51 @@ def _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, t, k):
     return _lift(a_g, a_v, p, alpha, model, tab)
 
 
+#: Half-width of the first bracket around the closed-form uplift time of a trigonometric
+#: pulse, relative to |t| + 1/omega: a few ulps of the phase, so that the bisection to the
+#: ulp takes ~8 halvings instead of ~50; widened 64-fold while it does not bracket.
+TRIG_BRACKET = 1e-14
+
+
+@njit(cache=True)
+def _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi):
+    """A sub-bracket of [lo, hi] (a monotone piece of a sine pulse where the block at rest
+    does not lift at lo and lifts at hi) around the closed-form time at which |a_g| reaches
+    g tan(alpha) (g alpha linearized), a sin(omega t + phase) = level at the phase
+    m pi +- asin(level / |a|) (section 2 of [000]). The exact test (:func:`_lift`) still
+    decides: the bracket is returned only where it holds at both ends."""
+    level = G * (alpha if model == MODEL_LINEAR else math.tan(alpha))
+    w, ph = mp[1], mp[2]
+    x = math.asin(min(level / abs(mp[0]), 1.0))
+    m = math.floor((w * lo + ph) / math.pi)
+    tc = np.inf
+    for j in range(4):  # crossings at phases m pi + x, m pi + pi - x, (m + 1) pi + x, ...
+        psi = (m + j // 2) * math.pi + (x if j % 2 == 0 else math.pi - x)
+        t = (psi - ph) / w
+        if lo <= t <= hi:
+            tc = t
+            break
+    if tc == np.inf:
+        return lo, hi
+    d = TRIG_BRACKET * (abs(tc) + 1.0 / w)
+    while d < hi - lo:
+        a, b = max(lo, tc - d), min(hi, tc + d)
+        lift_a = (
+            a > lo
+            and _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, a, 0)
+            > 0.0
+        )
+        lift_b = (
+            b == hi
+            or _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, b, 0)
+            > 0.0
+        )
+        if not lift_a and lift_b:
+            return a, b
+        d *= 64.0
+    return lo, hi
+
+
 @njit(cache=True)
 def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
     """First time >= t0 at which a block at rest lifts off (:func:`_lift` > 0), or inf.
@@ -287,6 +332,8 @@ def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
             k = segment_index(times, lo, k)
         k_hi = segment_index(times, hi, k) if rec else 0
         if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, hi, k_hi) > 0.0:
+            if kind == KIND_TRIG and model != MODEL_TABLE and vsamples.size == 0:
+                lo, hi = _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi)
             for _ in range(2000):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
@@ -558,12 +605,23 @@ def _record_poly(hist, ta, c, n, t, hs, t_end):
 
 
 @njit(cache=True)
-def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
+def _work_arrays(kind):
+    """Work arrays of one scene, allocated once and passed down to every phase: the DOP853
+    stage derivatives of theta and theta_dot (13 each), and the Taylor coefficients
+    (4, MAX_ORDER + 1) of :mod:`._taylor` for a record (a (4, 1) stub for a pulse, whose
+    steps are DOP853 only)."""
+    w = np.empty((4, MAX_ORDER + 1 if kind == KIND_RECORD else 1))
+    return np.empty(13), np.empty(13), w
+
+
+@njit(cache=True)
+def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
     blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
     mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
     :func:`scene`).
+    wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
     then just after that impact). Inside a record the block model steps by Taylor series
@@ -575,9 +633,7 @@ def _phase(blk, mot, log, st, ta, t_stop, stop_at_impacts=-1):
     rec = hist.shape[0] > 0
     t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
     dur = mp[3]
-    kx = np.empty(13)
-    kv = np.empty(13)
-    w = np.empty((4, MAX_ORDER + 1))
+    kx, kv, w = wk
     k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
     f0 = _accel(
         _ground_after(kind, mp, times, samples, t, k),
@@ -836,6 +892,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     at_rest = th0 == 0.0 and om0 == 0.0
     st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
     ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
+    wk = _work_arrays(kind)
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END
@@ -855,12 +912,12 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             at_rest = False
             if rec:
                 _push(hist, ta, t_up, 0.0, 0.0)
-        code = _phase(blk, mot, log, st, ta, dur)
+        code = _phase(blk, mot, log, st, ta, wk, dur)
         if code != PH_END and code != PH_REST:
             break
         at_rest = code == PH_REST
     if use_map and code == PH_END and not at_rest and ta[NIMP] == 0:
-        code = _phase(blk, mot, log, st, ta, t_tail, 1)  # integrate on to time the first impact
+        code = _phase(blk, mot, log, st, ta, wk, t_tail, 1)  # integrate on to time the first impact
         at_rest = code == PH_REST
     if at_rest:
         if rec:
@@ -877,7 +934,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             ta[NIMP] += n_post
         else:  # integrate the free rocking: for the history, to time the overturning, or to
             # count the impacts of a block that never rests (eta = 1) up to t_tail
-            code = _phase(blk, mot, log, st, ta, t_tail)
+            code = _phase(blk, mot, log, st, ta, wk, t_tail)
     status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
     over = code == PH_OVER
     t_ot = st[T] if over else np.nan

@@ -15,8 +15,6 @@ from ..constants import G
 from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import PULSES, pulse_kernel_rows
-from ..structures.block import frequency_parameter as _p_of_R
-from ..structures.block import restitution_housner
 from . import _auto, _linear, _linear_record, _rocking
 from ._vertical import refuse_free_fall, uplift_ratio
 
@@ -190,11 +188,11 @@ def simulate_batch(
     alpha = _column("slenderness", slenderness, n, 0.0, np.pi / 2)
     if half_diagonal is not None:
         R = _column("half_diagonal", half_diagonal, n, 0.0)
-        p = np.vectorize(_p_of_R)(R)
+        p = np.sqrt(3.0 * G / (4.0 * R))  # eq. (2.2) of [000], as block.frequency_parameter
     else:
         p = _column("frequency_parameter", frequency_parameter, n, 0.0)
     if restitution is None:
-        eta = np.vectorize(restitution_housner)(alpha)
+        eta = 1.0 - 1.5 * np.sin(alpha) ** 2  # eq. (2.4), as block.restitution_housner
     else:
         eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
     if record is not None:
