@@ -54,8 +54,11 @@ def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):
         else:
             hi = x
         xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
-        if abs(xn - x) <= tol * max(1.0, abs(x)):  # converged (also a step below the ulp,
-            return min(max(xn, lo), hi)  # which would fail the bracket test: x is an end)
+        # converged from the far side of the root (a step below the ulp there would fail the
+        # bracket test below, x being hi). Not from the near side: f = 0 at lo may be a start
+        # at contact (theta = 0 right after an impact) with the crossing sought further on.
+        if sign_lo * f < 0.0 and abs(xn - x) <= tol * max(1.0, abs(x)):
+            return min(max(xn, lo), hi)
         if not lo < xn < hi:
             xn = 0.5 * (lo + hi)
         if abs(xn - x) <= tol * max(1.0, abs(x)) or hi - lo <= tol * max(1.0, abs(hi)):

@@ -330,11 +330,3 @@ def test_compile_counter_sees_compilation_and_not_cache_hits():
     with _CompileCounter(lambda: calls.append(1)).listening() as counter:
         twice(2.5)  # already compiled for float64
     assert counter.count == 0 and calls == [1]
-
-
-def test_compile_kernels_refuses_a_process_count_it_cannot_use():
-    from rockstudy.study._warmup import compile_kernels
-
-    for bad in (0, 3, 1.5):
-        with pytest.raises(ValueError, match="processes"):
-            compile_kernels(processes=bad)

@@ -206,7 +206,7 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
             continue
         th_hi = th_end if hi == length else _seg_state(th, v, g0, f1, hi)[0]
         u_hi = s * th_hi
-        if u_lo >= 0.0 and u_hi < 0.0:  # from contact too: a lift that falls straight back
+        if u_lo > 0.0 and u_hi <= 0.0:
             return _seg_root(0.0, th, v, g0, f1, s, lo, hi, u_lo, u_hi), False
         if u_hi >= FALL_ROTATION:
             return _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi, u_lo, u_hi), True
@@ -232,7 +232,7 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
             return -1.0, False
         if u_end >= FALL_ROTATION:
             return _seg_root(FALL_ROTATION, th, v, g0, f1, s, 0.0, length, u0, u_end), True
-        if u0 >= 0.0 and u_end < 0.0:
+        if u0 > 0.0:
             return _seg_root(0.0, th, v, g0, f1, s, 0.0, length, u0, u_end), False
     elif (
         log[2].shape[0] == 0

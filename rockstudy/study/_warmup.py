@@ -15,25 +15,20 @@ file changes. So the warm-up also fingerprints every source file that holds kern
 constants, and clears the package's numba cache when the fingerprint has changed since the last
 warm-up (:func:`purge_stale_cache`).
 
-On a machine of two or more cores the warm-up compiles in two processes at once: this one
-drives the nonlinear kernel (``scene``, ``scene_batch``: two thirds of the work), a second one
-the kernels no nonlinear call reaches (the exact linear solvers, the complex model, the closed
-forms, the intensity measures and the spectrum). numba's cache is per function and safe
-across processes; the few small helpers both reach are compiled twice. This process then
-drives every call once more, loading what the other compiled, so nothing is left out.
+The warm-up compiles in one process. Two processes (the nonlinear kernel in one, the rest in
+the other) were tried: numba saves a function's cache index without a lock, so two processes
+compiling different signatures of one shared helper can lose an entry or map one signature to
+the other's machine code, and the gain was not measurable on the shared 2-core machine.
 
 ``python -m rockstudy.study._warmup`` does the same as ``rockstudy compile``.
 """
 
 from __future__ import annotations
 
-import concurrent.futures
 import contextlib
-import functools
 import hashlib
 import json
 import math
-import multiprocessing
 import os
 import re
 import time
@@ -168,27 +163,6 @@ def _closedform_calls():
     return names
 
 
-def _apart_calls():
-    """The calls of the warm-up that reach none of the nonlinear kernels (``scene``): exact
-    linear solvers on a trigonometric pulse and on a record without a vertical component (the
-    linear model under other motions runs ``scene``), the complex model,
-    intensity measures, spectrum and closed forms."""
-    from ..dynamics import simulate, simulate_batch
-    from ..motions import SinePulse, stochastic_record
-    from ..structures import Block
-
-    alpha = np.array([0.15, 0.2])
-    record = stochastic_record(peak=1.0, duration=2.0, dt=0.01, seed=0)
-    common = dict(half_diagonal=1.0, slenderness=alpha, method="linear")
-    simulate_batch(pulse="sine", amplitude=3.0 * G * np.tan(alpha), period=0.5, **common)
-    simulate_batch(record=record, scale=3.0 * G * np.tan(alpha), **common)
-    block, pulse = Block(1.0, 0.2), SinePulse(3.0 * G * math.tan(0.2), 0.5)
-    simulate(block, pulse, method="linear")
-    simulate(block, pulse, method="complex", initial_rotation=0.1, t_max=0.05)
-    _record_measure_calls()
-    _closedform_calls()
-
-
 def _all_calls():
     """Every call of the warm-up."""
     _simulate_calls()
@@ -205,7 +179,7 @@ def _count_compiled(calls, on_first_compile=None) -> int:
     return counter.count
 
 
-def compile_kernels(on_first_compile=None, processes=None) -> dict:
+def compile_kernels(on_first_compile=None) -> dict:
     """Compile every numba kernel signature the package uses, or load it from numba's cache.
 
     Parameters
@@ -213,41 +187,15 @@ def compile_kernels(on_first_compile=None, processes=None) -> dict:
     on_first_compile : callable, optional
         Called with no argument when the first kernel has to be compiled (not found in the
         cache), e.g. to tell the user why the wait.
-    processes : int, optional
-        1: compile in this process only; 2 (the default where there are two cores or more):
-        at the first cache miss, also start a second process on the kernels the nonlinear
-        calls do not reach (a primed cache starts none).
-
     Returns
     -------
     dict
         ``compiled``: dispatchers compiled now (0 when the cache was already primed);
         ``seconds``: wall time [s].
     """
-    if processes is None:
-        processes = 2 if (os.cpu_count() or 1) >= 2 else 1
-    if processes not in (1, 2):
-        raise ValueError(f"processes: {processes!r} is not allowed; give 1 or 2")
     t0 = time.perf_counter()
     purge_stale_cache()
-    spawn = multiprocessing.get_context("spawn")  # a fresh interpreter: no forked numba
-    with concurrent.futures.ProcessPoolExecutor(1, mp_context=spawn) as pool:
-        apart = []
-
-        def first_compile():  # the cache misses: start the second process (if any) now
-            if on_first_compile is not None:
-                on_first_compile()
-            if processes == 2:
-                apart.append(pool.submit(_count_compiled, _apart_calls))
-
-        nonlinear = functools.partial(_batch_calls, ("nonlinear",))
-        compiled = _count_compiled(nonlinear, first_compile)
-        for job in apart:
-            try:
-                compiled += job.result()
-            except concurrent.futures.process.BrokenProcessPool:
-                pass  # the second process died (e.g. out of memory): the pass below compiles
-    compiled += _count_compiled(_all_calls, None if compiled else on_first_compile)
+    compiled = _count_compiled(_all_calls, on_first_compile)
     return {"compiled": compiled, "seconds": time.perf_counter() - t0}
 
 
