@@ -18,12 +18,7 @@ Writes benchmarks/results/linear_records.json.
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import platform
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -67,23 +62,8 @@ def time_linear(repeat):
 
 
 def old_linear(rev, repeat):
-    """:func:`time_linear` of the source tree at ``rev``, in a subprocess."""
-    src = Path(tempfile.gettempdir()) / f"rockstudy-bench-{rev}"
-    if not (src / "rockstudy").is_dir():
-        src.mkdir(parents=True, exist_ok=True)
-        archive = subprocess.run(
-            ["git", "archive", rev, "rockstudy"], cwd=HERE.parent, check=True, capture_output=True
-        ).stdout
-        subprocess.run(["tar", "-x", "-C", str(src)], input=archive, check=True)
-    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1")
-    code = (
-        f"import sys, json; sys.path.insert(0, {str(HERE)!r}); import bench_linear_records as b; "
-        f"print(json.dumps(b.time_linear({repeat})))"
-    )
-    run = subprocess.run(
-        [sys.executable, "-c", code], env=env, cwd=src, check=True, capture_output=True, text=True
-    )
-    return json.loads(run.stdout.strip().splitlines()[-1])
+    """:func:`time_linear` of the source tree at ``rev`` (``bench_records.run_at_rev``)."""
+    return br.run_at_rev(rev, "bench_linear_records", f"time_linear({repeat})")
 
 
 def reference(name, rows):
@@ -185,18 +165,7 @@ def main():
         f"max rel error {summary['max_rel_error']:.1e}, "
         f"disagreements {summary['disagreements']}, {summary['wall_s']:.0f} s"
     )
-    OUT.mkdir(exist_ok=True)
-    meta = {
-        "blocks_per_record": br.N_BLOCKS,
-        "ref_scenes_per_record": int(rows.size),
-        "old_rev": args.old_rev,
-        "timing": "CPU seconds of the process (time.process_time), best of repeats, 1 thread",
-        "machine": platform.processor() or platform.machine(),
-        "load_average": os.getloadavg(),
-    }
-    (OUT / "linear_records.json").write_text(
-        json.dumps({"meta": meta, "records": results, "summary": summary}, indent=2)
-    )
+    br.write_results("linear_records.json", results, summary, rows.size, args.old_rev)
 
 
 if __name__ == "__main__":

@@ -237,17 +237,21 @@ def main():
         f"on the old kernel (geometric mean), p99 error <= {summary['p99_rel_error_max']:.1e}, "
         f"robust disagreements {summary['robust_disagreements']}, {summary['wall_s']:.0f} s"
     )
+    write_results("records.json", results, summary, rows.size, args.old_rev, rtol=args.rtol)
+
+
+def write_results(name, results, summary, ref_scenes, old_rev, **meta):
+    """benchmarks/results/<name>: the per-record figures, the summary and how they were timed."""
+    meta.update(
+        blocks_per_record=N_BLOCKS,
+        ref_scenes_per_record=int(ref_scenes),
+        old_rev=old_rev,
+        timing="CPU seconds of the process (time.process_time), best of repeats, 1 thread",
+        machine=platform.processor() or platform.machine(),
+        load_average=os.getloadavg(),
+    )
     OUT.mkdir(exist_ok=True)
-    meta = {
-        "rtol": args.rtol,
-        "blocks_per_record": N_BLOCKS,
-        "ref_scenes_per_record": int(rows.size),
-        "old_rev": args.old_rev,
-        "timing": "CPU seconds of the process (time.process_time), best of repeats, 1 thread",
-        "machine": platform.processor() or platform.machine(),
-        "load_average": os.getloadavg(),
-    }
-    (OUT / "records.json").write_text(
+    (OUT / name).write_text(
         json.dumps({"meta": meta, "records": results, "summary": summary}, indent=2)
     )
 
