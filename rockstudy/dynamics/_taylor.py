@@ -54,7 +54,9 @@ MODEL_LINEAR = 1
 NO_REFCOUNT = {"_nrt": False}
 #: numba's fastmath flag for fused multiply-adds (one rounding instead of two): shorter
 #: dependency chains in the recurrences and Horner sums; nothing else of fastmath (NaN and
-#: infinity keep their meaning).
+#: infinity keep their meaning). LLVM fuses only where the CPU has FMA instructions, so record
+#: results may differ in their last bits between machines with and without them (well inside
+#: the step tolerance; a study that must be bit-reproducible runs on one kind of machine).
 FMA = {"contract"}
 
 
