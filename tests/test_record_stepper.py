@@ -13,6 +13,7 @@ from test_records_rocking import FILES, load
 import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.dynamics import _taylor
+from rockstudy.dynamics._rocking import TRIG_STEP_CAP
 from rockstudy.dynamics.batch import simulate_batch
 
 P, ALPHA = 2.5, 0.2
@@ -69,6 +70,63 @@ def test_one_step_matches_a_high_order_reference(model, h):
         c, n = coefficients(th, om, s, model, h, a0, a1, v0, v1)
         x, d, _ = _taylor.poly_value(c, n, 1.0)
         ref = one_step_reference(th, om, s, model, h, a0, a1, v0, v1)
+        assert x == pytest.approx(ref[0], abs=1e-13)
+        assert d / h == pytest.approx(ref[1], abs=1e-12)
+
+
+def trig_coefficients(th, om, s, model, h, amp, omega, phase, tol=1e-13):
+    """The step polynomial under amp sin(omega t + phase) [m/s^2] from t = 0, and its order."""
+    w = _taylor.work_arrays()
+    sc_x, sc_v = tol * ALPHA, tol * P * ALPHA
+    n, err = _taylor.taylor_coefficients_trig(
+        w, th, om, s, P, ALPHA, model, h, amp, phase, omega * h, sc_x, sc_v
+    )
+    assert err <= 1.0
+    return w[0, : n + 1].copy(), n
+
+
+@pytest.mark.parametrize("omega", [1.0, 6.0, 25.0])
+def test_sine_pulse_series_is_the_linear_closed_form(omega):
+    # eq. (3.1) of [000] under a_g sin(omega t + phi): theta = alpha s + K sin(omega t + phi)
+    # + C cosh(p t) + D sinh(p t), K = p^2 a_g / (g (p^2 + omega^2)), C and D from the start
+    amp, phase, s, th0, om0 = 3.0, 0.7, -1.0, -0.04, 0.25
+    K = P * P * amp / (G * (P * P + omega * omega))
+    C = th0 - ALPHA * s - K * math.sin(phase)
+    D = (om0 - K * omega * math.cos(phase)) / P
+    for h in (0.02, TRIG_STEP_CAP / max(P, omega)):  # up to the kernel's longest step
+        c, n = trig_coefficients(th0, om0, s, _taylor.MODEL_LINEAR, h, amp, omega, phase)
+        x, d, _ = _taylor.poly_value(c, n, 1.0)
+        t = h
+        exact = ALPHA * s + K * math.sin(omega * t + phase) + C * math.cosh(P * t)
+        exact += D * math.sinh(P * t)
+        rate = K * omega * math.cos(omega * t + phase) + P * (C * math.sinh(P * t))
+        rate += P * D * math.cosh(P * t)
+        assert x == pytest.approx(exact, abs=1e-14)
+        assert d / h == pytest.approx(rate, abs=1e-13)
+
+
+def trig_step_reference(th, om, s, h, amp, omega, phase):
+    """theta, theta_dot after h of Housner's (2.2) under amp sin(omega t + phase), by scipy's
+    DOP853 at rtol 1e-13."""
+
+    def rhs(t, y):
+        a = amp * math.sin(omega * t + phase) / G
+        x = ALPHA * s - y[0]
+        return [y[1], -P * P * (math.sin(x) + a * math.cos(x))]
+
+    sol = solve_ivp(rhs, (0.0, h), [th, om], method="DOP853", rtol=1e-13, atol=1e-16)
+    return sol.y[:, -1]
+
+
+@pytest.mark.parametrize("amp", [0.0, 4.0, -9.0])
+@pytest.mark.parametrize("omega", [2.0, 20.0])
+def test_nonlinear_trig_step_matches_a_high_order_reference(amp, omega):
+    # the longest step the kernel takes (TRIG_STEP_CAP in p t and omega t), both sides
+    h = TRIG_STEP_CAP / max(P, omega)
+    for s, th, om in ((1.0, 0.05, 0.3), (-1.0, -0.12, 0.4), (1.0, 0.0, 0.0)):
+        c, n = trig_coefficients(th, om, s, _taylor.MODEL_NONLINEAR, h, amp, omega, 1.1)
+        x, d, _ = _taylor.poly_value(c, n, 1.0)
+        ref = trig_step_reference(th, om, s, h, amp, omega, 1.1)
         assert x == pytest.approx(ref[0], abs=1e-13)
         assert d / h == pytest.approx(ref[1], abs=1e-12)
 

@@ -43,6 +43,7 @@ from ._taylor import (
     step_impact,
     step_peak,
     taylor_coefficients,
+    taylor_coefficients_trig,
 )
 
 MODEL_NONLINEAR = 0
@@ -546,8 +547,9 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
-    """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next.
+def _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k):
+    """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next
+    (f0: theta_ddot at t, used for a start at rest on contact: :func:`_lift_curvature`).
 
     Both ground components are linear on the step. Returns
     the tuple of :func:`_dop853_attempt`, with the events located on the step polynomial
@@ -567,11 +569,70 @@ def _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k):
         v1 = vertical_acceleration(kind, mp, times, vsamples, t1, k)
     sc_x = tol * (ATOL_FRACTION * alpha + abs(th) + abs(om) * hs)
     sc_v = tol * (ATOL_FRACTION * p * alpha + abs(om) + abs(th) * p * p * hs)
-    n, err = taylor_coefficients(w, th, om, s, p, alpha, model, hs, a0, a1, v0, v1, sc_x, sc_v)
+    dd0 = _lift_curvature(th, om, f0)
+    n, err = taylor_coefficients(w, th, om, s, p, alpha, model, hs, a0, a1, v0, v1, sc_x, sc_v, dd0)
     if not err <= 1.0:  # rejected (or NaN)
         return EV_REJECT, 0.5 * hs, hs, t, th, om, np.nan, t, om, -1.0, np.nan, 0, 0
     h = max(h, 2.0 * hs) if last else 2.0 * hs
-    c = w[0]
+    return _taylor_events(w[0], n, s, t, hs, t1, h, fall)
+
+
+@njit(cache=True, inline="always")
+def _lift_curvature(th, om, f0):
+    """theta_ddot at the start of a Taylor step that leaves contact from rest (theta = theta_dot
+    = 0): f0, computed by :func:`_accel` with the arithmetic of the lift test (:func:`_lift`),
+    so that the step rises as that test said (``_taylor._start_curvature``); NaN otherwise."""
+    return f0 if th == 0.0 and om == 0.0 else np.nan
+
+
+#: Longest Taylor step under a trigonometric pulse or no ground motion, in units of 1/p and
+#: of 1/omega: the events of a step are located for one turning point of u = s theta at most
+#: (:func:`._taylor.step_impact`), as on a DOP853 step of the same length.
+TRIG_STEP_CAP = 0.5
+#: Local error target of a Taylor step under a pulse or no ground motion, as a fraction of
+#: TOL_SAFETY * rtol (a record's steps: TAYLOR_TOL_FRACTION).
+TRIG_TOL_FRACTION = 1e-2
+#: Order of the series at which a Taylor step stops growing: a longer step needs a higher
+#: order (the O(N^2) recurrences), a shorter one more steps.
+TARGET_ORDER = 14
+
+
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+def _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s):
+    """One Taylor step under a trigonometric pulse (``KIND_TRIG``, before its end) or with no
+    ground motion (after any motion has ended), from (t, th, om) towards t_next.
+
+    The ground series is exact (:func:`._taylor.taylor_coefficients_trig`); the step is at most
+    :data:`TRIG_STEP_CAP` in p t and in omega t, and grows (x2) while the series needs fewer
+    than :data:`TARGET_ORDER` terms. Returns the tuple of :func:`_taylor_attempt`.
+    """
+    p, alpha, model, fall = blk[0], blk[1], blk[3], blk[7]
+    tol = TRIG_TOL_FRACTION * blk[5]
+    mp = mot[1]
+    forced = t < mp[3]
+    h = min(h, TRIG_STEP_CAP / p, TRIG_STEP_CAP / mp[1] if forced else np.inf)
+    last = h >= t_next - t
+    hs = t_next - t if last else h
+    t1 = t_next if last else t + hs
+    amp = mp[0] if forced else 0.0
+    sc_x = tol * (ATOL_FRACTION * alpha + abs(th) + abs(om) * hs)
+    sc_v = tol * (ATOL_FRACTION * p * alpha + abs(om) + abs(th) * p * p * hs)
+    phase, wh, dd0 = mp[1] * t + mp[2], mp[1] * hs, _lift_curvature(th, om, f0)
+    n, err = taylor_coefficients_trig(
+        w, th, om, s, p, alpha, model, hs, amp, phase, wh, sc_x, sc_v, dd0
+    )
+    if not err <= 1.0:  # rejected (or NaN)
+        return EV_REJECT, 0.5 * hs, hs, t, th, om, np.nan, t, om, -1.0, np.nan, 0, 0
+    grown = 2.0 * hs if n < TARGET_ORDER else hs
+    h = max(h, grown) if last else grown
+    return _taylor_events(w[0], n, s, t, hs, t1, h, fall)
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _taylor_events(c, n, s, t, hs, t1, h, fall):
+    """The outcome of an accepted Taylor step from t of length hs (ending at t1, the next step
+    h): its impact, peak and overturning, located on the step polynomial c of order n. Returns
+    the tuple of :func:`_dop853_attempt`."""
     th1, dth1, ddth1 = poly_end(c, n)
     om1 = dth1 / hs
     f1 = ddth1 / (hs * hs)
@@ -605,13 +666,11 @@ def _record_poly(hist, ta, c, n, t, hs, t_end):
 
 
 @njit(cache=True)
-def _work_arrays(kind):
+def _work_arrays():
     """Work arrays of one scene, allocated once and passed down to every phase: the DOP853
-    stage derivatives of theta and theta_dot (13 each), and the Taylor coefficients
-    (4, MAX_ORDER + 1) of :mod:`._taylor` for a record (a (4, 1) stub for a pulse, whose
-    steps are DOP853 only)."""
-    w = np.empty((4, MAX_ORDER + 1 if kind == KIND_RECORD else 1))
-    return np.empty(13), np.empty(13), w
+    stage derivatives of theta and theta_dot (13 each), and the Taylor series
+    (5, MAX_ORDER + 1) of :mod:`._taylor` (``work_arrays``)."""
+    return np.empty(13), np.empty(13), np.empty((5, MAX_ORDER + 1))
 
 
 @njit(cache=True)
@@ -624,8 +683,9 @@ def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
     wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
     ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
     or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
-    then just after that impact). Inside a record the block model steps by Taylor series
-    (:func:`_taylor_attempt`), elsewhere (pulses, free rocking, mechanisms) by DOP853.
+    then just after that impact). The block models step by Taylor series inside a record
+    (:func:`_taylor_attempt`), under a trigonometric pulse and in the free rocking after any
+    motion (:func:`_taylor_trig_attempt`); a Ricker wavelet and a mechanism's table by DOP853.
     """
     p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
     kind, mp, times, samples, vsamples = mot
@@ -659,9 +719,13 @@ def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
         if in_record:  # end steps on record samples (kinks in u_g'')
             k = segment_index(times, t, k)
             t_next = min(t_next, times[k + 1])
-        taylor = in_record and model != MODEL_TABLE
-        if taylor:
-            out = _taylor_attempt(w, blk, mot, t, th, om, h, t_next, s, k)
+        # Taylor series for the block models (a tabulated mechanism steps by DOP853): on record
+        # samples, under a trigonometric pulse, and with no ground motion after any motion
+        taylor = model != MODEL_TABLE and (in_record or t >= dur or kind == KIND_TRIG)
+        if in_record and taylor:
+            out = _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k)
+        elif taylor:
+            out = _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s)
         else:
             args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
             out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
@@ -892,7 +956,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     at_rest = th0 == 0.0 and om0 == 0.0
     st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
     ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
-    wk = _work_arrays(kind)
+    wk = _work_arrays()
     if rec:
         _push(hist, ta, 0.0, th0, om0)
     code = PH_END

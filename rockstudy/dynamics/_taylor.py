@@ -12,10 +12,15 @@ Analysis*, 1966; Jorba & Zou, *Exp. Math.* 14, 2005):
 
 .. math:: k S_k = \\sum_{j=1}^{k} j x_j C_{k-j}, \\qquad k C_k = -\\sum_{j=1}^{k} j x_j S_{k-j},
 
-one sine and one cosine per step and O(N^2) flops for order N. The coefficients are kept
-scaled by the step, c_k = theta_k h^k, so the step is the polynomial sum_k c_k sigma^k on
-sigma in [0, 1]: an exact dense output (within the tolerance of the step), on which impacts,
-peaks and overturning are located by a safeguarded Newton-bisection.
+one sine and one cosine per step and O(N^2) flops for order N. Under a trigonometric pulse
+a_g sin(omega t + phase) (and with no ground motion at all, after any motion has ended) the
+ground term is a whole series, F_k = F_{k-2} (-(omega h)^2 / (k (k-1))), and enters the
+product F C as a Cauchy sum, again O(N^2) (:func:`taylor_coefficients_trig`).
+
+The coefficients are kept scaled by the step, c_k = theta_k h^k, so the step is the
+polynomial sum_k c_k sigma^k on sigma in [0, 1]: an exact dense output (within the
+tolerance of the step), on which impacts, peaks and overturning are located by a
+safeguarded Newton-bisection.
 
 The order is chosen step by step: terms are added until the last two are below the error
 scale of theta (and, times their order, of h theta_dot). Those two terms bound the
@@ -61,8 +66,9 @@ FMA = {"contract"}
 
 
 def work_arrays():
-    """Coefficient work space of :func:`taylor_coefficients`: rows c, j x_j, S, C."""
-    return np.empty((4, MAX_ORDER + 1))
+    """Coefficient work space of :func:`taylor_coefficients`: rows c, j x_j, S, C and the
+    ground series F."""
+    return np.empty((5, MAX_ORDER + 1))
 
 
 #: 1/k and 1/(k (k-1)), read by the recurrences (constants: no division in the loops).
@@ -70,8 +76,9 @@ _INV = np.array([0.0] + [1.0 / k for k in range(1, MAX_ORDER + 1)])
 _INV2 = np.array([0.0, 0.0] + [1.0 / (k * (k - 1)) for k in range(2, MAX_ORDER + 1)])
 
 
-#: Rows of the work array: the scaled coefficients c_k, j x_j, and the series S and C.
-ROW_C, ROW_JX, ROW_S, ROW_C_SERIES = 0, 1, 2, 3
+#: Rows of the work array: the scaled coefficients c_k, j x_j, the series S and C, and the
+#: series F of the ground term of a trigonometric pulse (:func:`taylor_coefficients_trig`).
+ROW_C, ROW_JX, ROW_S, ROW_C_SERIES, ROW_F = 0, 1, 2, 3, 4
 
 
 @njit(cache=True, inline="always")
@@ -99,15 +106,50 @@ def _sin_cos_next(w, k):
     return sk * _INV[k], ck * _INV[k]
 
 
+@njit(cache=True, inline="always")
+def _series_start(w, th, om, s, alpha, model, h):
+    """The orders 0 and 1 of a step's series: theta, h theta_dot (and j x_j), and S_0, C_0 of
+    x = alpha s - theta (linearized: S = x, C = 1)."""
+    x0 = alpha * s - th
+    w[ROW_C, 0] = th
+    w[ROW_C, 1] = om * h
+    w[ROW_JX, 1] = -om * h
+    if model == MODEL_LINEAR:
+        w[ROW_S, 0], w[ROW_C_SERIES, 0] = x0, 1.0
+    else:
+        w[ROW_S, 0], w[ROW_C_SERIES, 0] = math.sin(x0), math.cos(x0)
+
+
+@njit(cache=True, inline="always")
+def _series_sin_cos(w, k, model):
+    """S_k and C_k (:func:`_sin_cos_next`; linearized: x_k = -c_k and 0), stored and returned."""
+    if model == MODEL_LINEAR:
+        sk, ck = -w[ROW_C, k], 0.0
+    else:
+        sk, ck = _sin_cos_next(w, k)
+    w[ROW_S, k] = sk
+    w[ROW_C_SERIES, k] = ck
+    return sk, ck
+
+
+@njit(cache=True, inline="always")
+def _store(w, m, cm):
+    """Store the scaled coefficient c_m and m x_m = -m c_m (x = alpha s - theta)."""
+    w[ROW_C, m] = cm
+    w[ROW_JX, m] = -m * cm
+
+
 @njit(cache=True, fastmath=FMA)
-def taylor_coefficients(w, th, om, s, p, alpha, model, h, a0, a1, v0, v1, sc_x, sc_v):
+def taylor_coefficients(w, th, om, s, p, alpha, model, h, a0, a1, v0, v1, sc_x, sc_v, dd0=np.nan):
     """Scaled Taylor coefficients c_k = theta_k h^k of one step of length h [s] into w[0].
 
     th, om: theta [rad] and theta_dot [rad/s] at the start; s: the side (+1 or -1);
     a0, a1 (v0, v1): horizontal (vertical) ground acceleration [m/s^2] at the start and the
     end of the step, linear between. sc_x, sc_v: error scales of theta [rad] and theta_dot
-    [rad/s]. Returns (order n, error ratio): the step is sum_{k<=n} c_k sigma^k, accepted if
-    the ratio of its truncation-error bound to the scales is <= 1.
+    [rad/s]. dd0: theta_ddot at the start [rad/s^2] as the caller's lift test computed it, for a
+    block that leaves contact from rest (NaN otherwise: :func:`_start_curvature`). Returns
+    (order n, error ratio): the step is sum_{k<=n} c_k sigma^k, accepted if the ratio of its
+    truncation-error bound to the scales is <= 1.
 
     The rows of ``w`` are indexed in place (no row views: each would cost a reference count
     in every step).
@@ -117,42 +159,95 @@ def taylor_coefficients(w, th, om, s, p, alpha, model, h, a0, a1, v0, v1, sc_x, 
     ah1 = q * (a1 - a0) / G
     vh0 = q * (1.0 + v0 / G)
     vh1 = q * (v1 - v0) / G
-    x0 = alpha * s - th
-    w[ROW_C, 0] = th
-    w[ROW_C, 1] = om * h
-    w[ROW_JX, 1] = -om * h
-    if model == MODEL_LINEAR:
-        w[ROW_S, 0], w[ROW_C_SERIES, 0] = x0, 1.0
-    else:
-        w[ROW_S, 0], w[ROW_C_SERIES, 0] = math.sin(x0), math.cos(x0)
+    _series_start(w, th, om, s, alpha, model, h)
     tol_v = sc_v * h
-    c2 = 0.5 * (vh0 * w[ROW_S, 0] + ah0 * w[ROW_C_SERIES, 0])
-    w[ROW_C, 2] = c2
-    w[ROW_JX, 2] = -2.0 * c2
+    c2 = _start_curvature(0.5 * (vh0 * w[ROW_S, 0] + ah0 * w[ROW_C_SERIES, 0]), dd0, h)
+    _store(w, 2, c2)
     b = c2
     n = MAX_ORDER
     for m in range(3, MAX_ORDER + 1):
         k = m - 2
-        if model == MODEL_LINEAR:
-            sk, ck = -w[ROW_C, k], 0.0
-        else:
-            sk, ck = _sin_cos_next(w, k)
-        w[ROW_S, k] = sk
-        w[ROW_C_SERIES, k] = ck
+        sk, ck = _series_sin_cos(w, k, model)
         # the terms of the last order first (ready earlier), the new S_k and C_k last
         rhs = (vh1 * w[ROW_S, k - 1] + ah1 * w[ROW_C_SERIES, k - 1]) + (vh0 * sk + ah0 * ck)
         cm = rhs * _INV2[m]
-        w[ROW_C, m] = cm
-        w[ROW_JX, m] = -m * cm
-        if m >= MIN_ORDER:
-            e = abs(cm)
-            if abs(b) + e <= sc_x and (m - 1) * abs(b) + m * e <= tol_v:
-                n = m
-                break
+        _store(w, m, cm)
+        if m >= MIN_ORDER and _converged(b, cm, m, sc_x, tol_v):
+            n = m
+            break
         b = cm
+    return n, _error_ratio(w, n, sc_x, tol_v)
+
+
+@njit(cache=True, inline="always")
+def _start_curvature(c2, dd0, h):
+    """c_2 = theta_ddot h^2 / 2 of a step: from ``dd0`` where it is given (not NaN), else the
+    series' own ``c2``. A block lifted from rest by a ground acceleration within a few ulps of
+    its uplift level must rise as the lift test (other arithmetic) said it does: with c_2 of
+    the wrong sign by rounding it would fall back at once, an impact at the step's start, and
+    the Zeno rule would restart it there without end."""
+    return 0.5 * dd0 * h * h if dd0 == dd0 else c2
+
+
+@njit(cache=True, inline="always")
+def _converged(b, cm, m, sc_x, tol_v):
+    """Whether the series may stop at order m: its last two terms b = c_{m-1} and cm = c_m
+    are below the error scale of theta, and, times their order, of h theta_dot."""
+    e = abs(cm)
+    return abs(b) + e <= sc_x and (m - 1) * abs(b) + m * e <= tol_v
+
+
+@njit(cache=True, inline="always")
+def _error_ratio(w, n, sc_x, tol_v):
+    """The truncation-error bound of a series stopped at order n (its last two terms, as in
+    :func:`_converged`) over the error scales: the step is accepted if it is <= 1."""
     b = abs(w[ROW_C, n - 1])
     e = abs(w[ROW_C, n])
-    return n, max((b + e) / sc_x, ((n - 1) * b + n * e) / tol_v)
+    return max((b + e) / sc_x, ((n - 1) * b + n * e) / tol_v)
+
+
+@njit(cache=True, fastmath=FMA)
+def taylor_coefficients_trig(
+    w, th, om, s, p, alpha, model, h, amp, phase, wh, sc_x, sc_v, dd0=np.nan
+):
+    """:func:`taylor_coefficients` under the ground acceleration amp sin(phase + wh sigma)
+    [m/s^2] on the step (sigma = (t - t_start) / h in [0, 1]; amp = 0: no ground motion).
+
+    The ground series is F_k = (amp/g) wh^k / k! sin(phase + k pi/2), by the two-term
+    recurrence F_k = -F_{k-2} wh^2 / (k (k-1)); eq. (2.2) of [000] takes it through the
+    Cauchy product sum_j F_j C_{k-j} (the linearized eq. (3.1): F_k itself). Returns (order
+    n, error ratio), as :func:`taylor_coefficients`.
+    """
+    q = -((p * h) ** 2)
+    _series_start(w, th, om, s, alpha, model, h)
+    linear = model == MODEL_LINEAR
+    f = q * amp / G  # the ground series carries the factor q of the right-hand side
+    w[ROW_F, 0] = f * math.sin(phase) if amp != 0.0 else 0.0
+    w[ROW_F, 1] = f * wh * math.cos(phase) if amp != 0.0 else 0.0
+    wh2 = wh * wh
+    tol_v = sc_v * h
+    c2 = _start_curvature(0.5 * (q * w[ROW_S, 0] + w[ROW_F, 0] * w[ROW_C_SERIES, 0]), dd0, h)
+    _store(w, 2, c2)
+    b = c2
+    n = MAX_ORDER
+    for m in range(3, MAX_ORDER + 1):
+        k = m - 2
+        sk, ck = _series_sin_cos(w, k, model)
+        if k >= 2:
+            w[ROW_F, k] = -w[ROW_F, k - 2] * wh2 * _INV2[k]
+        rhs = q * sk
+        if linear:
+            rhs += w[ROW_F, k]
+        elif amp != 0.0:
+            for j in range(k + 1):
+                rhs += w[ROW_F, j] * w[ROW_C_SERIES, k - j]
+        cm = rhs * _INV2[m]
+        _store(w, m, cm)
+        if m >= MIN_ORDER and _converged(b, cm, m, sc_x, tol_v):
+            n = m
+            break
+        b = cm
+    return n, _error_ratio(w, n, sc_x, tol_v)
 
 
 @njit(cache=True, inline="always")
