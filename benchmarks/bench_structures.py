@@ -28,26 +28,14 @@ OUT = Path(__file__).parent / "results"
 @njit
 def _run(p, alpha, eta, model, kind, mp, fall, tab):
     z = np.zeros(2)
-    log = (np.empty((0, 3)), np.empty(0))
+    log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
+    body = _rocking.Body(p, alpha, eta, model, fall, tab)
+    controls = _rocking.Controls(1e-8, 10**6, True, np.inf)
+    rest = _rocking.Start(0.0, 0.0)
     acc = 0.0
     for i in range(mp.shape[0]):
-        r = _rocking.scene(
-            p,
-            alpha,
-            eta,
-            model,
-            (kind, mp[i], z, z, z[:0]),
-            1e-8,
-            True,
-            np.inf,
-            log,
-            10**6,
-            0.0,
-            0.0,
-            fall,
-            tab,
-        )
-        acc += r[1]
+        r = _rocking.scene(body, (kind, mp[i], z, z, z[:0]), controls, rest, log)
+        acc += r.max_rotation
     return acc
 
 

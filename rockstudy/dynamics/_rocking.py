@@ -19,6 +19,7 @@ search and the Zeno rule; the solvers refuse u_v'' <= -g (free fall) before call
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit, prange
@@ -931,25 +932,66 @@ def _free_map_table(u, v, eta, tab, other, omega_rest):
     return False, peak, _impacts_until_rest(w1, omega_rest, eta)
 
 
-@njit(cache=True)
-def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0, om0, fall, tab):
-    """Rock one block (or tabulated mechanism) through one motion, from rest or (th0, om0).
+Body = namedtuple("Body", ("p", "alpha", "eta", "model", "fall", "table"))
+Body.__doc__ = """What rocks in a :func:`scene`: p [rad/s], alpha [rad] (for MODEL_TABLE phi_cr,
+and p the mechanism's p_eq, which then only scales the error tolerances), the restitution
+eta [-], the model (MODEL_NONLINEAR, MODEL_LINEAR or MODEL_TABLE), the rotation ``fall``
+[rad] at which it is taken to have collapsed (FALL_ROTATION for a block), and the mechanism's
+``table`` (:data:`NO_TABLE` for a block)."""
 
-    mot = (kind, mp, times, samples, vsamples) (see :mod:`rockstudy.motions._kernels`);
-    log = (hist, imps, peaks, dense): arrays to fill with
+Controls = namedtuple("Controls", ("rtol", "max_steps", "free_map", "tail_end"))
+Controls.__doc__ = """How a :func:`scene` is computed: the relative tolerance ``rtol``, the
+most steps of one phase ``max_steps`` (exceeded: STATUS_MAX_STEPS), whether the free rocking
+after the motion is mapped (``free_map``: :func:`free_rocking_map`, no history) rather than
+integrated, and ``tail_end`` [s], where an integrated free rocking stops
+(:func:`free_tail_end`)."""
+
+Start = namedtuple("Start", ("theta", "theta_dot"))
+Start.__doc__ = """The state at the start of the motion of a :func:`scene`: theta [rad] and
+theta_dot [rad/s]; (0, 0) is rest (the block then waits for uplift)."""
+
+SceneOutcome = namedtuple(
+    "SceneOutcome",
+    (
+        "status",
+        "max_rotation",
+        "overturned",
+        "n_impacts",
+        "overturn_time",
+        "n_history",
+        "n_impact_times",
+        "steps",
+        "first_impact_time",
+        "n_peaks",
+    ),
+)
+SceneOutcome.__doc__ = """What a :func:`scene` returns: ``status`` (STATUS_OK or
+STATUS_MAX_STEPS), ``max_rotation`` max |theta| [rad], ``overturned``, ``n_impacts``,
+``overturn_time`` [s] (NaN if it stands), the rows the log needed (``n_history`` history
+rows, ``n_impact_times`` impact times, ``n_peaks`` peaks: more than the arrays hold means
+they overflowed), ``steps`` (integrator steps: DOP853, or Taylor inside a record) and
+``first_impact_time`` [s] (NaN if none)."""
+
+
+@njit(cache=True)
+def scene(body, mot, controls, start, log):
+    """Rock one block (or tabulated mechanism) through one motion, from rest or a given state.
+
+    body: a :class:`Body`; mot = (kind, mp, times, samples, vsamples) (see
+    :mod:`rockstudy.motions._kernels`); controls: a :class:`Controls`; start: a
+    :class:`Start`, (0, 0) for rest; log = (hist, imps, peaks, dense): arrays to fill with
     history rows (t, theta, theta_dot), impact times and peaks (t, theta, the maxima of
     |theta|), and the requested times dense[:, 0] (sorted), whose states the integration
     writes into dense[:, 1:3] (the rows it does not reach, in a rest or after a fall, keep
-    their values: fill them with 0, the state at rest); each of length 0 for none. For
-    MODEL_TABLE, alpha is phi_cr, p the p_eq of the mechanism (error scales only), ``tab`` its
-    table and ``fall`` the amplitude at which it is taken to have collapsed.
-    Returns (status, max rotation, overturned, impacts, overturning time, history rows,
-    impact times recorded, integrator steps (DOP853, or Taylor inside a record), first impact
-    time, peaks logged).
+    their values: fill them with 0, the state at rest); each of length 0 for none.
+    Returns a :class:`SceneOutcome`.
     """
+    p, alpha, eta, model, tab = body.p, body.alpha, body.eta, body.model, body.table
+    th0, om0 = start.theta, start.theta_dot
     kind, mp, times, samples, vsamples = mot
     omega_rest = REST_FRACTION * p * alpha
-    blk = (p, alpha, eta, model, omega_rest, TOL_SAFETY * rtol, max_steps, fall, tab)
+    tol = TOL_SAFETY * controls.rtol
+    blk = (p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab)
     hist = log[0]
     rec = hist.shape[0] > 0
     dur = mp[3]
@@ -963,7 +1005,7 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
     phases = 0
     while st[T] < dur:
         phases += 1
-        if phases > max_steps:  # a guard: every phase must move the state on
+        if phases > controls.max_steps:  # a guard: every phase must move the state on
             code = PH_FAIL
             break
         if at_rest:
@@ -980,8 +1022,9 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
         if code != PH_END and code != PH_REST:
             break
         at_rest = code == PH_REST
-    if use_map and code == PH_END and not at_rest and ta[NIMP] == 0:
-        code = _phase(blk, mot, log, st, ta, wk, t_tail, 1)  # integrate on to time the first impact
+    if controls.free_map and code == PH_END and not at_rest and ta[NIMP] == 0:
+        # integrate on to time the first impact
+        code = _phase(blk, mot, log, st, ta, wk, controls.tail_end, 1)
         at_rest = code == PH_REST
     if at_rest:
         if rec:
@@ -993,17 +1036,25 @@ def scene(p, alpha, eta, model, mot, rtol, use_map, t_tail, log, max_steps, th0,
             over, peak, n_post = _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
         else:
             over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
-        if use_map and not over and eta < 1.0:
+        if controls.free_map and not over and eta < 1.0:
             ta[MAXU] = max(ta[MAXU], peak)
             ta[NIMP] += n_post
         else:  # integrate the free rocking: for the history, to time the overturning, or to
-            # count the impacts of a block that never rests (eta = 1) up to t_tail
-            code = _phase(blk, mot, log, st, ta, wk, t_tail)
-    status = STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK
+            # count the impacts of a block that never rests (eta = 1) up to the tail's end
+            code = _phase(blk, mot, log, st, ta, wk, controls.tail_end)
     over = code == PH_OVER
-    t_ot = st[T] if over else np.nan
-    nh, ni, n_pk = int(ta[NH]), int(ta[NI]), int(ta[NP])
-    return status, ta[MAXU], over, int(ta[NIMP]), t_ot, nh, ni, int(ta[WORK]), ta[FIRST], n_pk
+    return SceneOutcome(
+        status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
+        max_rotation=ta[MAXU],
+        overturned=over,
+        n_impacts=int(ta[NIMP]),
+        overturn_time=st[T] if over else np.nan,
+        n_history=int(ta[NH]),
+        n_impact_times=int(ta[NI]),
+        steps=int(ta[WORK]),
+        first_impact_time=ta[FIRST],
+        n_peaks=int(ta[NP]),
+    )
 
 
 #: Columns of the batch output array.
@@ -1028,23 +1079,14 @@ def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, 
     out = np.empty((p.shape[0], 7))
     no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
     for i in prange(p.shape[0]):
-        mot = (kind, mp[i], times, samples, vsamples)
         r = scene(
-            p[i],
-            alpha[i],
-            eta[i],
-            model,
-            mot,
-            rtol,
-            True,
-            free_tail_end(p[i], eta[i], mp[i, 3]),
+            Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE),
+            (kind, mp[i], times, samples, vsamples),
+            Controls(rtol, max_steps, True, free_tail_end(p[i], eta[i], mp[i, 3])),
+            Start(0.0, 0.0),
             no_log,
-            max_steps,
-            0.0,
-            0.0,
-            FALL_ROTATION,
-            NO_TABLE,
         )
-        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
-        out[i, 4], out[i, 5], out[i, 6] = r[4], r[7], r[8]
+        out[i, 0], out[i, 1], out[i, 2] = r.status, r.max_rotation, r.overturned
+        out[i, 3], out[i, 4] = r.n_impacts, r.overturn_time
+        out[i, 5], out[i, 6] = r.steps, r.first_impact_time
     return out

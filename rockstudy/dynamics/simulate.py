@@ -60,39 +60,31 @@ def _kernel(
         dense = np.zeros((0 if t_eval is None else t_eval.size, 3))  # (0, 0): at rest
         if t_eval is not None:
             dense[:, 0] = t_eval
-        status, max_rot, over, n_imp, t_ot, nh, ni, work, _, n_pk = _rocking.scene(
-            p,
-            alpha,
-            eta,
-            model,
+        r = _rocking.scene(
+            _rocking.Body(p, alpha, eta, model, fall, tab),
             (kind, mp, times, samples, vsamples),
-            rtol,
-            False,
-            t_tail,
+            _rocking.Controls(rtol, max_steps, False, t_tail),
+            _rocking.Start(x0[0], x0[1]),
             (hist, imps, peaks, dense),
-            max_steps,
-            x0[0],
-            x0[1],
-            fall,
-            tab,
         )
-        if nh <= cap and ni <= cap and n_pk <= cap:
+        if max(r.n_history, r.n_impact_times, r.n_peaks) <= cap:
             break
         cap *= 4
-    if status == _rocking.STATUS_MAX_STEPS:
+    if r.status == _rocking.STATUS_MAX_STEPS:
         raise RuntimeError(f"{method}: more than max_steps={max_steps} steps in one phase")
+    nh, over, t_ot = r.n_history, bool(r.overturned), float(r.overturn_time)
     return RockingResult(
         hist[:nh, 0].copy(),
         hist[:nh, 1].copy(),
         hist[:nh, 2].copy(),
-        float(max_rot),
-        bool(over),
-        imps[:ni].copy(),
-        float(t_ot),
+        float(r.max_rotation),
+        over,
+        imps[: r.n_impact_times].copy(),
+        t_ot,
         method,
-        {"dop853_steps": int(work)},
-        peaks[:n_pk, 0].copy(),
-        peaks[:n_pk, 1].copy(),
+        {"dop853_steps": int(r.steps)},
+        peaks[: r.n_peaks, 0].copy(),
+        peaks[: r.n_peaks, 1].copy(),
         **_dense_fields(t_eval, dense[:, 1], dense[:, 2], over, t_ot),
     )
 
