@@ -28,7 +28,7 @@ OUT = Path(__file__).parent / "results"
 @njit
 def _run(p, alpha, eta, model, kind, mp, fall, tab):
     z = np.zeros(2)
-    log = (np.empty((0, 3)), np.empty(0))
+    log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
     acc = 0.0
     for i in range(mp.shape[0]):
         r = _rocking.scene(
