@@ -21,17 +21,17 @@ _E5 = tuple(float(x) for x in _DOP853.E5)
 _NS = len(_B)  # 12 stages; stage 13 is f at the new point (first-same-as-last)
 
 
-def make_dop853_step(rhs):
+def make_dop853_step(rhs, options=None):
     """Build the numba DOP853 step for the right-hand side ``rhs(t, theta, theta_dot, args)``.
 
     The returned ``step(args, t, y0, y1, f0, h, kx, kv)`` advances (y0, y1) = (theta,
     theta_dot) by h, with f0 = rhs at the start, and returns (theta_new, theta_dot_new).
     kx, kv are work arrays of length 13 that receive the stage derivatives of theta and
     theta_dot; before :func:`dop853_error` the caller stores the derivatives at the new point in
-    kx[12], kv[12].
+    kx[12], kv[12]. ``options``: further numba options of the step (a dict).
     """
 
-    @njit(cache=True)
+    @njit(cache=True, **(options or {}))
     def step(args, t, y0, y1, f0, h, kx, kv):
         # unrolled over the non-zero entries of the tableau, indexed by literals
         # fmt: off

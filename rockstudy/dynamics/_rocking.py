@@ -117,7 +117,7 @@ def _hermite3(u, tab, col, dcol):
     return val, der
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _mechanism_accel(u, v, a_g, a_v, tab):
     """u'' of a mechanism from eq. (8) of [003]: I u'' + I'/2 u'^2 - G (g + a_v) = -B a_g.
 
@@ -131,7 +131,7 @@ def _mechanism_accel(u, v, a_g, a_v, tab):
     return (g_nl * (G + a_v) - 0.5 * d_inertia * v * v - b_nl * a_g) / inertia
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _accel(a_g, a_v, th, om, p, alpha, s, model, tab):
     """theta_ddot on side s under the ground accelerations a_g (horizontal) and a_v
     (vertical, upwards) [m/s^2]: eq. (2.2) of [000] with gravity g + a_v,
@@ -148,7 +148,7 @@ def _accel(a_g, a_v, th, om, p, alpha, s, model, tab):
     return -p * p * (gv * math.sin(x) + a * math.cos(x))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _rhs(t, th, om, args):
     """theta_ddot at time t on side s (see :func:`_accel`)."""
     p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab = args
@@ -157,7 +157,7 @@ def _rhs(t, th, om, args):
     return _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _lift(a_g, a_v, p, alpha, model, tab):
     """u_ddot of a block at rest on the side that a_g pushes it towards (s = -sign a_g).
 
@@ -172,7 +172,7 @@ def _lift(a_g, a_v, p, alpha, model, tab):
     return s * _accel(a_g, a_v, 0.0, 0.0, p, alpha, s, model, tab)
 
 
-_step = make_dop853_step(_rhs)
+_step = make_dop853_step(_rhs, NO_REFCOUNT)
 
 
 @njit(cache=True, inline="always")
@@ -251,7 +251,7 @@ def _skip_quiet(mp, times, samples, alpha, model, lo, k):
     return max(lo, times[j - 1])
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, t, k):
     """:func:`_lift` under the ground accelerations at time t (record segment k)."""
     a_g = ground_acceleration(kind, mp, times, samples, t, k)
@@ -304,7 +304,7 @@ def _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi):
     return lo, hi
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
     """First time >= t0 at which a block at rest lifts off (:func:`_lift` > 0), or inf.
 
@@ -459,7 +459,7 @@ def _true_state(args, t, th, om, f0, dt, kx, kv):
     return th_s, om_s, _rhs(t + dt, th_s, om_s, args)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _step_events(s, h, th, om, f0, th1, om1, f1):
     """Impact and peak of u = s theta inside an accepted step, in unit step time.
 
@@ -496,7 +496,7 @@ EV_IMPACT = 2  # accepted up to an impact, at (t_ev, om_ev) with om_ev the speed
 EV_OVER = 3  # accepted up to overturning, at (t_ev, om_ev)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
     """One DOP853 step from (t, th, om) towards t_next, with its events.
 
@@ -674,7 +674,7 @@ def _work_arrays():
     return np.empty(13), np.empty(13), np.empty((5, MAX_ORDER + 1))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
     """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 

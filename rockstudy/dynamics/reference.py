@@ -16,7 +16,15 @@ from scipy.optimize import brentq
 
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
-from ._rocking import MODEL_LINEAR, REST_FRACTION, free_rocking_map
+from ._rocking import (
+    MODEL_LINEAR,
+    MODEL_TABLE,
+    REST_FRACTION,
+    _accel,
+    _free_map_table,
+    _lift,
+    free_rocking_map,
+)
 from ._vertical import refuse_free_fall
 
 
@@ -71,6 +79,7 @@ def simulate_reference(
     free_map=False,
     max_impacts=20000,
     t_eval=None,
+    table=None,
 ):
     """Integrate one scene with ``solve_ivp`` and events.
 
@@ -80,9 +89,9 @@ def simulate_reference(
         Frequency parameter [rad/s], slenderness [rad] and restitution [-].
     motion : Motion
     model : int
-        0 for Housner's nonlinear equation (2.2) of [000], 1 for the linearized (3.1); a
-        record's vertical component u_v'' turns g into g + u_v'' in either (refused where
-        u_v'' <= -g, free fall).
+        0 for Housner's nonlinear equation (2.2) of [000], 1 for the linearized (3.1), 2 for
+        a tabulated mechanism, eq. (8) of [003] (``table``); a record's vertical component
+        u_v'' turns g into g + u_v'' in each (refused where u_v'' <= -g, free fall).
     rtol : float
         Relative tolerance; the absolute tolerances are rtol * alpha and rtol * p * alpha.
     integrator : str
@@ -99,6 +108,11 @@ def simulate_reference(
         Sorted times [s] at which to return the state, from ``solve_ivp``'s dense output
         (not with ``free_map``): (0, 0) at rest, the state just before an impact at its time,
         NaN after an overturning.
+    table : (ndarray, float), optional
+        For model 2: the mechanism's tables and collapse amplitude, as returned by
+        ``_structure_tables.structure_table``; p and alpha are then its p_eq and phi_cr (they
+        set the tolerances) and the overturning is at the collapse amplitude, reported as the
+        max rotation.
 
     Returns
     -------
@@ -116,6 +130,7 @@ def simulate_reference(
     dur = motion.duration
     linear = model == MODEL_LINEAR
     thr = G * alpha if linear else G * math.tan(alpha)
+    tab, fall_at = table if model == MODEL_TABLE else (None, FALL_ROTATION)
     omega_rest = REST_FRACTION * p * alpha
     t_end = math.inf if t_max is None else float(t_max)
     atol = [rtol * alpha, rtol * p * alpha]
@@ -125,9 +140,13 @@ def simulate_reference(
         grid, breaks = np.linspace(0.0, dur, 4097), None
 
     def excess(t):  # >= 0 where a block at rest lifts: |u_h''| >= (g + u_v'') tan alpha
+        if tab is not None:  # the kernels' own test, eq. (10) of [003] for a mechanism
+            return _lift(acc(t), vert(t), p, alpha, MODEL_TABLE, tab)
         return abs(acc(t)) - thr * (1.0 + vert(t) / G)
 
     def rhs(t, y, s):
+        if tab is not None:
+            return [y[1], _accel(acc(t), vert(t), y[0], y[1], p, alpha, s, MODEL_TABLE, tab)]
         a = acc(t) / G
         gv = 1.0 + vert(t) / G
         if linear:
@@ -153,7 +172,15 @@ def simulate_reference(
             ts.append(t), ths.append(0.0), oms.append(0.0)
         if t >= dur and free_map and not mapped:
             mapped = True
-            over, peak, n_post = free_rocking_map(s * th, s * om, p, alpha, eta, model, omega_rest)
+            if tab is not None:
+                side = 0 if s > 0.0 else 1
+                over, peak, n_post = _free_map_table(
+                    s * th, s * om, eta, tab[side], tab[1 - side], omega_rest
+                )
+            else:
+                over, peak, n_post = free_rocking_map(
+                    s * th, s * om, p, alpha, eta, model, omega_rest
+                )
             if not over:
                 impacts.extend([math.nan] * n_post)
                 return _pack(ts, ths, oms, max(max_u, peak), False, impacts, math.nan, peaks)
@@ -168,7 +195,7 @@ def simulate_reference(
             return s * y[0]
 
         def fall(t_, y, s=s):
-            return s * y[0] - FALL_ROTATION
+            return s * y[0] - fall_at
 
         def peak(t_, y, s=s):
             return s * y[1]
@@ -197,8 +224,8 @@ def simulate_reference(
             peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
         if sol.t_events[1].size:
             t_ot = float(sol.t_events[1][0])
-            ts.append(t_ot), ths.append(s * FALL_ROTATION), oms.append(sol.y_events[1][0, 1])
-            return _pack(ts, ths, oms, FALL_ROTATION, True, impacts, t_ot, peaks, dense)
+            ts.append(t_ot), ths.append(s * fall_at), oms.append(sol.y_events[1][0, 1])
+            return _pack(ts, ths, oms, fall_at, True, impacts, t_ot, peaks, dense)
         if sol.t_events[0].size:
             t = float(sol.t_events[0][0])
             om_pre = float(sol.y_events[0][0, 1])
