@@ -174,6 +174,74 @@ def test_rest_phase_jump_over_a_quiet_stretch_is_exact():
     np.testing.assert_allclose(jump[5], ref.impact_times[0], rtol=0, atol=1e-9)
 
 
+def _peak_at_the_uplift_level(alpha, sign, ulps, before=()):
+    """A record whose loudest sample after ``before`` is ``ulps`` ulps above g alpha, between
+    two at half of it: a peak of |u_g''| at which a block at rest lifts off at that very
+    sample, the ground easing at once. Returns (record, time of the peak [s])."""
+    top = G * alpha
+    for _ in range(ulps):
+        top = np.nextafter(top, np.inf)
+    assert top / G > alpha  # above the uplift level of eq. (3.1) in this arithmetic too
+    peak = sign * np.array([0.5 * G * alpha, top, 0.5 * G * alpha])
+    acc = np.concatenate([before, np.zeros(50), peak, np.zeros(50)])
+    return Record(acc, dt=0.01), 0.01 * (len(before) + 51)
+
+
+def _assert_falls_back_like_the_reference(block, record, t_peak):
+    """simulate and simulate_batch (method="linear") against solve_ivp at rtol 1e-12 on a
+    record whose last lift-off (at ``t_peak``) falls straight back: the same overturning
+    decision and max rotation, the same impacts before the peak, and none after it but at
+    it. (The reference's Zeno rule restarts the block at an impact found at its own start,
+    at the peak, until its cap on impacts: their number there is not compared.)"""
+    alpha = block.slenderness
+    ref = rs.simulate(block, record, method="scipy-linear", rtol=1e-12)
+    r = rs.simulate(block, record, method="linear")
+    batch = rs.simulate_batch(
+        half_diagonal=[block.half_diagonal], slenderness=[alpha], record=record, method="linear"
+    )
+    assert ref.impact_times[-1] == pytest.approx(t_peak, abs=1e-12)  # the oracle falls back
+    for over, max_rot in (
+        (r.overturned, r.max_rotation),
+        (batch["overturned"][0], batch["max_rotation"][0]),
+    ):
+        assert bool(over) == ref.overturned
+        np.testing.assert_allclose(max_rot, ref.max_rotation, rtol=1e-10, atol=1e-12 * alpha)
+    early = t_peak - 1e-8
+    np.testing.assert_allclose(
+        r.impact_times[r.impact_times < early],
+        ref.impact_times[ref.impact_times < early],
+        rtol=0,
+        atol=1e-8,
+    )
+    np.testing.assert_allclose(r.impact_times[r.impact_times >= early], t_peak, atol=1e-8)
+    np.testing.assert_allclose(batch["first_impact_time"][0], ref.impact_times[0], atol=1e-8)
+    for x in (r, ref):  # no rise at the peak: nothing but contact from then on
+        assert np.all(np.abs(x.theta[x.t >= early]) <= 1e-12 * alpha)
+
+
+@pytest.mark.parametrize("sign, ulps", [(1.0, 1), (-1.0, 1), (1.0, 2), (-1.0, 2)])
+def test_a_lift_at_a_peak_within_ulps_of_the_uplift_level_falls_straight_back(sign, ulps):
+    """Eq. (3.1) of [000] with the first loud sample ulps above g alpha at a peak of |u_g''|:
+    the block lifts at that sample, rises for ~1e-18 of p t and falls back (its turning point
+    rounds away in the closed form). The exact solver used to start that phase from contact
+    without seeing the impact and rock on with s theta < 0 to a false overturning."""
+    block = rs.Block(1.0, 0.2)
+    record, t_peak = _peak_at_the_uplift_level(0.2, sign, ulps)
+    _assert_falls_back_like_the_reference(block, record, t_peak)
+
+
+@pytest.mark.parametrize("sign, ulps", [(1.0, 2), (-1.0, 1)])
+def test_a_lift_at_a_peak_of_the_uplift_level_after_rocking_and_a_rest(sign, ulps):
+    """The same peak mid-record: a strong pulse rocks the block (eq. 3.1 of [000]) to a Zeno
+    rest, and seconds later the block at rest meets the peak; the peak pushes it the other
+    way for sign -1."""
+    alpha = 0.2
+    pulse = 3.0 * G * alpha * np.sin(2.0 * np.pi * np.arange(0.0, 0.3, 0.01) / 0.3)
+    before = np.concatenate([pulse, np.zeros(1200)])
+    record, t_peak = _peak_at_the_uplift_level(alpha, sign, ulps, before)
+    _assert_falls_back_like_the_reference(rs.Block(1.0, alpha), record, t_peak)
+
+
 def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
     """Two of the shared real records, a few blocks each: the batch solver (free rocking
     mapped) against solve_ivp with the same map, to the reference's own accuracy. Chattering

@@ -196,7 +196,8 @@ def _below(u0, du0, ddu0, ddu1, length, level):
 @njit(cache=True)
 def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
     """A segment on which theta may turn: split at its turning points (the peaks, logged),
-    on each monotone piece look for an impact (s theta reaching 0) or the fall (FALL_ROTATION).
+    on each monotone piece look for an impact (s theta reaching 0) or the fall (FALL_ROTATION);
+    a piece from contact that never rises is an impact at its start (a lift that falls back).
     Returns (sigma of the event or -1, whether it is the fall)."""
     c1, c2 = _seg_turning_points(th, v, g0, f1, length, 1.0 + sh + cm1)
     lo = 0.0
@@ -208,6 +209,15 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
         u_hi = s * th_hi
         if u_lo > 0.0 and u_hi <= 0.0:
             return _seg_root(0.0, th, v, g0, f1, s, lo, hi, u_lo, u_hi), False
+        if u_lo <= 0.0 and u_hi < 0.0 and s * f1 >= 0.0:
+            # never above contact since a lift from rest, and the ground easing (s f1 >= 0):
+            # a lift at a peak of |u_g''| within ulps of g alpha, whose rise (~1e-18 of
+            # sigma, its turning point rounded away) falls straight back. An impact here at
+            # ~zero speed (the Zeno rule rests the block), as solve_ivp and the kernel find;
+            # not run on with s theta < 0 (a false overturning). Where the ground pushes
+            # harder (s f1 < 0), a start a few ulps below contact (the lift test and the
+            # closed form differing in the last bit) rises at once: it goes on.
+            return lo, False
         if u_hi >= FALL_ROTATION:
             return _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi, u_lo, u_hi), True
         if hi < length and u_hi > 0.0 and u_hi - s * (g0 + f1 * hi) < 0.0:  # u'' < 0: a peak
@@ -455,10 +465,11 @@ def record_scene(
     s = math.copysign(1.0, th0 if th0 != 0.0 else om0)
     k = 0
     code = PH_END
+    t_rest = 0.0  # [s] from which a block at rest waits for the ground to lift it
     while True:
         lifted = not rocking  # this phase starts from rest
         if not rocking:
-            t_up, k = _record_uplift(p, alpha, mp, times, samples, loud, tau / p, k)
+            t_up, k = _record_uplift(p, alpha, mp, times, samples, loud, t_rest, k)
             k_up = k
             if t_up >= dur:
                 if logging:
@@ -476,9 +487,10 @@ def record_scene(
         )
         if code != PH_REST:
             break
-        if lifted:
-            tau = max(tau, p * _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
-        k = segment_index(times, tau / p, k)
+        t_rest = tau / p
+        if lifted:  # kept in seconds: p (t_up + 1 ulp) / p may round back to t_up (no progress)
+            t_rest = max(t_rest, _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
+        k = segment_index(times, t_rest, k)
     n_log = int(ta[_NH]), int(ta[_NI]), int(ta[_NP])
     if code == PH_OVER:
         return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p, n_log
