@@ -20,6 +20,7 @@ from ._warnings import (
     ComplexAccuracyWarning,
     ComplexFromRestWarning,
     EquivalentBlockWarning,
+    IncompleteReferenceWarning,
     LinearizationWarning,
     LooseToleranceWarning,
 )
@@ -52,6 +53,7 @@ __all__ = [
     "EquivalentBlockWarning",
     "LinearizationWarning",
     "LooseToleranceWarning",
+    "IncompleteReferenceWarning",
     "RockingResult",
     "closedform",
     "motions",

@@ -29,5 +29,9 @@ class LooseToleranceWarning(AccuracyWarning):
     """The nonlinear kernel was run at a tolerance looser than its measured reliable range."""
 
 
+class IncompleteReferenceWarning(AccuracyWarning):
+    """The scipy reference stopped early (its impact cap): the result covers only the start."""
+
+
 class EquivalentBlockWarning(AccuracyWarning):
     """A structure was run as its equivalent block of [003], which only approximates it."""

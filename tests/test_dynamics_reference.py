@@ -158,3 +158,18 @@ def test_linear_exact_matches_linear_kernel_in_batch():
         f_ex, f_rk = exact[col["first_impact_time"]], rk[col["first_impact_time"]]
         np.testing.assert_array_equal(np.isnan(f_ex), np.isnan(f_rk))
         np.testing.assert_allclose(f_rk, f_ex, rtol=0, atol=1e-8)
+
+
+def test_the_reference_says_when_its_impact_cap_cuts_the_run_short():
+    """A reference run that stops at ``max_impacts`` warns instead of returning a short history
+    as if it were the whole response (a rocking block under a pulse: 10 impacts or more)."""
+    from rockstudy.dynamics.reference import simulate_reference
+
+    block = rs.Block(1.0, 0.2)
+    pulse = rs.motions.SinePulse(2.0 * G * np.tan(0.2), 0.5)
+    p, eta = block.frequency_parameter, block.restitution
+    full = simulate_reference(p, 0.2, eta, pulse, rtol=1e-10)
+    assert full["impact_times"].size > 10 and not full["overturned"]
+    with pytest.warns(rs.IncompleteReferenceWarning, match="max_impacts=3"):
+        short = simulate_reference(p, 0.2, eta, pulse, rtol=1e-10, max_impacts=3)
+    assert short["impact_times"].size == 4

@@ -194,7 +194,9 @@ def _assert_falls_back_like_the_reference(block, record, t_peak):
     it. (The reference's Zeno rule restarts the block at an impact found at its own start,
     at the peak, until its cap on impacts: their number there is not compared.)"""
     alpha = block.slenderness
-    ref = rs.simulate(block, record, method="scipy-linear", rtol=1e-12)
+    with warnings.catch_warnings():  # its impact cap, reached at the peak (after it: silence)
+        warnings.simplefilter("ignore", rs.IncompleteReferenceWarning)
+        ref = rs.simulate(block, record, method="scipy-linear", rtol=1e-12)
     r = rs.simulate(block, record, method="linear")
     batch = rs.simulate_batch(
         half_diagonal=[block.half_diagonal], slenderness=[alpha], record=record, method="linear"
@@ -246,8 +248,11 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
     """Two of the shared real records, a few blocks each: the batch solver (free rocking
     mapped) against solve_ivp with the same map, to the reference's own accuracy. Chattering
     through many impacts amplifies the reference's error: on one of these scenes its max
-    rotation moves by 1.4e-8 between rtol 1e-12 and 3e-13; the exact solver must lie within
-    that spread (and within 1e-10 where the reference has converged)."""
+    rotation moves by 1.6e-9 between rtol 1e-13 and 3e-14 (and by 1e-11 only between 1e-12
+    and 3e-13, while still 2e-9 away from its limit: two loose tolerances can agree on a wrong
+    value). The exact solver must lie within three times the last step of the reference's
+    convergence at its tightest tolerances (and within 1e-10 where the reference has
+    converged)."""
     from rockstudy.dynamics._rocking import MODEL_LINEAR
     from rockstudy.dynamics.reference import simulate_reference
 
@@ -275,12 +280,12 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
                     rtol,
                     free_map=True,
                 )
-                for rtol in (1e-12, 3e-13)
+                for rtol in (1e-13, 3e-14)
             )
             assert bool(out[i, 2]) == ref["overturned"] == finer["overturned"]
             spread = abs(ref["max_rotation"] - finer["max_rotation"])
-            tol = 1e-10 * ref["max_rotation"] + 3.0 * spread
-            np.testing.assert_allclose(out[i, 1], ref["max_rotation"], rtol=0, atol=tol)
+            tol = 1e-10 * finer["max_rotation"] + 3.0 * spread
+            np.testing.assert_allclose(out[i, 1], finer["max_rotation"], rtol=0, atol=tol)
             assert out[i, 2] or ref["max_rotation"] == 0.0 or spread < 1e-7 * ref["max_rotation"]
-            if ref["impact_times"].size:
-                np.testing.assert_allclose(out[i, 6], ref["impact_times"][0], rtol=0, atol=1e-8)
+            if finer["impact_times"].size:
+                np.testing.assert_allclose(out[i, 6], finer["impact_times"][0], rtol=0, atol=1e-8)

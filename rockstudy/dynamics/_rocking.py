@@ -763,6 +763,12 @@ def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
             continue
 
         # impact at t_ev, with speed om_ev just before it
+        if t_ev <= t and th == 0.0 and om == 0.0:
+            # a lift from rest that falls back within the resolution of t (the ground above
+            # the uplift level for less than an ulp of t): the impact one ulp on, where the
+            # ground has eased, so that the Zeno rule rests the block instead of restarting it
+            # at the same t without end
+            t_ev = np.nextafter(t, np.inf)
         t = t_ev
         om_pre = om_ev
         om = eta * om_pre  # eq. (2.3) of [000], once per impact

@@ -9,11 +9,13 @@ It costs milliseconds per scene and is meant for verification at rtol down to 1e
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from .._warnings import IncompleteReferenceWarning
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
 from ._rocking import (
@@ -104,6 +106,9 @@ def simulate_reference(
         After the motion ends, use the closed-form free-rocking map of the kernels instead of
         integrating (integrating on only if the block overturns). This is the scipy path with
         the same algorithm as the kernels, for a like-for-like timing.
+    max_impacts : int
+        Cap on the impacts followed; past it the run stops and says so
+        (:class:`rockstudy.IncompleteReferenceWarning`): the result covers only its start.
     t_eval : ndarray, optional
         Sorted times [s] at which to return the state, from ``solve_ivp``'s dense output
         (not with ``free_map``): (0, 0) at rest, the state just before an impact at its time,
@@ -243,6 +248,12 @@ def simulate_reference(
             else:
                 s, om = -s, om_post
             if len(impacts) > max_impacts:
+                warnings.warn(
+                    f"scipy reference: more than max_impacts={max_impacts} impacts by t = {t!r} "
+                    "s (a chatter it cannot end); the result covers [0, that time] only",
+                    IncompleteReferenceWarning,
+                    stacklevel=2,
+                )
                 break
             continue
         t, th, om = float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1])
