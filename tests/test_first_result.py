@@ -231,7 +231,7 @@ def test_dask_workers_load_the_kernels_the_client_primed(tmp_path):
     hits = {name: sum(h.values()) for name, h, _ in rows}
     misses = {name: sum(m.values()) for name, _, m in rows if m}
     assert misses == {}
-    assert hits["scene_batch"] >= 1
+    assert hits["scene_batch_trig"] >= 1  # the sine-pulse kernel (pruned branches)
 
 
 def test_a_cold_run_compiles_in_the_client_only(tmp_path):
@@ -330,3 +330,25 @@ def test_compile_counter_sees_compilation_and_not_cache_hits():
     with _CompileCounter(lambda: calls.append(1)).listening() as counter:
         twice(2.5)  # already compiled for float64
     assert counter.count == 0 and calls == [1]
+
+
+def test_a_sine_pulse_batch_compiles_no_step_it_cannot_take(tmp_path):
+    """From an empty cache, a batch of sine-pulse scenes compiles the Taylor steps it runs and
+    none of the others (the DOP853 step of Ricker wavelets and mechanisms, the record step,
+    the mechanism's free-rocking map): ``scene_batch_trig``, whose pruned branches halve the
+    compile of a pulse study. Its results are the scipy reference's (tests of the kernel)."""
+    code = (
+        COUNTER
+        + """
+import json
+from rockstudy.dynamics.batch import simulate_batch
+out = simulate_batch(half_diagonal=[1.0, 2.0], slenderness=0.2, pulse="sine", amplitude=5.0,
+                     period=0.5)
+print(json.dumps(counts["compiled"]))
+"""
+    )
+    env = dict(ENV, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"), NUMBA_NUM_THREADS="1")
+    compiled = json.loads(run(["-c", code], tmp_path, env).strip().splitlines()[-1])
+    names = {name.rsplit(".", 1)[-1] for name in compiled}
+    assert {"scene_batch", "scene", "phase", "_taylor_trig_attempt"} <= names
+    assert not names & {"_dop853_attempt", "step", "_taylor_attempt", "_free_map_table"}

@@ -181,6 +181,45 @@ def test_one_ulp_above_uplift_ends_in_bounded_work():
     assert float(out.stdout.split()[-1]) < 5.0  # seconds for the 4 scenes, both paths
 
 
+@pytest.mark.parametrize("linear", [False, True])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_record_peak_an_ulp_above_uplift_after_a_rest_ends_in_bounded_work(linear, sign):
+    """A strong pulse rocks the block to a Zeno rest; seconds later a single sample an ulp above
+    the uplift level (a peak of |u_g''|) lifts it for less than an ulp of t, and it falls back.
+    The record kernel used to restart it there through 10^6 impacts (status max_steps). The
+    response must be the one of the same record with that sample just below the level, which
+    never lifts (solve_ivp at rtol 1e-12 on that record), and the Zeno sequence bounded."""
+    alpha = 0.2
+    level = G * (alpha if linear else math.tan(alpha))
+    pulse = 3.0 * level * np.sin(2.0 * np.pi * np.arange(0.0, 0.3, 0.01) / 0.3)
+
+    def record(top):
+        peak = sign * np.array([0.5 * level, top, 0.5 * level])
+        return rs.motions.Record(np.concatenate([pulse, np.zeros(1200), peak, np.zeros(50)]), 0.01)
+
+    block = rs.Block(1.0, alpha)
+    model = _rocking.MODEL_LINEAR if linear else _rocking.MODEL_NONLINEAR
+    body = _rocking.Body(
+        block.frequency_parameter, alpha, block.restitution, model, rs.constants.FALL_ROTATION,
+        _rocking.NO_TABLE,
+    )  # fmt: skip
+    no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
+    controls = _rocking.Controls(1e-10, 10**6, True, np.inf)
+    above = record(np.nextafter(level, np.inf))
+    out = _rocking.scene(body, above.kernel_spec(), controls, _rocking.Start(0.0, 0.0), no_log)
+    ref = rs.simulate(
+        block, record(np.nextafter(level, 0.0)), method="scipy-linear" if linear else "scipy",
+        rtol=1e-12,
+    )  # fmt: skip
+    assert out.status == _rocking.STATUS_OK and not out.overturned and not ref.overturned
+    assert out.max_rotation == pytest.approx(ref.max_rotation, rel=1e-8)
+    assert out.steps < 5000 and out.n_impacts <= ref.n_impacts + 2
+    if not linear:  # the public entry point says the same
+        res = rs.simulate(block, above, rtol=1e-10)
+        assert res.max_rotation == pytest.approx(ref.max_rotation, rel=1e-8)
+        np.testing.assert_allclose(res.impact_times[: ref.n_impacts], ref.impact_times, atol=1e-8)
+
+
 _ULP_LINEAR_SCRIPT = """
 import itertools, math, time
 import rockstudy as rs
@@ -260,45 +299,6 @@ def test_undamped_free_rocking_impacts_follow_the_closed_form_half_cycle():
 
 # -- 7. rtol and max_steps within what the kernels honour ----------------------------------
 
-
-
-@pytest.mark.parametrize("linear", [False, True])
-@pytest.mark.parametrize("sign", [1.0, -1.0])
-def test_a_record_peak_an_ulp_above_uplift_after_a_rest_ends_in_bounded_work(linear, sign):
-    """A strong pulse rocks the block to a Zeno rest; seconds later a single sample an ulp above
-    the uplift level (a peak of |u_g''|) lifts it for less than an ulp of t, and it falls back.
-    The record kernel used to restart it there through 10^6 impacts (status max_steps). The
-    response must be the one of the same record with that sample just below the level, which
-    never lifts (solve_ivp at rtol 1e-12 on that record), and the Zeno sequence bounded."""
-    alpha = 0.2
-    level = G * (alpha if linear else math.tan(alpha))
-    pulse = 3.0 * level * np.sin(2.0 * np.pi * np.arange(0.0, 0.3, 0.01) / 0.3)
-
-    def record(top):
-        peak = sign * np.array([0.5 * level, top, 0.5 * level])
-        return rs.motions.Record(np.concatenate([pulse, np.zeros(1200), peak, np.zeros(50)]), 0.01)
-
-    block = rs.Block(1.0, alpha)
-    model = _rocking.MODEL_LINEAR if linear else _rocking.MODEL_NONLINEAR
-    body = _rocking.Body(
-        block.frequency_parameter, alpha, block.restitution, model, rs.constants.FALL_ROTATION,
-        _rocking.NO_TABLE,
-    )  # fmt: skip
-    no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
-    controls = _rocking.Controls(1e-10, 10**6, True, np.inf)
-    above = record(np.nextafter(level, np.inf))
-    out = _rocking.scene(body, above.kernel_spec(), controls, _rocking.Start(0.0, 0.0), no_log)
-    ref = rs.simulate(
-        block, record(np.nextafter(level, 0.0)), method="scipy-linear" if linear else "scipy",
-        rtol=1e-12,
-    )  # fmt: skip
-    assert out.status == _rocking.STATUS_OK and not out.overturned and not ref.overturned
-    assert out.max_rotation == pytest.approx(ref.max_rotation, rel=1e-8)
-    assert out.steps < 5000 and out.n_impacts <= ref.n_impacts + 2
-    if not linear:  # the public entry point says the same
-        res = rs.simulate(block, above, rtol=1e-10)
-        assert res.max_rotation == pytest.approx(ref.max_rotation, rel=1e-8)
-        np.testing.assert_allclose(res.impact_times[: ref.n_impacts], ref.impact_times, atol=1e-8)
 
 def test_rtol_and_max_steps_ranges():
     block = rs.Block(1.0, 0.2)

@@ -674,135 +674,149 @@ def _work_arrays():
     return np.empty(13), np.empty(13), np.empty((5, MAX_ORDER + 1))
 
 
-@njit(cache=True, **NO_REFCOUNT)
-def _phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
-    """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
+def _make_phase(general):
+    """The phase kernel (:func:`_phase`): for every motion and model (``general``), or only for
+    the block models under a trigonometric pulse without a vertical component, which step by
+    Taylor series throughout (:func:`_phase_trig`). The branches of the other steps are
+    constants of the closure, pruned before numba types them: that variant compiles in about
+    half the time (a study of sine pulses from an empty cache)."""
+    trig_only = not general
 
-    blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
-    mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
-    :func:`scene`).
-    wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
-    ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
-    or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
-    then just after that impact). The block models step by Taylor series inside a record
-    (:func:`_taylor_attempt`), under a trigonometric pulse and in the free rocking after any
-    motion (:func:`_taylor_trig_attempt`); a Ricker wavelet and a mechanism's table by DOP853.
-    """
-    p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
-    kind, mp, times, samples, vsamples = mot
-    hist, imps, peaks, dense = log
-    rec = hist.shape[0] > 0
-    t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
-    dur = mp[3]
-    kx, kv, w = wk
-    k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
-    f0 = _accel(
-        _ground_after(kind, mp, times, samples, t, k),
-        _vertical_after(kind, mp, times, vsamples, t, k),
-        th,
-        om,
-        p,
-        alpha,
-        s,
-        model,
-        tab,
-    )
-    steps = 0
-    code = PH_END
-    while t < t_stop:
-        steps += 1
-        ta[WORK] += 1
-        if steps > max_steps:
-            code = PH_FAIL
-            break
-        t_next = t_stop
-        in_record = kind == KIND_RECORD and t < dur
-        if in_record:  # end steps on record samples (kinks in u_g'')
-            k = segment_index(times, t, k)
-            t_next = min(t_next, times[k + 1])
-        # Taylor series for the block models (a tabulated mechanism steps by DOP853): on record
-        # samples, under a trigonometric pulse, and with no ground motion after any motion
-        taylor = model != MODEL_TABLE and (in_record or t >= dur or kind == KIND_TRIG)
-        if in_record and taylor:
-            out = _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k)
-        elif taylor:
-            out = _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s)
-        else:
-            args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
-            out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
-        ev, h, hs, t1, th1, om1, f1, t_ev, om_ev, u_pk, t_pk, work, order = out
-        ta[WORK] += work
-        if ev == EV_REJECT:
-            continue
-        if u_pk >= 0.0:  # the peak site: a peak of u = s theta inside the step
-            ta[MAXU] = max(ta[MAXU], u_pk)
-            _log_peak(peaks, ta, t_pk, s * u_pk)
-        t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
-        if taylor:
-            if dense.shape[0] > 0:
-                _dense_poly(dense, ta, w, order, t, hs, t_end)
-            if rec:
-                _record_poly(hist, ta, w[0], order, t, hs, t_end)
-        else:
-            args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
-            _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv)
-            if rec:
-                _record_inside(hist, ta, args, t, t_end - t, th, om, f0, kx, kv)
-        if ev == EV_OVER:
-            t, th, om = t_ev, s * fall, om_ev
-            ta[MAXU] = fall
-            if rec:
-                _push(hist, ta, t, th, om)
-            code = PH_OVER
-            break
-        if ev == EV_NONE:
-            ta[MAXU] = max(ta[MAXU], s * th1)
-            if rec:
-                _push(hist, ta, t1, th1, om1)
-            t, th, om, f0 = t1, th1, om1, f1
-            continue
+    @njit(cache=True, **NO_REFCOUNT)
+    def phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
+        """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
 
-        # impact at t_ev, with speed om_ev just before it
-        if t_ev <= t and th == 0.0 and om == 0.0:
-            # a lift from rest that falls back within the resolution of t (the ground above
-            # the uplift level for less than an ulp of t): the impact one ulp on, where the
-            # ground has eased, so that the Zeno rule rests the block instead of restarting it
-            # at the same t without end
-            t_ev = np.nextafter(t, np.inf)
-        t = t_ev
-        om_pre = om_ev
-        om = eta * om_pre  # eq. (2.3) of [000], once per impact
-        th = 0.0
-        if ta[NIMP] == 0:
-            ta[FIRST] = t
-        ta[NIMP] += 1
-        if rec:
-            n = int(ta[NI])
-            if n < imps.shape[0]:
-                imps[n] = t
-            ta[NI] = n + 1
-            _push(hist, ta, t, 0.0, om_pre)
-            _push(hist, ta, t, 0.0, om)
-        if kind == KIND_RECORD:
-            k = segment_index(times, min(t, dur), k)
-        a_v = _vertical_after(kind, mp, times, vsamples, t, k)
-        if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
-            a_g = _ground_after(kind, mp, times, samples, t, k)
-            if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
-                om = 0.0
-                code = PH_REST
+        blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
+        mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
+        :func:`scene`).
+        wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
+        ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
+        or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
+        then just after that impact). The block models step by Taylor series inside a record
+        (:func:`_taylor_attempt`), under a trigonometric pulse and in the free rocking after any
+        motion (:func:`_taylor_trig_attempt`); a Ricker wavelet and a mechanism's table by DOP853.
+        """
+        p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
+        kind, mp, times, samples, vsamples = mot
+        hist, imps, peaks, dense = log
+        rec = hist.shape[0] > 0
+        t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
+        dur = mp[3]
+        kx, kv, w = wk
+        k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
+        f0 = _accel(
+            _ground_after(kind, mp, times, samples, t, k),
+            _vertical_after(kind, mp, times, vsamples, t, k),
+            th,
+            om,
+            p,
+            alpha,
+            s,
+            model,
+            tab,
+        )
+        steps = 0
+        code = PH_END
+        while t < t_stop:
+            steps += 1
+            ta[WORK] += 1
+            if steps > max_steps:
+                code = PH_FAIL
                 break
-            s = -1.0 if a_g > 0.0 else 1.0
-            om = 0.0
-        else:
-            s = -s
-        if ta[NIMP] == stop_at_impacts:
-            code = PH_IMPACT
-            break
-        a_g = _ground_after(kind, mp, times, samples, t, k)
-        f0 = _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
-    st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
-    return code
+            t_next = t_stop
+            in_record = kind == KIND_RECORD and t < dur
+            if in_record:  # end steps on record samples (kinks in u_g'')
+                k = segment_index(times, t, k)
+                t_next = min(t_next, times[k + 1])
+            # Taylor series for the block models (a tabulated mechanism steps by DOP853): on record
+            # samples, under a trigonometric pulse, and with no ground motion after any motion
+            taylor = model != MODEL_TABLE and (in_record or t >= dur or kind == KIND_TRIG)
+            if general and in_record and taylor:
+                out = _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k)
+            elif trig_only or taylor:
+                out = _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s)
+            else:
+                args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
+                out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
+            ev, h, hs, t1, th1, om1, f1, t_ev, om_ev, u_pk, t_pk, work, order = out
+            ta[WORK] += work
+            if ev == EV_REJECT:
+                continue
+            if u_pk >= 0.0:  # the peak site: a peak of u = s theta inside the step
+                ta[MAXU] = max(ta[MAXU], u_pk)
+                _log_peak(peaks, ta, t_pk, s * u_pk)
+            t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
+            if trig_only or taylor:
+                if dense.shape[0] > 0:
+                    _dense_poly(dense, ta, w, order, t, hs, t_end)
+                if rec:
+                    _record_poly(hist, ta, w[0], order, t, hs, t_end)
+            else:
+                args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
+                _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv)
+                if rec:
+                    _record_inside(hist, ta, args, t, t_end - t, th, om, f0, kx, kv)
+            if ev == EV_OVER:
+                t, th, om = t_ev, s * fall, om_ev
+                ta[MAXU] = fall
+                if rec:
+                    _push(hist, ta, t, th, om)
+                code = PH_OVER
+                break
+            if ev == EV_NONE:
+                ta[MAXU] = max(ta[MAXU], s * th1)
+                if rec:
+                    _push(hist, ta, t1, th1, om1)
+                t, th, om, f0 = t1, th1, om1, f1
+                continue
+
+            # impact at t_ev, with speed om_ev just before it
+            if t_ev <= t and th == 0.0 and om == 0.0:
+                # a lift from rest that falls back within the resolution of t (the ground above
+                # the uplift level for less than an ulp of t): the impact one ulp on, where the
+                # ground has eased, so that the Zeno rule rests the block instead of restarting it
+                # at the same t without end
+                t_ev = np.nextafter(t, np.inf)
+            t = t_ev
+            om_pre = om_ev
+            om = eta * om_pre  # eq. (2.3) of [000], once per impact
+            th = 0.0
+            if ta[NIMP] == 0:
+                ta[FIRST] = t
+            ta[NIMP] += 1
+            if rec:
+                n = int(ta[NI])
+                if n < imps.shape[0]:
+                    imps[n] = t
+                ta[NI] = n + 1
+                _push(hist, ta, t, 0.0, om_pre)
+                _push(hist, ta, t, 0.0, om)
+            if kind == KIND_RECORD:
+                k = segment_index(times, min(t, dur), k)
+            a_v = _vertical_after(kind, mp, times, vsamples, t, k)
+            if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
+                a_g = _ground_after(kind, mp, times, samples, t, k)
+                if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
+                    om = 0.0
+                    code = PH_REST
+                    break
+                s = -1.0 if a_g > 0.0 else 1.0
+                om = 0.0
+            else:
+                s = -s
+            if ta[NIMP] == stop_at_impacts:
+                code = PH_IMPACT
+                break
+            a_g = _ground_after(kind, mp, times, samples, t, k)
+            f0 = _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
+        st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
+        return code
+
+    return phase
+
+
+_phase = _make_phase(True)
+_phase_trig = _make_phase(False)
 
 
 @njit(cache=True, inline="always")
@@ -979,88 +993,109 @@ they overflowed), ``steps`` (integrator steps: DOP853, or Taylor inside a record
 ``first_impact_time`` [s] (NaN if none)."""
 
 
-@njit(cache=True)
-def scene(body, mot, controls, start, log):
-    """Rock one block (or tabulated mechanism) through one motion, from rest or a given state.
+def _make_scene(general):
+    """:func:`scene` on :func:`_phase` (``general``), or :func:`scene_trig` on
+    :func:`_phase_trig` (block models under a trigonometric pulse, no vertical component)."""
 
-    body: a :class:`Body`; mot = (kind, mp, times, samples, vsamples) (see
-    :mod:`rockstudy.motions._kernels`); controls: a :class:`Controls`; start: a
-    :class:`Start`, (0, 0) for rest; log = (hist, imps, peaks, dense): arrays to fill with
-    history rows (t, theta, theta_dot), impact times and peaks (t, theta, the maxima of
-    |theta|), and the requested times dense[:, 0] (sorted), whose states the integration
-    writes into dense[:, 1:3] (the rows it does not reach, in a rest or after a fall, keep
-    their values: fill them with 0, the state at rest); each of length 0 for none.
-    Returns a :class:`SceneOutcome`.
-    """
-    p, alpha, eta, model, tab = body.p, body.alpha, body.eta, body.model, body.table
-    th0, om0 = start.theta, start.theta_dot
-    kind, mp, times, samples, vsamples = mot
-    omega_rest = REST_FRACTION * p * alpha
-    tol = TOL_SAFETY * controls.rtol
-    blk = (p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab)
-    hist = log[0]
-    rec = hist.shape[0] > 0
-    dur = mp[3]
-    at_rest = th0 == 0.0 and om0 == 0.0
-    st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
-    ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
-    wk = _work_arrays()
-    if rec:
-        _push(hist, ta, 0.0, th0, om0)
-    code = PH_END
-    phases = 0
-    while st[T] < dur:
-        phases += 1
-        if phases > controls.max_steps:  # a guard: every phase must move the state on
-            code = PH_FAIL
-            break
-        if at_rest:
-            t_up = next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, st[T])
-            if t_up >= dur:
-                break
-            k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
-            a_g = ground_acceleration(kind, mp, times, samples, t_up, k)
-            st[T], st[TH], st[OM], st[SIDE] = t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0
-            at_rest = False
-            if rec:
-                _push(hist, ta, t_up, 0.0, 0.0)
-        code = _phase(blk, mot, log, st, ta, wk, dur)
-        if code != PH_END and code != PH_REST:
-            break
-        at_rest = code == PH_REST
-    if controls.free_map and code == PH_END and not at_rest and ta[NIMP] == 0:
-        # integrate on to time the first impact
-        code = _phase(blk, mot, log, st, ta, wk, controls.tail_end, 1)
-        at_rest = code == PH_REST
-    if at_rest:
+    @njit(cache=True)
+    def scene(body, mot, controls, start, log):
+        """Rock one block (or tabulated mechanism) through one motion, from rest or a given state.
+
+        body: a :class:`Body`; mot = (kind, mp, times, samples, vsamples) (see
+        :mod:`rockstudy.motions._kernels`); controls: a :class:`Controls`; start: a
+        :class:`Start`, (0, 0) for rest; log = (hist, imps, peaks, dense): arrays to fill with
+        history rows (t, theta, theta_dot), impact times and peaks (t, theta, the maxima of
+        |theta|), and the requested times dense[:, 0] (sorted), whose states the integration
+        writes into dense[:, 1:3] (the rows it does not reach, in a rest or after a fall, keep
+        their values: fill them with 0, the state at rest); each of length 0 for none.
+        Returns a :class:`SceneOutcome`.
+        """
+        p, alpha, eta, model, tab = body.p, body.alpha, body.eta, body.model, body.table
+        th0, om0 = start.theta, start.theta_dot
+        kind, mp, times, samples, vsamples = mot
+        omega_rest = REST_FRACTION * p * alpha
+        tol = TOL_SAFETY * controls.rtol
+        blk = (p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab)
+        hist = log[0]
+        rec = hist.shape[0] > 0
+        dur = mp[3]
+        at_rest = th0 == 0.0 and om0 == 0.0
+        st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
+        ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
+        wk = _work_arrays()
         if rec:
-            _push(hist, ta, dur, 0.0, 0.0)
-    elif code == PH_END or code == PH_IMPACT:
-        u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
-        if model == MODEL_TABLE:
-            side = 0 if st[SIDE] > 0.0 else 1
-            over, peak, n_post = _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
-        else:
-            over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
-        if controls.free_map and not over and eta < 1.0:
-            ta[MAXU] = max(ta[MAXU], peak)
-            ta[NIMP] += n_post
-        else:  # integrate the free rocking: for the history, to time the overturning, or to
-            # count the impacts of a block that never rests (eta = 1) up to the tail's end
-            code = _phase(blk, mot, log, st, ta, wk, controls.tail_end)
-    over = code == PH_OVER
-    return SceneOutcome(
-        status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
-        max_rotation=ta[MAXU],
-        overturned=over,
-        n_impacts=int(ta[NIMP]),
-        overturn_time=st[T] if over else np.nan,
-        n_history=int(ta[NH]),
-        n_impact_times=int(ta[NI]),
-        steps=int(ta[WORK]),
-        first_impact_time=ta[FIRST],
-        n_peaks=int(ta[NP]),
-    )
+            _push(hist, ta, 0.0, th0, om0)
+        code = PH_END
+        phases = 0
+        while st[T] < dur:
+            phases += 1
+            if phases > controls.max_steps:  # a guard: every phase must move the state on
+                code = PH_FAIL
+                break
+            if at_rest:
+                t_up = next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, st[T])
+                if t_up >= dur:
+                    break
+                k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
+                a_g = ground_acceleration(kind, mp, times, samples, t_up, k)
+                st[T], st[TH], st[OM], st[SIDE] = t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0
+                at_rest = False
+                if rec:
+                    _push(hist, ta, t_up, 0.0, 0.0)
+            if general:
+                code = _phase(blk, mot, log, st, ta, wk, dur)
+            else:
+                code = _phase_trig(blk, mot, log, st, ta, wk, dur)
+            if code != PH_END and code != PH_REST:
+                break
+            at_rest = code == PH_REST
+        if controls.free_map and code == PH_END and not at_rest and ta[NIMP] == 0:
+            # integrate on to time the first impact
+            if general:
+                code = _phase(blk, mot, log, st, ta, wk, controls.tail_end, 1)
+            else:
+                code = _phase_trig(blk, mot, log, st, ta, wk, controls.tail_end, 1)
+            at_rest = code == PH_REST
+        if at_rest:
+            if rec:
+                _push(hist, ta, dur, 0.0, 0.0)
+        elif code == PH_END or code == PH_IMPACT:
+            u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
+            if general and model == MODEL_TABLE:
+                side = 0 if st[SIDE] > 0.0 else 1
+                over, peak, n_post = _free_map_table(
+                    u, v, eta, tab[side], tab[1 - side], omega_rest
+                )
+            else:
+                over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
+            if controls.free_map and not over and eta < 1.0:
+                ta[MAXU] = max(ta[MAXU], peak)
+                ta[NIMP] += n_post
+            else:  # integrate the free rocking: for the history, to time the overturning, or to
+                # count the impacts of a block that never rests (eta = 1) up to the tail's end
+                if general:
+                    code = _phase(blk, mot, log, st, ta, wk, controls.tail_end)
+                else:
+                    code = _phase_trig(blk, mot, log, st, ta, wk, controls.tail_end)
+        over = code == PH_OVER
+        return SceneOutcome(
+            status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
+            max_rotation=ta[MAXU],
+            overturned=over,
+            n_impacts=int(ta[NIMP]),
+            overturn_time=st[T] if over else np.nan,
+            n_history=int(ta[NH]),
+            n_impact_times=int(ta[NI]),
+            steps=int(ta[WORK]),
+            first_impact_time=ta[FIRST],
+            n_peaks=int(ta[NP]),
+        )
+
+    return scene
+
+
+scene = _make_scene(True)
+scene_trig = _make_scene(False)
 
 
 #: Columns of the batch output array.
@@ -1075,24 +1110,34 @@ BATCH_COLUMNS = (
 )
 
 
-@njit(cache=True, parallel=True)
-def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
-    """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
-    (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
+def _make_scene_batch(general):
+    """:func:`scene_batch` (every motion and model) or :func:`scene_batch_trig` (the block
+    models under trigonometric pulses without a vertical component, :func:`scene_trig`)."""
 
-    Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
-    """
-    out = np.empty((p.shape[0], 7))
-    no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
-    for i in prange(p.shape[0]):
-        r = scene(
-            Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE),
-            (kind, mp[i], times, samples, vsamples),
-            Controls(rtol, max_steps, True, free_tail_end(p[i], eta[i], mp[i, 3])),
-            Start(0.0, 0.0),
-            no_log,
-        )
-        out[i, 0], out[i, 1], out[i, 2] = r.status, r.max_rotation, r.overturned
-        out[i, 3], out[i, 4] = r.n_impacts, r.overturn_time
-        out[i, 5], out[i, 6] = r.steps, r.first_impact_time
-    return out
+    @njit(cache=True, parallel=True)
+    def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
+        """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
+        (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
+
+        Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
+        """
+        out = np.empty((p.shape[0], 7))
+        no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
+        for i in prange(p.shape[0]):
+            blk = Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE)
+            mot = (kind, mp[i], times, samples, vsamples)
+            ctl = Controls(rtol, max_steps, True, free_tail_end(p[i], eta[i], mp[i, 3]))
+            if general:
+                r = scene(blk, mot, ctl, Start(0.0, 0.0), no_log)
+            else:
+                r = scene_trig(blk, mot, ctl, Start(0.0, 0.0), no_log)
+            out[i, 0], out[i, 1], out[i, 2] = r.status, r.max_rotation, r.overturned
+            out[i, 3], out[i, 4] = r.n_impacts, r.overturn_time
+            out[i, 5], out[i, 6] = r.steps, r.first_impact_time
+        return out
+
+    return scene_batch
+
+
+scene_batch = _make_scene_batch(True)
+scene_batch_trig = _make_scene_batch(False)

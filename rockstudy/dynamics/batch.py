@@ -295,9 +295,9 @@ def _run(rows, idx, model, rtol, max_steps):
         return _linear.trig_batch(*args, mp[idx])
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD and not vsamples.size:
         return _linear_record.record_batch(*args, mp[idx, 0], times, samples)
-    return _rocking.scene_batch(
-        *args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps
-    )
+    trig = kind == mk.KIND_TRIG and model != _rocking.MODEL_TABLE and not vsamples.size
+    kernel = _rocking.scene_batch_trig if trig else _rocking.scene_batch  # compiles in half
+    return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps)
 
 
 def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):

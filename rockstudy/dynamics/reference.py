@@ -247,9 +247,9 @@ def simulate_reference(
                 s, om = (-1.0 if a > 0 else 1.0), 0.0
             else:
                 s, om = -s, om_post
-            if len(impacts) > max_impacts:
+            if len(impacts) >= max_impacts:
                 warnings.warn(
-                    f"scipy reference: more than max_impacts={max_impacts} impacts by t = {t!r} "
+                    f"scipy reference: max_impacts={max_impacts} impacts reached at t = {t!r} "
                     "s (a chatter it cannot end); the result covers [0, that time] only",
                     IncompleteReferenceWarning,
                     stacklevel=2,

@@ -82,7 +82,7 @@ def _kernel(
         imps[: r.n_impact_times].copy(),
         t_ot,
         method,
-        {"dop853_steps": int(r.steps)},
+        {"steps": int(r.steps), "dop853_steps": int(r.steps)},
         peaks[: r.n_peaks, 0].copy(),
         peaks[: r.n_peaks, 1].copy(),
         **_dense_fields(t_eval, dense[:, 1], dense[:, 2], over, t_ot),
@@ -207,6 +207,7 @@ def _linear_record_exact(p, alpha, eta, motion, t_max, method, x0, t_eval=None):
         method,
         {
             "solver": "exact piecewise: eq. (3.1) of [000] in closed form on each record segment",
+            "steps": 0,
             "dop853_steps": 0,
         },
         np.concatenate([peaks[:, 0], peak_t + dur]),
@@ -343,10 +344,13 @@ def simulate(
         every method but ``"complex"``, which refuses it; u_v'' <= -g anywhere (free fall)
         is refused with a ValueError before any integration.
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
-        ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven DOP853 kernel.
+        ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven kernel: Taylor-series
+        steps under trigonometric pulses, inside records and in free rocking, DOP853 steps
+        under a Ricker wavelet and for mechanisms (``info["steps"]`` counts both;
+        ``info["dop853_steps"]`` is its former name, kept).
         ``"linear"``: the linearized eq. (3.1) of [000]; exact piecewise solution for
         trigonometric pulses and for records (closed form on each sample segment, nothing
-        integrated: ``info["dop853_steps"]`` = 0), the same kernel otherwise (a record with a
+        integrated: ``info["steps"]`` = 0), the same kernel otherwise (a record with a
         vertical component, a Ricker wavelet; ``info["solver"]`` says which ran).
         ``"scipy"`` / ``"scipy-linear"``: the slow ``solve_ivp`` reference of either model.
         ``"complex"``: the single-ODE formulation of [001] with angular momentum ``l``
