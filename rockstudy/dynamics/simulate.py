@@ -125,7 +125,7 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
         r = _kernel(*args, t_eval=t_eval)
         if vsamples.size:
             r.info["solver"] = (
-                "DOP853 kernel of the linearized eq. (3.1) of [000] with gravity g + u_v'' "
+                "Taylor-step kernel of the linearized eq. (3.1) of [000] with gravity g + u_v'' "
                 "(the exact record solver has constant coefficients: no vertical component)"
             )
         return r
