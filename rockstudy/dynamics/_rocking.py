@@ -36,7 +36,6 @@ from ..motions._kernels import (
 from ._dop853 import dop853_error, hermite5, make_dop853_step
 from ._taylor import (
     FMA,
-    MAX_ORDER,
     NO_REFCOUNT,
     poly_end,
     poly_root,
@@ -45,6 +44,7 @@ from ._taylor import (
     step_peak,
     taylor_coefficients,
     taylor_coefficients_trig,
+    work_arrays,
 )
 
 MODEL_NONLINEAR = 0
@@ -673,8 +673,8 @@ def _record_poly(hist, ta, c, n, t, hs, t_end):
 def _work_arrays():
     """Work arrays of one scene, allocated once and passed down to every phase: the DOP853
     stage derivatives of theta and theta_dot (13 each), and the Taylor series
-    (5, MAX_ORDER + 1) of :mod:`._taylor` (``work_arrays``)."""
-    return np.empty(13), np.empty(13), np.empty((5, MAX_ORDER + 1))
+    of :mod:`._taylor` (:func:`._taylor.work_arrays`)."""
+    return np.empty(13), np.empty(13), work_arrays()
 
 
 def _make_phase(general):

@@ -65,6 +65,7 @@ NO_REFCOUNT = {"_nrt": False}
 FMA = {"contract"}
 
 
+@njit(cache=True)
 def work_arrays():
     """Coefficient work space of :func:`taylor_coefficients`: rows c, j x_j, S, C and the
     ground series F."""
