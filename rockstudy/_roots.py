@@ -47,17 +47,21 @@ def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):
         The root (the last Newton or bisection iterate).
     """
     x = x0
+    start = lo
     for _ in range(max_iter):
         f, df = fdf(x, args)
-        if sign_lo * f >= 0.0:
+        near = sign_lo * f >= 0.0
+        if near:
             lo = x
         else:
             hi = x
         xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
-        # converged from the far side of the root (a step below the ulp there would fail the
-        # bracket test below, x being hi). Not from the near side: f = 0 at lo may be a start
-        # at contact (theta = 0 right after an impact) with the crossing sought further on.
-        if sign_lo * f < 0.0 and abs(xn - x) <= tol * max(1.0, abs(x)):
+        # converged: a Newton step below tol, from either side of the root. Not at the start
+        # of the bracket from the near side: f = 0 there may be a start at contact (theta = 0
+        # right after an impact) with the crossing sought further on. (A step that rounds to
+        # nothing on the near side would otherwise fail the bracket test below and fall to
+        # bisection all the way from the far end: some 30 evaluations instead of 2.)
+        if abs(xn - x) <= tol * max(1.0, abs(x)) and not (near and x == start):
             return min(max(xn, lo), hi)
         if not lo < xn < hi:
             xn = 0.5 * (lo + hi)

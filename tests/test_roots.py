@@ -72,3 +72,39 @@ def test_compiled_finder_inlined_into_a_kernel():
     dottie, tan_half = _jitted_roots()
     assert dottie == pytest.approx(DOTTIE, rel=4e-16)
     assert tan_half == pytest.approx(math.tan(0.5), rel=4e-16)
+
+
+def _counted(fdf):
+    calls = []
+
+    def counted(x, args):
+        calls.append(x)
+        return fdf(x, args)
+
+    return counted, calls
+
+
+def exp_minus_inv_e(x, _):
+    return math.exp(-x) - math.exp(-1.0), -math.exp(-x)
+
+
+def test_a_root_reached_from_the_near_side_stops_there():
+    """f = e^-x - e^-1 is convex and decreasing: Newton from the left stays left of the root
+    (x = 1) and its last step rounds to nothing while f is still > 0. That is convergence,
+    not a step out of the bracket to be replaced by bisections from the far end (which took
+    some 30 evaluations)."""
+    fdf, calls = _counted(exp_minus_inv_e)
+    x = newton_bisect.py_func(fdf, (), 0.0, 3.0, 0.5, 1.0, 1e-16, 100)
+    assert x == pytest.approx(1.0, rel=4e-16)
+    assert len(calls) <= 8
+
+
+def x_one_minus_x(x, _):
+    return x * (1.0 - x), 1.0 - 2.0 * x
+
+
+def test_a_zero_at_the_start_of_the_bracket_is_not_the_root():
+    """f = 0 at the bracket's start (contact right after an impact) with the crossing sought
+    further on (x = 1): a zero Newton step there is not convergence."""
+    x = newton_bisect.py_func(x_one_minus_x, (), 0.0, 2.0, 0.0, 1.0, 1e-16, 100)
+    assert x == pytest.approx(1.0, rel=4e-16)

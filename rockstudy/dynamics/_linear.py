@@ -45,6 +45,7 @@ from ._rocking import (
 from ._rocking import (
     _next_break as _ground_break,
 )
+from ._taylor import NO_REFCOUNT
 
 _NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record; no vertical
 
@@ -56,14 +57,14 @@ ROOT_TOL = 1e-16
 ROOT_MAX_ITER = 100
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _lifts(kind, mp, times, samples, p, alpha, t, k):
     """Whether the ground just after t [s] lifts a block at rest (``_rocking._lift`` > 0)."""
     a_g = _ground_after(kind, mp, times, samples, t, k)
     return _lift(a_g, 0.0, p, alpha, MODEL_LINEAR, NO_TABLE) > 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _lift_ends(kind, mp, times, samples, p, alpha, t0):
     """First time >= t0 [s] at which the ground stops lifting a block at rest, or the end of
     the motion: the counterpart of ``_rocking.next_uplift``, on the same monotone pieces.
@@ -117,14 +118,14 @@ def _u_fdf(x, args):
     return f, (_u(k + 1, A, B, c, W, x0, alpha, s, x) if k < 2 else 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _root(k, target, sgn, A, B, c, W, x0, alpha, s, lo, hi):
     """sigma in [lo, hi] where sgn * (u^(k) - target) turns from >= 0 to < 0 (Newton-bisection)."""
     args = (k, target, A, B, c, W, x0, alpha, s)
     return newton_bisect(_u_fdf, args, lo, hi, 0.5 * (lo + hi), sgn, ROOT_TOL, ROOT_MAX_ITER)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _next_break(x, r0):
     """Next forcing phase after x where q sin crosses +-alpha (x = r0, pi - r0 mod pi) or peaks
     (x = pi/2 mod pi). Between these the ground term of u'' has one sign and is monotone, so u'
@@ -165,14 +166,14 @@ def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
 _MAXU, _NIMP, _FIRST = 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _impact_tally(ta, tau):
     if ta[_NIMP] == 0:
         ta[_FIRST] = tau
     ta[_NIMP] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
     """Rock (exactly) from tau0 until rest, overturning or tau_ex (end of pulse or of history).
 
@@ -241,7 +242,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
         v0 = v_post
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _first_root_above_one(a2, a1, a0):
     """Smallest root x > 1 of a2 x^2 + a1 x + a0 = 0, or inf."""
     best = np.inf
@@ -260,7 +261,7 @@ def _first_root_above_one(a2, a1, a0):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _free_next_event(u, v, alpha):
     """Free linearized rocking from (u, v): sigma to the next impact and to the fall, and the
     speed at that impact. u(sigma) = alpha + A e^-sigma + B e^sigma (eq. 3.5 of [000]), so both
@@ -273,7 +274,7 @@ def _free_next_event(u, v, alpha):
     return math.log(x_imp), math.log(x_ot), v_imp
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _free_after_pulse(u, v, alpha, eta, tau, ta, over):
     """Tally the free rocking after the pulse: the first impact (if none yet) and, for a block
     that overturns, the impacts on the way and the tau of the fall (else NaN)."""

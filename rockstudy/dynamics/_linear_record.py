@@ -47,6 +47,7 @@ from ._rocking import (
     STATUS_OK,
     _lift,
 )
+from ._taylor import FMA, NO_REFCOUNT
 
 #: Below this |sigma| the segment functions are Taylor polynomials: the first term left out
 #: is below 1e-18 of the sum (sinh - sigma to sigma^13, cosh - 1 to sigma^12).
@@ -61,7 +62,7 @@ SAME_LENGTH = 1e-9
 _NH, _NI, _NP, _ND = 3, 4, 5, 6
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _seg_functions(sig):
     """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation."""
     if abs(sig) >= SERIES_LIMIT:
@@ -69,20 +70,27 @@ def _seg_functions(sig):
         sh = math.sinh(sig)
         return sh, 2.0 * half * half, sh - sig
     x2 = sig * sig
-    smx = x2 * (1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (1.0 / 39916800.0)))
-    smx = sig * x2 * (1.0 / 6.0 + x2 * (1.0 / 120.0 + smx + x2 * x2 * x2 * x2 / 6227020800.0))
-    cm1 = x2 * (1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (1.0 / 3628800.0)))
-    cm1 = x2 * (0.5 + x2 * (1.0 / 24.0 + cm1 + x2 * x2 * x2 * x2 / 479001600.0))
+    x4 = x2 * x2
+    # the sums in x2 of sinh - sigma (from sigma^3) and cosh - 1 (from sigma^2), in pairs
+    # (shorter dependency chains than Horner's), the factorials' inverses folded at compile time
+    smx = (1.0 / 6.0 + x2 * (1.0 / 120.0)) + x4 * (
+        (1.0 / 5040.0 + x2 * (1.0 / 362880.0)) + x4 * (1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0))
+    )
+    cm1 = (0.5 + x2 * (1.0 / 24.0)) + x4 * (
+        (1.0 / 720.0 + x2 * (1.0 / 40320.0)) + x4 * (1.0 / 3628800.0 + x2 * (1.0 / 479001600.0))
+    )
+    smx *= sig * x2
+    cm1 *= x2
     return sig + smx, cm1, smx
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _seg_advance(th0, v0, g0, f1, sh, cm1, smx):
     """theta and theta' after sigma on a record segment, given :func:`_seg_functions` of sigma."""
     return th0 + v0 * sh + (th0 - g0) * cm1 - f1 * smx, v0 + (th0 - g0) * sh + (v0 - f1) * cm1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _seg_state(th0, v0, g0, f1, sig):
     """theta [rad] and theta' = d theta / d tau at sigma on a record segment (closed form of
     the module docstring, eq. 3.1 of [000] under a linear ground)."""
@@ -90,7 +98,7 @@ def _seg_state(th0, v0, g0, f1, sig):
     return _seg_advance(th0, v0, g0, f1, sh, cm1, smx)
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _seg_turning_points(th0, v0, g0, f1, length, e_length):
     """The sigma in (0, length) where theta' = 0 (B x^2 + f1 x - A = 0, x = e^sigma), in order;
     inf where there is none. ``e_length`` is e^length (no logarithm unless a root is inside)."""
@@ -114,7 +122,7 @@ def _seg_turning_points(th0, v0, g0, f1, length, e_length):
     return min(s1, s2), max(s1, s2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _seg_fdf(x, args):
     """f = s theta - target at sigma = x on a record segment (:func:`_seg_state`), and the
     slope that makes a Newton step of :func:`newton_bisect` a Halley step, f' - f f'' / 2 f'
@@ -126,19 +134,45 @@ def _seg_fdf(x, args):
     return f, (df - 0.5 * f * s * (th - g0 - f1 * x) / df if df != 0.0 else 0.0)
 
 
-@njit(cache=True)
-def _seg_root(target, th0, v0, g0, f1, s, lo, hi, u_lo, u_hi):
+@njit(cache=True, fastmath=FMA, inline="always")
+def _root_guess(target, lo, hi, u_lo, u_hi, du_lo, du_hi):
+    """Where u = target on [lo, hi], u monotone from u_lo to u_hi with slopes du_lo, du_hi at
+    the ends (0 at a turning point). Both slopes of the rise's sign: the cubic Hermite
+    interpolant of the inverse function sigma(u) (error ~ length^4, against length^2 for the
+    secant). A turning point at one end: the parabola with its vertex there (an inverse with an
+    infinite slope, where the secant lands far from the root). Otherwise the secant."""
+    rise = u_hi - u_lo
+    if rise == 0.0:
+        return 0.5 * (lo + hi)
+    t = (target - u_lo) / rise
+    if du_lo * rise > 0.0 and du_hi * rise > 0.0:
+        t2 = t * t
+        return (
+            lo
+            + (t2 * (3.0 - 2.0 * t)) * (hi - lo)
+            + (t * (1.0 - t) * (1.0 - t)) * rise / du_lo
+            - (t2 * (1.0 - t)) * rise / du_hi
+        )
+    if du_lo == 0.0 and 0.0 <= t <= 1.0:
+        return lo + (hi - lo) * math.sqrt(t)
+    if du_hi == 0.0 and 0.0 <= t <= 1.0:
+        return hi - (hi - lo) * math.sqrt(1.0 - t)
+    return lo + (hi - lo) * t
+
+
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+def _seg_root(target, th0, v0, g0, f1, s, lo, hi, u_lo, u_hi, du_lo, du_hi):
     """sigma in [lo, hi] where s theta - target changes sign, theta monotone on [lo, hi] with
-    s theta = u_lo, u_hi at the ends (Newton steps from the secant guess, safeguarded by
-    bisection, to rounding)."""
+    s theta = u_lo, u_hi and slopes du_lo, du_hi (0 where unknown) at the ends (Halley steps
+    from :func:`_root_guess`, safeguarded by bisection, to rounding)."""
     sign_lo = 1.0 if u_lo - target >= 0.0 else -1.0
-    x0 = lo + (hi - lo) * (u_lo - target) / (u_lo - u_hi) if u_lo != u_hi else 0.5 * (lo + hi)
+    x0 = _root_guess(target, lo, hi, u_lo, u_hi, du_lo, du_hi)
     x0 = min(max(x0, lo), hi)
     args = (target, th0, v0, g0, f1, s)
     return newton_bisect(_seg_fdf, args, lo, hi, x0, sign_lo, ROOT_TOL, ROOT_MAX_ITER)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _push(hist, ta, t, theta, theta_dot):
     """Append the row (t, theta, theta_dot) to the history, if it has room; count it."""
     n = int(ta[_NH])
@@ -147,18 +181,25 @@ def _push(hist, ta, t, theta, theta_dot):
     ta[_NH] = n + 1
 
 
-@njit(cache=True, inline="always")
-def _push_event(times, ta, counter, t, theta):
-    """Append an impact (``times`` 1-D: t) or a peak (2-D: t, theta) to its log; count it."""
-    n = int(ta[counter])
+@njit(cache=True, fastmath=FMA, inline="always")
+def _push_impact(times, ta, t):
+    """Append an impact time to its log, if it has room; count it."""
+    n = int(ta[_NI])
     if n < times.shape[0]:
-        times.ravel()[n * times.ndim] = t
-        if times.ndim == 2:
-            times.ravel()[n * times.ndim + 1] = theta
-    ta[counter] = n + 1
+        times[n] = t
+    ta[_NI] = n + 1
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, inline="always")
+def _push_peak(peaks, ta, t, theta):
+    """Append a peak (t, theta) to its log, if it has room; count it."""
+    n = int(ta[_NP])
+    if n < peaks.shape[0]:
+        peaks[n, 0], peaks[n, 1] = t, theta
+    ta[_NP] = n + 1
+
+
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _dense_piece(dense, ta, p, tau_a, tau_b, th, v, g0, f1):
     """Write the states at the requested times in (tau_a, tau_b] (tau units, sorted, from
     ``ta[_ND]`` on) from the closed form of the segment piece starting at tau_a in (th, v);
@@ -173,7 +214,7 @@ def _dense_piece(dense, ta, p, tau_a, tau_b, th, v, g0, f1):
     ta[_ND] = i
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _monotone(v, v_end, d0, d1, length):
     """Whether theta is monotone on a segment: theta' keeps one strict sign. theta'' = A e^-sigma
     + B e^sigma is monotone or of one sign, so it has its extremes d0, d1 at the ends: where
@@ -184,7 +225,7 @@ def _monotone(v, v_end, d0, d1, length):
     return d0 * d1 > 0.0 or abs(v) + abs(v_end) > max(abs(d0), abs(d1)) * length
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _below(u0, du0, ddu0, ddu1, length, level):
     """Whether u = s theta stays at or below ``level`` on a segment where it starts at u0 with
     u' = du0 and u'' = ddu0 ... ddu1 at the ends (u'' has its maximum at an end, as theta''):
@@ -193,8 +234,8 @@ def _below(u0, du0, ddu0, ddu1, length, level):
     return top <= level
 
 
-@njit(cache=True)
-def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+def _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log):
     """A segment on which theta may turn: split at its turning points (the peaks, logged),
     on each monotone piece look for an impact (s theta reaching 0) or the fall (FALL_ROTATION);
     a piece from contact that never rises is an impact at its start (a lift that falls back).
@@ -207,8 +248,10 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
             continue
         th_hi = th_end if hi == length else _seg_state(th, v, g0, f1, hi)[0]
         u_hi = s * th_hi
+        du_lo = s * v if lo == 0.0 else 0.0  # a turning point otherwise
+        du_hi = s * v_end if hi == length else 0.0
         if u_lo > 0.0 and u_hi <= 0.0:
-            return _seg_root(0.0, th, v, g0, f1, s, lo, hi, u_lo, u_hi), False
+            return _seg_root(0.0, th, v, g0, f1, s, lo, hi, u_lo, u_hi, du_lo, du_hi), False
         if u_lo <= 0.0 and u_hi < 0.0 and s * f1 >= 0.0:
             # never above contact since a lift from rest, and the ground easing (s f1 >= 0):
             # a lift at a peak of |u_g''| within ulps of g alpha, whose rise (~1e-18 of
@@ -219,15 +262,18 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log):
             # closed form differing in the last bit) rises at once: it goes on.
             return lo, False
         if u_hi >= FALL_ROTATION:
-            return _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi, u_lo, u_hi), True
+            return (
+                _seg_root(FALL_ROTATION, th, v, g0, f1, s, lo, hi, u_lo, u_hi, du_lo, du_hi),
+                True,
+            )
         if hi < length and u_hi > 0.0 and u_hi - s * (g0 + f1 * hi) < 0.0:  # u'' < 0: a peak
-            _push_event(log[2], ta, _NP, (tau + hi) / p, th_hi)
+            _push_peak(log[2], ta, (tau + hi) / p, th_hi)
         ta[_MAXU] = max(ta[_MAXU], u_hi)
         lo, u_lo = hi, u_hi
     return -1.0, False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log):
     """The first impact or fall on a segment: (sigma or -1, whether it is the fall), with the
     max rotation (``ta[_MAXU]``) and the peaks updated. Most segments are decided without a
@@ -237,13 +283,17 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
     d0 = th - g0  # theta'' at both ends
     d1 = th_end - g0 - f1 * length
     if _monotone(v, v_end, d0, d1, length):
+        du0, du1 = s * v, s * v_end
         if 0.0 < u_end < FALL_ROTATION:
             ta[_MAXU] = max(ta[_MAXU], u_end)
             return -1.0, False
         if u_end >= FALL_ROTATION:
-            return _seg_root(FALL_ROTATION, th, v, g0, f1, s, 0.0, length, u0, u_end), True
+            return (
+                _seg_root(FALL_ROTATION, th, v, g0, f1, s, 0.0, length, u0, u_end, du0, du1),
+                True,
+            )
         if u0 > 0.0:
-            return _seg_root(0.0, th, v, g0, f1, s, 0.0, length, u0, u_end), False
+            return _seg_root(0.0, th, v, g0, f1, s, 0.0, length, u0, u_end, du0, du1), False
     elif (
         log[2].shape[0] == 0
         and s * v > 0.0 > s * v_end
@@ -251,10 +301,10 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
         and _below(u0, s * v, s * d0, s * d1, length, ta[_MAXU])
     ):
         return -1.0, False  # one turning point, a maximum: no impact, and not a new max
-    return _slow_segment(th, v, g0, f1, s, length, th_end, sh, cm1, tau, p, ta, log)
+    return _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log)
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _record_phase(alpha, eta, p, c, times, samples, k, tau, th, v, s, ta, log):
     """Rock exactly from (tau, theta, theta', side) on record segment k until rest, overturning
     or the end of the record (eq. 3.1 of [000] with u_g''/g = c samples; impacts with
@@ -309,7 +359,7 @@ def _record_phase(alpha, eta, p, c, times, samples, k, tau, th, v, s, ta, log):
         th = 0.0
         if logging:
             _push(log[0], ta, tau / p, 0.0, p * v_hit)
-            _push_event(log[1], ta, _NI, tau / p, 0.0)
+            _push_impact(log[1], ta, tau / p)
         if abs(v_post) < rest_v:
             if logging:
                 _push(log[0], ta, tau / p, 0.0, 0.0)
@@ -331,7 +381,7 @@ def loud_table(samples):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _first_loud(samples, loud, level, j):
     """The first sample index >= j (below the last) with |sample| >= level, or the last."""
     n = samples.shape[0]
@@ -345,7 +395,7 @@ def _first_loud(samples, loud, level, j):
     return n - 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, fastmath=FMA, inline="always")
 def _lifts(p, alpha, mp, times, samples, t, k):
     """Whether the ground at t [s] (segment k) lifts a block at rest (``_rocking._lift``)."""
     a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t, k)
@@ -356,7 +406,7 @@ def _lifts(p, alpha, mp, times, samples, t, k):
 ULP_STEPS = 16
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, lifts_hi):
     """The time in (lo, hi] on segment k where the lift test turns to ``lifts_hi``, to the ulp.
 
@@ -390,7 +440,7 @@ def _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, lifts_hi):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _record_uplift(p, alpha, mp, times, samples, loud, t, k):
     """First time >= t [s] (on segment k) at which the record lifts a block at rest, and its
     segment; (inf, k) if none. The samples below the uplift level (less QUIET_MARGIN) are
@@ -415,7 +465,7 @@ def _record_uplift(p, alpha, mp, times, samples, loud, t, k):
     return np.inf, k
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _record_lift_end(p, alpha, mp, times, samples, t, k):
     """First time >= t [s] (segment k) at which the ground stops lifting a block at rest, or
     the end of the record (``_linear._lift_ends``: a block lifted from rest cannot come back
