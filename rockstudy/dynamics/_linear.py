@@ -40,7 +40,9 @@ from ._rocking import (
     _lift,
     free_rocking_map,
     free_tail_end,
+    new_tallies,
     next_uplift,
+    tally_impact,
 )
 from ._rocking import (
     _next_break as _ground_break,
@@ -162,23 +164,22 @@ def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
     rec[0, 0] = n + 1
 
 
-# running tallies of a scene: max |theta|, impacts, tau of the first impact
-_MAXU, _NIMP, _FIRST = 0, 1, 2
+@njit(cache=True)
+def _tallied(tallies):
+    """The results in an array of ``_rocking.new_tallies``, read out as values: (max rotation
+    [rad], impacts, first impact time [s], (history rows, impact times, peaks))."""
+    ta = tallies[0]
+    log_rows = (ta.n_history, ta.n_impact_times, ta.n_peaks)
+    return ta.max_rotation, ta.n_impacts, ta.first_impact_time, log_rows
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def _impact_tally(ta, tau):
-    if ta[_NIMP] == 0:
-        ta[_FIRST] = tau
-    ta[_NIMP] += 1
-
-
-@njit(cache=True, **NO_REFCOUNT)
-def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
+def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, p, ta, rec):
     """Rock (exactly) from tau0 until rest, overturning or tau_ex (end of pulse or of history).
 
-    theta and v = d theta / d tau are in rad; q = 0 gives free rocking. ``ta`` holds the
-    tallies (updated in place); ``rec`` is a phase log (see :func:`_log_phase`; shape (0, 7) to
+    theta and v = d theta / d tau are in rad; q = 0 gives free rocking; p [rad/s] gives the
+    impact times in seconds (tau / p). ``ta`` holds the tallies (a ``_rocking.TALLIES``
+    record, updated in place); ``rec`` is a phase log (see :func:`_log_phase`; shape (0, 7) to
     skip logging). Returns (code, tau, theta, v, s).
     """
     c = q / (1.0 + W * W)
@@ -210,7 +211,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
             if va >= 0.0 and _u(1, A, B, c, W, x0, alpha, s, end) <= 0.0:
                 s_pk = _root(1, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, end)
                 u_pk = _u(0, A, B, c, W, x0, alpha, s, s_pk)
-                ta[_MAXU] = max(ta[_MAXU], u_pk)
+                ta.max_rotation = max(ta.max_rotation, u_pk)
                 if log:
                     _log_phase(rec, tau0 + s_pk, s * u_pk, 0.0, 0.0, s, q, ROW_PEAK)
             if s_imp >= 0.0:
@@ -219,9 +220,9 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
                 s_ot = _root(0, FALL_ROTATION, -1.0, A, B, c, W, x0, alpha, s, sa, sb)
                 if log:
                     _log_phase(rec, tau0, tau0 + s_ot, A, B, s, q, 0.0)
-                ta[_MAXU] = FALL_ROTATION
+                ta.max_rotation = FALL_ROTATION
                 return PH_OVER, tau0 + s_ot, s * FALL_ROTATION, 0.0, s
-            ta[_MAXU] = max(ta[_MAXU], ub)
+            ta.max_rotation = max(ta.max_rotation, ub)
             sa = sb
             va = vb
         if s_imp < 0.0:
@@ -234,7 +235,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, ta, rec):
             _log_phase(rec, tau0, tau0 + s_imp, A, B, s, q, 1.0)
         v_post = eta * s * _u(1, A, B, c, W, x0, alpha, s, s_imp)
         tau0 += s_imp
-        _impact_tally(ta, tau0)
+        tally_impact(ta, tau0 / p)
         th0 = 0.0
         if abs(v_post) < rest_v:  # Zeno rule: at rest; the caller decides whether it lifts
             return PH_REST, tau0, 0.0, 0.0, s
@@ -275,16 +276,17 @@ def _free_next_event(u, v, alpha):
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def _free_after_pulse(u, v, alpha, eta, tau, ta, over):
-    """Tally the free rocking after the pulse: the first impact (if none yet) and, for a block
-    that overturns, the impacts on the way and the tau of the fall (else NaN)."""
+def _free_after_pulse(u, v, alpha, eta, tau, p, ta, over):
+    """Tally the free rocking after the pulse (from tau; p [rad/s] gives the impact times in
+    seconds): the first impact (if none yet) and, for a block that overturns, the impacts on
+    the way and the tau of the fall (else NaN)."""
     for _ in range(3):
         s_imp, s_ot, v_imp = _free_next_event(u, v, alpha)
         if over and s_ot <= s_imp:
             return tau + s_ot
         if s_imp == np.inf:
             return np.nan
-        _impact_tally(ta, tau + s_imp)
+        tally_impact(ta, (tau + s_imp) / p)
         if not over:
             return np.nan
         tau += s_imp
@@ -306,7 +308,8 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
     q = a_g / G
     W = w / p
     tau_ex = p * dur
-    ta = np.array([abs(th_init), 0.0, np.nan])
+    tallies = new_tallies(abs(th_init))
+    ta = tallies[0]  # updated in place; every return reads tallies, last (new_tallies)
     t = 0.0
     rocking = th_init != 0.0 or om_init != 0.0
     th = th_init
@@ -329,7 +332,8 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
                 t,
             )
             if t_up >= dur:  # the still ground after the motion never lifts a block
-                return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
+                peak, n_imp, first, _ = _tallied(tallies)
+                return STATUS_OK, peak, False, n_imp, np.nan, first
             a_up = ground_acceleration(KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, t_up, 0)
             s = -1.0 if a_up > 0.0 else 1.0
             t = t_up
@@ -338,7 +342,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         rocking = False
         if t >= dur:
             break
-        code, tau, th, v, s = _trig_phase(alpha, eta, q, W, ph, tau_ex, p * t, th, v, s, ta, rec)
+        code, tau, th, v, s = _trig_phase(alpha, eta, q, W, ph, tau_ex, p * t, th, v, s, p, ta, rec)
         if code != PH_REST:
             break
         t = tau / p
@@ -349,19 +353,20 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
             over, peak, n_post = free_rocking_map(
                 s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
             )
-            n_before = ta[_NIMP]
-            tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, ta, over)
+            n_before = ta.n_impacts
+            tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, p, ta, over)
             if not over:
-                ta[_MAXU] = max(ta[_MAXU], peak)
-                ta[_NIMP] = n_before + n_post
+                ta.max_rotation = max(ta.max_rotation, peak)
+                ta.n_impacts = n_before + n_post
             code = PH_OVER if over else PH_END
         else:
             code, tau, th, v, s = _trig_phase(
-                alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, ta, rec
+                alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, p, ta, rec
             )
+    peak, n_imp, first, _ = _tallied(tallies)
     if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p
-    return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p
+        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p, first
+    return STATUS_OK, peak, False, n_imp, np.nan, first
 
 
 @njit(cache=True, parallel=True)

@@ -35,7 +35,7 @@ from numba import njit, prange
 from .._roots import newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
-from ._linear import _FIRST, _MAXU, _NIMP, ROOT_MAX_ITER, ROOT_TOL, _impact_tally, trig_scene
+from ._linear import ROOT_MAX_ITER, ROOT_TOL, _tallied, trig_scene
 from ._rocking import (
     MODEL_LINEAR,
     NO_TABLE,
@@ -46,6 +46,8 @@ from ._rocking import (
     REST_FRACTION,
     STATUS_OK,
     _lift,
+    new_tallies,
+    tally_impact,
 )
 from ._taylor import FMA, NO_REFCOUNT
 
@@ -57,9 +59,6 @@ LOUD_BLOCK = 64
 #: Relative change of the segment length below which the cached segment functions are reused
 #: (the sample times of a uniform record differ from k dt by rounding).
 SAME_LENGTH = 1e-9
-
-# log counters of a scene (after _MAXU, _NIMP, _FIRST): history rows, impacts, peaks, dense
-_NH, _NI, _NP, _ND = 3, 4, 5, 6
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
@@ -175,43 +174,43 @@ def _seg_root(target, th0, v0, g0, f1, s, lo, hi, u_lo, u_hi, du_lo, du_hi):
 @njit(cache=True, fastmath=FMA, inline="always")
 def _push(hist, ta, t, theta, theta_dot):
     """Append the row (t, theta, theta_dot) to the history, if it has room; count it."""
-    n = int(ta[_NH])
+    n = ta.n_history
     if n < hist.shape[0]:
         hist[n, 0], hist[n, 1], hist[n, 2] = t, theta, theta_dot
-    ta[_NH] = n + 1
+    ta.n_history = n + 1
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
 def _push_impact(times, ta, t):
     """Append an impact time to its log, if it has room; count it."""
-    n = int(ta[_NI])
+    n = ta.n_impact_times
     if n < times.shape[0]:
         times[n] = t
-    ta[_NI] = n + 1
+    ta.n_impact_times = n + 1
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
 def _push_peak(peaks, ta, t, theta):
     """Append a peak (t, theta) to its log, if it has room; count it."""
-    n = int(ta[_NP])
+    n = ta.n_peaks
     if n < peaks.shape[0]:
         peaks[n, 0], peaks[n, 1] = t, theta
-    ta[_NP] = n + 1
+    ta.n_peaks = n + 1
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _dense_piece(dense, ta, p, tau_a, tau_b, th, v, g0, f1):
     """Write the states at the requested times in (tau_a, tau_b] (tau units, sorted, from
-    ``ta[_ND]`` on) from the closed form of the segment piece starting at tau_a in (th, v);
+    ``ta.n_dense`` on) from the closed form of the segment piece starting at tau_a in (th, v);
     requested times before tau_a fall in a rest and keep (0, 0)."""
-    i = int(ta[_ND])
+    i = ta.n_dense
     while i < dense.shape[0] and p * dense[i, 0] <= tau_b:
         if p * dense[i, 0] >= tau_a:
             th_i, v_i = _seg_state(th, v, g0, f1, p * dense[i, 0] - tau_a)
             dense[i, 1] = th_i
             dense[i, 2] = p * v_i
         i += 1
-    ta[_ND] = i
+    ta.n_dense = i
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
@@ -268,7 +267,7 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, 
             )
         if hi < length and u_hi > 0.0 and u_hi - s * (g0 + f1 * hi) < 0.0:  # u'' < 0: a peak
             _push_peak(log[2], ta, (tau + hi) / p, th_hi)
-        ta[_MAXU] = max(ta[_MAXU], u_hi)
+        ta.max_rotation = max(ta.max_rotation, u_hi)
         lo, u_lo = hi, u_hi
     return -1.0, False
 
@@ -276,7 +275,7 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, 
 @njit(cache=True, fastmath=FMA, inline="always")
 def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log):
     """The first impact or fall on a segment: (sigma or -1, whether it is the fall), with the
-    max rotation (``ta[_MAXU]``) and the peaks updated. Most segments are decided without a
+    max rotation (``ta.max_rotation``) and the peaks updated. Most segments are decided without a
     root: theta monotone (:func:`_monotone`), or, when no peak is logged, a single turning
     point that cannot raise the max rotation so far (:func:`_below`)."""
     u0, u_end = s * th, s * th_end
@@ -285,7 +284,7 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
     if _monotone(v, v_end, d0, d1, length):
         du0, du1 = s * v, s * v_end
         if 0.0 < u_end < FALL_ROTATION:
-            ta[_MAXU] = max(ta[_MAXU], u_end)
+            ta.max_rotation = max(ta.max_rotation, u_end)
             return -1.0, False
         if u_end >= FALL_ROTATION:
             return (
@@ -298,7 +297,7 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
         log[2].shape[0] == 0
         and s * v > 0.0 > s * v_end
         and u_end > 0.0
-        and _below(u0, s * v, s * d0, s * d1, length, ta[_MAXU])
+        and _below(u0, s * v, s * d0, s * d1, length, ta.max_rotation)
     ):
         return -1.0, False  # one turning point, a maximum: no impact, and not a new max
     return _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, log)
@@ -350,12 +349,12 @@ def _record_phase(alpha, eta, p, c, times, samples, k, tau, th, v, s, ta, log):
         th_hit, v_hit = _seg_state(th, v, g0, f1, hit)
         tau += hit
         if fall:
-            ta[_MAXU] = FALL_ROTATION
+            ta.max_rotation = FALL_ROTATION
             if logging:
                 _push(log[0], ta, tau / p, s * FALL_ROTATION, p * v_hit)
             return PH_OVER, k, tau, s * FALL_ROTATION, 0.0, s
         v_post = eta * v_hit
-        _impact_tally(ta, tau)
+        tally_impact(ta, tau / p)
         th = 0.0
         if logging:
             _push(log[0], ta, tau / p, 0.0, p * v_hit)
@@ -506,7 +505,8 @@ def record_scene(
     """
     dur = times[-1]
     mp = np.array([scale, 0.0, 0.0, dur])
-    ta = np.array([abs(th0), 0.0, np.nan, 0.0, 0.0, 0.0, 0.0])
+    tallies = new_tallies(abs(th0))
+    ta = tallies[0]  # updated in place; every return reads tallies, last (new_tallies)
     logging = log[0].shape[0] > 0
     if logging:
         _push(log[0], ta, 0.0, th0, om0)
@@ -524,8 +524,8 @@ def record_scene(
             if t_up >= dur:
                 if logging:
                     _push(log[0], ta, dur, 0.0, 0.0)
-                n_log = int(ta[_NH]), int(ta[_NI]), int(ta[_NP])
-                return STATUS_OK, ta[_MAXU], False, int(ta[_NIMP]), np.nan, ta[_FIRST] / p, n_log
+                peak, n_imp, first, n_log = _tallied(tallies)
+                return STATUS_OK, peak, False, n_imp, np.nan, first, n_log
             a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t_up, k)
             s = -1.0 if a_g > 0.0 else 1.0
             tau, th, v = p * t_up, 0.0, 0.0
@@ -541,17 +541,16 @@ def record_scene(
         if lifted:  # kept in seconds: p (t_up + 1 ulp) / p may round back to t_up (no progress)
             t_rest = max(t_rest, _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
         k = segment_index(times, t_rest, k)
-    n_log = int(ta[_NH]), int(ta[_NI]), int(ta[_NP])
+    peak, n_imp, first, n_log = _tallied(tallies)
     if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, int(ta[_NIMP]), tau / p, ta[_FIRST] / p, n_log
+        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p, first, n_log
     # the free rocking after the record: trig_scene under a motion of zero length, from here
     t_free = max(t_tail - dur, 0.0)
     tail = trig_scene(
         p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_free, tail_log, th, v * p
     )
-    first = ta[_FIRST] / p if ta[_NIMP] > 0 else tail[5] + dur
-    peak = max(ta[_MAXU], tail[1])
-    return STATUS_OK, peak, tail[2], int(ta[_NIMP]) + tail[3], tail[4] + dur, first, n_log
+    first = first if n_imp > 0 else tail[5] + dur
+    return STATUS_OK, max(peak, tail[1]), tail[2], n_imp + tail[3], tail[4] + dur, first, n_log
 
 
 @njit(cache=True, parallel=True)

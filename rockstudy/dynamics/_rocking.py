@@ -377,22 +377,74 @@ def _root_hermite(target, sgn, deriv, h, y0, d0, a0, y1, d1, a1, lo, hi):
     )
 
 
-# Per-scene work arrays: the rocking state ...
-T, TH, OM, SIDE, H = 0, 1, 2, 3, 4
-# ... and the running tallies (counts are stored as floats): max u, impacts, DOP853 steps,
-# history rows, impact times, first impact time, peaks, next requested time (dense output)
-MAXU, NIMP, WORK, NH, NI, FIRST, NP, NE = 0, 1, 2, 3, 4, 5, 6, 7
+#: The running tallies of one scene, one record updated in place by the kernel and the exact
+#: linear solvers: max |theta| [rad], the first impact time [s] (NaN before it), impacts,
+#: integrator steps (0 in the exact solvers), and the rows the logs needed (history rows,
+#: impact times, peaks: more than an array holds means it overflowed), with the requested
+#: times of the dense output passed so far (the index of the next one to serve).
+TALLIES = np.dtype(
+    [
+        ("max_rotation", np.float64),
+        ("first_impact_time", np.float64),
+        ("n_impacts", np.int64),
+        ("steps", np.int64),
+        ("n_history", np.int64),
+        ("n_impact_times", np.int64),
+        ("n_peaks", np.int64),
+        ("n_dense", np.int64),
+    ],
+    align=True,
+)
+
+
+@njit(cache=True)
+def new_tallies(max_rotation):
+    """An array of one :data:`TALLIES` record: no impact yet (first_impact_time NaN), all
+    counts 0, max |theta| from ``max_rotation`` [rad] (the start's).
+
+    The kernels pass its element ``tallies[0]`` down (a numba Record, by reference) and
+    update it in place. The element does not keep the array alive, and numba frees an array
+    after its last use: the function that allocates it reads the results from ``tallies``
+    after every other use (a record kept from ``np.zeros(1, TALLIES)[0]`` alone is
+    overwritten by the next allocation).
+    """
+    tallies = np.zeros(1, TALLIES)
+    ta = tallies[0]
+    ta.max_rotation = max_rotation
+    ta.first_impact_time = np.nan
+    return tallies
+
+
+@njit(cache=True, inline="always")
+def tally_impact(ta, t):
+    """Count an impact at t [s] in the tallies ``ta``, the first one's time kept."""
+    if ta.n_impacts == 0:
+        ta.first_impact_time = t
+    ta.n_impacts += 1
+
+
+PhaseState = namedtuple("PhaseState", ("t", "theta", "theta_dot", "side", "h"))
+PhaseState.__doc__ = """The state of a rocking phase (:func:`_phase`): the time t [s], theta
+[rad], theta_dot [rad/s], the side s (+1.0 or -1.0) it rocks on and the next step size h [s]."""
+
+Stepping = namedtuple(
+    "Stepping", ("p", "alpha", "eta", "model", "omega_rest", "tol", "max_steps", "fall", "table")
+)
+Stepping.__doc__ = """What a rocking phase (:func:`_phase`) steps: the body (p [rad/s], alpha
+[rad], eta, model, ``fall`` [rad] and ``table`` of a :class:`Body`), the speed ``omega_rest``
+[rad/s] below which an impact leaves it at rest, the local error target ``tol`` (TOL_SAFETY
+rtol) and the most steps ``max_steps`` of one phase."""
 
 
 @njit(cache=True)
 def _push(hist, ta, t, th, om):
     """Append a history row if there is room; always count it, so overflow is detectable."""
-    n = int(ta[NH])
+    n = ta.n_history
     if n < hist.shape[0]:
         hist[n, 0] = t
         hist[n, 1] = th
         hist[n, 2] = om
-    ta[NH] = n + 1
+    ta.n_history = n + 1
 
 
 @njit(cache=True)
@@ -408,11 +460,11 @@ def _record_inside(hist, ta, args, t, h, th, om, f0, kx, kv):
 def _log_peak(peaks, ta, t, th):
     """Append the peak (t, theta) to ``peaks`` if there is room; always count it, so that
     overflow is detectable."""
-    n = int(ta[NP])
+    n = ta.n_peaks
     if n < peaks.shape[0]:
         peaks[n, 0] = t
         peaks[n, 1] = th
-    ta[NP] = n + 1
+    ta.n_peaks = n + 1
 
 
 @njit(cache=True)
@@ -431,25 +483,25 @@ def _dense(dense, ta, args, t, t_end, th, om, f0, kx, kv):
     each requested time dense[j, 0] in [t, t_end] not yet served, by one DOP853 step from t
     (as accurate as the step), into dense[j, 1:3]. Requested times before t fall in a rest
     and keep the (0, 0) they hold; a time on an impact gets the state just before it."""
-    j = int(ta[NE])
+    j = ta.n_dense
     while j < dense.shape[0] and dense[j, 0] <= t_end:
         if dense[j, 0] >= t:
             dense[j, 1], dense[j, 2] = _step(args, t, th, om, f0, dense[j, 0] - t, kx, kv)
         j += 1
-    ta[NE] = j
+    ta.n_dense = j
 
 
 @njit(cache=True, **NO_REFCOUNT)
 def _dense_poly(dense, ta, w, n, t, hs, t_end):
     """:func:`_dense` on an accepted Taylor step of length hs from t, by its polynomial w[0]
     of order n (the solution within the step's tolerance), up to t_end."""
-    j = int(ta[NE])
+    j = ta.n_dense
     while j < dense.shape[0] and dense[j, 0] <= t_end:
         if dense[j, 0] >= t:
             x, d, _ = poly_value(w[0], n, (dense[j, 0] - t) / hs)
             dense[j, 1], dense[j, 2] = x, d / hs
         j += 1
-    ta[NE] = j
+    ta.n_dense = j
 
 
 @njit(cache=True)
@@ -548,7 +600,7 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
-def _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k):
+def _taylor_attempt(w, stepping, mot, t, th, om, f0, h, t_next, s, k):
     """One Taylor step (:mod:`._taylor`) on record segment k, from (t, th, om) towards t_next
     (f0: theta_ddot at t, used for a start at rest on contact: :func:`_lift_curvature`).
     Inlined into the phase loop: the call, with its ~50 flattened arguments, cost 6-18 % of a
@@ -559,8 +611,8 @@ def _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k):
     the tuple of :func:`_dop853_attempt`, with the events located on the step polynomial
     (the order of that polynomial last; its coefficients stay in w[0]).
     """
-    p, alpha, model, fall = blk[0], blk[1], blk[3], blk[7]
-    tol = TAYLOR_TOL_FRACTION * blk[5]
+    p, alpha, model, fall = stepping.p, stepping.alpha, stepping.model, stepping.fall
+    tol = TAYLOR_TOL_FRACTION * stepping.tol
     kind, mp, times, samples, vsamples = mot
     last = h >= t_next - t
     hs = t_next - t if last else h
@@ -602,7 +654,7 @@ TARGET_ORDER = 14
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s):
+def _taylor_trig_attempt(w, stepping, mot, t, th, om, f0, h, t_next, s):
     """One Taylor step under a trigonometric pulse (``KIND_TRIG``, before its end) or with no
     ground motion (after any motion has ended), from (t, th, om) towards t_next.
 
@@ -610,8 +662,8 @@ def _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s):
     :data:`TRIG_STEP_CAP` in p t and in omega t, and grows (x2) while the series needs fewer
     than :data:`TARGET_ORDER` terms. Returns the tuple of :func:`_taylor_attempt`.
     """
-    p, alpha, model, fall = blk[0], blk[1], blk[3], blk[7]
-    tol = TRIG_TOL_FRACTION * blk[5]
+    p, alpha, model, fall = stepping.p, stepping.alpha, stepping.model, stepping.fall
+    tol = TRIG_TOL_FRACTION * stepping.tol
     mp = mot[1]
     forced = t < mp[3]
     h = min(h, TRIG_STEP_CAP / p, TRIG_STEP_CAP / mp[1] if forced else np.inf)
@@ -686,24 +738,26 @@ def _make_phase(general):
     trig_only = not general
 
     @njit(cache=True, **NO_REFCOUNT)
-    def phase(blk, mot, log, st, ta, wk, t_stop, stop_at_impacts=-1):
-        """Integrate rocking from the state ``st`` until rest, overturning or t_stop.
+    def phase(stepping, mot, log, state, ta, wk, t_stop, stop_at_impacts=-1):
+        """Integrate rocking from ``state`` (a :class:`PhaseState`) until rest, overturning or
+        t_stop.
 
-        blk = (p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab),
-        mot = (kind, mp, times, samples, vsamples), log = (hist, imps, peaks, dense) (see
-        :func:`scene`).
+        stepping: a :class:`Stepping`; mot = (kind, mp, times, samples, vsamples), log = (hist,
+        imps, peaks, dense) (see :func:`scene`).
         wk = (kx, kv, w): the scene's work arrays (:func:`_work_arrays`).
-        ``st`` and the tallies ``ta`` are updated in place. Returns PH_END, PH_REST, PH_OVER
-        or PH_FAIL; or PH_IMPACT once the impact count reaches ``stop_at_impacts`` (the state is
-        then just after that impact). The block models step by Taylor series inside a record
+        The tallies ``ta`` (a :data:`TALLIES` record) are updated in place. Returns (code,
+        the :class:`PhaseState` at the end): PH_END, PH_REST, PH_OVER or PH_FAIL; or PH_IMPACT
+        once the impact count reaches ``stop_at_impacts`` (the state is then just after that
+        impact). The block models step by Taylor series inside a record
         (:func:`_taylor_attempt`), under a trigonometric pulse and in the free rocking after any
         motion (:func:`_taylor_trig_attempt`); a Ricker wavelet and a mechanism's table by DOP853.
         """
-        p, alpha, eta, model, omega_rest, tol, max_steps, fall, tab = blk
+        p, alpha, eta, model = stepping.p, stepping.alpha, stepping.eta, stepping.model
+        tab, fall = stepping.table, stepping.fall
         kind, mp, times, samples, vsamples = mot
         hist, imps, peaks, dense = log
         rec = hist.shape[0] > 0
-        t, th, om, s, h = st[T], st[TH], st[OM], st[SIDE], st[H]
+        t, th, om, s, h = state
         dur = mp[3]
         kx, kv, w = wk
         k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
@@ -722,8 +776,8 @@ def _make_phase(general):
         code = PH_END
         while t < t_stop:
             steps += 1
-            ta[WORK] += 1
-            if steps > max_steps:
+            ta.steps += 1
+            if steps > stepping.max_steps:
                 code = PH_FAIL
                 break
             t_next = t_stop
@@ -735,18 +789,18 @@ def _make_phase(general):
             # samples, under a trigonometric pulse, and with no ground motion after any motion
             taylor = model != MODEL_TABLE and (in_record or t >= dur or kind == KIND_TRIG)
             if general and in_record and taylor:
-                out = _taylor_attempt(w, blk, mot, t, th, om, f0, h, t_next, s, k)
+                out = _taylor_attempt(w, stepping, mot, t, th, om, f0, h, t_next, s, k)
             elif trig_only or taylor:
-                out = _taylor_trig_attempt(w, blk, mot, t, th, om, f0, h, t_next, s)
+                out = _taylor_trig_attempt(w, stepping, mot, t, th, om, f0, h, t_next, s)
             else:
                 args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
-                out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv)
+                out = _dop853_attempt(args, t, th, om, f0, h, t_next, s, stepping.tol, fall, kx, kv)
             ev, h, hs, t1, th1, om1, f1, t_ev, om_ev, u_pk, t_pk, work, order = out
-            ta[WORK] += work
+            ta.steps += work
             if ev == EV_REJECT:
                 continue
             if u_pk >= 0.0:  # the peak site: a peak of u = s theta inside the step
-                ta[MAXU] = max(ta[MAXU], u_pk)
+                ta.max_rotation = max(ta.max_rotation, u_pk)
                 _log_peak(peaks, ta, t_pk, s * u_pk)
             t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
             if trig_only or taylor:
@@ -761,13 +815,13 @@ def _make_phase(general):
                     _record_inside(hist, ta, args, t, t_end - t, th, om, f0, kx, kv)
             if ev == EV_OVER:
                 t, th, om = t_ev, s * fall, om_ev
-                ta[MAXU] = fall
+                ta.max_rotation = fall
                 if rec:
                     _push(hist, ta, t, th, om)
                 code = PH_OVER
                 break
             if ev == EV_NONE:
-                ta[MAXU] = max(ta[MAXU], s * th1)
+                ta.max_rotation = max(ta.max_rotation, s * th1)
                 if rec:
                     _push(hist, ta, t1, th1, om1)
                 t, th, om, f0 = t1, th1, om1, f1
@@ -784,20 +838,18 @@ def _make_phase(general):
             om_pre = om_ev
             om = eta * om_pre  # eq. (2.3) of [000], once per impact
             th = 0.0
-            if ta[NIMP] == 0:
-                ta[FIRST] = t
-            ta[NIMP] += 1
+            tally_impact(ta, t)
             if rec:
-                n = int(ta[NI])
+                n = ta.n_impact_times
                 if n < imps.shape[0]:
                     imps[n] = t
-                ta[NI] = n + 1
+                ta.n_impact_times = n + 1
                 _push(hist, ta, t, 0.0, om_pre)
                 _push(hist, ta, t, 0.0, om)
             if kind == KIND_RECORD:
                 k = segment_index(times, min(t, dur), k)
             a_v = _vertical_after(kind, mp, times, vsamples, t, k)
-            if abs(om) < omega_rest:  # Zeno rule: rest, or restart on the forced side
+            if abs(om) < stepping.omega_rest:  # Zeno rule: rest, or restart on the forced side
                 a_g = _ground_after(kind, mp, times, samples, t, k)
                 if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
                     om = 0.0
@@ -807,13 +859,12 @@ def _make_phase(general):
                 om = 0.0
             else:
                 s = -s
-            if ta[NIMP] == stop_at_impacts:
+            if ta.n_impacts == stop_at_impacts:
                 code = PH_IMPACT
                 break
             a_g = _ground_after(kind, mp, times, samples, t, k)
             f0 = _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
-        st[T], st[TH], st[OM], st[SIDE], st[H] = t, th, om, s, h
-        return code
+        return code, PhaseState(t, th, om, s, h)
 
     return phase
 
@@ -996,6 +1047,26 @@ they overflowed), ``steps`` (integrator steps: DOP853, or Taylor inside a record
 ``first_impact_time`` [s] (NaN if none)."""
 
 
+@njit(cache=True)
+def _outcome(code, state, tallies):
+    """The :class:`SceneOutcome` of a scene whose last phase ended with ``code`` in ``state`` (a
+    :class:`PhaseState`), from its tallies (the array of :func:`new_tallies`)."""
+    ta = tallies[0]
+    over = code == PH_OVER
+    return SceneOutcome(
+        status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
+        max_rotation=ta.max_rotation,
+        overturned=over,
+        n_impacts=ta.n_impacts,
+        overturn_time=state.t if over else np.nan,
+        n_history=ta.n_history,
+        n_impact_times=ta.n_impact_times,
+        steps=ta.steps,
+        first_impact_time=ta.first_impact_time,
+        n_peaks=ta.n_peaks,
+    )
+
+
 def _make_scene(general):
     """:func:`scene` on :func:`_phase` (``general``), or :func:`scene_trig` on
     :func:`_phase_trig` (block models under a trigonometric pulse, no vertical component)."""
@@ -1018,81 +1089,75 @@ def _make_scene(general):
         kind, mp, times, samples, vsamples = mot
         omega_rest = REST_FRACTION * p * alpha
         tol = TOL_SAFETY * controls.rtol
-        blk = (p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab)
+        stepping = Stepping(
+            p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab
+        )
         hist = log[0]
         rec = hist.shape[0] > 0
         dur = mp[3]
         at_rest = th0 == 0.0 and om0 == 0.0
-        st = np.array([0.0, th0, om0, math.copysign(1.0, th0 if th0 != 0.0 else om0), 0.01 / p])
-        ta = np.array([abs(th0), 0.0, 0.0, 0.0, 0.0, np.nan, 0.0, 0.0])
+        s0 = math.copysign(1.0, th0 if th0 != 0.0 else om0)  # the side the start rocks on
+        state = PhaseState(0.0, th0, om0, s0, 0.01 / p)
+        tallies = new_tallies(abs(th0))
+        ta = tallies[0]  # updated in place; the outcome reads tallies, last (new_tallies)
         wk = _work_arrays()
         if rec:
             _push(hist, ta, 0.0, th0, om0)
         code = PH_END
         phases = 0
-        while st[T] < dur:
+        while state.t < dur:
             phases += 1
             if phases > controls.max_steps:  # a guard: every phase must move the state on
                 code = PH_FAIL
                 break
             if at_rest:
-                t_up = next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, st[T])
+                t_up = next_uplift(
+                    kind, mp, times, samples, vsamples, p, alpha, model, tab, state.t
+                )
                 if t_up >= dur:
                     break
                 k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
                 a_g = ground_acceleration(kind, mp, times, samples, t_up, k)
-                st[T], st[TH], st[OM], st[SIDE] = t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0
+                state = PhaseState(t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0, state.h)
                 at_rest = False
                 if rec:
                     _push(hist, ta, t_up, 0.0, 0.0)
             if general:
-                code = _phase(blk, mot, log, st, ta, wk, dur)
+                code, state = _phase(stepping, mot, log, state, ta, wk, dur)
             else:
-                code = _phase_trig(blk, mot, log, st, ta, wk, dur)
+                code, state = _phase_trig(stepping, mot, log, state, ta, wk, dur)
             if code != PH_END and code != PH_REST:
                 break
             at_rest = code == PH_REST
-        if controls.free_map and code == PH_END and not at_rest and ta[NIMP] == 0:
+        if controls.free_map and code == PH_END and not at_rest and ta.n_impacts == 0:
             # integrate on to time the first impact
             if general:
-                code = _phase(blk, mot, log, st, ta, wk, controls.tail_end, 1)
+                code, state = _phase(stepping, mot, log, state, ta, wk, controls.tail_end, 1)
             else:
-                code = _phase_trig(blk, mot, log, st, ta, wk, controls.tail_end, 1)
+                code, state = _phase_trig(stepping, mot, log, state, ta, wk, controls.tail_end, 1)
             at_rest = code == PH_REST
         if at_rest:
             if rec:
                 _push(hist, ta, dur, 0.0, 0.0)
         elif code == PH_END or code == PH_IMPACT:
-            u, v = st[SIDE] * st[TH], st[SIDE] * st[OM]
+            u, v = state.side * state.theta, state.side * state.theta_dot
             if general and model == MODEL_TABLE:
-                side = 0 if st[SIDE] > 0.0 else 1
+                side = 0 if state.side > 0.0 else 1
                 over, peak, n_post = _free_map_table(
                     u, v, eta, tab[side], tab[1 - side], omega_rest
                 )
             else:
                 over, peak, n_post = free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
             if controls.free_map and not over and eta < 1.0:
-                ta[MAXU] = max(ta[MAXU], peak)
-                ta[NIMP] += n_post
+                ta.max_rotation = max(ta.max_rotation, peak)
+                ta.n_impacts += n_post
             else:  # integrate the free rocking: for the history, to time the overturning, or to
                 # count the impacts of a block that never rests (eta = 1) up to the tail's end
                 if general:
-                    code = _phase(blk, mot, log, st, ta, wk, controls.tail_end)
+                    code, state = _phase(stepping, mot, log, state, ta, wk, controls.tail_end)
                 else:
-                    code = _phase_trig(blk, mot, log, st, ta, wk, controls.tail_end)
-        over = code == PH_OVER
-        return SceneOutcome(
-            status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
-            max_rotation=ta[MAXU],
-            overturned=over,
-            n_impacts=int(ta[NIMP]),
-            overturn_time=st[T] if over else np.nan,
-            n_history=int(ta[NH]),
-            n_impact_times=int(ta[NI]),
-            steps=int(ta[WORK]),
-            first_impact_time=ta[FIRST],
-            n_peaks=int(ta[NP]),
-        )
+                    code, state = _phase_trig(stepping, mot, log, state, ta, wk, controls.tail_end)
+        return _outcome(code, state, tallies)
 
     return scene
 
@@ -1127,13 +1192,13 @@ def _make_scene_batch(general):
         out = np.empty((p.shape[0], 7))
         no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
         for i in prange(p.shape[0]):
-            blk = Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE)
+            body = Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE)
             mot = (kind, mp[i], times, samples, vsamples)
             ctl = Controls(rtol, max_steps, True, free_tail_end(p[i], eta[i], mp[i, 3]))
             if general:
-                r = scene(blk, mot, ctl, Start(0.0, 0.0), no_log)
+                r = scene(body, mot, ctl, Start(0.0, 0.0), no_log)
             else:
-                r = scene_trig(blk, mot, ctl, Start(0.0, 0.0), no_log)
+                r = scene_trig(body, mot, ctl, Start(0.0, 0.0), no_log)
             out[i, 0], out[i, 1], out[i, 2] = r.status, r.max_rotation, r.overturned
             out[i, 3], out[i, 4] = r.n_impacts, r.overturn_time
             out[i, 5], out[i, 6] = r.steps, r.first_impact_time
