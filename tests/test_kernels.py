@@ -87,3 +87,25 @@ def test_batch_rows_do_not_depend_on_batch_composition():
     part = simulate_batch(**{k: v[10:20] for k, v in kw.items()})
     for key in ("max_rotation", "overturned", "n_impacts"):
         np.testing.assert_array_equal(full[key][10:20], part[key])
+
+
+def test_kernel_variants_compile_under_their_own_names():
+    """The factories' two variants of a kernel (general, trig-only) have their own qualified
+    names: numba names a compiled closure, and its cache entry, by that name and a counter of
+    the compiling process, so two variants of one name, each compiled first in its own process,
+    collided when a third process loaded both (``_rocking._variant_named``)."""
+    pairs = (
+        (_rocking._phase, _rocking._phase_trig),
+        (_rocking.scene, _rocking.scene_trig),
+        (_rocking.scene_batch, _rocking.scene_batch_trig),
+    )
+    assert len({kernel.py_func.__qualname__ for pair in pairs for kernel in pair}) == 6
+
+
+def test_tallies_start_empty_with_integer_counts():
+    tallies = _rocking.new_tallies(0.25)
+    assert tallies.shape == (1,) and tallies.dtype == _rocking.TALLIES
+    assert tallies[0]["max_rotation"] == 0.25 and np.isnan(tallies[0]["first_impact_time"])
+    counts = [name for name in _rocking.TALLIES.names if name.startswith("n_") or name == "steps"]
+    assert len(counts) == 6
+    assert all(_rocking.TALLIES[name] == np.int64 and tallies[0][name] == 0 for name in counts)

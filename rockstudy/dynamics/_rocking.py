@@ -729,6 +729,23 @@ def _work_arrays():
     return np.empty(13), np.empty(13), work_arrays()
 
 
+def _variant_named(general):
+    """Decorator (under ``@njit``) that names a factory's trig-only variant apart:
+    ``<name>_trig``. numba names a compiled function, and so its cache entry, by its qualified
+    name and a counter of the process that compiled it; two variants of one name that were each
+    the first function compiled in their process (a CLI run, a test's child process) got one
+    name, and a process that loaded both from the cache ran the second with the first's
+    environment (scene_batch after scene_batch_trig: RuntimeError "'descr' is NULL")."""
+
+    def name(fn):
+        if not general:
+            fn.__name__ += "_trig"
+            fn.__qualname__ += "_trig"
+        return fn
+
+    return name
+
+
 def _make_phase(general):
     """The phase kernel (:func:`_phase`): for every motion and model (``general``), or only for
     the block models under a trigonometric pulse without a vertical component, which step by
@@ -738,6 +755,7 @@ def _make_phase(general):
     trig_only = not general
 
     @njit(cache=True, **NO_REFCOUNT)
+    @_variant_named(general)
     def phase(stepping, mot, log, state, ta, wk, t_stop, stop_at_impacts=-1):
         """Integrate rocking from ``state`` (a :class:`PhaseState`) until rest, overturning or
         t_stop.
@@ -1072,6 +1090,7 @@ def _make_scene(general):
     :func:`_phase_trig` (block models under a trigonometric pulse, no vertical component)."""
 
     @njit(cache=True)
+    @_variant_named(general)
     def scene(body, mot, controls, start, log):
         """Rock one block (or tabulated mechanism) through one motion, from rest or a given state.
 
@@ -1183,6 +1202,7 @@ def _make_scene_batch(general):
     models under trigonometric pulses without a vertical component, :func:`scene_trig`)."""
 
     @njit(cache=True, parallel=True)
+    @_variant_named(general)
     def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
         """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
         (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
