@@ -19,6 +19,10 @@ from __future__ import annotations
 
 from numba import njit
 
+#: Cap on the halvings of a bisection of a time bracket down to adjacent doubles (where the
+#: loops stop: about 60 for a bracket of seconds); the cap only guards against an endless loop.
+ULP_BISECTIONS = 2000
+
 
 @njit(cache=True, inline="always")
 def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .._roots import newton_bisect
+from .._roots import ULP_BISECTIONS, newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, KIND_TRIG, ground_acceleration, segment_index
 from ._rocking import (
@@ -86,7 +86,7 @@ def _lift_ends(kind, mp, times, samples, p, alpha, t0):
         if kind == KIND_RECORD:
             k = segment_index(times, lo, k)
         if not _lifts(kind, mp, times, samples, p, alpha, hi, k):
-            for _ in range(2000):
+            for _ in range(ULP_BISECTIONS):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .._roots import newton_bisect
+from .._roots import ULP_BISECTIONS, newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
 from ._linear import ROOT_MAX_ITER, ROOT_TOL, _tallied, trig_scene
@@ -428,7 +428,7 @@ def _bisect_lift(p, alpha, mp, times, samples, lo, hi, k, lifts_hi):
             if before <= lo or _lifts(p, alpha, mp, times, samples, before, k) != lifts_hi:
                 return t
             t = before
-    for _ in range(2000):
+    for _ in range(ULP_BISECTIONS):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break

@@ -24,7 +24,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
-from .._roots import newton_bisect
+from .._roots import ULP_BISECTIONS, newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import (
     KIND_RECORD,
@@ -79,6 +79,20 @@ TOL_SAFETY = 0.1
 TAYLOR_TOL_FRACTION = 1e-4
 #: Shortest step (in units of 1/p) retried when an impact falls outside its step.
 MIN_STEP = 1e-9
+#: A DOP853 step whose impact the interpolant placed outside it is retried this much shorter.
+IMPACT_RETRY_SHRINK = 0.25
+#: Step-size control of the DOP853 steps (Hairer, Norsett and Wanner's): the next step is
+#: h STEP_SAFETY err^(-1/8), aimed below the tolerance so that it is rarely rejected ...
+STEP_SAFETY = 0.9
+#: ... and at least STEP_SHRINK_LIMIT h (also after a NaN error), at most STEP_GROW_LIMIT h
+#: (also after a zero error), so that one odd error estimate cannot swing it further.
+STEP_SHRINK_LIMIT = 0.2
+STEP_GROW_LIMIT = 5.0
+#: The first step tried in a scene, in units of 1/p (the controller adapts it from there).
+FIRST_STEP = 0.01
+#: Cap on the halvings of the bisections on a mechanism's table: 100 take any bracket of
+#: rotations down to adjacent doubles, where they stop.
+TABLE_BISECTIONS = 100
 #: Absolute error scales of theta and theta_dot, as fractions of alpha and p*alpha.
 ATOL_FRACTION = 1e-3
 #: Impact count of :func:`free_rocking_map` when eta = 1 (the block never comes to rest).
@@ -336,7 +350,7 @@ def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
         if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, hi, k_hi) > 0.0:
             if kind == KIND_TRIG and model != MODEL_TABLE and vsamples.size == 0:
                 lo, hi = _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi)
-            for _ in range(2000):
+            for _ in range(ULP_BISECTIONS):
                 mid = 0.5 * (lo + hi)
                 if mid <= lo or mid >= hi:
                     break
@@ -570,9 +584,11 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
     sc_v = tol * (ATOL_FRACTION * p * alpha + max(abs(om), abs(om1)))
     err = dop853_error(kx, kv, hs, sc_x, sc_v)
     if not err <= 1.0:  # rejected (or NaN)
-        h = hs * max(0.2, 0.9 * err ** (-0.125)) if err == err else 0.2 * hs
+        shrink = max(STEP_SHRINK_LIMIT, STEP_SAFETY * err ** (-0.125))
+        h = hs * shrink if err == err else STEP_SHRINK_LIMIT * hs
         return EV_REJECT, h, hs, t, th, om, f0, t, om, -1.0, np.nan, 0, 0
-    fac = 5.0 if err == 0.0 else min(5.0, 0.9 * err ** (-0.125))
+    grow = STEP_GROW_LIMIT if err == 0.0 else STEP_SAFETY * err ** (-0.125)
+    fac = min(STEP_GROW_LIMIT, grow)
     h = max(h, hs * fac) if last else hs * fac
     work = 0
     u_pk, t_pk = -1.0, np.nan
@@ -594,7 +610,8 @@ def _dop853_attempt(args, t, th, om, f0, h, t_next, s, tol, fall, kx, kv):
     dl = -x / v if v != 0.0 else 0.0
     if not 0.0 <= s_imp * hs + dl <= hs:  # the interpolant misplaced it
         if hs * p > MIN_STEP:  # retry with a shorter step
-            return EV_REJECT, 0.25 * hs, hs, t, th, om, f0, t, om, u_pk, t_pk, work, 0
+            h = IMPACT_RETRY_SHRINK * hs
+            return EV_REJECT, h, hs, t, th, om, f0, t, om, u_pk, t_pk, work, 0
         dl = min(max(s_imp * hs + dl, 0.0), hs) - s_imp * hs
     return EV_IMPACT, h, hs, t1, th1, om1, f1, t + s_imp * hs + dl, v + a * dl, u_pk, t_pk, work, 0
 
@@ -746,6 +763,43 @@ def _variant_named(general):
     return name
 
 
+@njit(cache=True, inline="always")
+def _impact(t, th, om, t_ev, om_ev, eta, ta, imps, hist):
+    """The impact at t_ev [s] of a phase at (t, th, om), with speed om_ev just before it:
+    the speed after it, eta om_ev (eq. 2.3 of [000]), tallied and logged (``imps``, ``hist``:
+    arrays of length 0 for none). Returns (time, speed after).
+
+    A lift from rest that falls back within the resolution of t (the ground above the uplift
+    level for less than an ulp of t) has its impact one ulp on, where the ground has eased, so
+    that the Zeno rule rests the block instead of restarting it at the same t without end.
+    """
+    if t_ev <= t and th == 0.0 and om == 0.0:
+        t_ev = np.nextafter(t, np.inf)
+    om_post = eta * om_ev
+    tally_impact(ta, t_ev)
+    if hist.shape[0] > 0:
+        n = ta.n_impact_times
+        if n < imps.shape[0]:
+            imps[n] = t_ev
+        ta.n_impact_times = n + 1
+        _push(hist, ta, t_ev, 0.0, om_ev)
+        _push(hist, ta, t_ev, 0.0, om_post)
+    return t_ev, om_post
+
+
+@njit(cache=True, inline="always")
+def _zeno(om, s, omega_rest, a_g, a_v, p, alpha, model, tab):
+    """The side after an impact that left the speed om [rad/s] with the ground (a_g, a_v):
+    the other side, or, below ``omega_rest``, the Zeno rule: at rest unless the ground lifts
+    the block (:func:`_lift`), which then restarts from rest on the side it is pushed to.
+    Returns (at rest, side, speed)."""
+    if abs(om) >= omega_rest:
+        return False, -s, om
+    if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
+        return True, s, 0.0
+    return False, (-1.0 if a_g > 0.0 else 1.0), 0.0
+
+
 def _make_phase(general):
     """The phase kernel (:func:`_phase`): for every motion and model (``general``), or only for
     the block models under a trigonometric pulse without a vertical component, which step by
@@ -846,41 +900,19 @@ def _make_phase(general):
                 continue
 
             # impact at t_ev, with speed om_ev just before it
-            if t_ev <= t and th == 0.0 and om == 0.0:
-                # a lift from rest that falls back within the resolution of t (the ground above
-                # the uplift level for less than an ulp of t): the impact one ulp on, where the
-                # ground has eased, so that the Zeno rule rests the block instead of restarting it
-                # at the same t without end
-                t_ev = np.nextafter(t, np.inf)
-            t = t_ev
-            om_pre = om_ev
-            om = eta * om_pre  # eq. (2.3) of [000], once per impact
+            t, om = _impact(t, th, om, t_ev, om_ev, eta, ta, imps, hist)
             th = 0.0
-            tally_impact(ta, t)
-            if rec:
-                n = ta.n_impact_times
-                if n < imps.shape[0]:
-                    imps[n] = t
-                ta.n_impact_times = n + 1
-                _push(hist, ta, t, 0.0, om_pre)
-                _push(hist, ta, t, 0.0, om)
             if kind == KIND_RECORD:
                 k = segment_index(times, min(t, dur), k)
+            a_g = _ground_after(kind, mp, times, samples, t, k)
             a_v = _vertical_after(kind, mp, times, vsamples, t, k)
-            if abs(om) < stepping.omega_rest:  # Zeno rule: rest, or restart on the forced side
-                a_g = _ground_after(kind, mp, times, samples, t, k)
-                if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
-                    om = 0.0
-                    code = PH_REST
-                    break
-                s = -1.0 if a_g > 0.0 else 1.0
-                om = 0.0
-            else:
-                s = -s
+            resting, s, om = _zeno(om, s, stepping.omega_rest, a_g, a_v, p, alpha, model, tab)
+            if resting:
+                code = PH_REST
+                break
             if ta.n_impacts == stop_at_impacts:
                 code = PH_IMPACT
                 break
-            a_g = _ground_after(kind, mp, times, samples, t, k)
             f0 = _accel(a_g, a_v, th, om, p, alpha, s, model, tab)
         return code, PhaseState(t, th, om, s, h)
 
@@ -971,8 +1003,10 @@ def free_rocking_map(u, v, p, alpha, eta, model, omega_rest):
 @njit(cache=True)
 def _potential_level(level, lo, hi, tab):
     """u in [lo, hi] where V(u) = level, V increasing there (bisection on the table)."""
-    for _ in range(100):
+    for _ in range(TABLE_BISECTIONS):
         mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
         if _hermite3(mid, tab, TAB_V, TAB_DV)[0] < level:
             lo = mid
         else:
@@ -988,8 +1022,10 @@ def _critical(tab):
     while i < g.shape[0] - 1 and g[i + 1] < 0.0:
         i += 1
     lo, hi = tab[i, TAB_PHI], tab[min(i + 1, g.shape[0] - 1), TAB_PHI]
-    for _ in range(60):
+    for _ in range(TABLE_BISECTIONS):
         mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
         if _hermite3(mid, tab, TAB_G, TAB_DG)[0] < 0.0:
             lo = mid
         else:
@@ -1116,7 +1152,7 @@ def _make_scene(general):
         dur = mp[3]
         at_rest = th0 == 0.0 and om0 == 0.0
         s0 = math.copysign(1.0, th0 if th0 != 0.0 else om0)  # the side the start rocks on
-        state = PhaseState(0.0, th0, om0, s0, 0.01 / p)
+        state = PhaseState(0.0, th0, om0, s0, FIRST_STEP / p)
         tallies = new_tallies(abs(th0))
         ta = tallies[0]  # updated in place; the outcome reads tallies, last (new_tallies)
         wk = _work_arrays()

@@ -30,11 +30,15 @@ from scipy.optimize import brentq
 from .._warnings import ComplexAccuracyWarning, ComplexFromRestWarning
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ._rocking import STEP_GROW_LIMIT, STEP_SAFETY, STEP_SHRINK_LIMIT
 
 _A = tuple(tuple(float(x) for x in row) for row in RK45.A)
 _B = tuple(float(x) for x in RK45.B)
 _C = tuple(float(x) for x in RK45.C)
 _E = tuple(float(x) for x in RK45.E)
+#: A step with a NaN error estimate, or that takes the log-radius below 0, is retried this much
+#: shorter (the controller's formula has nothing to say about it).
+BAD_STEP_SHRINK = 0.25
 
 
 #: Above this l the complex formulation's error exceeds about 1 % of alpha on [001]'s
@@ -130,12 +134,14 @@ def _integrate(
             scale = rtol * (1e-3 + max(abs(y[m]), abs(ynew[m])))
             err = max(err, abs(hs * e) / scale)
         if not err <= 1.0 or ynew[0] <= 0.0:
-            h = hs * 0.25 if not err == err or ynew[0] <= 0.0 else hs * max(0.2, 0.9 * err**-0.2)
+            bad = not err == err or ynew[0] <= 0.0
+            h = hs * (BAD_STEP_SHRINK if bad else max(STEP_SHRINK_LIMIT, STEP_SAFETY * err**-0.2))
             continue
         t += hs
         y[:] = ynew
         k[0, :] = k[6, :]
-        h = min(h_max, hs * (5.0 if err == 0.0 else min(5.0, 0.9 * err**-0.2)))
+        grow = STEP_GROW_LIMIT if err == 0.0 else min(STEP_GROW_LIMIT, STEP_SAFETY * err**-0.2)
+        h = min(h_max, hs * grow)
         if nh < hist.shape[0]:
             hist[nh, 0] = t
             hist[nh, 1] = y[0]
