@@ -20,7 +20,7 @@ from __future__ import annotations
 from numba import njit
 
 #: Cap on the halvings of a bisection of a time bracket down to adjacent doubles (where the
-#: loops stop: about 60 for a bracket of seconds); the cap only guards against an endless loop.
+#: loops stop: about 50 for a bracket of seconds); the cap only guards against an endless loop.
 ULP_BISECTIONS = 2000
 
 
@@ -60,12 +60,15 @@ def newton_bisect(fdf, args, lo, hi, x0, sign_lo, tol, max_iter):
         else:
             hi = x
         xn = x - f / df if df != 0.0 else 0.5 * (lo + hi)
-        # converged: a Newton step below tol, from either side of the root. Not at the start
-        # of the bracket from the near side: f = 0 there may be a start at contact (theta = 0
-        # right after an impact) with the crossing sought further on. (A step that rounds to
-        # nothing on the near side would otherwise fail the bracket test below and fall to
-        # bisection all the way from the far end: some 30 evaluations instead of 2.)
-        if abs(xn - x) <= tol * max(1.0, abs(x)) and not (near and x == start):
+        # converged: a Newton step below tol from the far side, or from the near side towards
+        # the far one. Not a near-side step that points back (f rising from 0 just past a start
+        # at contact or a turning point: its tiny f / f' says nothing of the crossing sought
+        # further on), nor one from the bracket's start (f = 0 there may be a start at contact,
+        # theta = 0 right after an impact). A near-side step that rounds to nothing would
+        # otherwise fail the bracket test below and fall to bisection from the far end: some
+        # 30 evaluations instead of 2.
+        forward = not near or (x != start and sign_lo * df < 0.0)
+        if abs(xn - x) <= tol * max(1.0, abs(x)) and forward:
             return min(max(xn, lo), hi)
         if not lo < xn < hi:
             xn = 0.5 * (lo + hi)

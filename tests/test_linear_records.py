@@ -289,3 +289,34 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
             assert out[i, 2] or ref["max_rotation"] == 0.0 or spread < 1e-7 * ref["max_rotation"]
             if finer["impact_times"].size:
                 np.testing.assert_allclose(out[i, 6], finer["impact_times"][0], rtol=0, atol=1e-8)
+
+
+def _exact_segment_functions(sig):
+    """sinh(sigma) - sigma and cosh(sigma) - 1 of the double sigma, by their Taylor series in
+    exact rational arithmetic (terms to sigma^61: below 1e-40 of the sum for |sigma| <= 3)."""
+    from fractions import Fraction
+
+    x = Fraction(sig)
+    smx = cm1 = Fraction(0)
+    term = x  # x^k / k!
+    for k in range(2, 62):
+        term = term * x / k
+        if k % 2:
+            smx += term
+        else:
+            cm1 += term
+    return float(smx), float(cm1)
+
+
+@pytest.mark.parametrize(
+    "sig", [1e-9, 3e-4, 0.01, 0.037, -0.1, 0.2, 0.2499, 0.25, 0.26, -0.4, 0.6, 0.75, 1.3, 2.9]
+)
+def test_segment_functions_to_a_few_ulps(sig):
+    """The functions of sigma that every record segment is advanced by (the closed form of
+    eq. 3.1 of [000]): within a few ulps of the exact series, on both sides of the switch from
+    the series to the library's sinh (where sinh - sigma would cancel)."""
+    sh, cm1, smx = _linear_record._seg_functions.py_func(sig)
+    smx_exact, cm1_exact = _exact_segment_functions(sig)
+    assert smx == pytest.approx(smx_exact, rel=8 * np.finfo(float).eps)
+    assert cm1 == pytest.approx(cm1_exact, rel=8 * np.finfo(float).eps)
+    assert sh == pytest.approx(sig + smx_exact, rel=4 * np.finfo(float).eps)

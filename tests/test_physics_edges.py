@@ -328,3 +328,26 @@ def test_tightest_rtol_is_honoured():
         ker = rs.simulate(block, pulse, rtol=1e-12)
         ref = rs.simulate(block, pulse, method="scipy", rtol=1e-12)
         assert ker.max_rotation == pytest.approx(ref.max_rotation, rel=1e-8, abs=1e-15)
+
+
+@pytest.mark.parametrize("theta_dot0", [1e-4, 3e-4])
+def test_a_tiny_rise_from_contact_returns_when_gravity_says(theta_dot0):
+    """A block leaving contact (theta = 1e-21 rad) at theta_dot0 on a still ground rises and
+    falls back under u'' = -p^2 sin(alpha - u) ~ -p^2 sin(alpha) (eq. 2.2 of [000], u ~ 1e-9
+    rad): first impact at 2 theta_dot0 / (p^2 sin alpha), peak theta_dot0^2 / (2 p^2 sin
+    alpha), to relative order u / alpha. Not an impact at the start (the root finder taking
+    a backward Newton step past contact for convergence)."""
+    from rockstudy.motions import SinePulse
+
+    R, alpha = 1.0, 0.2
+    p2 = 3.0 * G / (4.0 * R)
+    r = rs.simulate(
+        rs.Block(R, alpha, 0.9),
+        SinePulse(1e-9, 1.0),
+        initial_rotation=1e-21,
+        initial_velocity=theta_dot0,
+        t_max=0.01,
+    )
+    accel = p2 * math.sin(alpha)
+    assert r.impact_times[0] == pytest.approx(2.0 * theta_dot0 / accel, rel=1e-6)
+    assert r.max_rotation == pytest.approx(theta_dot0**2 / (2.0 * accel), rel=1e-6)

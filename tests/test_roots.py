@@ -108,3 +108,12 @@ def test_a_zero_at_the_start_of_the_bracket_is_not_the_root():
     further on (x = 1): a zero Newton step there is not convergence."""
     x = newton_bisect.py_func(x_one_minus_x, (), 0.0, 2.0, 0.0, 1.0, 1e-16, 100)
     assert x == pytest.approx(1.0, rel=4e-16)
+
+
+@pytest.mark.parametrize("x0", [1e-300, 1e-18, 1e-17])
+def test_a_step_back_towards_the_start_is_not_convergence(x0):
+    """f = x (1 - x) rises from 0 at the bracket's start: from a first guess a few ulps past
+    it, the near-side Newton step points back (f / f' ~ x0, below tol), which says nothing of
+    the crossing sought at x = 1."""
+    x = newton_bisect.py_func(x_one_minus_x, (), 0.0, 2.0, x0, 1.0, 1e-16, 100)
+    assert x == pytest.approx(1.0, rel=4e-16)

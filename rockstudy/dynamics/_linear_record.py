@@ -52,7 +52,7 @@ from ._rocking import (
 from ._taylor import FMA, NO_REFCOUNT
 
 #: Below this |sigma| the segment functions are Taylor polynomials: the first term left out
-#: is below 1e-18 of the sum (sinh - sigma to sigma^13, cosh - 1 to sigma^12).
+#: is about 1e-18 of the sum at most (sinh - sigma to sigma^13, cosh - 1 to sigma^12).
 SERIES_LIMIT = 0.25
 #: Samples per entry of the table of |u_g''| maxima that a block at rest skips by.
 LOUD_BLOCK = 64
@@ -62,25 +62,46 @@ SAME_LENGTH = 1e-9
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
-def _seg_functions(sig):
-    """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation."""
-    if abs(sig) >= SERIES_LIMIT:
-        half = math.sinh(0.5 * sig)
-        sh = math.sinh(sig)
-        return sh, 2.0 * half * half, sh - sig
+def _seg_series(sig):
+    """sinh(sigma) - sigma and cosh(sigma) - 1 by their Taylor series (|sigma| < SERIES_LIMIT):
+    the tails in pairs (shorter dependency chains than Horner's), the leading terms added last
+    (the factorials' inverses folded at compile time)."""
     x2 = sig * sig
     x4 = x2 * x2
-    # the sums in x2 of sinh - sigma (from sigma^3) and cosh - 1 (from sigma^2), in pairs
-    # (shorter dependency chains than Horner's), the factorials' inverses folded at compile time
-    smx = (1.0 / 6.0 + x2 * (1.0 / 120.0)) + x4 * (
-        (1.0 / 5040.0 + x2 * (1.0 / 362880.0)) + x4 * (1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0))
+    tail_s = (1.0 / 5040.0 + x2 * (1.0 / 362880.0)) + x4 * (
+        1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0)
     )
-    cm1 = (0.5 + x2 * (1.0 / 24.0)) + x4 * (
-        (1.0 / 720.0 + x2 * (1.0 / 40320.0)) + x4 * (1.0 / 3628800.0 + x2 * (1.0 / 479001600.0))
+    tail_c = (1.0 / 720.0 + x2 * (1.0 / 40320.0)) + x4 * (
+        1.0 / 3628800.0 + x2 * (1.0 / 479001600.0)
     )
-    smx *= sig * x2
-    cm1 *= x2
-    return sig + smx, cm1, smx
+    smx = sig * x2 * (1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * tail_s))
+    cm1 = x2 * (0.5 + x2 * (1.0 / 24.0 + x2 * tail_c))
+    return smx, cm1
+
+
+@njit(cache=True, fastmath=FMA, inline="always")
+def _seg_functions(sig):
+    """sinh(sigma), cosh(sigma) - 1 and sinh(sigma) - sigma, each without cancellation: the
+    series below SERIES_LIMIT (:func:`_seg_series`); above it cosh - 1 = 2 sinh^2(sigma / 2),
+    and sinh - sigma from the series at sigma / 3^m by the triple-angle identity
+    sinh 3y - 3y = 3 (sinh y - y) + 4 sinh^3 y (terms of one sign: sinh(sigma) - sigma loses
+    a hundred ulps to cancellation at sigma = 0.25)."""
+    if abs(sig) < SERIES_LIMIT:
+        smx, cm1 = _seg_series(sig)
+        return sig + smx, cm1, smx
+    y = sig
+    m = 0
+    while abs(y) >= SERIES_LIMIT:
+        y /= 3.0
+        m += 1
+    smx = _seg_series(y)[0]
+    sh = y + smx
+    for _ in range(m):
+        cube = 4.0 * sh * sh * sh
+        smx = 3.0 * smx + cube
+        sh = 3.0 * sh + cube
+    half = math.sinh(0.5 * sig)
+    return math.sinh(sig), 2.0 * half * half, smx
 
 
 @njit(cache=True, fastmath=FMA, inline="always")
@@ -162,7 +183,7 @@ def _root_guess(target, lo, hi, u_lo, u_hi, du_lo, du_hi):
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
 def _seg_root(target, th0, v0, g0, f1, s, lo, hi, u_lo, u_hi, du_lo, du_hi):
     """sigma in [lo, hi] where s theta - target changes sign, theta monotone on [lo, hi] with
-    s theta = u_lo, u_hi and slopes du_lo, du_hi (0 where unknown) at the ends (Halley steps
+    s theta = u_lo, u_hi and slopes du_lo, du_hi (0 at a turning point) at the ends (Halley steps
     from :func:`_root_guess`, safeguarded by bisection, to rounding)."""
     sign_lo = 1.0 if u_lo - target >= 0.0 else -1.0
     x0 = _root_guess(target, lo, hi, u_lo, u_hi, du_lo, du_hi)

@@ -81,17 +81,19 @@ TAYLOR_TOL_FRACTION = 1e-4
 MIN_STEP = 1e-9
 #: A DOP853 step whose impact the interpolant placed outside it is retried this much shorter.
 IMPACT_RETRY_SHRINK = 0.25
-#: Step-size control of the DOP853 steps (Hairer, Norsett and Wanner's): the next step is
-#: h STEP_SAFETY err^(-1/8), aimed below the tolerance so that it is rarely rejected ...
+#: Step-size control of the DOP853 steps (Hairer, Norsett and Wanner's; also the complex
+#: formulation's RK45 steps, with err^(-1/5)): the next step is h STEP_SAFETY err^(-1/8),
+#: aimed below the tolerance so that it is rarely rejected ...
 STEP_SAFETY = 0.9
-#: ... and at least STEP_SHRINK_LIMIT h (also after a NaN error), at most STEP_GROW_LIMIT h
-#: (also after a zero error), so that one odd error estimate cannot swing it further.
+#: ... and at least STEP_SHRINK_LIMIT h (in DOP853 also after a NaN error), at most
+#: STEP_GROW_LIMIT h (also after a zero error), so that one odd error estimate cannot swing it
+#: further.
 STEP_SHRINK_LIMIT = 0.2
 STEP_GROW_LIMIT = 5.0
 #: The first step tried in a scene, in units of 1/p (the controller adapts it from there).
 FIRST_STEP = 0.01
-#: Cap on the halvings of the bisections on a mechanism's table: 100 take any bracket of
-#: rotations down to adjacent doubles, where they stop.
+#: Cap on the halvings of the bisections on a mechanism's table, which stop at adjacent
+#: doubles: 100 halve a bracket of rotations below 1e-30 rad.
 TABLE_BISECTIONS = 100
 #: Absolute error scales of theta and theta_dot, as fractions of alpha and p*alpha.
 ATOL_FRACTION = 1e-3
@@ -793,7 +795,7 @@ def _zeno(om, s, omega_rest, a_g, a_v, p, alpha, model, tab):
     the other side, or, below ``omega_rest``, the Zeno rule: at rest unless the ground lifts
     the block (:func:`_lift`), which then restarts from rest on the side it is pushed to.
     Returns (at rest, side, speed)."""
-    if abs(om) >= omega_rest:
+    if not abs(om) < omega_rest:  # (a NaN speed too: carried on, not rested)
         return False, -s, om
     if not _lift(a_g, a_v, p, alpha, model, tab) > 0.0:
         return True, s, 0.0
