@@ -187,7 +187,10 @@ def _local_cluster(workers):
                 host="127.0.0.1",
                 dashboard_address="127.0.0.1:0",  # an HTTP server always starts: no routes
                 scheduler_kwargs={"dashboard": False},
-                silence_logs=logging.ERROR,  # a stopped run prints one line, not its workers'
+                # a stopped run prints one line, not its workers': a worker whose heartbeat
+                # meets the scheduler already closed (a run ending on an error) logs that at
+                # ERROR with a traceback; the run reports what failed itself
+                silence_logs=logging.CRITICAL,
             )
     except Exception as exc:  # noqa: BLE001 - reported in one sentence, with its cause
         raise RuntimeError(
