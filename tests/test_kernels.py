@@ -94,12 +94,47 @@ def test_kernel_variants_compile_under_their_own_names():
     names: numba names a compiled closure, and its cache entry, by that name and a counter of
     the compiling process, so two variants of one name, each compiled first in its own process,
     collided when a third process loaded both (``_rocking._variant_named``)."""
-    pairs = (
+    variants = (
         (_rocking._phase, _rocking._phase_trig),
         (_rocking.scene, _rocking.scene_trig),
-        (_rocking.scene_batch, _rocking.scene_batch_trig),
+        (
+            _rocking.scene_batch,
+            _rocking.scene_batch_trig,
+            _rocking.scene_batch_serial,
+            _rocking.scene_batch_trig_serial,
+        ),
     )
-    assert len({kernel.py_func.__qualname__ for pair in pairs for kernel in pair}) == 6
+    assert len({kernel.py_func.__qualname__ for group in variants for kernel in group}) == 8
+
+
+def test_a_batch_on_one_thread_equals_the_parallel_batch():
+    """A study's workers run the batch on one thread (the serial kernels); the outputs do not
+    depend on the number of threads, for pulses and records alike."""
+    import numba
+
+    from rockstudy.motions import stochastic_record
+
+    rng = np.random.default_rng(5)
+    alpha = rng.uniform(0.1, 0.3, 40)
+    common = dict(half_diagonal=rng.uniform(0.3, 3.0, 40), slenderness=alpha)
+    record = stochastic_record(peak=1.0, duration=3.0, dt=0.01, seed=2)
+    runs = []
+    for threads in (numba.config.NUMBA_NUM_THREADS, 1):
+        numba.set_num_threads(threads)
+        try:
+            runs.append(
+                (
+                    simulate_batch(
+                        pulse="sine", amplitude=3 * G * np.tan(alpha), period=0.5, **common
+                    ),
+                    simulate_batch(record=record, scale=3 * G * np.tan(alpha), **common),
+                )
+            )
+        finally:
+            numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    for parallel, serial in zip(*runs, strict=True):
+        for key in ("max_rotation", "overturned", "n_impacts", "first_impact_time"):
+            np.testing.assert_array_equal(parallel[key], serial[key])
 
 
 def test_tallies_start_empty_with_integer_counts():

@@ -37,6 +37,7 @@ from ._dop853 import dop853_error, hermite5, make_dop853_step
 from ._taylor import (
     FMA,
     NO_REFCOUNT,
+    OF_VALUE,
     poly_end,
     poly_root,
     poly_value,
@@ -60,6 +61,9 @@ PH_REST = 1
 PH_OVER = 2
 PH_FAIL = 3
 PH_IMPACT = 4
+# numpy scalars, not Python ints: numba types a literal argument as Literal[int] and compiles a
+# specialization of the callee for each value (a phase, an uplift test compiled twice)
+NO_STOP = np.int64(-1)  # a phase's stop_at_impacts: never
 
 STATUS_OK = 0
 STATUS_MAX_STEPS = 1
@@ -279,6 +283,7 @@ def _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, t, k):
 #: pulse, relative to |t| + 1/omega: a few ulps of the phase, so that the bisection to the
 #: ulp takes ~8 halvings instead of ~50; widened 64-fold while it does not bracket.
 TRIG_BRACKET = 1e-14
+TRIG, FIRST = np.int64(KIND_TRIG), np.int64(0)  # the motion kind and segment index, not literals
 
 
 @njit(cache=True)
@@ -306,12 +311,12 @@ def _trig_uplift_bracket(mp, times, samples, vsamples, p, alpha, model, lo, hi):
         a, b = max(lo, tc - d), min(hi, tc + d)
         lift_a = (
             a > lo
-            and _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, a, 0)
+            and _lift_at(TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, a, FIRST)
             > 0.0
         )
         lift_b = (
             b == hi
-            or _lift_at(KIND_TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, b, 0)
+            or _lift_at(TRIG, mp, times, samples, vsamples, p, alpha, model, NO_TABLE, b, FIRST)
             > 0.0
         )
         if not lift_a and lift_b:
@@ -336,7 +341,7 @@ def next_uplift(kind, mp, times, samples, vsamples, p, alpha, model, tab, t0):
     if t0 > dur:
         return np.inf
     rec = kind == KIND_RECORD
-    k = segment_index(times, t0, 0) if rec else 0
+    k = segment_index(times, t0, FIRST) if rec else 0
     lo = t0
     if _lift_at(kind, mp, times, samples, vsamples, p, alpha, model, tab, lo, k) > 0.0:
         return lo
@@ -719,7 +724,7 @@ def _taylor_events(c, n, s, t, hs, t1, h, fall):
             u_pk = s * poly_value(c, n, s_pk)[0]
         t_pk = t + s_pk * hs
         if s * th1 >= fall:
-            s_ot = poly_root(c, n, s * fall, -s, False, 0.0, 1.0)
+            s_ot = poly_root(c, n, s * fall, -s, OF_VALUE, 0.0, 1.0)
             om_ot = poly_value(c, n, s_ot)[1] / hs
             return EV_OVER, h, hs, t1, th1, om1, f1, t + s_ot * hs, om_ot, u_pk, t_pk, 0, n
         return EV_NONE, h, hs, t1, th1, om1, f1, t1, om1, u_pk, t_pk, 0, n
@@ -748,18 +753,19 @@ def _work_arrays():
     return np.empty(13), np.empty(13), work_arrays()
 
 
-def _variant_named(general):
+def _variant_named(general, serial=False):
     """Decorator (under ``@njit``) that names a factory's trig-only variant apart:
-    ``<name>_trig``. numba names a compiled function, and so its cache entry, by its qualified
-    name and a counter of the process that compiled it; two variants of one name that were each
-    the first function compiled in their process (a CLI run, a test's child process) got one
-    name, and a process that loaded both from the cache ran the second with the first's
-    environment (scene_batch after scene_batch_trig: RuntimeError "'descr' is NULL")."""
+    ``<name>_trig``, and a serial one ``<name>_serial``. numba names a compiled function, and
+    so its cache entry, by its qualified name and a counter of the process that compiled it;
+    two variants of one name that were each the first function compiled in their process (a
+    CLI run, a test's child process) got one name, and a process that loaded both from the
+    cache ran the second with the first's environment (scene_batch after scene_batch_trig:
+    RuntimeError "'descr' is NULL")."""
 
     def name(fn):
-        if not general:
-            fn.__name__ += "_trig"
-            fn.__qualname__ += "_trig"
+        suffix = ("" if general else "_trig") + ("_serial" if serial else "")
+        fn.__name__ += suffix
+        fn.__qualname__ += suffix
         return fn
 
     return name
@@ -812,7 +818,7 @@ def _make_phase(general):
 
     @njit(cache=True, **NO_REFCOUNT)
     @_variant_named(general)
-    def phase(stepping, mot, log, state, ta, wk, t_stop, stop_at_impacts=-1):
+    def phase(stepping, mot, log, state, ta, wk, t_stop, stop_at_impacts):
         """Integrate rocking from ``state`` (a :class:`PhaseState`) until rest, overturning or
         t_stop.
 
@@ -822,7 +828,7 @@ def _make_phase(general):
         The tallies ``ta`` (a :data:`TALLIES` record) are updated in place. Returns (code,
         the :class:`PhaseState` at the end): PH_END, PH_REST, PH_OVER or PH_FAIL; or PH_IMPACT
         once the impact count reaches ``stop_at_impacts`` (the state is then just after that
-        impact). The block models step by Taylor series inside a record
+        impact; :data:`NO_STOP` for never). The block models step by Taylor series inside a record
         (:func:`_taylor_attempt`), under a trigonometric pulse and in the free rocking after any
         motion (:func:`_taylor_trig_attempt`); a Ricker wavelet and a mechanism's table by DOP853.
         """
@@ -834,7 +840,7 @@ def _make_phase(general):
         t, th, om, s, h = state
         dur = mp[3]
         kx, kv, w = wk
-        k = segment_index(times, t, 0) if kind == KIND_RECORD else 0
+        k = segment_index(times, t, FIRST) if kind == KIND_RECORD else 0
         f0 = _accel(
             _ground_after(kind, mp, times, samples, t, k),
             _vertical_after(kind, mp, times, vsamples, t, k),
@@ -1173,25 +1179,29 @@ def _make_scene(general):
                 )
                 if t_up >= dur:
                     break
-                k = segment_index(times, t_up, 0) if kind == KIND_RECORD else 0
+                k = segment_index(times, t_up, FIRST) if kind == KIND_RECORD else 0
                 a_g = ground_acceleration(kind, mp, times, samples, t_up, k)
                 state = PhaseState(t_up, 0.0, 0.0, -1.0 if a_g > 0.0 else 1.0, state.h)
                 at_rest = False
                 if rec:
                     _push(hist, ta, t_up, 0.0, 0.0)
             if general:
-                code, state = _phase(stepping, mot, log, state, ta, wk, dur)
+                code, state = _phase(stepping, mot, log, state, ta, wk, dur, NO_STOP)
             else:
-                code, state = _phase_trig(stepping, mot, log, state, ta, wk, dur)
+                code, state = _phase_trig(stepping, mot, log, state, ta, wk, dur, NO_STOP)
             if code != PH_END and code != PH_REST:
                 break
             at_rest = code == PH_REST
         if controls.free_map and code == PH_END and not at_rest and ta.n_impacts == 0:
             # integrate on to time the first impact
             if general:
-                code, state = _phase(stepping, mot, log, state, ta, wk, controls.tail_end, 1)
+                code, state = _phase(
+                    stepping, mot, log, state, ta, wk, controls.tail_end, np.int64(1)
+                )
             else:
-                code, state = _phase_trig(stepping, mot, log, state, ta, wk, controls.tail_end, 1)
+                code, state = _phase_trig(
+                    stepping, mot, log, state, ta, wk, controls.tail_end, np.int64(1)
+                )
             at_rest = code == PH_REST
         if at_rest:
             if rec:
@@ -1211,9 +1221,13 @@ def _make_scene(general):
             else:  # integrate the free rocking: for the history, to time the overturning, or to
                 # count the impacts of a block that never rests (eta = 1) up to the tail's end
                 if general:
-                    code, state = _phase(stepping, mot, log, state, ta, wk, controls.tail_end)
+                    code, state = _phase(
+                        stepping, mot, log, state, ta, wk, controls.tail_end, NO_STOP
+                    )
                 else:
-                    code, state = _phase_trig(stepping, mot, log, state, ta, wk, controls.tail_end)
+                    code, state = _phase_trig(
+                        stepping, mot, log, state, ta, wk, controls.tail_end, NO_STOP
+                    )
         return _outcome(code, state, tallies)
 
     return scene
@@ -1235,12 +1249,15 @@ BATCH_COLUMNS = (
 )
 
 
-def _make_scene_batch(general):
+def _make_scene_batch(general, parallel=True):
     """:func:`scene_batch` (every motion and model) or :func:`scene_batch_trig` (the block
-    models under trigonometric pulses without a vertical component, :func:`scene_trig`)."""
+    models under trigonometric pulses without a vertical component, :func:`scene_trig`); with
+    ``parallel=False`` their one-thread variants (``*_serial``), which a study's workers run
+    (one thread each): the parallel loop's lowering costs a fifth of a cold sine study's
+    compile (about 6 s of 30 s CPU)."""
 
-    @njit(cache=True, parallel=True)
-    @_variant_named(general)
+    @njit(cache=True, parallel=parallel)
+    @_variant_named(general, serial=not parallel)
     def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
         """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
         (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
@@ -1267,3 +1284,5 @@ def _make_scene_batch(general):
 
 scene_batch = _make_scene_batch(True)
 scene_batch_trig = _make_scene_batch(False)
+scene_batch_serial = _make_scene_batch(True, parallel=False)
+scene_batch_trig_serial = _make_scene_batch(False, parallel=False)

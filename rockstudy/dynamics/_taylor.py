@@ -287,6 +287,10 @@ def _poly_fdf(x, args):
     return (d - target, dd) if deriv else (v - target, d)
 
 
+# deriv flags as numpy booleans: a Python literal would compile a specialization per value
+OF_VALUE, OF_SLOPE = np.bool_(False), np.bool_(True)
+
+
 @njit(cache=True)
 def poly_root(c, n, target, sgn, deriv, lo, hi):
     """Root in [lo, hi] of the polynomial's value (deriv=False) or derivative, minus target.
@@ -335,19 +339,19 @@ def step_impact(c, n, s, u1, du1):
     (up, down through zero, up again) at the quarter points.
     """
     if u1 < 0.0:
-        return poly_root_near(c, n, 0.0, s, False, 0.0, 1.0, _secant(s * c[0], u1, 0.0, 1.0))
+        return poly_root_near(c, n, 0.0, s, OF_VALUE, 0.0, 1.0, _secant(s * c[0], u1, 0.0, 1.0))
     if s * c[1] < 0.0:
         if du1 > 0.0:
             x0 = _secant(s * c[1], du1, 0.0, 1.0)
-            x_min = poly_root_near(c, n, 0.0, -s, True, 0.0, 1.0, x0)
+            x_min = poly_root_near(c, n, 0.0, -s, OF_SLOPE, 0.0, 1.0, x0)
             if s * poly_value(c, n, x_min)[0] < 0.0:
-                return poly_root(c, n, 0.0, s, False, 0.0, x_min)
+                return poly_root(c, n, 0.0, s, OF_VALUE, 0.0, x_min)
         return 2.0
     if _rises_throughout(c, n, s):
         return 2.0
     for j in range(1, 4):
         if s * poly_value(c, n, 0.25 * j)[0] < 0.0:
-            return poly_root(c, n, 0.0, s, False, 0.25 * (j - 1), 0.25 * j)
+            return poly_root(c, n, 0.0, s, OF_VALUE, 0.25 * (j - 1), 0.25 * j)
     return 2.0
 
 
@@ -357,5 +361,5 @@ def step_peak(c, n, s, x_end, du_end):
     u' turns from >= 0 to <= 0; du_end = u'(x_end)."""
     if s * c[1] >= 0.0 and du_end <= 0.0:
         x0 = _secant(s * c[1], du_end, 0.0, x_end) if s * c[1] > du_end else 0.5 * x_end
-        return poly_root_near(c, n, 0.0, s, True, 0.0, x_end, x0)
+        return poly_root_near(c, n, 0.0, s, OF_SLOPE, 0.0, x_end, x0)
     return -1.0

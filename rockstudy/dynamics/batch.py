@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Literal
 
+import numba
 import numpy as np
 
 from .. import _validate
@@ -26,6 +27,14 @@ _CODES = {
 }
 
 OUTPUTS = _rocking.BATCH_COLUMNS + ("model",)
+# (trig-only, one thread) -> batch kernel: on one thread (a study's workers) the serial
+# variants, which compile without the parallel loop's cost
+_BATCH_KERNELS = {
+    (False, False): _rocking.scene_batch,
+    (True, False): _rocking.scene_batch_trig,
+    (False, True): _rocking.scene_batch_serial,
+    (True, True): _rocking.scene_batch_trig_serial,
+}
 
 
 def _column(name, values, n, low=None, high=None, low_open=True, high_open=True):
@@ -296,7 +305,7 @@ def _run(rows, idx, model, rtol, max_steps):
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_RECORD and not vsamples.size:
         return _linear_record.record_batch(*args, mp[idx, 0], times, samples)
     trig = kind == mk.KIND_TRIG and model != _rocking.MODEL_TABLE and not vsamples.size
-    kernel = _rocking.scene_batch_trig if trig else _rocking.scene_batch  # compiles in half
+    kernel = _BATCH_KERNELS[trig, numba.get_num_threads() == 1]  # trig: compiles in half
     return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps)
 
 

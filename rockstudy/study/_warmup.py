@@ -128,7 +128,21 @@ def _simulate_calls():
 
 
 def _batch_calls(methods=("nonlinear", "linear", "auto")):
-    """:func:`rockstudy.simulate_batch` on pulses and on a record, for each of ``methods``."""
+    """:func:`rockstudy.simulate_batch` on pulses and on a record, for each of ``methods``,
+    in parallel and on one thread (a study's workers run the serial kernels)."""
+    import numba
+
+    threads = numba.get_num_threads()
+    try:
+        for n in sorted({threads, 1}):
+            numba.set_num_threads(n)
+            _batch_calls_of(methods)
+    finally:
+        numba.set_num_threads(threads)
+
+
+def _batch_calls_of(methods):
+    """:func:`_batch_calls` on the current number of threads."""
     from ..dynamics import simulate_batch
     from ..motions import stochastic_record
 
