@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate
-from ..constants import G
+from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity
 from .base import Motion
 from .pulse_extraction import VelocityPulse, extract_pulse
@@ -19,7 +19,8 @@ from .pulse_extraction import VelocityPulse, extract_pulse
 #: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
 MAX_RECORD_BYTES = 64 * 2**20
 
-_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+#: Factor to m/s^2 of each acceleration unit; "g" is standard gravity (the PEER convention).
+_UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
 
 #: Column names :meth:`Record.from_csv` reads.
 COLUMNS = ("time", "horizontal", "vertical")
@@ -300,6 +301,10 @@ class Record(Motion):
     def from_at2(cls, path, vertical=None) -> Record:
         """Read a PEER NGA ``.AT2`` file (acceleration in g), returned in m/s^2.
 
+        g is standard gravity, 9.80665 m/s^2 (:data:`rockstudy.constants.STANDARD_GRAVITY`),
+        the unit of PEER's processing: with it the record's own velocity and displacement are
+        PEER's.
+
         Both header styles are read: ``NPTS= 2048, DT= .0066 SEC`` (with or without filter
         information after it) and the older ``2048 0.0066 NPTS, DT``. ``vertical`` is the path
         of the vertical component's ``.AT2`` file, on the same samples.
@@ -325,7 +330,7 @@ class Record(Motion):
             values = np.array(tokens, dtype=float)
         except ValueError:
             raise ValueError(f"{path}: the values after line 4 are not all numbers") from None
-        record = _build(path, lambda: cls(values * G, dt=dt, name=path.stem))
+        record = _build(path, lambda: cls(values * STANDARD_GRAVITY, dt=dt, name=path.stem))
         return (
             record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
         )
