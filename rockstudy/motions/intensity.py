@@ -14,14 +14,15 @@ Conventions (those of eqsig and of the usual processing; see docs/records.rst):
 - The response spectrum is that of the linearly interpolated record
   (:mod:`rockstudy.motions._spectrum`).
 
-Baseline correction (:func:`baseline_coefficients`): the ground starts at rest
-(v = d = 0 at t = 0), and a least-squares polynomial c2 t^2 + c3 t^3 fitted to the
-displacement is removed (a linear baseline of the acceleration, 2 c2 + 6 c3 t, fitted to the
-displacement: the classic polynomial baseline of strong-motion processing, e.g. Boore 2005,
-with the lowest degrees that keep the record starting at rest). Nothing is filtered. A
-processed (PEER) record hardly changes (PGV and PGD by < 0.5 %); an unprocessed one keeps
-what a baseline cannot remove: El Centro 1940 (elcentro_NS.dat) gets PGD 0.33 m, against
-1.81 m with a constant offset alone and 2.5 m without any correction.
+Baseline correction. The ground starts at rest (v = d = 0 at t = 0). Velocity: a constant
+acceleration offset c = v(t_end) / t_end is removed (:func:`baseline_offset`), so the ground
+is at rest again at the end; nothing else is filtered. Displacement: the double integral of
+that record less the least-squares polynomial c2 t^2 + c3 t^3 (:func:`displacement_baseline`:
+the polynomial baseline of strong-motion processing, of the lowest degrees that keep
+d(0) = d'(0) = 0). A processed (PEER) record's PGD hardly changes (< 0.5 %); an unprocessed
+one keeps what a baseline cannot remove: El Centro 1940 (elcentro_NS.dat) gets PGD 0.33 m,
+against 1.81 m with the constant offset alone. A permanent displacement (fling) is not
+kept in PGD.
 """
 
 from __future__ import annotations
@@ -80,61 +81,56 @@ def uniform_samples(t, values):
     return grid, np.interp(grid, t, values), dt
 
 
-def _raw_integrals(t, acc):
-    """(v, d) [m/s, m]: exact integrals of the linearly interpolated record from rest.
-
-    .. math:: v_{i+1} = v_i + h_i (a_i + a_{i+1}) / 2, \\quad
-              d_{i+1} = d_i + h_i v_i + h_i^2 (2 a_i + a_{i+1}) / 6
-    """
-    h = np.diff(t)
-    v = np.concatenate(([0.0], np.cumsum(0.5 * h * (acc[1:] + acc[:-1]))))
-    inc = h * v[:-1] + h * h * (2.0 * acc[:-1] + acc[1:]) / 6.0
-    return v, np.concatenate(([0.0], np.cumsum(inc)))
-
-
-def baseline_coefficients(t, acc) -> tuple:
-    """(c2 [m/s^2], c3 [m/s^3]): the least-squares fit c2 t^2 + c3 t^3 of the displacement.
-
-    Removing it from the displacement removes 2 c2 t + 3 c3 t^2 from the velocity and the
-    linear baseline 2 c2 + 6 c3 t from the acceleration; the record still starts at rest.
-    Time is scaled by the duration in the fit (a well-conditioned 2 x 2 system).
-    """
-    span = float(t[-1] - t[0])
-    if span <= 0.0:
-        return 0.0, 0.0
-    x = (t - t[0]) / span
-    _, d = _raw_integrals(t, acc)
-    basis = np.stack((x * x, x * x * x), axis=1)
-    coef, *_ = np.linalg.lstsq(basis, d, rcond=None)
-    return float(coef[0]) / span**2, float(coef[1]) / span**3
+def baseline_offset(t, acc) -> float:
+    """c [m/s^2]: the constant acceleration whose removal brings v(t_end) back to zero."""
+    v_end = float(np.sum(0.5 * np.diff(t) * (acc[1:] + acc[:-1])))
+    return v_end / float(t[-1] - t[0])
 
 
 def ground_velocity(t, acc):
-    """Ground velocity [m/s] at the samples: the exact integral of the record after the
-    baseline correction of :func:`baseline_coefficients`.
+    """Ground velocity [m/s] at the samples: the exact (trapezoidal) integral of the record
+    less the constant c of :func:`baseline_offset`, so that it ends at rest.
 
-    .. math:: v_c(t) = v(t) - 2 c_2 t - 3 c_3 t^2
+    .. math:: v_{i+1} = v_i + h_i (a_i + a_{i+1}) / 2, \\quad a \\to a - c
     """
-    c2, c3 = baseline_coefficients(t, acc)
-    x = t - t[0]
-    return _raw_integrals(t, acc)[0] - 2.0 * c2 * x - 3.0 * c3 * x * x
+    a = acc - baseline_offset(t, acc)
+    return np.concatenate(([0.0], np.cumsum(0.5 * np.diff(t) * (a[1:] + a[:-1]))))
+
+
+def _integrated_displacement(t, acc):
+    """Exact double integral [m] of the offset-corrected record at the samples.
+
+    .. math:: d_{i+1} = d_i + h_i v_i + h_i^2 (2 a_i + a_{i+1}) / 6
+    """
+    a = acc - baseline_offset(t, acc)
+    h = np.diff(t)
+    v = ground_velocity(t, acc)
+    inc = h * v[:-1] + h * h * (2.0 * a[:-1] + a[1:]) / 6.0
+    return np.concatenate(([0.0], np.cumsum(inc)))
+
+
+def displacement_baseline(t, acc) -> tuple:
+    """(c2 [m/s^2], c3 [m/s^3]): the least-squares fit c2 t^2 + c3 t^3 of the displacement
+    of :func:`_integrated_displacement` (a polynomial baseline that keeps d(0) = d'(0) = 0).
+
+    Time is scaled by the duration in the fit (a well-conditioned 2-column system).
+    """
+    span = float(t[-1] - t[0])
+    x = (t - t[0]) / span
+    basis = np.stack((x * x, x * x * x), axis=1)
+    coef, *_ = np.linalg.lstsq(basis, _integrated_displacement(t, acc), rcond=None)
+    return float(coef[0]) / span**2, float(coef[1]) / span**3
 
 
 def ground_displacement(t, acc):
-    """Ground displacement [m] at the samples: the exact double integral of the record after
-    the baseline correction of :func:`baseline_coefficients`.
+    """Ground displacement [m] at the samples: the double integral of the offset-corrected
+    record less its polynomial baseline (:func:`displacement_baseline`).
 
     .. math:: d_c(t) = d(t) - c_2 t^2 - c_3 t^3
     """
-    c2, c3 = baseline_coefficients(t, acc)
+    c2, c3 = displacement_baseline(t, acc)
     x = t - t[0]
-    return _raw_integrals(t, acc)[1] - c2 * x * x - c3 * x * x * x
-
-
-def baseline_acceleration(t, acc):
-    """The acceleration [m/s^2] that :func:`ground_velocity` integrates: acc - 2 c2 - 6 c3 t."""
-    c2, c3 = baseline_coefficients(t, acc)
-    return acc - 2.0 * c2 - 6.0 * c3 * (t - t[0])
+    return _integrated_displacement(t, acc) - c2 * x * x - c3 * x * x * x
 
 
 def _peak(acc) -> float:
@@ -403,3 +399,28 @@ def spectrum_intensity(t, acc, damping: float = 0.05) -> float:
     periods = np.linspace(lo, hi, int(round((hi - lo) / SPECTRUM_INTENSITY_STEP)) + 1)
     psv = 2.0 * math.pi / periods * spectral_displacement(t, acc, periods, damping)
     return float(simpson(psv, x=periods))
+
+
+#: Span around the guess [x guess] and grid of :func:`pseudo_velocity_peak_period`.
+PSV_PEAK_SPAN = (0.25, 4.0)
+PSV_PEAK_POINTS = 121
+
+
+def pseudo_velocity_peak_period(t, acc, guess: float, damping: float = 0.05) -> float:
+    """The period [s] of the peak of PSV(T) = omega SD(T) within [0.25, 4] x ``guess`` [s]:
+    the best of a geometric grid of 121 periods, refined by a bounded scalar search between
+    its neighbours (to 1e-4 relative)."""
+    from scipy.optimize import minimize_scalar
+
+    periods = np.geomspace(PSV_PEAK_SPAN[0] * guess, PSV_PEAK_SPAN[1] * guess, PSV_PEAK_POINTS)
+    psv = 2.0 * math.pi / periods * spectral_displacement(t, acc, periods, damping)
+    i = int(np.argmax(psv))
+    lo, hi = periods[max(i - 1, 0)], periods[min(i + 1, periods.size - 1)]
+
+    def minus_psv(period):
+        return -2.0 * math.pi / period * spectral_displacement(t, acc, [period], damping)[0]
+
+    res = minimize_scalar(
+        minus_psv, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4 * lo}
+    )
+    return float(res.x) if -res.fun >= psv[i] else float(periods[i])

@@ -14,13 +14,17 @@ from .. import _validate
 from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity
 from .base import Motion
-from .pulse_extraction import VelocityPulse, extract_pulse
+from .pulse_extraction import extract_pulse
+from .wavelet_pulse import extract_wavelet_pulse
 
 #: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
 MAX_RECORD_BYTES = 64 * 2**20
 
 #: Factor to m/s^2 of each acceleration unit; "g" is standard gravity (the PEER convention).
 _UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+
+#: Methods of :meth:`Record.pulse`.
+PULSE_METHODS = {"wavelet": extract_wavelet_pulse, "mavroeidis": extract_pulse}
 
 #: Column names :meth:`Record.from_csv` reads.
 COLUMNS = ("time", "horizontal", "vertical")
@@ -264,12 +268,25 @@ class Record(Motion):
         sd = self._spectral_displacement(periods, damping)
         return intensity.response_spectrum_dataset(periods, sd, intensity.check_damping(damping))
 
-    def pulse(self) -> VelocityPulse:
-        """The dominant velocity pulse (Mavroeidis-Papageorgiou fit, Baker's indicator).
+    def pulse(self, method: str = "wavelet"):
+        """The velocity pulse of the record, with ``period`` [s] and ``indicator``.
 
-        See :mod:`rockstudy.motions.pulse_extraction`.
+        Parameters
+        ----------
+        method : {"wavelet", "mavroeidis"}
+            ``"wavelet"``: Baker (2007) and Shahi & Baker (2014), db4 wavelets, T_p the peak
+            of the extracted pulse's pseudo-velocity spectrum
+            (:class:`rockstudy.motions.wavelet_pulse.WaveletPulse`). ``"mavroeidis"``: a
+            least-squares Mavroeidis-Papageorgiou (2003) pulse
+            (:class:`rockstudy.motions.pulse_extraction.VelocityPulse`).
         """
-        return self._cached("pulse", lambda: extract_pulse(self._times, self.acceleration))
+        try:
+            extract = PULSE_METHODS[method]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"method must be one of {sorted(PULSE_METHODS)}, got {method!r}"
+            ) from None
+        return self._cached(("pulse", method), lambda: extract(self._times, self.acceleration))
 
     def _with_vertical(self, vertical: Record, path) -> Record:
         """This record with the vertical component ``vertical`` read from ``path``."""
