@@ -35,7 +35,7 @@ discrete correlation with db4 sampled at each scale.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import signal
@@ -58,7 +58,7 @@ LEVEL = 10
 DAMPING = 0.05
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class WaveletPulse:
     """The velocity pulse of a record by the wavelet method (Baker 2007; Shahi & Baker 2014).
 
@@ -87,8 +87,8 @@ class WaveletPulse:
     end: float
     pgv_ratio: float
     energy_ratio: float
-    _times: np.ndarray
-    _velocity: np.ndarray
+    _times: np.ndarray = field(repr=False)
+    _velocity: np.ndarray = field(repr=False)
 
     @property
     def pulse_like(self) -> bool:
