@@ -423,3 +423,23 @@ def test_shared_records_plausible(records_dir):
         assert 0.1 < im["mean_period"] < 2.0
     elcentro = recs[-1]
     assert elcentro.peak / STANDARD_GRAVITY == pytest.approx(0.349, abs=0.001)  # README: 0.349 g
+
+
+def test_a_study_cube_states_both_gravities(tmp_path):
+    """The cube says which g the physics used and which g a record in g was read with."""
+    import xarray as xr
+    from test_study import study_text
+
+    from rockstudy.study import make_design, validate_text
+    from rockstudy.study.store import claim, create_store
+
+    study = validate_text(study_text(chunk=10, n=20))
+    out = tmp_path / "cube.zarr"
+    lock, _ = claim(out, study, {}, resume=False)
+    try:
+        create_store(out, make_design(study), study)
+    finally:
+        lock.release()
+    attrs = xr.open_zarr(out).attrs
+    assert attrs["gravity"] == G == 9.81
+    assert attrs["record_g_unit"] == STANDARD_GRAVITY == 9.80665
