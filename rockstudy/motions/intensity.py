@@ -407,12 +407,14 @@ PSV_PEAK_POINTS = 121
 
 
 def pseudo_velocity_peak_period(t, acc, guess: float, damping: float = 0.05) -> float:
-    """The period [s] of the peak of PSV(T) = omega SD(T) within [0.25, 4] x ``guess`` [s]:
-    the best of a geometric grid of 121 periods, refined by a bounded scalar search between
-    its neighbours (to 1e-4 relative)."""
+    """The period [s] of the peak of PSV(T) = omega SD(T) within [0.25, 4] x ``guess`` [s]
+    (and below the longest period the spectrum computes): the best of a geometric grid of 121
+    periods, refined by a bounded scalar search between its neighbours (to 1e-4 relative)."""
     from scipy.optimize import minimize_scalar
 
-    periods = np.geomspace(PSV_PEAK_SPAN[0] * guess, PSV_PEAK_SPAN[1] * guess, PSV_PEAK_POINTS)
+    longest = 0.99 * 2.0 * math.pi * float(np.min(np.diff(t))) / MIN_PHASE_STEP
+    hi = min(PSV_PEAK_SPAN[1] * guess, longest)
+    periods = np.geomspace(min(PSV_PEAK_SPAN[0] * guess, hi), hi, PSV_PEAK_POINTS)
     psv = 2.0 * math.pi / periods * spectral_displacement(t, acc, periods, damping)
     i = int(np.argmax(psv))
     lo, hi = periods[max(i - 1, 0)], periods[min(i + 1, periods.size - 1)]
