@@ -229,10 +229,17 @@ class Record(Motion):
             ``pga`` [m/s^2], ``pgv`` [m/s], ``pgd`` [m], ``arias`` [m/s], ``cav`` [m/s],
             ``significant_duration`` [s] (5-95 %), ``mean_period`` [s] (Rathje et al. 2004),
             ``spectrum_intensity`` [m] (Housner 1952) and ``sa`` [m/s^2], an array over
-            ``periods``. See :mod:`rockstudy.motions.intensity` for definitions and the
-            baseline correction of velocity and displacement. PGD is only as good as the
-            record's processing: an unfiltered record drifts (elcentro_NS.dat of the shared
-            records gives 1.8 m, all of it the final offset).
+            ``periods``. Arias, CAV and the Husid curve are trapezoids over the samples (as
+            eqsig); see :mod:`rockstudy.motions.intensity` for definitions and the baseline
+            corrections (a constant offset for the velocity, a least-squares c2 t^2 + c3 t^3
+            for the displacement). PGD is still only as good as the record's processing:
+            elcentro_NS.dat of the shared records, unfiltered, gives 0.33 m.
+
+        Raises
+        ------
+        ValueError
+            Naming ``periods`` outside [1e-12 s, 2 pi dt / 1e-5], ``dt`` too coarse for the
+            mean period's band, or an ``acceleration`` whose Arias intensity overflows.
         """
         periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
         damping = intensity.check_damping(damping)
