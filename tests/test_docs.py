@@ -29,8 +29,18 @@ def site(tmp_path_factory):
         return html
     html = tmp_path_factory.mktemp("docs") / "html"
     subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
-         str(ROOT / "docs"), str(html)],
+        [
+            sys.executable,
+            "-m",
+            "sphinx",
+            "-W",
+            "--keep-going",
+            "-q",
+            "-b",
+            "html",
+            str(ROOT / "docs"),
+            str(html),
+        ],
         check=True,
         timeout=1200,
     )
@@ -67,11 +77,25 @@ def render_all(html, pages, workdir):
     harness = html / "_render_check.html"
     harness.write_text(HARNESS % json.dumps([p.relative_to(html).as_posix() for p in pages]))
     out = subprocess.run(
-        [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--allow-file-access-from-files", f"--user-data-dir={workdir / 'chromium-profile'}",
-         "--virtual-time-budget=60000", "--dump-dom", harness.as_uri()],
-        capture_output=True, text=True, timeout=300,
+        [
+            exe,
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--allow-file-access-from-files",
+            f"--user-data-dir={workdir / 'chromium-profile'}",
+            "--virtual-time-budget=60000",
+            "--dump-dom",
+            harness.as_uri(),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     harness.unlink()
     m = re.search(r"RESULTS\n(.*)\nEND", out.stdout, re.S)
@@ -81,8 +105,12 @@ def render_all(html, pages, workdir):
 
 def test_every_page_renders_and_every_gallery_image_loads(site, tmp_path):
     skip = {"_static", "_modules", "_sources", "_images"}
-    pages = sorted(p for p in site.rglob("*.html") if not skip & set(p.relative_to(site).parts)
-                   and p.name not in ("search.html", "genindex.html"))
+    pages = sorted(
+        p
+        for p in site.rglob("*.html")
+        if not skip & set(p.relative_to(site).parts)
+        and p.name not in ("search.html", "genindex.html")
+    )
     rows = render_all(site, pages, tmp_path)
     assert len(rows) == len(pages)
     for row in rows:

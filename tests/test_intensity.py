@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize, signal
 
-from rockstudy.constants import G
-from rockstudy.motions import Record, SinePulse
+from rockstudy.constants import STANDARD_GRAVITY, G
+from rockstudy.motions import Record, SinePulse, intensity
 from rockstudy.motions.intensity import UNITS
 
 KEYS = {
@@ -116,26 +116,63 @@ def test_spectrum_dataset_and_pseudo_relations():
 
 
 def test_short_period_sa_tends_to_pga():
-    """A rigid oscillator follows the ground: Sa(T -> 0) -> PGA (up to its lag 2 zeta a'/omega)."""
+    """A rigid oscillator follows the ground: Sa(T -> 0) -> PGA (up to its lag 2 zeta a'/omega)
+    for a record that starts at zero."""
     rec = _random_record(dt=0.02)
-    sa = rec.intensity_measures(periods=[1e-4])["sa"][0]
-    assert sa == pytest.approx(rec.peak, rel=1e-3)
+    rec = Record(np.concatenate(([0.0], rec.acceleration)), dt=0.02)
+    for period in (1e-4, 1e-9):
+        sa = rec.intensity_measures(periods=[period])["sa"][0]
+        assert sa == pytest.approx(rec.peak, rel=1e-3)
 
 
-def test_sine_record_velocity_displacement_cav_closed_forms():
-    """Whole cycles of A sin(W t): v = A/W (1 - cos W t), d = A/W (t - sin(W t)/W), so
-    PGV = 2 A / W, PGD = A t_end / W, CAV = 4 A / W per cycle, Arias = pi A^2 t_end / (4 g)."""
+def test_short_period_sa_of_a_record_that_starts_with_a_step():
+    """The record is zero before t = 0: its first value is a step, which a stiff oscillator
+    overshoots by exp(-zeta pi / sqrt(1 - zeta^2)) (closed form of the step response)."""
+    zeta = 0.05
+    acc = np.array([2.0, 0.5, -1.0, 0.3, 0.0])
+    rec = Record(acc, dt=0.02)
+    expected = 2.0 * (1 + math.exp(-zeta * math.pi / math.sqrt(1 - zeta * zeta)))
+    for period in (2e-4, 1e-7, 1e-12):  # sub-stepped, then the rigid limit
+        sa = rec.intensity_measures(periods=[period], damping=zeta)["sa"][0]
+        assert sa == pytest.approx(expected, rel=2e-3)
+
+
+def test_spectrum_sub_steps_short_periods_against_dense_lsim():
+    """Issue 23: a 40-sample noise record at dt 0.02 s lost 23 % at T = 0.0258 s (omega dt > pi
+    hid an oscillation). Oracle: lsim on a 400x sub-sampled piecewise-linear interpolant."""
+    rec = Record(np.random.default_rng(1).standard_normal(40), dt=0.02)
+    periods = [0.005, 0.0258, 0.04, 0.1]
+    sd = rec.response_spectrum(periods, damping=0.05)["sd"].values
+    for period, value in zip(periods, sd, strict=True):
+        ref, _ = _lsim_peak(rec, period, 0.05, 400)
+        assert value == pytest.approx(ref, rel=2e-5)
+        assert value >= ref * (1 - 1e-6)
+
+
+@pytest.mark.parametrize("period", [1e-300, 1e300, 0.0, -1.0, float("nan")])
+def test_absurd_periods_are_refused(period):
+    """Issue 26: Sa at 1e-300 s was NaN, at 1e300 s a SystemError from numba."""
+    with pytest.raises(ValueError, match="periods"):
+        _random_record(n=50).intensity_measures(periods=[period])
+
+
+def test_too_long_a_period_for_the_step_is_refused():
+    with pytest.raises(ValueError, match="periods.*too long"):
+        _random_record(n=50, dt=0.01).response_spectrum([1e5])
+
+
+def test_sine_record_cav_arias_duration_closed_forms():
+    """Whole cycles of A sin(W t), N samples a cycle: the trapezoidal sums over the samples are
+    exactly t_end / 2 for sin^2 (discrete orthogonality), so Arias = pi A^2 t_end / (4 g);
+    CAV = 4 A / W per cycle (to O(dt^2)); the Husid curve is that of sin^2."""
     A, Tg, cycles = 2.0, 0.5, 6
     W = 2 * math.pi / Tg
     dt = Tg / 4000
     t = dt * np.arange(cycles * 4000 + 1)
     im = Record(A * np.sin(W * t), dt=dt).intensity_measures()
     assert set(im) == KEYS
-    assert im["pgv"] == pytest.approx(2 * A / W, rel=1e-6)
-    assert im["pgd"] == pytest.approx(A * t[-1] / W, rel=1e-6)
     assert im["cav"] == pytest.approx(cycles * 4 * A / W, rel=1e-6)
-    assert im["arias"] == pytest.approx(math.pi * A * A * t[-1] / (4 * G), rel=1e-6)
-    # Husid curve of sin^2: H(t) = (t/2 - sin(2 W t)/(4 W)) / (t_end / 2)
+    assert im["arias"] == pytest.approx(math.pi * A * A * t[-1] / (4 * G), rel=1e-12)
     husid = lambda s, q: (s / 2 - math.sin(2 * W * s) / (4 * W)) / (t[-1] / 2) - q  # noqa: E731
     d595 = optimize.brentq(husid, 0, t[-1], args=(0.95,)) - optimize.brentq(
         husid, 0, t[-1], args=(0.05,)
@@ -143,33 +180,104 @@ def test_sine_record_velocity_displacement_cav_closed_forms():
     assert im["significant_duration"] == pytest.approx(d595, rel=1e-4)
 
 
+def test_arias_of_a_sine_at_a_quarter_of_the_sampling_rate():
+    """Issue 23: samples 0, A, 0, -A, ... The trapezoid over the samples gives the true Arias
+    intensity of the sine, pi A^2 t_end / (4 g); the interpolated record gave 2/3 of it."""
+    A, dt = 3.0, 0.01
+    t = dt * np.arange(4 * 500 + 1)
+    acc = A * np.sin(2 * math.pi * t / (4 * dt))
+    arias = Record(acc, dt=dt).intensity_measures()["arias"]
+    assert arias == pytest.approx(math.pi * A * A * t[-1] / (4 * G), rel=1e-9)
+
+
+def test_baseline_correction_properties():
+    """Velocity: the trapezoidal integral of the record less the constant that brings
+    v(t_end) to zero (scipy). Displacement: the integral of that velocity on the linearly
+    interpolated record (dense scipy trapezoid) less a cubic c2 t^2 + c3 t^3, and orthogonal
+    to t^2 and t^3 (least squares)."""
+    rec = _random_record()
+    t, a = rec.time, rec.acceleration
+    c = integrate.trapezoid(a, t) / t[-1]
+    v = integrate.cumulative_trapezoid(a - c, t, initial=0.0)
+    np.testing.assert_allclose(intensity.ground_velocity(t, a), v, atol=1e-12)
+    d = intensity.ground_displacement(t, a)
+    assert d[0] == 0.0
+    x = t / t[-1]
+    for basis in (x * x, x**3):
+        assert abs(basis @ d) <= 1e-9 * np.linalg.norm(basis) * np.linalg.norm(d)
+    tf = np.linspace(0, t[-1], (t.size - 1) * 20 + 1)
+    vf = integrate.cumulative_trapezoid(np.interp(tf, t, a - c), tf, initial=0.0)
+    raw = integrate.cumulative_trapezoid(vf, tf, initial=0.0)[::20]
+    drift = raw - d  # a cubic without constant or linear term
+    fit = np.polynomial.polynomial.polyfit(x, drift, [2, 3])
+    np.testing.assert_allclose(
+        drift, np.polynomial.polynomial.polyval(x, fit), atol=1e-5 * np.ptp(raw)
+    )
+    im = rec.intensity_measures()
+    assert im["pgv"] == pytest.approx(np.max(np.abs(v)), rel=1e-12)
+    assert im["pgd"] == np.max(np.abs(d))
+
+
+def test_el_centro_drift_is_removed(records_dir):
+    """Issue 23: El Centro 1940 had PGD 1.81 m with the constant offset alone; the polynomial
+    baseline leaves a PGD below 0.4 m, while the processed PEER records change by < 0.5 %."""
+    rec = Record.from_csv(records_dir / "elcentro_NS.dat")
+    assert rec.intensity_measures()["pgd"] < 0.4
+    for path in sorted(records_dir.glob("*.AT2")):
+        r = Record.from_at2(path)
+        t, a = r.time, r.acceleration
+        c = integrate.trapezoid(a, t) / t[-1]
+        v = integrate.cumulative_trapezoid(a - c, t, initial=0.0)
+        d = integrate.cumulative_trapezoid(v, t, initial=0.0)
+        assert r.intensity_measures()["pgd"] == pytest.approx(np.max(np.abs(d)), rel=5e-3)
+
+
 def test_pgv_and_arias_against_trapezoidal_integrals():
     rec = _random_record()
     t, a = rec.time, rec.acceleration
-    # the stated baseline correction: remove the constant that brings v(t_end) to zero
-    c = integrate.trapezoid(a, t) / t[-1]
-    v = integrate.cumulative_trapezoid(a - c, t, initial=0.0)
     im = rec.intensity_measures()
-    assert im["pgv"] == pytest.approx(np.max(np.abs(v)), rel=1e-12)
-    # Arias of the linearly interpolated record: trapezoid on a 40x finer grid (O(h^2))
-    tf = np.linspace(0, t[-1], (t.size - 1) * 40 + 1)
-    arias = math.pi / (2 * G) * integrate.trapezoid(np.interp(tf, t, a) ** 2, tf)
-    assert im["arias"] == pytest.approx(arias, rel=1e-3)
-    cav = integrate.trapezoid(np.abs(np.interp(tf, t, a)), tf)
-    assert im["cav"] == pytest.approx(cav, rel=1e-3)
+    arias = math.pi / (2 * G) * integrate.trapezoid(a**2, t)
+    assert im["arias"] == pytest.approx(arias, rel=1e-12)
+    assert im["cav"] == pytest.approx(integrate.trapezoid(np.abs(a), t), rel=1e-12)
 
 
-def test_cav_exact_through_a_sign_change():
-    """A ramp from 1 to -1 over h: integral of |a| = h / 2."""
-    assert Record([1.0, -1.0], dt=0.4).intensity_measures()["cav"] == pytest.approx(0.2, rel=1e-15)
+def test_huge_records_do_not_overflow_silently():
+    """Issue 26: a record scaled by 1e300 gave Arias and CAV = inf or NaN. CAV is finite and
+    scales; Arias (1e600) cannot be represented and is refused, naming the acceleration."""
+    rec = _random_record(n=200)
+    big = rec.scaled(1e300)
+    assert intensity.cumulative_absolute_velocity(big.time, big.acceleration) == pytest.approx(
+        1e300 * rec.intensity_measures()["cav"], rel=1e-12
+    )
+    with pytest.raises(ValueError, match="acceleration"):
+        intensity.arias_intensity(big.time, big.acceleration)
+    small = rec.scaled(1e-160)  # a^2 underflows, the intensity does not
+    assert intensity.arias_intensity(small.time, small.acceleration) == pytest.approx(
+        1e-320 * rec.intensity_measures()["arias"], rel=1e-6
+    )
 
 
-def test_mean_period_of_a_sine():
-    f0 = 2.0
-    dt = 0.005
-    t = dt * np.arange(int(60 / dt) + 1)
-    tm = Record(np.sin(2 * math.pi * f0 * t), dt=dt).intensity_measures()["mean_period"]
-    assert tm == pytest.approx(1 / f0, rel=0.02)
+def test_cav_of_a_ramp_through_zero():
+    """Samples 1, -1 over h: the trapezoid over the samples gives h (|1| + |-1|) / 2 = h."""
+    assert Record([1.0, -1.0], dt=0.4).intensity_measures()["cav"] == pytest.approx(0.4, rel=1e-15)
+
+
+def test_mean_period_of_two_tones():
+    """A1 sin(2 pi f1 t) + A2 sin(2 pi f2 t) on exact FFT bins: the Rathje et al. (2004) mean
+    period weights C^2, so T_m = (A1^2 / f1 + A2^2 / f2) / (A1^2 + A2^2) = 0.325 s here (the
+    C^1 weights would give 0.4375 s, a flat weight 0.625 s)."""
+    dt, n = 1 / 128, 2**14
+    t = dt * np.arange(n)
+    (a1, f1), (a2, f2) = (1.0, 1.0), (3.0, 4.0)
+    acc = a1 * np.sin(2 * math.pi * f1 * t) + a2 * np.sin(2 * math.pi * f2 * t)
+    tm = Record(acc, dt=dt).intensity_measures()["mean_period"]
+    assert tm == pytest.approx((a1**2 / f1 + a2**2 / f2) / (a1**2 + a2**2), rel=1e-9)
+
+
+def test_mean_period_refuses_a_step_that_resolves_no_frequency_of_its_band():
+    """Issue 26: mean_period at dt 1e100 was NaN without a warning."""
+    with pytest.raises(ValueError, match="dt"):
+        Record(np.random.default_rng(0).standard_normal(64), dt=1e100).intensity_measures()
 
 
 def test_spectrum_intensity_of_a_step():
@@ -277,7 +385,9 @@ def test_at2_pair(tmp_path):
     _write_at2(h, [0.1, 0.2, -0.1, 0.0, 0.05, 0.0], 0.01)
     _write_at2(v, [0.0, 0.05, 0.02, -0.01, 0.0, 0.0], 0.01)
     rec = Record.from_at2(h, vertical=v)
-    np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.02, -0.01, 0.0, 0.0]) * G)
+    np.testing.assert_allclose(
+        rec.vertical, np.array([0.0, 0.05, 0.02, -0.01, 0.0, 0.0]) * STANDARD_GRAVITY
+    )
     short, coarse = tmp_path / "short.AT2", tmp_path / "coarse.AT2"
     _write_at2(short, [0.0, 0.05, 0.02], 0.01)
     _write_at2(coarse, [0.0, 0.05, 0.02, -0.01, 0.0, 0.0], 0.02)
@@ -292,7 +402,7 @@ def test_csv_pair(tmp_path):
     v.write_text("0 0.0\n0.01 0.05\n0.02 0.01\n")
     bad.write_text("0 0.0\n0.02 0.05\n0.04 0.01\n")
     rec = Record.from_csv(h, vertical=v)
-    np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.01]) * G)
+    np.testing.assert_allclose(rec.vertical, np.array([0.0, 0.05, 0.01]) * STANDARD_GRAVITY)
     with pytest.raises(ValueError, match="vertical.*bad.csv"):
         Record.from_csv(h, vertical=bad)
 
@@ -312,4 +422,24 @@ def test_shared_records_plausible(records_dir):
         assert 0 < im["significant_duration"] < rec.duration
         assert 0.1 < im["mean_period"] < 2.0
     elcentro = recs[-1]
-    assert elcentro.peak / G == pytest.approx(0.349, abs=0.001)  # README of the records
+    assert elcentro.peak / STANDARD_GRAVITY == pytest.approx(0.349, abs=0.001)  # README: 0.349 g
+
+
+def test_a_study_cube_states_both_gravities(tmp_path):
+    """The cube says which g the physics used and which g a record in g was read with."""
+    import xarray as xr
+    from test_study import study_text
+
+    from rockstudy.study import make_design, validate_text
+    from rockstudy.study.store import claim, create_store
+
+    study = validate_text(study_text(chunk=10, n=20))
+    out = tmp_path / "cube.zarr"
+    lock, _ = claim(out, study, {}, resume=False)
+    try:
+        create_store(out, make_design(study), study)
+    finally:
+        lock.release()
+    attrs = xr.open_zarr(out).attrs
+    assert attrs["gravity"] == G == 9.81
+    assert attrs["record_g_unit"] == STANDARD_GRAVITY == 9.80665

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY
 from rockstudy.motions import (
     CosinePulse,
     HalfSinePulse,
@@ -80,14 +80,14 @@ def test_at2_reader(records_dir, name):
     assert rec.dt == pytest.approx(dt)
     assert rec.duration == pytest.approx((npts - 1) * dt)
     first = float(open(records_dir / name).read().splitlines()[4].split()[0])
-    assert rec.acceleration[0] == pytest.approx(first * G)
+    assert rec.acceleration[0] == pytest.approx(first * STANDARD_GRAVITY)
 
 
 def test_two_column_reader_el_centro(records_dir):
     rec = Record.from_csv(records_dir / "elcentro_NS.dat", units="g")
     assert rec.acceleration.size == 2688
     assert rec.dt == pytest.approx(0.02)
-    assert rec.peak / G == pytest.approx(0.349, abs=5e-4)
+    assert rec.peak / STANDARD_GRAVITY == pytest.approx(0.349, abs=5e-4)
 
 
 def test_record_interpolates_linearly():

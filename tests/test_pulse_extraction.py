@@ -1,5 +1,6 @@
-"""Pulse extraction on synthetic records of known pulse (Mavroeidis-Papageorgiou 2003) plus
-broadband stochastic noise, and a look at the shared real records."""
+"""Pulse extraction: the wavelet method (default; Baker 2007, Shahi & Baker 2014) and the
+Mavroeidis-Papageorgiou fit, on known pulses in broadband, low-frequency and white noise, on
+noise alone, and on the shared real records against a published T_p."""
 
 import math
 
@@ -10,6 +11,7 @@ from scipy import integrate, signal
 from rockstudy.motions import Record, stochastic_record
 from rockstudy.motions.mavroeidis import mp_pulse_acceleration, mp_pulse_velocity
 from rockstudy.motions.pulse_extraction import baker_indicator
+from rockstudy.motions.wavelet_pulse import _db4, _kernel
 
 DT = 0.005
 
@@ -55,7 +57,7 @@ def test_model_acceleration_is_the_derivative_of_the_velocity():
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("period, amplitude, gamma, phase", PULSES)
 def test_recovers_period_and_amplitude(period, amplitude, gamma, phase, seed):
-    pulse = _pulse_record(period, amplitude, gamma, phase, seed).pulse()
+    pulse = _pulse_record(period, amplitude, gamma, phase, seed).pulse(method="mavroeidis")
     assert pulse.period == pytest.approx(period, rel=0.05)
     assert pulse.amplitude == pytest.approx(amplitude, rel=0.10)
     assert pulse.pulse_like
@@ -66,7 +68,7 @@ def test_recovers_period_and_amplitude(period, amplitude, gamma, phase, seed):
 def test_noiseless_pulse_exactly():
     """Without noise the fit returns the pulse, up to the O(dt^2) of integrating the sampled
     acceleration into velocity."""
-    pulse = _pulse_record(2.5, 0.9, 1.7, 1.2, seed=0, noise_ratio=0.0).pulse()
+    pulse = _pulse_record(2.5, 0.9, 1.7, 1.2, seed=0, noise_ratio=0.0).pulse(method="mavroeidis")
     assert pulse.period == pytest.approx(2.5, rel=1e-4)
     assert pulse.amplitude == pytest.approx(0.9, rel=1e-4)
     assert pulse.gamma == pytest.approx(1.7, rel=1e-4)
@@ -78,7 +80,8 @@ def test_noiseless_pulse_exactly():
 def test_broadband_noise_alone_is_not_pulse_like(seed):
     """Noise with the low-frequency fall-off of real spectra (2nd-order high-pass at 0.3 Hz)."""
     acc = 3.0 * _noise(30.0, seed, 0.3, order=2)
-    assert not Record(acc, dt=DT).pulse().pulse_like
+    for method in ("wavelet", "mavroeidis"):
+        assert not Record(acc, dt=DT).pulse(method).pulse_like
 
 
 def test_baker_indicator_limits():
@@ -89,24 +92,104 @@ def test_baker_indicator_limits():
 
 
 def test_still_record_has_no_pulse():
-    pulse = Record(np.zeros(100), dt=0.01).pulse()
-    assert pulse.amplitude == 0.0 and pulse.indicator == 0.0
+    for method in ("wavelet", "mavroeidis"):
+        pulse = Record(np.zeros(100), dt=0.01).pulse(method)
+        assert pulse.amplitude == 0.0 and pulse.indicator == 0.0
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("method", ["wavelet", "mavroeidis"])
+def test_white_noise_has_no_pulse_and_none_outside_the_record(seed, method):
+    """Issue 26: white noise got T_p = 1325 s starting at -196 s with indicator 0.9998. A pulse
+    outside the record or longer than it is not a pulse."""
+    rec = Record(np.random.default_rng(seed).standard_normal(3000), dt=0.01)
+    pulse = rec.pulse(method)
+    assert pulse.period < rec.duration
+    if method == "wavelet":
+        assert not pulse.pulse_like
+        assert 0.0 <= pulse.start < pulse.end <= rec.duration
+    else:  # the M-P fit may call the random-walk velocity of white noise a pulse (docs)
+        end = pulse.center + 0.5 * pulse.gamma * pulse.period
+        assert pulse.indicator == 0.0 or (
+            pulse.start >= -0.5 * pulse.period and end <= rec.duration + 0.5 * pulse.period
+        )
+
+
+def _db4_pulse_record(period, amplitude, dt, n, centre, noise):
+    """A db4 wavelet of pseudo-period ``period`` in the velocity (amplitude = its peak) plus
+    ``noise`` [m/s^2] in the acceleration; returns the record."""
+    x, psi = _db4()
+    import pywt
+
+    scale = period * pywt.central_frequency("db4") / dt
+    kernel = _kernel(scale, x, psi)
+    v = np.zeros(n)
+    i0 = int(centre / dt) - kernel.size // 2
+    v[i0 : i0 + kernel.size] = amplitude * kernel / np.max(np.abs(kernel))
+    acc = np.gradient(v, dt) + noise
+    return Record(acc, dt=dt)
+
+
+@pytest.mark.parametrize("period", [0.6, 1.0, 2.0, 3.5])
+@pytest.mark.parametrize("kind", ["broadband", "low", "white"])
+def test_wavelet_pulse_in_noise_is_recovered(period, kind):
+    """A pure db4 wavelet in the velocity (its pseudo-period the truth) is found under
+    broadband noise (Kanai-Tajimi, high-passed at 0.3 Hz, 2nd order: real spectra's fall-off),
+    low-frequency noise (low-passed at 1 / T_p: noise in the pulse's own band) or white noise,
+    each scaled so that its velocity peaks at 30 % of the pulse's."""
+    dt, n = DT, int(30.0 / DT)
+    rng = np.random.default_rng(7)
+    if kind == "broadband":
+        noise = _noise(30.0, 3, 0.3, order=2)[:n]
+    elif kind == "low":
+        sos = signal.butter(2, 1.0 / period, "lowpass", fs=1 / dt, output="sos")
+        noise = signal.sosfiltfilt(sos, rng.standard_normal(n))
+    else:
+        noise = rng.standard_normal(n)
+    noise_velocity = Record(noise, dt=dt).intensity_measures()["pgv"]
+    noise *= 0.3 * 0.6 / noise_velocity
+    pulse = _db4_pulse_record(period, 0.6, dt, n, 10.0, noise).pulse()
+    # broadband noise peaks in velocity at 2-3 s, in the pulses' band: it moves the best scale
+    # by up to 9 % (measured over 4 seeds x 4 periods); the others by up to 2 %
+    assert pulse.period == pytest.approx(period, rel=0.10 if kind == "broadband" else 0.03)
+    assert pulse.pulse_like
+    assert pulse.start < 10.0 < pulse.end
+
+
+def test_wavelet_pulse_without_noise_exactly():
+    rec = _db4_pulse_record(1.3, 0.8, DT, 6000, 12.0, 0.0)
+    pulse = rec.pulse()
+    assert pulse.period == pytest.approx(1.3, rel=3e-3)
+    assert pulse.indicator > 0.999
+    assert pulse.amplitude == pytest.approx(0.8, rel=0.02)
+
+
+def test_unknown_method_is_refused():
+    with pytest.raises(ValueError, match="method"):
+        Record(np.zeros(10), dt=0.01).pulse("baker")
 
 
 def test_shared_records(records_dir):
-    """Prints what the fit finds. The records' README names Jensen, Gazli and El Centro #8 as
-    near-fault records with distinct pulses; the two Northridge/Imperial Valley far records
-    (Arcadia, El Centro 1940) are not pulse-like."""
+    """The wavelet T_p of Jensen (RSN982) against its published value, and which records are
+    pulse-like.
+
+    Published: NGA-West2 (Shahi & Baker 2014) gives T_p = 3.16 s for RSN982, extracted in the
+    orientation of the strongest pulse (rotated; Baker 2007 used fault-normal components). Our
+    record is the 292 degree component as recorded, which carries a shorter pulse: the test
+    can only check that its T_p lies below the rotated one and within a factor 2.5 of it,
+    not the value. The two far records (Arcadia, El Centro 1940) are not pulse-like; neither
+    is the 0 degree component of Gazli by this method (its pulse lies in the other
+    component). Prints what each method finds."""
     found = {}
     for path in sorted(records_dir.glob("*.AT2")):
-        found[path.stem] = Record.from_at2(path).pulse()
-    found["elcentro_NS"] = Record.from_csv(records_dir / "elcentro_NS.dat").pulse()
-    for name, p in found.items():
-        print(
-            f"{name}: T_p={p.period:.2f} s A={p.amplitude:.3f} m/s gamma={p.gamma:.2f} "
-            f"start={p.start:.2f} s indicator={p.indicator:.3f}"
-        )
-    assert found["RSN982_NORTHR_JEN292"].pulse_like
-    assert found["RSN126_GAZLI_GAZ000"].pulse_like
-    assert not found["RSN948_NORTHR_CAM009"].pulse_like
-    assert not found["elcentro_NS"].pulse_like
+        found[path.stem] = Record.from_at2(path)
+    found["elcentro_NS"] = Record.from_csv(records_dir / "elcentro_NS.dat")
+    for name, rec in found.items():
+        w, m = rec.pulse(), rec.pulse("mavroeidis")
+        print(f"{name}: wavelet T_p={w.period:.2f} s PI={w.indicator:.3f}; M-P T_p={m.period:.2f}")
+        assert 0.0 <= w.start < w.end <= rec.duration
+    jensen = found["RSN982_NORTHR_JEN292"].pulse()
+    assert jensen.pulse_like
+    assert 3.16 / 2.5 < jensen.period < 3.16
+    assert not found["RSN948_NORTHR_CAM009"].pulse().pulse_like
+    assert not found["elcentro_NS"].pulse().pulse_like

@@ -11,7 +11,7 @@ comments, and a first row of column names.
 import numpy as np
 import pytest
 
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY
 from rockstudy.motions import Record
 
 VALUES_G = np.array(
@@ -51,7 +51,7 @@ def write_at2(path, header_line, values=VALUES_G, units_line=None):
 
 
 def check(rec, values_g, dt):
-    np.testing.assert_allclose(rec.acceleration, values_g * G, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(rec.acceleration, values_g * STANDARD_GRAVITY, rtol=1e-12, atol=0)
     assert rec.dt == pytest.approx(dt, rel=1e-12)
     assert rec.duration == pytest.approx((len(values_g) - 1) * dt, rel=1e-12)
 
@@ -118,7 +118,7 @@ def test_two_column_text(tmp_path, text):
     path = tmp_path / "rec.csv"
     path.write_text(text)
     rec = Record.from_csv(path, units="g")
-    np.testing.assert_allclose(rec.acceleration, ACC * G, rtol=1e-12)
+    np.testing.assert_allclose(rec.acceleration, ACC * STANDARD_GRAVITY, rtol=1e-12)
     np.testing.assert_allclose(rec.time, TIMES, rtol=0, atol=1e-15)
     assert rec.dt == pytest.approx(0.02)
 

@@ -13,7 +13,7 @@ import pytest
 import scipy.signal
 from distributed import Client, LocalCluster
 
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.study import StudyError, load_study, run_study
 from rockstudy.study import records_designs as rd
@@ -24,7 +24,7 @@ from rockstudy.study.store import open_result
 
 def write_at2(path, record):
     """A PEER .AT2 file of ``record`` (in g)."""
-    values = record.acceleration / G
+    values = record.acceleration / STANDARD_GRAVITY
     lines = [
         "PEER STRONG MOTION DATABASE RECORD",
         "synthetic near-fault record for the tests",

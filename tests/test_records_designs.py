@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import rockstudy as rs
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.similarity import record_groups
 from rockstudy.structures.block import frequency_parameter
@@ -35,11 +35,11 @@ def suite_dir(tmp_path):
     for stem in ("RSN1_A000", "RSN1_A-UP", "RSN2_B090", "RSN2_B-UP"):
         acc = rng.normal(0, 0.1, 23)
         _write_at2(tmp_path / f"{stem}.AT2", acc, 0.01)
-        data[stem] = acc * G
+        data[stem] = acc * STANDARD_GRAVITY
     t = 0.02 * np.arange(11)
     acc = rng.normal(0, 0.1, 11)
     np.savetxt(tmp_path / "c_text.dat", np.column_stack([t, acc]))
-    data["c_text"] = acc * G
+    data["c_text"] = acc * STANDARD_GRAVITY
     return tmp_path, data
 
 

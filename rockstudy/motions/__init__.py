@@ -8,6 +8,7 @@ from .records import Record
 from .stochastic import envelope_jennings, kanai_tajimi_filter, stochastic_record
 from .suites import RECORD_SUFFIXES, load_suite
 from .synthetic import synthetic_near_fault
+from .wavelet_pulse import WaveletPulse
 
 __all__ = [
     "Motion",
@@ -25,6 +26,7 @@ __all__ = [
     "kanai_tajimi_filter",
     "synthetic_near_fault",
     "VelocityPulse",
+    "WaveletPulse",
     "mp_pulse_velocity",
     "mp_pulse_acceleration",
 ]

@@ -1,6 +1,10 @@
 """The dominant velocity pulse of a record: a least-squares fit of the Mavroeidis-Papageorgiou
 (2003) pulse to the ground velocity, with the pulse indicator of Baker (2007).
 
+This is ``Record.pulse(method="mavroeidis")``; the default is the wavelet method of Baker
+(2007) and Shahi & Baker (2014), :mod:`rockstudy.motions.wavelet_pulse`, whose T_p is the
+field's. The M-P period of a pulse is about 10-15 % off that T_p (e.g. the shipped records).
+
 Method
 ------
 1. Scan: for every (T_p, gamma) of a grid, the pulse is linear in (A cos nu, A sin nu), so its
@@ -19,10 +23,8 @@ Method
    velocity than one wavelet: a record whose velocity is one long, clean oscillation (e.g.
    unprocessed noise dominated by its lowest frequencies) scores high.
 
-Why a fit rather than Baker's wavelet transform: it needs no wavelet library (Baker uses the
-Daubechies db4 wavelet of PyWavelets, outside this project's dependencies), and the M-P
-parameters (T_p, A, gamma, nu, t_0) are the ones that the synthetic records
-(:func:`rockstudy.motions.synthetic_near_fault`) and the record groups use.
+What the fit is for: the M-P parameters (T_p, A, gamma, nu, t_0) are the ones that the
+synthetic records (:func:`rockstudy.motions.synthetic_near_fault`) are made with.
 """
 
 from __future__ import annotations
@@ -44,6 +46,9 @@ SCAN_SAMPLES = 24
 GAMMA_BOUNDS = (1.0, 5.0)
 #: Baker (2007): the pulse indicator above which a record is pulse-like.
 PULSE_LIKE_INDICATOR = 0.85
+#: A fitted pulse that reaches more than this many periods outside the record is not a pulse
+#: (indicator 0): white noise was fitted a 1325 s pulse starting at -196 s (issue 26).
+OUTSIDE = 0.5
 
 
 @dataclass(frozen=True)
@@ -59,7 +64,8 @@ class VelocityPulse:
     indicator : float
         Baker's (2007) pulse indicator in [0, 1].
     start : float
-        t_0 - gamma T_p / 2 [s], when the pulse begins (may be < 0 if it began before the record).
+        t_0 - gamma T_p / 2 [s], when the pulse begins. A fit whose pulse reaches more than
+        half a period outside the record gets indicator 0: it is not a pulse of the record.
     gamma : float
         Oscillations under the envelope.
     phase : float
@@ -144,8 +150,9 @@ def _refine(t, v, start):
     """Least-squares fit of the five pulse parameters from ``start`` = (A, T_p, gamma, nu, t_0)."""
     span = t[-1] - t[0]
     dt_min = float(np.min(np.diff(t)))
-    lower = [0.0, 4.0 * dt_min, GAMMA_BOUNDS[0], start[3] - 2 * math.pi, t[0] - span]
-    upper = [np.inf, 2.0 * span, GAMMA_BOUNDS[1], start[3] + 2 * math.pi, t[-1] + span]
+    # the pulse lies in the record: its centre inside it, its period no longer than it
+    lower = [0.0, 4.0 * dt_min, GAMMA_BOUNDS[0], start[3] - 2 * math.pi, t[0]]
+    upper = [np.inf, span, GAMMA_BOUNDS[1], start[3] + 2 * math.pi, t[-1]]
     x0 = np.clip(start, np.array(lower) + 1e-12, np.array(upper) - 1e-12)
 
     def residual(x):
@@ -171,10 +178,12 @@ def extract_pulse(t, acc) -> VelocityPulse:
     residual = v - mp_pulse_velocity(t, amplitude, period, gamma, phase, center)
     pgv_ratio = float(np.max(np.abs(residual)) / np.max(np.abs(v)))
     energy_ratio = float(_csv(t, residual) / _csv(t, v))
+    half = 0.5 * gamma * period
+    outside = center - half < t[0] - OUTSIDE * period or center + half > t[-1] + OUTSIDE * period
     return VelocityPulse(
         period=float(period),
         amplitude=float(amplitude),
-        indicator=baker_indicator(pgv_ratio, energy_ratio),
+        indicator=0.0 if outside else baker_indicator(pgv_ratio, energy_ratio),
         start=float(center - 0.5 * gamma * period),
         gamma=float(gamma),
         phase=float(phase % (2.0 * math.pi)),

@@ -11,15 +11,20 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate
-from ..constants import G
+from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity
 from .base import Motion
-from .pulse_extraction import VelocityPulse, extract_pulse
+from .pulse_extraction import extract_pulse
+from .wavelet_pulse import extract_wavelet_pulse
 
 #: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
 MAX_RECORD_BYTES = 64 * 2**20
 
-_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+#: Factor to m/s^2 of each acceleration unit; "g" is standard gravity (the PEER convention).
+_UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+
+#: Methods of :meth:`Record.pulse`.
+PULSE_METHODS = {"wavelet": extract_wavelet_pulse, "mavroeidis": extract_pulse}
 
 #: Column names :meth:`Record.from_csv` reads.
 COLUMNS = ("time", "horizontal", "vertical")
@@ -224,10 +229,17 @@ class Record(Motion):
             ``pga`` [m/s^2], ``pgv`` [m/s], ``pgd`` [m], ``arias`` [m/s], ``cav`` [m/s],
             ``significant_duration`` [s] (5-95 %), ``mean_period`` [s] (Rathje et al. 2004),
             ``spectrum_intensity`` [m] (Housner 1952) and ``sa`` [m/s^2], an array over
-            ``periods``. See :mod:`rockstudy.motions.intensity` for definitions and the
-            baseline correction of velocity and displacement. PGD is only as good as the
-            record's processing: an unfiltered record drifts (elcentro_NS.dat of the shared
-            records gives 1.8 m, all of it the final offset).
+            ``periods``. Arias, CAV and the Husid curve are trapezoids over the samples (as
+            eqsig); see :mod:`rockstudy.motions.intensity` for definitions and the baseline
+            corrections (a constant offset for the velocity, a least-squares c2 t^2 + c3 t^3
+            for the displacement). PGD is still only as good as the record's processing:
+            elcentro_NS.dat of the shared records, unfiltered, gives 0.33 m.
+
+        Raises
+        ------
+        ValueError
+            Naming ``periods`` outside [1e-12 s, 2 pi dt / 1e-5], ``dt`` too coarse for the
+            mean period's band, or an ``acceleration`` whose Arias intensity overflows.
         """
         periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
         damping = intensity.check_damping(damping)
@@ -263,12 +275,25 @@ class Record(Motion):
         sd = self._spectral_displacement(periods, damping)
         return intensity.response_spectrum_dataset(periods, sd, intensity.check_damping(damping))
 
-    def pulse(self) -> VelocityPulse:
-        """The dominant velocity pulse (Mavroeidis-Papageorgiou fit, Baker's indicator).
+    def pulse(self, method: str = "wavelet"):
+        """The velocity pulse of the record, with ``period`` [s] and ``indicator``.
 
-        See :mod:`rockstudy.motions.pulse_extraction`.
+        Parameters
+        ----------
+        method : {"wavelet", "mavroeidis"}
+            ``"wavelet"``: Baker (2007) and Shahi & Baker (2014), db4 wavelets, T_p the peak
+            of the extracted pulse's pseudo-velocity spectrum
+            (:class:`rockstudy.motions.wavelet_pulse.WaveletPulse`). ``"mavroeidis"``: a
+            least-squares Mavroeidis-Papageorgiou (2003) pulse
+            (:class:`rockstudy.motions.pulse_extraction.VelocityPulse`).
         """
-        return self._cached("pulse", lambda: extract_pulse(self._times, self.acceleration))
+        try:
+            extract = PULSE_METHODS[method]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"method must be one of {sorted(PULSE_METHODS)}, got {method!r}"
+            ) from None
+        return self._cached(("pulse", method), lambda: extract(self._times, self.acceleration))
 
     def _with_vertical(self, vertical: Record, path) -> Record:
         """This record with the vertical component ``vertical`` read from ``path``."""
@@ -300,6 +325,10 @@ class Record(Motion):
     def from_at2(cls, path, vertical=None) -> Record:
         """Read a PEER NGA ``.AT2`` file (acceleration in g), returned in m/s^2.
 
+        g is standard gravity, 9.80665 m/s^2 (:data:`rockstudy.constants.STANDARD_GRAVITY`),
+        the unit of PEER's processing: with it the record's own velocity and displacement are
+        PEER's.
+
         Both header styles are read: ``NPTS= 2048, DT= .0066 SEC`` (with or without filter
         information after it) and the older ``2048 0.0066 NPTS, DT``. ``vertical`` is the path
         of the vertical component's ``.AT2`` file, on the same samples.
@@ -325,7 +354,7 @@ class Record(Motion):
             values = np.array(tokens, dtype=float)
         except ValueError:
             raise ValueError(f"{path}: the values after line 4 are not all numbers") from None
-        record = _build(path, lambda: cls(values * G, dt=dt, name=path.stem))
+        record = _build(path, lambda: cls(values * STANDARD_GRAVITY, dt=dt, name=path.stem))
         return (
             record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
         )

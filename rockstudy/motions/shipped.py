@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import G
+from ..constants import STANDARD_GRAVITY as G_UNIT
 from .synthetic import synthetic_near_fault
 
 #: The synthetic near-fault suite shipped in ``data/records`` (no download needed): name,
@@ -69,7 +69,7 @@ def shipped_suite_texts() -> dict[str, str]:
     texts = {}
     for name, period, pga_g, seed in SHIPPED_SUITE:
         rec = synthetic_near_fault(
-            pulse_period=period, pga=pga_g * G, seed=seed, vertical=True, dt=SHIPPED_DT
+            pulse_period=period, pga=pga_g * G_UNIT, seed=seed, vertical=True, dt=SHIPPED_DT
         )
         call = (
             f"rockstudy.motions.synthetic_near_fault(pulse_period={period!r}, "
@@ -82,7 +82,7 @@ def shipped_suite_texts() -> dict[str, str]:
             ("UP", rec.vertical, "vertical"),
         ):
             texts[f"{stem}_{part}.AT2"] = at2_text(
-                values / G,
+                values / G_UNIT,
                 SHIPPED_DT,
                 f"SYNTHETIC near-fault record {name}, {what}: not a recording "
                 f"(python -m rockstudy.motions.shipped --write data/records)",

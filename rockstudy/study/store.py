@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ..constants import STANDARD_GRAVITY, G
 from .evaluate import OUTPUTS, STATUS_FAILED, STATUS_OK, STATUS_PENDING
 from .spec import Study
 
@@ -339,6 +340,8 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         chunk_size=study.chunk_size,
         versions=json.dumps(package_versions()),
         Conventions="CF-1.8",
+        gravity=G,  # [m/s^2] the physics' g: p = sqrt(3 g / 4 R), uplift g tan(alpha)
+        record_g_unit=STANDARD_GRAVITY,  # [m/s^2] the unit g of records read in g
     )
     chunks = {
         name: {"chunks": (size,) + var.shape[1:]}
