@@ -13,6 +13,7 @@ import pytest
 import scipy.signal
 from distributed import Client, LocalCluster
 
+from rockstudy import simulate_batch
 from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.study import StudyError, load_study, run_study
@@ -148,6 +149,39 @@ def test_design_study_cube_equals_the_python_design(suite, client, tmp_path, kin
     for name in ("max_rotation", "capacity", "scale"):
         if name in api:
             np.testing.assert_allclose(nc[name], api[name], rtol=1e-12, equal_nan=True)
+
+
+def test_design_study_ida_capacity_against_an_independent_dense_scan(suite, client, tmp_path):
+    """The study's IDA capacities, checked against a dense scan of 1500 log-spaced levels
+    per record and block (simulate_batch on each record read afresh): the capacity overturns,
+    the scale below it survives, and every dense level below it that overturns lies in a
+    window narrower than the ladder step (the dense scan survives within one step above it)."""
+    study = design_study(suite, "ida", tmp_path)
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    q = 1.0 + cube.attrs["step"]
+    checked = narrow = 0
+    for i, rec in enumerate(load_suite(str(suite / "*_H.AT2"))):
+        for j in range(cube.sizes["structure"]):
+            R, a = float(cube["half_diagonal"][j]), float(cube["slenderness"][j])
+            grid = np.geomspace(0.5 * G * a / rec.peak, 30 * G * np.tan(a) / rec.peak, 1500)
+            over = simulate_batch(half_diagonal=R, slenderness=a, record=rec, scale=grid)[
+                "overturned"
+            ]
+            c, lo = float(cube["capacity_scale"][i, j]), float(cube["capacity_scale_lower"][i, j])
+            if np.isfinite(c):
+                ends = simulate_batch(half_diagonal=R, slenderness=a, record=rec, scale=[lo, c])
+                assert list(ends["overturned"]) == [False, True]
+            else:  # censored: it stood on every rung, the top one included
+                assert bool(cube["censored"][i, j]) and lo == pytest.approx(grid[-1], rel=1e-9)
+            for k in np.flatnonzero(over & (grid < lo)):
+                step_above = (grid > grid[k]) & (grid <= grid[k] * q)
+                assert (~over[step_above]).any(), (i, j, grid[k], c)
+                narrow += 1
+            checked += 1
+    print(f"IDA study vs dense scan: {checked} pairs, {narrow} narrow levels below the capacity")
+    assert checked == 9
 
 
 def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, client, tmp_path):
