@@ -326,6 +326,24 @@ def refused(tmp_path, motion, design="", field=None):
     return message
 
 
+def test_ida_options_out_of_range_are_refused_naming_the_field(suite, tmp_path):
+    motion = MOTION.replace("RECORDS", str(suite))
+    for key, value in (
+        ("tolerance", "1e-300"),
+        ("tolerance", "0.9"),
+        ("scan", "-1"),
+        ("scan", "1000000"),
+        ("step", "0.0"),
+        ("max_pga_ratio", "1.0"),
+    ):
+        msg = refused(tmp_path, motion, f'[design]\nkind = "ida"\n{key} = {value}\n', key)
+        assert f"design.{key}" in msg and "must be" in msg, msg
+    msg = refused(tmp_path, motion, '[design]\nkind = "ida"\ngrowth = 1.5\n', "design.growth")
+    assert "give step" in msg
+    ok = design_study(suite, "ida", tmp_path)
+    assert ok.design.ida() == rd.IdaOptions(im="pgv", tolerance=0.02, scan=2)
+
+
 def test_bad_record_suites_are_refused_naming_the_field(suite, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()

@@ -422,6 +422,22 @@ def test_ida_censors_at_free_fall_and_the_fit_takes_it_as_censored():
     assert table["n"].iloc[0] == 1
 
 
+def test_stripes_levels_at_free_fall_are_censored_and_the_others_run():
+    rec = _half_sine_with_vertical()  # free fall from scale g / 3 (u_v'' = -3 u_h'', peak 1)
+    levels = np.array([1.0, 2.0, 3.5, 4.0])  # PGA [m/s^2]: 3.5 and 4.0 reach -g
+    block = {"half_diagonal": [0.3], "slenderness": [0.2]}
+    ds = rd.multiple_stripes(rec, block, levels)
+    assert list(ds["censored"][0, 0].values) == [False, False, True, True]
+    assert list(ds["status"][0, 0].values) == [0, 0, 2, 2]
+    assert ds.attrs["n_simulations"] == 2
+    for k in (0, 1):
+        one = rs.simulate(rs.Block(0.3, 0.2), rec.scaled(levels[k]), method="scipy", rtol=1e-10)
+        assert bool(ds["overturned"][0, 0, k]) == one.overturned
+    from rockstudy.study import records_fragility as rf
+
+    assert rf.stripe_fragility(ds, n_boot=0)["n"].iloc[0] == 2  # the censored left out
+
+
 def test_designs_bad_input(records):
     with pytest.raises(ValueError, match="im must be one of"):
         rd.multiple_stripes(records, STRUCTURES, [1.0], im="pgx")
