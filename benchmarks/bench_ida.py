@@ -174,7 +174,7 @@ def accuracy(records, blocks, n_levels, step=0.01):
             for name, (cap, sims) in caps.items():
                 o = out[name]
                 o["pairs"] += 1
-                o["sims"] += sims / scales.shape[0]
+                o["sims"] += sims / scales.shape[0]  # per pair: the record's over its blocks
                 c = cap[j]
                 if not has or not np.isfinite(c):
                     o["censored_both" if has == np.isfinite(c) else "censored_mismatch"] += 1
@@ -190,7 +190,7 @@ def accuracy(records, blocks, n_levels, step=0.01):
         r = np.array(o.pop("miss_ratios"))
         o["miss_ratio_median"] = float(np.median(r)) if r.size else None
         o["miss_ratio_max"] = float(r.max()) if r.size else None
-        o["sims_per_pair"] = o.pop("sims") / len(records)
+        o["sims_per_pair"] = o.pop("sims") / o["pairs"]
     out["narrow_first_windows"] = int(narrow)
     return out
 
@@ -266,7 +266,7 @@ def main():
     ap.add_argument("--skip-a", action="store_true", help="only the 50 x 200 cost")
     args = ap.parse_args()
     load = os.getloadavg()
-    incremental_dynamic_analysis(_suite(1, duration=5.0), _blocks(2), scan=1)  # compile
+    incremental_dynamic_analysis(_suite(1, duration=10.0), _blocks(2), scan=1)  # compile
     a = None
     if not args.skip_a:
         a = {

@@ -1,8 +1,9 @@
 """Record designs on top of :func:`rockstudy.simulate_batch`: cloud, multiple-stripe analysis
-and incremental dynamic analysis (IDA) by bracketing and bisection.
+and incremental dynamic analysis (IDA) by a ladder refined by bisection.
 
 Each design runs one batch call per record (all structures and scales of the record in it; IDA
-one call per record and iteration) and returns an :class:`xarray.Dataset` on the dimensions
+one call per record and iteration: a few ladder rungs of every structure, or one bisection
+step) and returns an :class:`xarray.Dataset` on the dimensions
 ``record`` and ``structure`` (and ``level`` for stripes, ``step`` for the IDA points), with each
 record's intensity measures (:meth:`rockstudy.motions.Record.intensity_measures`), its pulse
 (:meth:`rockstudy.motions.Record.pulse`) and its dimensionless groups for each structure
@@ -11,8 +12,8 @@ intensity of a scaled record is its unscaled value times ``scale`` (``scale`` sq
 intensity); :func:`rockstudy.study.records_fragility.intensity` forms it in quoted units.
 
 Rocking is not monotonic in intensity: a block that overturns at one scale can survive a
-higher one. IDA reports the first overturning level and flags resurrection found by a coarse
-scan above it.
+higher one. The IDA reports the first overturning rung of a ladder of 1 % steps (refined by
+bisection) and the switch band above it, where the block is seen to survive again.
 """
 
 from __future__ import annotations
@@ -482,9 +483,12 @@ def incremental_dynamic_analysis(
     capacity is within ``tolerance`` of the lowest overturning scale of the ladder's grid,
     and no overturning window wider than a step (the factor ``1 + step``) lies below it.
     A window narrower than the step can fall between two rungs and be missed: rocking is
-    not monotonic in intensity. Measured against a dense scan of 800-2000 log-spaced levels
-    (tests/test_records_designs.py and benchmarks/bench_ida.py), the first overturning was
-    missed this way in a small share of pairs, listed in docs/records.rst.
+    not monotonic in intensity. Against a dense scan of 1500 log-spaced levels
+    (benchmarks/bench_ida.py, step 1 %), the first overturning window was narrower than the
+    step in 22 of 25 pairs of five real records x five museum objects and in 38 of 48
+    synthetic pairs, and the ladder landed above it in 13 of 25 (median 2.6 % higher, at
+    most 1.40 times) and 16 of 48 (median 1.7 %, at most 2.48 times); it never missed a
+    window at least one step wide. See docs/records.rst.
 
     Parameters
     ----------
