@@ -13,6 +13,7 @@ import pytest
 import scipy.signal
 from distributed import Client, LocalCluster
 
+import rockstudy as rs
 from rockstudy import simulate_batch
 from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
@@ -202,6 +203,35 @@ def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, c
     assert all(r.vertical is not None for r in records) and len(records) == 3
     api = python_api("cloud", records, cube)
     np.testing.assert_allclose(cube["max_rotation"], api["max_rotation"], rtol=1e-12)
+
+
+def test_stripes_levels_at_free_fall_are_stored_censored_and_the_others_run(
+    suite, client, tmp_path
+):
+    """H/V pairs scaled to PGA levels on both sides of each record's free-fall level (where
+    the scaled vertical reaches -g): those above are stored as censored (kernel_status 2), the
+    others run and equal single-scene simulations; the record's task does not fail."""
+    records = load_suite(suite, vertical=(r"_H\.AT2$", "_UP.AT2"))
+    falls = [rd.free_fall_scale(r) * r.peak for r in records]  # PGA [m/s^2] at free fall
+    levels = [0.5 * min(falls), 0.9 * min(falls), 1.5 * max(falls)]
+    grid = ", ".join(f"{v!r}" for v in levels)
+    text = HEAD + HV.replace("RECORDS", str(suite))
+    text += f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = [{grid}] }} }}\n'
+    text += '[design]\nkind = "stripes"\n[run]\noutputs = ["max_rotation", "overturned"]\n'
+    path = tmp_path / "falls.toml"
+    path.write_text(text)
+    out = tmp_path / "cube.zarr"
+    report = run_study(load_study(path), out, client=client, base_dir=tmp_path, progress=False)
+    assert report.failed_samples == 0
+    cube = open_result(out).load()
+    censored = cube["censored"].values
+    assert censored[..., 2].all() and not censored[..., :2].any()
+    assert (cube["status"].values[..., 2] == 2).all()
+    assert np.all(cube["run_status"].values == STATUS_OK)
+    for i, rec in enumerate(records):
+        b = rs.Block(float(cube["half_diagonal"][0]), float(cube["slenderness"][0]))
+        one = rs.simulate(b, rec.scaled(float(cube["scale"][i, 0, 1])))
+        assert bool(cube["overturned"][i, 0, 1]) == one.overturned
 
 
 def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, client, tmp_path):

@@ -130,13 +130,13 @@ def outputs(study) -> dict:
         out.update({k: (*v, None) for k, v in _RUN.items()})
         if de.kind == "stripes":
             out["scale"] = ("factor applied to the record", "1", "f8", np.nan, None)
-            out["censored"] = (
-                "1 if not run: the scaled vertical reaches -g (free fall; kernel_status 2)",
-                "1",
-                "i1",
-                -1,
-                None,
-            )
+        out["censored"] = (
+            "1 if not run: the scaled vertical reaches -g (free fall; kernel_status 2)",
+            "1",
+            "i1",
+            -1,
+            None,
+        )
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
         "1",
@@ -363,7 +363,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
     else:
         attrs["n_simulations"] = n_rec * n_st
-    if kind == "stripes":  # as the API: bool, and the points not run are not simulations
+    if kind != "ida":  # as the API: bool, and the points not run are not simulations
         ds["censored"] = ds["censored"] == 1
         attrs["n_simulations"] = int((~ds["censored"]).sum())
     ds.attrs = attrs

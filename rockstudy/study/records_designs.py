@@ -261,17 +261,22 @@ def cloud(
     -------
     xarray.Dataset
         ``max_rotation`` [rad], ``overturned``, ``n_impacts``, ``overturn_time`` [s] and
-        ``status`` on (record, structure), with the record and structure tables.
+        ``status`` on (record, structure), with the record and structure tables. A record
+        whose vertical component reaches -g is not run (free fall): ``censored`` and
+        ``status`` :data:`STATUS_FREE_FALL` on its points.
     """
     records = _records(records)
     st = _structures(structures)
     _, periods = _target("pga", None, periods)
     ds = _record_dataset(records, st, periods, damping)
     idx = np.arange(st["slenderness"].size)
-    outs = [_run(r, st, idx, 1.0, method, rtol, max_steps) for r in records]
+    ones = np.ones(idx.size)
+    outs = [_run_below_free_fall(r, st, idx, ones, method, rtol, max_steps) for r in records]
     for k in _OUT:
         ds[k] = (("record", "structure"), np.array([o[k] for o in outs]))
-    ds.attrs.update(design="cloud", method=method, rtol=rtol, n_simulations=len(records) * idx.size)
+    ds["censored"] = ds["status"] == STATUS_FREE_FALL
+    n_run = int((~ds["censored"]).sum())
+    ds.attrs.update(design="cloud", method=method, rtol=rtol, n_simulations=n_run)
     return ds
 
 
