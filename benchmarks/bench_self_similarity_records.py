@@ -85,7 +85,7 @@ def main():
             "records": [str(n) for n in ds["record_name"].values],
             "simulations": int(ds.attrs["n_simulations"]),
             "censored": int(ds["censored"].sum()),
-            "resurrections": int(ds["resurrection"].sum()),
+            "survive_above_capacity": int(ds["survives_above_capacity"].sum()),
             "ida_seconds": round(t_ida, 1),
             "report_seconds": round(t_report, 1),
             "spread": rows,

@@ -13,6 +13,8 @@ import pytest
 import scipy.signal
 from distributed import Client, LocalCluster
 
+import rockstudy as rs
+from rockstudy import simulate_batch
 from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.study import StudyError, load_study, run_study
@@ -150,6 +152,39 @@ def test_design_study_cube_equals_the_python_design(suite, client, tmp_path, kin
             np.testing.assert_allclose(nc[name], api[name], rtol=1e-12, equal_nan=True)
 
 
+def test_design_study_ida_capacity_against_an_independent_dense_scan(suite, client, tmp_path):
+    """The study's IDA capacities, checked against a dense scan of 1500 log-spaced levels
+    per record and block (simulate_batch on each record read afresh): the capacity overturns,
+    the scale below it survives, and every dense level below it that overturns lies in a
+    window narrower than the ladder step (the dense scan survives within one step above it)."""
+    study = design_study(suite, "ida", tmp_path)
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    q = 1.0 + cube.attrs["step"]
+    checked = narrow = 0
+    for i, rec in enumerate(load_suite(str(suite / "*_H.AT2"))):
+        for j in range(cube.sizes["structure"]):
+            R, a = float(cube["half_diagonal"][j]), float(cube["slenderness"][j])
+            grid = np.geomspace(0.5 * G * a / rec.peak, 30 * G * np.tan(a) / rec.peak, 1500)
+            over = simulate_batch(half_diagonal=R, slenderness=a, record=rec, scale=grid)[
+                "overturned"
+            ]
+            c, lo = float(cube["capacity_scale"][i, j]), float(cube["capacity_scale_lower"][i, j])
+            if np.isfinite(c):
+                ends = simulate_batch(half_diagonal=R, slenderness=a, record=rec, scale=[lo, c])
+                assert list(ends["overturned"]) == [False, True]
+            else:  # censored: it stood on every rung, the top one included
+                assert bool(cube["censored"][i, j]) and lo == pytest.approx(grid[-1], rel=1e-9)
+            for k in np.flatnonzero(over & (grid < lo)):
+                step_above = (grid > grid[k]) & (grid <= grid[k] * q)
+                assert (~over[step_above]).any(), (i, j, grid[k], c)
+                narrow += 1
+            checked += 1
+    print(f"IDA study vs dense scan: {checked} pairs, {narrow} narrow levels below the capacity")
+    assert checked == 9
+
+
 def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, client, tmp_path):
     """A folder of H/V pairs: each record is read with its vertical file; if the solvers take
     vertical shaking the cube equals the Python design on the same pairs, else the study is
@@ -168,6 +203,35 @@ def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, c
     assert all(r.vertical is not None for r in records) and len(records) == 3
     api = python_api("cloud", records, cube)
     np.testing.assert_allclose(cube["max_rotation"], api["max_rotation"], rtol=1e-12)
+
+
+def test_stripes_levels_at_free_fall_are_stored_censored_and_the_others_run(
+    suite, client, tmp_path
+):
+    """H/V pairs scaled to PGA levels on both sides of each record's free-fall level (where
+    the scaled vertical reaches -g): those above are stored as censored (kernel_status 2), the
+    others run and equal single-scene simulations; the record's task does not fail."""
+    records = load_suite(suite, vertical=(r"_H\.AT2$", "_UP.AT2"))
+    falls = [rd.free_fall_scale(r) * r.peak for r in records]  # PGA [m/s^2] at free fall
+    levels = [0.5 * min(falls), 0.9 * min(falls), 1.5 * max(falls)]
+    grid = ", ".join(f"{v!r}" for v in levels)
+    text = HEAD + HV.replace("RECORDS", str(suite))
+    text += f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = [{grid}] }} }}\n'
+    text += '[design]\nkind = "stripes"\n[run]\noutputs = ["max_rotation", "overturned"]\n'
+    path = tmp_path / "falls.toml"
+    path.write_text(text)
+    out = tmp_path / "cube.zarr"
+    report = run_study(load_study(path), out, client=client, base_dir=tmp_path, progress=False)
+    assert report.failed_samples == 0
+    cube = open_result(out).load()
+    censored = cube["censored"].values
+    assert censored[..., 2].all() and not censored[..., :2].any()
+    assert (cube["status"].values[..., 2] == 2).all()
+    assert np.all(cube["run_status"].values == STATUS_OK)
+    for i, rec in enumerate(records):
+        b = rs.Block(float(cube["half_diagonal"][0]), float(cube["slenderness"][0]))
+        one = rs.simulate(b, rec.scaled(float(cube["scale"][i, 0, 1])))
+        assert bool(cube["overturned"][i, 0, 1]) == one.overturned
 
 
 def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, client, tmp_path):
@@ -290,6 +354,24 @@ def refused(tmp_path, motion, design="", field=None):
     if field is not None:
         assert field in message, message
     return message
+
+
+def test_ida_options_out_of_range_are_refused_naming_the_field(suite, tmp_path):
+    motion = MOTION.replace("RECORDS", str(suite))
+    for key, value in (
+        ("tolerance", "1e-300"),
+        ("tolerance", "0.9"),
+        ("scan", "-1"),
+        ("scan", "1000000"),
+        ("step", "0.0"),
+        ("max_pga_ratio", "1.0"),
+    ):
+        msg = refused(tmp_path, motion, f'[design]\nkind = "ida"\n{key} = {value}\n', key)
+        assert f"design.{key}" in msg and "must be" in msg, msg
+    msg = refused(tmp_path, motion, '[design]\nkind = "ida"\ngrowth = 1.5\n', "design.growth")
+    assert "give step" in msg
+    ok = design_study(suite, "ida", tmp_path)
+    assert ok.design.ida() == rd.IdaOptions(im="pgv", tolerance=0.02, scan=2)
 
 
 def test_bad_record_suites_are_refused_naming_the_field(suite, tmp_path):

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import matplotlib.image as mpimg
 import numpy as np
+import pandas as pd
 import pytest
 from test_report import chromium_figures
 
@@ -58,23 +59,62 @@ def check_page(page, tmp_path, figures, tables):
     return text
 
 
-def test_ida_report(tmp_path, records):
-    ds = incremental_dynamic_analysis(
-        records, STRUCTURES, tolerance=0.05, scan=2, periods=(0.5,), rtol=1e-6
+@pytest.fixture(scope="module")
+def ida(records):
+    return incremental_dynamic_analysis(
+        records, STRUCTURES, step=0.05, tolerance=0.05, scan=8, periods=(0.5,), rtol=1e-6
     )
+
+
+def test_ida_report(tmp_path, records, ida):
+    ds = ida
     page = record_report(ds, tmp_path / "report", title="ida <b>test</b>", n_boot=10)
     text = check_page(
         page,
         tmp_path,
         ["record_fragility", "ida_points", "size_collapse"],
-        ["summary", "records", "record_fragility", "im_efficiency", "per_record", "size_collapse"],
+        [
+            "summary",
+            "records",
+            "record_fragility",
+            "im_efficiency",
+            "per_record",
+            "size_collapse",
+            "switch_band",
+        ],
     )
+    # the switch band of all records: the blocks seen to survive above their first
+    # overturning, counted from the simulated points themselves
+    band = pd.read_csv(tmp_path / "report" / "switch_band.csv", index_col=0)
+    s, over = ds["step_scale"].values, ds["step_overturned"].values
+    cap = ds["capacity_scale"].values[..., None]
+    seen = ((s > cap) & (over == 0)).any(axis=-1).sum()
+    assert band.loc["all records", "of which seen to survive above it"] == seen
+    assert "survive above their first overturning" in text
     assert "<b>test</b>" not in text
     assert html_mod.escape("Sa(T = 0.5 s) [g]") in text
     eff = (tmp_path / "report" / "im_efficiency.csv").read_text()
     assert "PGV p / (g tan alpha) [-]" in eff and "dimensionless" in eff
     medians = (tmp_path / "report" / "size_class_medians.csv").read_text()
     assert "R 0.3 to" in medians
+
+
+def test_stripes_and_ida_side_by_side_warn_where_their_bands_part(tmp_path, records, ida):
+    levels = np.geomspace(0.1, 3.0, 6) * G
+    stripes = multiple_stripes(records, STRUCTURES, levels, periods=(0.5,), rtol=1e-6)
+    page = record_report(ida, tmp_path / "same", n_boot=10, compare=stripes)
+    table = pd.read_csv(tmp_path / "same" / "stripes_and_ida.csv")
+    assert len(table) >= 5 and {"IDA median", "stripes median"} <= set(table.columns)
+    text = page.read_text()
+    agree = table["bands overlap"].all()
+    assert ("disagree beyond their 90 % bands" in text) == (not agree)
+    # the same stripes read as ten times stronger (their scales multiplied by 10): the
+    # fragility against PGA moves tenfold, far outside the bands; the report must say so
+    louder = stripes.assign(scale=stripes["scale"] * 10.0)
+    page = record_report(louder, tmp_path / "apart", n_boot=10, compare=ida)
+    assert "disagree beyond their 90 % bands" in page.read_text()
+    with pytest.raises(ValueError, match="compare"):
+        record_report(ida, tmp_path / "bad", compare=ida)
 
 
 def test_stripes_report_and_the_dispatch_of_make_report(tmp_path, records):

@@ -168,7 +168,7 @@ def _design_chunk(study, cols, base_dir) -> dict:
     n = cols["sample"].size
     try:
         result = record_studies.evaluate_rows(study, cols, base_dir)
-        failed = result["kernel_status"] != 0
+        failed = result["kernel_status"] == 1  # 2: a free-fall point, censored, not failed
         message = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
     except Exception as exc:  # recorded per row, never aborts the run
         result = record_studies.empty_rows(study, n)

@@ -58,20 +58,49 @@ _RUN = {
     "overturn_time": ("time at which |theta| reached pi/2 (NaN if it survived)", "s", "f8", np.nan),
 }
 _IDA = {
-    "capacity": ("overturning intensity, in the units of the design's im", "", "f8", np.nan),
+    "capacity": ("first overturning intensity, in the units of the design's im", "", "f8", np.nan),
     "capacity_scale": (
-        "lowest scale seen to overturn (upper end of the bracket)",
+        "lowest scale seen to overturn (upper end of the final bracket)",
         "1",
         "f8",
         np.nan,
     ),
-    "capacity_scale_lower": ("highest scale below it seen to survive", "1", "f8", np.nan),
-    "censored": ("1 if still standing at max_pga_ratio", "1", "i1", -1),
-    "resurrection": ("1 if a scan above the capacity found a survival", "1", "i1", -1),
-    "resurrection_scale": ("lowest surviving scan scale above the capacity", "1", "f8", np.nan),
+    "capacity_scale_lower": (
+        "highest scale below it seen to survive (censored: the highest surviving rung)",
+        "1",
+        "f8",
+        np.nan,
+    ),
+    "censored": ("1 if no rung overturned", "1", "i1", -1),
+    "censored_reason": (
+        "0 not censored, 1 standing at max_pga_ratio, 2 free fall above (u_v'' reaches -g)",
+        "1",
+        "i1",
+        -1,
+    ),
+    "survives_above_capacity": (
+        "1 if a simulated scale above the capacity survived",
+        "1",
+        "i1",
+        -1,
+    ),
+    "highest_survival_scale": (
+        "highest simulated scale above the capacity that survived (top of the switch band)",
+        "1",
+        "f8",
+        np.nan,
+    ),
+    "switch_band_overturn_share": (
+        "share of the simulated scales in the switch band that overturn",
+        "1",
+        "f8",
+        np.nan,
+    ),
+    "rungs": ("ladder rungs simulated", "1", "i8", -1),
     "simulations": ("simulations run", "1", "i8", -1),
 }
-_STEPS = ("step_scale", "step_max_rotation", "step_overturned")
+_STEPS = rd.STEP_VARIABLES
+_BOOLS = ("censored", "survives_above_capacity")
 
 
 def _float(long_name, units):
@@ -93,7 +122,7 @@ def outputs(study) -> dict:
     out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
     if de.kind == "ida":
         out.update({k: (*v, None) for k, v in _IDA.items()})
-        unit = UNITS.get(de.ida_options()["im"], "1")
+        unit = UNITS.get(de.ida().im, "1")
         out["capacity"] = (_IDA["capacity"][0], unit, "f8", np.nan, None)
         for k in _STEPS:
             out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
@@ -101,20 +130,35 @@ def outputs(study) -> dict:
         out.update({k: (*v, None) for k, v in _RUN.items()})
         if de.kind == "stripes":
             out["scale"] = ("factor applied to the record", "1", "f8", np.nan, None)
-    out["kernel_status"] = ("0 ok; else a simulation hit the step limit", "1", "i8", -1, None)
+        out["censored"] = (
+            "1 if not run: the scaled vertical reaches -g (free fall; kernel_status 2)",
+            "1",
+            "i1",
+            -1,
+            None,
+        )
+    out["kernel_status"] = (
+        "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
+        "1",
+        "i8",
+        -1,
+        None,
+    )
     return out
 
 
 def ida_steps(study) -> int:
-    """Most simulations one structure of the study can take in the IDA: the bracket (from
-    g alpha to max_pga_ratio g tan alpha in steps of ``growth``), the bisection (from ``growth``
-    down to ``1 + tolerance``) and the scan."""
-    o = study.design.ida_options()
+    """Most simulations one structure of the study can take in the IDA: the ladder (from at
+    least half the rest scale g alpha / PGA, which a downward vertical can lower by at most
+    that, up to max_pga_ratio g tan alpha, in steps of ``1 + step``), the bisection (from
+    ``1 + step`` down to ``1 + tolerance``) and the scan."""
+    o = study.design.ida()
     alpha = study.largest_critical_rotation()
-    span = o["max_pga_ratio"] * math.tan(alpha) / alpha
-    bracket = math.ceil(math.log(span) / math.log(o["growth"])) + 1
-    bisect = math.ceil(math.log2(math.log(o["growth"]) / math.log1p(o["tolerance"]))) + 1
-    return bracket + bisect + o["scan"]
+    span = 2.0 * o.max_pga_ratio * math.tan(alpha) / alpha
+    ladder = math.ceil(math.log(span) / math.log1p(o.step)) + 2
+    ratio = math.log1p(o.step) / math.log1p(o.tolerance)
+    bisect = math.ceil(math.log2(ratio)) + 1 if ratio > 1 else 0
+    return ladder + bisect + o.scan
 
 
 def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
@@ -309,25 +353,19 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         attrs.update(im=t["im"], im_period=np.nan if t["period"] is None else t["period"])
         attrs["n_simulations"] = n_rec * n_st * n_lev
     elif kind == "ida":
-        o = {k: de[k] for k in ("im", "period", "tolerance", "growth", "max_pga_ratio")}
-        defaults = {"im": "pga", "tolerance": 0.01, "growth": 1.5, "max_pga_ratio": 30.0}
-        o = {k: (defaults.get(k) if v is None else v) for k, v in o.items()}
-        attrs.update(
-            im=o["im"],
-            im_period=np.nan if o["period"] is None else o["period"],
-            tolerance=o["tolerance"],
-            growth=o["growth"],
-            max_pga_ratio=o["max_pga_ratio"],
-        )
+        attrs.update(rd.IdaOptions.given(de).attrs())
         attrs["n_simulations"] = int(
             np.nansum(np.where(ds["simulations"] >= 0, ds["simulations"], 0))
         )
-        for k in ("censored", "resurrection"):  # as the API: bool (a failed row: False,
+        for k in _BOOLS:  # as the API: bool (a failed row: False,
             ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
         used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
         ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
     else:
         attrs["n_simulations"] = n_rec * n_st
+    if kind != "ida":  # as the API: bool, and the points not run are not simulations
+        ds["censored"] = ds["censored"] == 1
+        attrs["n_simulations"] = int((~ds["censored"]).sum())
     ds.attrs = attrs
     return ds
 

@@ -47,7 +47,7 @@ IM_NAMES = {
 _DESIGN_NAMES = {
     "cloud": "cloud (records unscaled)",
     "stripes": "multiple-stripe analysis",
-    "ida": "incremental dynamic analysis (bracket and bisection)",
+    "ida": "incremental dynamic analysis (a ladder of rungs, refined by bisection)",
 }
 #: Frequency bins of omega_p / p (of equal count) within which PGA / (g tan alpha) is compared.
 FREQUENCY_BINS = 3
@@ -144,12 +144,15 @@ def _summary(page, ds):
     if design == "stripes":
         rows["levels"] = int(ds.sizes["level"])
     if design == "ida":
+        rows["ladder step (relative)"] = float(ds.attrs.get("step", np.nan))
         rows["bisection tolerance (relative)"] = float(ds.attrs.get("tolerance", np.nan))
-        rows["capacities censored (standing at the top of the range)"] = int(
-            (ds["censored"].values == 1).sum()
+        reason = ds["censored_reason"].values
+        rows["capacities censored: standing at the top of the range"] = int((reason == 1).sum())
+        rows["capacities censored: free fall above (vertical reaches -g)"] = int(
+            (reason == 2).sum()
         )
-        rows["resurrections found by the scan above the capacity"] = int(
-            (ds["resurrection"].values == 1).sum()
+        rows["blocks seen to survive above their first overturning"] = int(
+            (ds["survives_above_capacity"].values == 1).sum()
         )
     else:
         rows["overturned points"] = int(ds["overturned"].values.sum())
@@ -299,7 +302,7 @@ def _responses(page, ds):
                 upto = ~(s > cap)  # the curve up to the first overturning (all if censored)
                 (line,) = ax.plot(x[upto], s[upto] * pga_g[i], "-", lw=1, label=_mpl_text(name))
                 ax.plot(x[over], s[over] * pga_g[i], "x", color=line.get_color(), ms=5)
-                above = (s > cap) & ~over  # survived above the capacity: resurrection
+                above = (s > cap) & ~over  # survived above the first overturning
                 ax.plot(x[above], s[above] * pga_g[i], "o", mfc="none", color=line.get_color())
             else:
                 y = pga_g[i] * (ds["scale"].values[i, j] if design == "stripes" else 1.0)
@@ -342,8 +345,8 @@ def _responses(page, ds):
         f"{what}, for blocks spanning the design's sizes; crosses: overturned (drawn at "
         "theta_max / alpha = 1)"
         + (
-            "; the line ends at the first overturning, open circles mark survival above it "
-            "(resurrection)"
+            "; the line ends at the first overturning, open circles mark the scales above it "
+            "at which the block was seen to survive"
             if design == "ida"
             else ""
         ),
@@ -367,8 +370,8 @@ def _per_record(page, ds):
                 float(np.nanmin(cap)) if np.isfinite(cap).any() else np.nan
             )
             row["censored blocks"] = int((ds["censored"].values[i] == 1).sum())
-            row["blocks that resurrect above their capacity"] = int(
-                (ds["resurrection"].values[i] == 1).sum()
+            row["blocks seen to survive above their first overturning"] = int(
+                (ds["survives_above_capacity"].values[i] == 1).sum()
             )
         else:
             over = ds["overturned"].values[i]
@@ -384,6 +387,113 @@ def _per_record(page, ds):
     table = pd.DataFrame(rows).T
     table.index.name = "record"
     page.table(table, "per_record", "Per-record breakdown over all blocks")
+
+
+def _switch_band(page, ds):
+    """Per record: the blocks seen to survive above their first overturning, the width of
+    the switch band (highest survival / first overturning) and the share of the simulated
+    scales inside it that overturn."""
+    cap = ds["capacity_scale"].values
+    high = ds["highest_survival_scale"].values
+    share = ds["switch_band_overturn_share"].values
+    names = _names(ds)
+    rows = {}
+    for i, name in enumerate([*names, "all records"]):
+        sel = slice(None) if i == len(names) else [i]
+        c, h, sh = cap[sel].ravel(), high[sel].ravel(), share[sel].ravel()
+        seen = np.isfinite(h) & np.isfinite(c)
+        rows[name] = {
+            "blocks with a first overturning": int(np.isfinite(c).sum()),
+            "of which seen to survive above it": int(seen.sum()),
+            "switch band, highest survival / first overturning, median [-]": _median(
+                h[seen] / c[seen]
+            ),
+            "switch band, largest [-]": float(np.max(h[seen] / c[seen])) if seen.any() else np.nan,
+            "share of the scales in the band that overturn, median [-]": _median(sh[seen]),
+        }
+    table = pd.DataFrame(rows).T
+    table.index.name = "record"
+    page.table(
+        table,
+        "switch_band",
+        "The switch band: from the first overturning (the capacity) to the highest scale at "
+        "which the block was seen to survive, over the ladder rungs, the bisection and the scan "
+        f"above it (step {float(ds.attrs.get('step', np.nan)):.3g}, "
+        f"{int(ds.attrs.get('scan', 0))} scan levels); a capacity reads 'first overturning', "
+        "not 'overturns at every higher level'",
+    )
+
+
+def _side_by_side(page, ida, stripes, edges, n_boot):
+    """The fragility of the IDA and of the stripes on the same records and blocks, measure by
+    measure and size class; a warning where their median bands do not overlap."""
+    rows, plt = [], _plt()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for im, period in _measures(ida):
+        try:
+            t_ida = _fit(ida, im, period, edges, n_boot)
+            t_str = _fit(stripes, im, period, edges, n_boot)
+        except ValueError as err:
+            page.text(f"Stripes and IDA against {im_label(im, period)}: {err}")
+            continue
+        for group in t_ida.index.intersection(t_str.index):
+            a, b = t_ida.loc[group], t_str.loc[group]
+            overlap = max(a["theta_lo"], b["theta_lo"]) <= min(a["theta_hi"], b["theta_hi"])
+            rows.append(
+                {
+                    "intensity": im_label(im, period),
+                    "group": group,
+                    "IDA median": a["theta"],
+                    "IDA median, lower": a["theta_lo"],
+                    "IDA median, upper": a["theta_hi"],
+                    "IDA beta": a["beta"],
+                    "stripes median": b["theta"],
+                    "stripes median, lower": b["theta_lo"],
+                    "stripes median, upper": b["theta_hi"],
+                    "stripes beta": b["beta"],
+                    "bands overlap": bool(overlap),
+                }
+            )
+        if im == "pga":
+            _plot_pair(ax, t_ida, t_str, im)
+    if not rows:
+        plt.close(fig)
+        return
+    table = pd.DataFrame(rows).set_index(["intensity", "group"])
+    apart = table[~table["bands overlap"]]
+    if len(apart):
+        listed = "; ".join(f"{im} ({g})" for im, g in apart.index)
+        page.text(
+            f"Warning: the IDA and the stripes disagree beyond their 90 % bands of the median "
+            f"in {len(apart)} of {len(table)} fits: {listed}. The IDA counts the first "
+            "overturning; the stripes count overturning at each level, which survival above "
+            "the first overturning lowers."
+        )
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "stripes_and_ida",
+        "Fragility against PGA from the IDA (solid) and the stripes (dashed), with the bands "
+        "of their medians",
+    )
+    page.table(table, "stripes_and_ida", "Stripes and IDA side by side (90 % bands)")
+
+
+def _plot_pair(ax, t_ida, t_str, im):
+    low = np.nanmin([t_ida["im_min"].min(), t_str["im_min"].min()])
+    high = np.nanmax([t_ida["im_max"].max(), t_str["im_max"].max()])
+    if not (np.isfinite(low) and np.isfinite(high) and high > low > 0):
+        return
+    grid = np.geomspace(low, high, 200)
+    for table, style, what in ((t_ida, "-", "IDA"), (t_str, "--", "stripes")):
+        curve = fragility_curve(table, grid)
+        for g in curve.group.values:
+            c = curve.sel(group=g)
+            (line,) = ax.plot(grid, c.probability, style, label=f"{what}: {g}")
+            ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
+    ax.set(xscale="log", xlabel=im_label(im), ylabel="probability of overturning")
+    _log_ticks(ax)
+    ax.legend(fontsize=6)
 
 
 def _median(values) -> float:
@@ -479,6 +589,7 @@ def record_report(
     description: str = "",
     n_boot: int = 50,
     appendix=None,
+    compare: xr.Dataset | None = None,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
 
@@ -497,6 +608,10 @@ def record_report(
         Resamples of the records for the bootstrapped bands.
     appendix : callable, optional
         Called with the page last, to add sections (a study's report adds its study file).
+    compare : xarray.Dataset, optional
+        The other of an IDA and a stripes design on the same records and structures: the
+        page then shows both fragilities side by side and warns where their median bands
+        do not overlap.
     """
     design = ds.attrs.get("design")
     if design not in DESIGNS:
@@ -515,6 +630,18 @@ def record_report(
     _efficiency(page, ds, n_boot)
     page.heading({"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[design])
     _responses(page, ds)
+    if design == "ida":
+        page.heading("Switch band")
+        _switch_band(page, ds)
+    if compare is not None:
+        kinds = {design, compare.attrs.get("design")}
+        if kinds != {"ida", "stripes"}:
+            raise ValueError(
+                f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
+            )
+        page.heading("Stripes and IDA side by side")
+        ida, stripes = (ds, compare) if design == "ida" else (compare, ds)
+        _side_by_side(page, ida, stripes, edges, n_boot)
     page.heading("Per-record breakdown")
     _per_record(page, ds)
     if edges is not None:

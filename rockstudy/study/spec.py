@@ -43,6 +43,7 @@ import math
 import re
 import reprlib
 import tomllib
+from dataclasses import asdict
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -60,6 +61,7 @@ from pydantic import (
 
 from .distributions import Distribution
 from .feasibility import problems
+from .records_designs import IdaOptionError, IdaOptions
 
 
 def _param_tag(value):
@@ -376,45 +378,52 @@ class RecordSpec(_Model):
 class DesignSpec(_Model):
     """A record design over records x structures (``sampler.n`` structures drawn by the
     sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
-    each level of ``motion.scale_to.value``, a grid), or ``ida`` (the overturning intensity of
-    each structure under each record in ``im``, by bracketing and bisection to ``tolerance``;
-    see :func:`rockstudy.study.records_designs.incremental_dynamic_analysis` for ``growth``,
-    ``max_pga_ratio`` and ``scan``). ``periods`` [s] are those of the spectral accelerations
-    ``sa`` stored for every record, ``damping`` their damping ratio."""
+    each level of ``motion.scale_to.value``, a grid), or ``ida`` (the first overturning
+    intensity of each structure under each record in ``im``, by a ladder of ``step`` refined
+    by bisection to ``tolerance``; ``max_pga_ratio`` and ``scan`` as in
+    :class:`rockstudy.study.records_designs.IdaOptions`, which holds their defaults and
+    ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
+    record, ``damping`` their damping ratio."""
 
     kind: Literal["cloud", "stripes", "ida"]
     periods: list[_Period] = []
     damping: _Damping = 0.05
     im: ScaleIM | None = None
     period: _Period | None = None
-    tolerance: float | None = Field(default=None, gt=0.0, lt=1.0)
-    growth: float | None = Field(default=None, gt=1.0, le=100.0)
-    max_pga_ratio: float | None = Field(default=None, gt=1.0, le=1e4)
-    scan: int | None = Field(default=None, ge=0, le=100)
+    step: float | None = None
+    tolerance: float | None = None
+    max_pga_ratio: float | None = None
+    scan: int | None = None
+    growth: float | None = None  # replaced by step: refused with a message saying so
 
     @model_validator(mode="after")
     def _ida_keys(self):
-        ida = ("im", "period", "tolerance", "growth", "max_pga_ratio", "scan")
+        ida = ("im", "period", "step", "tolerance", "max_pga_ratio", "scan")
+        if self.growth is not None:
+            raise FieldError(
+                "growth",
+                "is no longer an option: the IDA climbs a ladder of rungs; give step (the "
+                "relative step between rungs, default 0.01) instead",
+            )
         if self.kind != "ida":
             for name in ida:
                 if getattr(self, name) is not None:
                     raise FieldError(name, f"applies to kind = 'ida' only, not {self.kind!r}")
             return self
         _check_period(self.im or "pga", self.period, "period")
-        if not self.ida_options()["growth"] > 1.0 + self.ida_options()["tolerance"]:
-            raise FieldError("growth", "must be > 1 + tolerance")
+        try:
+            self.ida()
+        except IdaOptionError as exc:
+            raise FieldError(exc.option, str(exc).partition(" ")[2]) from None
         return self
+
+    def ida(self) -> IdaOptions:
+        """The IDA's options (defaults filled in)."""
+        return IdaOptions.given(self.model_dump())
 
     def ida_options(self) -> dict:
         """Keyword arguments of the IDA (defaults filled in)."""
-        return {
-            "im": self.im or "pga",
-            "period": self.period,
-            "tolerance": 0.01 if self.tolerance is None else self.tolerance,
-            "growth": 1.5 if self.growth is None else self.growth,
-            "max_pga_ratio": 30.0 if self.max_pga_ratio is None else self.max_pga_ratio,
-            "scan": 4 if self.scan is None else self.scan,
-        }
+        return asdict(self.ida())
 
 
 class StochasticSpec(_Model):
