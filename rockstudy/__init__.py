@@ -26,7 +26,7 @@ from ._warnings import (
 )
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
-    from . import closedform, motions, similarity, structures
+    from . import closedform, motions, risk, similarity, structures
     from .dynamics import RockingResult, simulate, simulate_batch
     from .structures import Block
 
@@ -40,6 +40,7 @@ _LAZY = {
     "simulate_batch": (".dynamics", "simulate_batch"),
     "closedform": (".closedform", None),
     "motions": (".motions", None),
+    "risk": (".risk", None),
     "similarity": (".similarity", None),
     "structures": (".structures", None),
 }
@@ -57,6 +58,7 @@ __all__ = [
     "RockingResult",
     "closedform",
     "motions",
+    "risk",
     "similarity",
     "simulate",
     "simulate_batch",
