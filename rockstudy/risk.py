@@ -472,7 +472,7 @@ def rate_deaggregation(median, dispersion, hazard: HazardCurve, units: str | Non
     """Which IM levels the annual rate of overturning comes from.
 
     The contribution of each interval of the hazard curve's levels to
-    lambda_OT = int P(OT | x) |d lambda(x)| (:func:`annual_rate`): for [a, b],
+    ``lambda_OT = int P(OT | x) |d lambda(x)|`` (:func:`annual_rate`): for [a, b],
     lambda(a) F(a) - lambda(b) F(b) + int_a^b lambda dF (by parts, each term in closed form on
     the interval's power law), with F the fragility. The first interval is (0, x_0] and the
     last [x_{n-1}, inf): what the extrapolation beyond the grid contributes.
