@@ -271,3 +271,42 @@ def test_linear_model_demand_near_the_nonlinear_for_a_stocky_block():
     lin = rs.simulate(block, pulse, method="linear")
     non = rs.simulate(block, pulse)
     assert lin.friction_demand == pytest.approx(non.friction_demand, rel=0.05**2 * 4)
+
+
+def test_batch_friction_demand_rows():
+    """simulate_batch(outputs=[..., "friction_demand", "lift_off"]): below uplift
+    max |a_g| / g exactly; rows that rock as the scipy reference's demand (another solver);
+    the other outputs bit for bit as without them, and not in the default outputs."""
+    amps = np.array([0.5, 0.99, 1.6, 2.5]) * UPLIFT
+    kw = dict(half_diagonal=R, slenderness=ALPHA, pulse="sine", amplitude=amps, period=0.6)
+    plain = rs.simulate_batch(**kw, rtol=1e-10)
+    assert "friction_demand" not in plain
+    out = rs.simulate_batch(**kw, rtol=1e-10, outputs=[*plain, "friction_demand", "lift_off"])
+    for name, values in plain.items():
+        np.testing.assert_array_equal(out[name], values)
+    np.testing.assert_allclose(out["friction_demand"][:2], amps[:2] / G, rtol=1e-14)
+    for amp, demand in zip(amps[2:], out["friction_demand"][2:], strict=True):
+        ref = rs.simulate(BLOCK, SinePulse(amplitude=amp, period=0.6), method="scipy", rtol=1e-10)
+        assert demand == pytest.approx(ref.friction_demand, rel=1e-7)
+    assert not out["lift_off"].any()
+
+
+def test_batch_lift_off_and_vertical_rows():
+    t, a_h, a_v = lift_record()
+    rec = Record(a_h, time=t, vertical=a_v)
+    scale = np.array([0.2, 1.0])
+    out = rs.simulate_batch(
+        half_diagonal=R,
+        slenderness=ALPHA,
+        record=rec,
+        scale=scale,
+        outputs=["friction_demand", "lift_off"],
+    )
+    assert out["lift_off"].tolist() == [False, True]
+    assert out["friction_demand"][1] == math.inf
+    expected = np.max(np.abs(0.2 * a_h) / (G + 0.2 * a_v))  # at rest throughout
+    assert out["friction_demand"][0] == pytest.approx(expected, rel=1e-14)
+    with pytest.raises(ValueError, match="allowed: .*'friction_demand', 'lift_off'"):
+        rs.simulate_batch(
+            half_diagonal=R, slenderness=ALPHA, amplitude=1.0, period=0.5, outputs=["friction"]
+        )
