@@ -80,6 +80,11 @@ def test_sharp_capacity_is_the_hazard_at_the_capacity():
     hazard = HazardCurve("pga", [0.1, 0.2, 0.4], [1e-2, 3e-3, 5e-4], units="g")
     for theta in (0.05, 0.1, 0.15, 0.4, 0.7):
         assert annual_rate(theta, 0.0, hazard) == pytest.approx(hazard.rate(theta), rel=1e-12)
+        # |d lambda| over [theta, inf), interval by interval: lambda(max(a, theta)) - lambda(b)
+        lower, upper, parts = rate_deaggregation(theta, 0.0, hazard)
+        a = np.maximum(lower, theta)
+        expected = np.where(upper > theta, hazard.rate(a) - hazard.rate(upper), 0.0)
+        np.testing.assert_allclose(parts, expected, rtol=1e-12, atol=1e-15)
     # between levels the interpolant is the power law through the two neighbours
     k = math.log(3e-3 / 5e-4) / math.log(2.0)
     assert hazard.rate(0.3) == pytest.approx(3e-3 * 1.5**-k, rel=1e-12)

@@ -156,8 +156,9 @@ def simulate_batch(
         lifts, so that no returned value lies outside what ``auto`` promises. Also, never by
         default: ``friction_demand`` and ``lift_off`` (as
         :attr:`rockstudy.RockingResult.friction_demand`), for which every row that lifts is
-        run again on its own with a history (the single-scene path, same model and rtol; 1-40 ms a row), while a row that
-        never lifts has ``max |u_h''| / (g + u_v'')``, exactly, without a run.
+        run again on its own with a history (the single-scene path, same model and rtol;
+        1-40 ms a row), while a row that never lifts has ``max |u_h''| / (g + u_v'')``,
+        exactly, without a run.
     max_steps : int
         Cap on the integrator steps in one rocking phase of a row (status 1 when reached), a
         whole number in [1, 1e12].
