@@ -253,7 +253,8 @@ def check_contact(t, theta, theta_dot, motion, p, alpha, eta, linear=False, over
     (``|u_h''|`` / (g + u_v''), exactly: at the record's samples or the pulse's extrema), while
     rocking (the forces on the quintic Hermite interpolant of the history's states and the
     equation of motion's theta_ddot, at 4 points inside each history interval and at the ground's
-    kinks, the largest refined on finer grids around it), and at the impacts (the impulse ratio
+    kinks, the largest refined on finer grids around it; F_v is checked at the same points,
+    unrefined), and at the impacts (the impulse ratio
     (1 - eta) / ((1 + eta) tan alpha)). Of an overturned block, up to the last time
     |theta| = alpha (on the interpolant): its fall after it is the overturning, in which F_v
     tends to 0 (at cos phi = 1/3 for a block falling from rest).
