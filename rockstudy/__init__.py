@@ -19,6 +19,7 @@ from ._warnings import (
     ClosedFormValidityWarning,
     ComplexAccuracyWarning,
     ComplexFromRestWarning,
+    ContactWarning,
     EquivalentBlockWarning,
     IncompleteReferenceWarning,
     LinearizationWarning,
@@ -26,7 +27,7 @@ from ._warnings import (
 )
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
-    from . import closedform, motions, similarity, structures
+    from . import closedform, motions, risk, similarity, structures
     from .dynamics import RockingResult, simulate, simulate_batch
     from .structures import Block
 
@@ -40,6 +41,7 @@ _LAZY = {
     "simulate_batch": (".dynamics", "simulate_batch"),
     "closedform": (".closedform", None),
     "motions": (".motions", None),
+    "risk": (".risk", None),
     "similarity": (".similarity", None),
     "structures": (".structures", None),
 }
@@ -50,6 +52,7 @@ __all__ = [
     "ClosedFormValidityWarning",
     "ComplexAccuracyWarning",
     "ComplexFromRestWarning",
+    "ContactWarning",
     "EquivalentBlockWarning",
     "LinearizationWarning",
     "LooseToleranceWarning",
@@ -57,6 +60,7 @@ __all__ = [
     "RockingResult",
     "closedform",
     "motions",
+    "risk",
     "similarity",
     "simulate",
     "simulate_batch",

@@ -35,3 +35,8 @@ class IncompleteReferenceWarning(AccuracyWarning):
 
 class EquivalentBlockWarning(AccuracyWarning):
     """A structure was run as its equivalent block of [003], which only approximates it."""
+
+
+class ContactWarning(AccuracyWarning):
+    """The block needs more friction than given, or lifts off: it would slide or leave the
+    ground, which the rocking model (no sliding, no lift-off) does not describe."""

@@ -17,7 +17,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
-from . import _auto, _linear, _linear_record, _rocking
+from . import _auto, _linear, _linear_record, _rocking, contact
 from ._vertical import refuse_free_fall, uplift_ratio
 from .reference import simulate_reference
 from .result import RockingResult
@@ -330,6 +330,7 @@ def simulate(
     l: float = 1e-4,
     t_eval=None,
     dt_out: float | None = None,
+    friction: float | None = None,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -401,6 +402,11 @@ def simulate(
         Instead of ``t_eval``: the uniform grid 0, dt_out, 2 dt_out, ... [s] up to ``t_max``
         or, without it, up to the end of the history (rest or overturning; the scene then
         runs twice, once to find that end).
+    friction : float, optional
+        The friction coefficient mu > 0 of the contact: a :class:`~rockstudy.ContactWarning`
+        when ``result.friction_demand`` exceeds it (the block would slide) or the block lifts
+        off. Only for a :class:`~rockstudy.Block` and the methods that compute the demand
+        (all but ``"complex"``).
 
     Returns
     -------
@@ -409,7 +415,9 @@ def simulate(
         located by each method on its own solution: on the DOP853 step's interpolant and one
         Newton step on a true step (the kernels), on the closed form (``"linear"`` on a
         pulse or a record), by scipy's event location (``"scipy"``) or on the cubic Hermite
-        interpolant of the steps (``"complex"``).
+        interpolant of the steps (``"complex"``). For a :class:`~rockstudy.Block` (all
+        methods but ``"complex"``), ``friction_demand`` and ``lift_off``
+        (:func:`rockstudy.dynamics.contact.check_contact`).
     """
     try:
         runner, model = _METHODS[method]
@@ -444,6 +452,14 @@ def simulate(
         _auto.warn_loose_tolerance(rtol)
     x0 = (th0, om0)
     t_eval = _validate.output_times(t_eval, dt_out, t_max)
+    block = not hasattr(structure, "mechanism") and method in contact.METHODS
+    if friction is not None:
+        friction = _validate.positive("friction", friction)
+        if not block:
+            raise ValueError(
+                f"friction: the friction demand is computed for a Block under the methods "
+                f"{contact.METHODS}, not for a {type(structure).__name__} under {method!r}"
+            )
     run_args = (motion, method, rtol, t_max, int(max_steps), x0, l)
     if hasattr(structure, "mechanism"):
         run, run_args = _simulate_structure, (structure, *run_args)
@@ -460,7 +476,7 @@ def simulate(
         initial_rotation=th0,
         initial_velocity=om0,
     )
-    return r
+    return contact.with_contact(r, motion, method, friction) if block else r
 
 
 def _describe(motion) -> str:

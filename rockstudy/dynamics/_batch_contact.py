@@ -1,0 +1,62 @@
+"""The friction demand and lift-off of :func:`rockstudy.simulate_batch` rows (private).
+
+The batch kernels keep no history, and the demand needs one; so the rows that lift are run
+again, one by one, through the single-scene path of :func:`rockstudy.simulate` with the same
+encoding, model and tolerance, and their histories go through
+:func:`rockstudy.dynamics.contact.check_contact`. The batch's other outputs are untouched (its
+kernels run as before); a row that never lifts needs no run: its demand is
+``max |u_h''| / (g + u_v'')`` exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..constants import G
+from ..motions import Motion
+from ..motions import _kernels as mk
+from . import _auto, _rocking, contact
+from ._vertical import uplift_ratio
+from .simulate import _kernel, _linear_exact
+
+
+class _RowMotion(Motion):
+    """One batch row's motion: its kernel encoding (kind, params, times, samples,
+    vsamples)."""
+
+    def __init__(self, spec):
+        self._spec = spec
+
+    def kernel_spec(self):
+        return self._spec
+
+    @property
+    def duration(self) -> float:
+        return float(self._spec[1][3])
+
+
+def contact_rows(rows, codes, method, rtol, max_steps):
+    """(friction_demand, lift_off) of every row: ``rows`` = (p, alpha, eta, kind, mp, times,
+    samples, vsamples) as :func:`rockstudy.simulate_batch` encodes them, ``codes`` the model
+    each row ran (:data:`rockstudy.dynamics._auto.MODEL_NAMES`), ``method`` and ``rtol`` the
+    batch's (``"auto"`` reruns its nonlinear rows at the kernel's rtol, as it ran them)."""
+    p, alpha, eta, kind, mp, times, samples, vsamples = rows
+    if kind == mk.KIND_RECORD:
+        psi = uplift_ratio(mp[:, 0], alpha, samples, vsamples)
+    else:
+        psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
+    demand = psi * np.tan(alpha)  # at rest throughout: max |u_h''| / (g + u_v'')
+    lift_off = np.zeros(p.size, bool)
+    for i in np.flatnonzero(psi >= 1.0):
+        motion = _RowMotion((kind, mp[i], times, samples, vsamples))
+        linear = codes[i] == _auto.MODEL_LINEAR
+        run = _linear_exact if linear else _kernel
+        model = _rocking.MODEL_LINEAR if linear else _rocking.MODEL_NONLINEAR
+        k_rtol = _auto.kernel_rtol(rtol) if method == "auto" and not linear else rtol
+        args = (p[i], alpha[i], eta[i], motion, model, k_rtol, None, max_steps, method)
+        r = run(*args, (0.0, 0.0))
+        check = contact.check_contact(
+            r.t, r.theta, r.theta_dot, motion, p[i], alpha[i], eta[i], linear, r.overturned
+        )
+        demand[i], lift_off[i] = check.friction_demand, check.lift_off
+    return demand, lift_off
