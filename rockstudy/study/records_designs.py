@@ -145,7 +145,7 @@ def _record_measure(record, im, period, damping, structures):
 def _scale_for(level, measure, im):
     """Scale factor(s) that bring ``measure`` to ``level`` (Arias goes as the square)."""
     ratio = level / measure
-    return np.sqrt(ratio) if im == "arias" else ratio
+    return ratio ** (1.0 / _im.SCALING_POWER[im])
 
 
 # ------------------------------------------------------------------------------ tables
@@ -419,7 +419,7 @@ def incremental_dynamic_analysis(
                 steps[i, j, : len(h)] = h
     for c, k in enumerate(("step_scale", "step_max_rotation", "step_overturned")):
         ds[k] = (dims + ("step",), steps[..., c])
-    power = 2.0 if im == "arias" else 1.0
+    power = _im.SCALING_POWER[im]
     ds["capacity"] = (
         dims,
         np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** power),
