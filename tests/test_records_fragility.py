@@ -366,3 +366,18 @@ def test_bad_fragility_arguments_are_named():
         for bad in (-1, 2.5, True):
             with pytest.raises(ValueError, match="n_boot must be a non-negative integer"):
                 fit(ds, n_boot=bad)
+
+
+def test_record_designs_carry_units():
+    from rockstudy.motions import Record
+    from rockstudy.motions.intensity import UNITS
+    from rockstudy.study.records_designs import _record_dataset
+
+    t = np.arange(0, 2.0, 0.01)
+    rec = Record(np.sin(2 * np.pi * t), dt=0.01, name="x")
+    st = {"slenderness": np.array([0.2]), "uplift_acceleration": np.array([G * np.tan(0.2)])}
+    st["frequency_parameter"] = np.array([2.0])
+    ds = _record_dataset([rec], st, np.array([0.5]), 0.05)
+    for k in ("pga", "pgv", "arias", "sa", "cav"):
+        assert ds[k].attrs["units"] == UNITS[k]
+    assert ds["pga_ratio"].attrs["units"] == "1"

@@ -181,6 +181,16 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     ds["pgv_ratio"] = ds["pgv"] * p / up
     ds["pulse_frequency_ratio"] = w_p / p
     ds["pulse_amplitude_ratio"] = w_p * ds["pulse_amplitude"] / up
+    ratios = ("pga_ratio", "pgv_ratio", "pulse_frequency_ratio", "pulse_amplitude_ratio")
+    units = {
+        **_im.UNITS,
+        "pulse_period": "s",
+        "pulse_amplitude": "m/s",
+        **dict.fromkeys(ratios, "1"),
+    }
+    for k, unit in units.items():  # every intensity measure carries its units
+        if k in ds:
+            ds[k].attrs["units"] = unit
     return ds
 
 
@@ -423,6 +433,7 @@ def incremental_dynamic_analysis(
     ds["capacity"] = (
         dims,
         np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** power),
+        {"units": _im.UNITS[im], "long_name": f"overturning {im} (first overturning level)"},
     )
     ds.attrs.update(
         design="ida",
