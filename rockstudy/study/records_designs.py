@@ -145,7 +145,7 @@ def _record_measure(record, im, period, damping, structures):
 def _scale_for(level, measure, im):
     """Scale factor(s) that bring ``measure`` to ``level`` (Arias goes as the square)."""
     ratio = level / measure
-    return ratio ** (1.0 / _im.SCALING_POWER[im])
+    return ratio ** (1.0 / _im.SCALING_POWER[DIMENSIONLESS.get(im, im)])
 
 
 # ------------------------------------------------------------------------------ tables
@@ -429,11 +429,14 @@ def incremental_dynamic_analysis(
                 steps[i, j, : len(h)] = h
     for c, k in enumerate(("step_scale", "step_max_rotation", "step_overturned")):
         ds[k] = (dims + ("step",), steps[..., c])
-    power = _im.SCALING_POWER[im]
+    power = _im.SCALING_POWER[DIMENSIONLESS.get(im, im)]
     ds["capacity"] = (
         dims,
         np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** power),
-        {"units": _im.UNITS[im], "long_name": f"overturning {im} (first overturning level)"},
+        {
+            "units": "1" if im in DIMENSIONLESS else _im.UNITS[im],
+            "long_name": f"overturning {im} (first overturning level)",
+        },
     )
     ds.attrs.update(
         design="ida",
