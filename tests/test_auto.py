@@ -1,8 +1,10 @@
 """method="auto" and the failure maps behind it (issue 6).
 
-The oracle is Housner's model integrated by the nonlinear kernel at rtol 1e-12 (the kernel is
-tested against scipy's DOP853 in test_engine.py); the linear model is tested against the
-closed forms in test_closedform.py.
+The oracle of single scenes is scipy's solve_ivp (DOP853 with events, ``method="scipy"``) at
+rtol 1e-12; that of the large random sets (thousands of scenes, too many for solve_ivp in a
+test) Housner's model integrated by the nonlinear kernel at rtol 1e-12, the kernel being tested
+against scipy in test_engine.py and benchmarks/bench_auto_vs_scipy.py; the linear model is
+tested against the closed forms in test_closedform.py.
 """
 
 import math
@@ -118,12 +120,13 @@ def test_auto_avoids_chattering_error():
 def test_auto_in_simulate_meets_the_tolerance():
     """simulate(method="auto"): no integration below uplift, the kernel at 0.05 rtol otherwise
     (the exact linear solver is dearer than the kernel when a history is built), within rtol of
-    Housner; simulate_batch takes the linear model for the slender block."""
+    Housner integrated by scipy's solve_ivp; simulate_batch takes the linear model for the
+    slender block."""
     blk = rs.Block(half_diagonal=1.5, slenderness=0.05)
     for ratio, model in [(0.8, "rest (no uplift)"), (3.0, "nonlinear")]:
         pulse = rs.motions.SinePulse(ratio * G * math.tan(0.05), 0.5)
         res = rs.simulate(blk, pulse, method="auto", rtol=1e-2)
-        ref = rs.simulate(blk, pulse, rtol=1e-12)
+        ref = rs.simulate(blk, pulse, method="scipy", rtol=1e-12)
         assert res.info["model"] == model
         assert res.overturned == ref.overturned
         if ref.max_rotation > 0 and not ref.overturned:
@@ -140,9 +143,37 @@ def test_auto_in_simulate_meets_the_tolerance():
     assert batch["model"][0] == _auto.MODEL_LINEAR
     stocky = rs.Block(half_diagonal=1.5, slenderness=0.5)
     pulse = rs.motions.SinePulse(2.0 * G * math.tan(0.5), 0.5)
-    res = rs.simulate(stocky, pulse, method="auto", rtol=1e-2)
-    ref = rs.simulate(stocky, pulse, rtol=1e-12)
-    assert res.max_rotation == pytest.approx(ref.max_rotation, rel=1e-2)
+    for tol in (1e-2, 1e-4):
+        res = rs.simulate(stocky, pulse, method="auto", rtol=tol)
+        ref = rs.simulate(stocky, pulse, method="scipy", rtol=1e-12)
+        assert res.max_rotation == pytest.approx(ref.max_rotation, rel=tol)
+
+
+def test_auto_on_the_chattering_scene_of_issue_23():
+    """R 0.98105 m, alpha 0.052411, psi 1.02222, omega / p 8.0901, one-cycle sine: ~990
+    impacts with theta_max / alpha 5e-5. Reported 8.3 rtol off at rtol 1e-3; auto (through
+    simulate and simulate_batch) must be within rtol of solve_ivp at rtol 1e-12 (whose own
+    spread against rtol 1e-11 is 2e-6 here, so rtol 1e-6 cannot be judged on this scene)."""
+    alpha, psi, omega = 0.052411, 1.02222, 8.0901
+    blk = rs.Block(half_diagonal=0.98105, slenderness=alpha)
+    amp = psi * G * math.tan(alpha)
+    period = 2 * math.pi / (omega * blk.frequency_parameter)
+    pulse = rs.motions.SinePulse(amp, period)
+    ref = rs.simulate(blk, pulse, method="scipy", rtol=1e-12)
+    assert not ref.overturned and ref.max_rotation / alpha < 1e-4  # the chattering scene
+    for tol in (1e-3, 1e-4):
+        res = rs.simulate(blk, pulse, method="auto", rtol=tol)
+        out = simulate_batch(
+            half_diagonal=0.98105,
+            slenderness=alpha,
+            amplitude=amp,
+            period=period,
+            method="auto",
+            rtol=tol,
+            outputs=COVERED,
+        )
+        assert res.max_rotation == pytest.approx(ref.max_rotation, rel=tol)
+        assert out["max_rotation"][0] == pytest.approx(ref.max_rotation, rel=tol)
 
 
 def test_linear_warns_where_its_bound_is_large():

@@ -8,6 +8,7 @@ import xarray as xr
 from scipy import optimize, stats
 
 from rockstudy.constants import G
+from rockstudy.study import analysis, fragility_fit
 from rockstudy.study import records_fragility as rf
 
 
@@ -218,3 +219,177 @@ def test_intensity_in_quoted_units_and_bad_names():
         rf.intensity(ds, "cav")
     with pytest.raises(ValueError, match="by must be"):
         rf.ida_fragility(ds, by="nothing")
+
+
+# ------------------------------------------------------------------ bands over theta and beta
+
+_X = 0.5 * np.exp(np.array([-2.0, 2.0]) * 0.4)  # theta e^{-+2 beta} of theta 0.5, beta 0.4
+_TRUE = stats.norm.cdf([-2.0, 2.0])
+
+
+def _coverage(tables):
+    """Share of fitted tables whose pointwise band of P holds the true P at each of _X."""
+    hits = [
+        (c.lower.values <= _TRUE) & (_TRUE <= c.upper.values)
+        for c in (analysis.fragility_curve(t, _X).isel(group=0) for t in tables)
+    ]
+    return np.mean(hits, axis=0)
+
+
+@pytest.mark.parametrize("n", [10, 30, 100])
+def test_ida_bands_of_p_cover_the_true_fragility(n):
+    # capacities drawn from the known lognormal: the 90 % pointwise bands hold the true P at
+    # theta e^{-+2 beta} at least 85 % of the time (the bands that varied theta alone at the
+    # point beta held it 54-72 % of the time)
+    rng = np.random.default_rng(100 + n)
+    tables = []
+    for _ in range(150):
+        c = 0.5 * np.exp(0.4 * rng.standard_normal(n))
+        ds = _ida_dataset((c * G)[:, None], np.ones(n), np.ones(n), [1.0], [1.0])
+        tables.append(rf.ida_fragility(ds))
+    assert tables[0].loc["all", "p_band"] == "noncentral_t"
+    assert np.all(_coverage(tables) >= 0.85)
+
+
+def test_censored_ida_bands_of_p_cover_the_true_fragility():
+    rng = np.random.default_rng(3)
+    top = 0.5 * np.exp(0.4)  # about 16 % of the blocks stand at the top of the range
+    hits = []
+    for _ in range(150):
+        c = 0.5 * np.exp(0.4 * rng.standard_normal(30))
+        cap, cens = c[c <= top], np.full((c > top).sum(), top)
+        theta, beta = rf.fit_capacities(cap, cens)
+        cov = fragility_fit.capacities_covariance(cap, cens, theta, beta)
+        lo, hi = fragility_fit.probability_band(_X, theta, beta, 30, cov, "likelihood", 0.9)
+        hits.append((lo <= _TRUE) & (_TRUE <= hi))
+    assert np.all(np.mean(hits, axis=0) >= 0.85)
+    # the IDA table of the last draw says the same through its band columns
+    ds = _ida_dataset(
+        (np.minimum(c, top) * G)[:, None],
+        np.ones(30),
+        np.ones(30),
+        [1.0],
+        [1.0],
+        (c > top)[:, None],
+    )
+    ds["capacity_scale_lower"] = ds["capacity_scale_lower"].where(~ds["censored"], top * G)
+    table = rf.ida_fragility(ds, n_boot=0)
+    assert table.loc["all", "p_band"] == "likelihood"
+    curve = analysis.fragility_curve(table, _X).isel(group=0)
+    np.testing.assert_allclose([curve.lower.values, curve.upper.values], [lo, hi], rtol=1e-6)
+
+
+def _cloud(level_g, overturned):
+    y = np.asarray(overturned, bool)[:, None]
+    return xr.Dataset(
+        {
+            "pga": ("record", np.asarray(level_g, float) * G),
+            "overturned": (("record", "structure"), y),
+            "status": (("record", "structure"), np.zeros(y.shape, np.int64)),
+        },
+        coords={"structure": [0]},
+        attrs={"design": "cloud"},
+    )
+
+
+def test_cloud_bands_of_p_cover_the_true_fragility():
+    # clouds of 40 independent records, one level each, with the outcome "capacity <= level"
+    rng = np.random.default_rng(4)
+    tables = []
+    for _ in range(150):
+        level = 0.5 * np.exp(0.4 * rng.standard_normal(40))
+        capacity = 0.5 * np.exp(0.4 * rng.standard_normal(40))
+        tables.append(rf.stripe_fragility(_cloud(level, capacity <= level), n_boot=0))
+    assert np.all(_coverage(tables) >= 0.85)
+
+
+def test_binomial_covariance_matches_the_scatter_of_the_fits():
+    # the covariance of (ln theta, ln beta) against the scatter of 300 independent refits
+    rng = np.random.default_rng(5)
+    level = 0.5 * np.exp(rng.uniform(-3, 3, 400) * 0.4)
+    fits = []
+    for _ in range(300):
+        y = rng.random(level.size) < stats.norm.cdf(np.log(level / 0.5) / 0.4)
+        fits.append(np.log(rf.fit_binomial(level, y, np.ones(level.size))))
+    cov = fragility_fit.binomial_covariance(level, np.ones(level.size), 0.5, 0.4)
+    np.testing.assert_allclose(np.cov(np.array(fits).T), cov, rtol=0.25, atol=0.1 * cov[0, 0])
+
+
+def test_stripe_covariance_is_clustered_by_record():
+    # the same outcome repeated for 4 blocks of each record: 4 times the points, no more
+    # information; the sandwich clustered by record sees it, the independent information not
+    rng = np.random.default_rng(6)
+    level = 0.5 * np.exp(0.6 * rng.standard_normal(60))
+    y = 0.5 * np.exp(0.4 * rng.standard_normal(60)) <= level
+    one = rf.stripe_fragility(_cloud(level, y), n_boot=0)
+    four = _cloud(level, y).isel(structure=[0, 0, 0, 0]).assign_coords(structure=np.arange(4))
+    rep = rf.stripe_fragility(four, n_boot=0)
+    assert rep.loc["all", "theta"] == pytest.approx(one.loc["all", "theta"], rel=1e-6)
+    assert rep.loc["all", "var_ln_theta"] == pytest.approx(
+        one.loc["all", "var_ln_theta"] * 60 / 59, rel=0.35
+    )
+
+
+def test_imefficiency_ranks_equal_measures_of_different_powers_equal():
+    # Arias intensity exactly proportional to PGA^2 over the records: the same information;
+    # ln(Arias) spreads twice as far, and beta / power ranks the two equal
+    rng = np.random.default_rng(13)
+    pga = rng.uniform(2.0, 8.0, 25)
+    ds = _ida_dataset(rng.lognormal(0.0, 0.5, (25, 1)), pga, pga / 10, [1.0], [1.0])
+    ds["arias"] = ("record", 0.03 * pga**2)
+    t = rf.im_efficiency(ds, candidates=("pga", "arias"))
+    assert t.loc[("arias", "all"), "beta"] == pytest.approx(2 * t.loc[("pga", "all"), "beta"])
+    assert t.loc[("arias", "all"), "beta_linear"] == pytest.approx(
+        t.loc[("pga", "all"), "beta_linear"], rel=1e-9
+    )
+    assert t.loc[("arias", "all"), "power"] == 2 == 2 * t.loc[("pga", "all"), "power"]
+
+
+def test_the_scaling_power_is_the_measures_own():
+    # the table against the measures of a record and of the record scaled by 3
+    from rockstudy.motions import Record
+    from rockstudy.motions.intensity import SCALING_POWER, SPECTRAL, UNITS
+
+    assert set(SCALING_POWER) == set(UNITS)
+    t = np.arange(0, 4.0, 0.01)
+    rec = Record(np.sin(2 * np.pi * t) * np.exp(-0.3 * t), dt=0.01, name="x")
+    for k, p in SCALING_POWER.items():
+        period = 0.5 if k in SPECTRAL else None
+        a = rec.intensity_measure(k, period=period)
+        b = rec.scaled(3.0).intensity_measure(k, period=period)
+        assert b == pytest.approx(3.0**p * a, rel=1e-9), k
+
+
+def test_bad_fragility_arguments_are_named():
+    ida = _ida_dataset([[1.0], [2.0], [3.0]], [G] * 3, [1.0] * 3, [1.0], [1.0])
+    cloud = _cloud([0.1, 0.2, 0.3], [0, 1, 1])
+    with pytest.raises(ValueError, match="ds: stripe_fragility needs a stripes or cloud"):
+        rf.stripe_fragility(ida)
+    with pytest.raises(ValueError, match="ds: ida_fragility needs an IDA"):
+        rf.ida_fragility(cloud)
+    with pytest.raises(ValueError, match="candidates must be a non-empty"):
+        rf.im_efficiency(ida, candidates=[])
+    with pytest.raises(ValueError, match="candidates: 'pgz' is not one of"):
+        rf.im_efficiency(ida, candidates=["pgz"])
+    for fit, ds in ((rf.ida_fragility, ida), (rf.stripe_fragility, cloud)):
+        for bad in (1.5, float("nan"), 0.0, True, "0.9"):
+            with pytest.raises(ValueError, match="conf_level must be"):
+                fit(ds, conf_level=bad)
+        for bad in (-1, 2.5, True):
+            with pytest.raises(ValueError, match="n_boot must be a non-negative integer"):
+                fit(ds, n_boot=bad)
+
+
+def test_record_designs_carry_units():
+    from rockstudy.motions import Record
+    from rockstudy.motions.intensity import UNITS
+    from rockstudy.study.records_designs import _record_dataset
+
+    t = np.arange(0, 2.0, 0.01)
+    rec = Record(np.sin(2 * np.pi * t), dt=0.01, name="x")
+    st = {"slenderness": np.array([0.2]), "uplift_acceleration": np.array([G * np.tan(0.2)])}
+    st["frequency_parameter"] = np.array([2.0])
+    ds = _record_dataset([rec], st, np.array([0.5]), 0.05)
+    for k in ("pga", "pgv", "arias", "sa", "cav"):
+        assert ds[k].attrs["units"] == UNITS[k]
+    assert ds["pga_ratio"].attrs["units"] == "1"

@@ -17,7 +17,10 @@ kernel because they hold thin safe tongues narrower than any affordable grid.
 What ``rtol`` covers (:data:`COVERED_OUTPUTS`): the relative error of the max rotation and
 the overturning decision. ``overturn_time``, ``first_impact_time`` and ``n_impacts`` are
 not bounded by the linear model's table, so ``auto`` runs the kernel on every row where a
-caller asks for them.
+caller asks for them. ``rtol`` is a measured accuracy, not a proven bound: the measurement
+against scipy's solve_ivp, its quantiles and the scenes it cannot judge (a reference that
+has not converged on chattering responses) are in docs/methods.rst
+(``benchmarks/bench_auto_vs_scipy.py``).
 """
 
 from __future__ import annotations

@@ -58,6 +58,23 @@ UNITS = {
     "sd": "m",
 }
 SPECTRAL = ("sa", "psv", "sd")
+#: name -> power k with which each measure of :data:`UNITS` follows a scale factor s of the
+#: record: IM(s a_g) = |s|^k IM(a_g). Amplitudes, spectral values, CAV and spectrum intensity
+#: are linear in the record (k = 1); Arias intensity, an integral of a_g^2, goes as s^2;
+#: durations and periods do not change (k = 0). The one place every reader takes it from.
+SCALING_POWER = {
+    "pga": 1,
+    "pgv": 1,
+    "pgd": 1,
+    "arias": 2,
+    "cav": 1,
+    "significant_duration": 0,
+    "mean_period": 0,
+    "spectrum_intensity": 1,
+    "sa": 1,
+    "psv": 1,
+    "sd": 1,
+}
 
 
 def _steps(t):

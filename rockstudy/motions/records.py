@@ -166,7 +166,7 @@ class Record(Motion):
         period, damping
             For the spectral measures: T [s] and zeta.
         """
-        if im in ("significant_duration", "mean_period"):
+        if intensity.SCALING_POWER.get(im) == 0:
             raise ValueError(f"im={im!r} does not change with a scale factor; cannot scale to it")
         value = _validate.positive("value", value)
         current = self.intensity_measure(im, period=period, damping=damping)
@@ -176,7 +176,7 @@ class Record(Motion):
                 f"so no scale factor reaches {value!r}"
             )
         ratio = value / current
-        return self.scaled(math.sqrt(ratio) if im == "arias" else ratio)
+        return self.scaled(ratio ** (1.0 / intensity.SCALING_POWER[im]))
 
     def _cached(self, key, compute):
         if key not in self._cache:

@@ -110,6 +110,7 @@ def _capacities_as_measured(table: pd.DataFrame) -> pd.DataFrame:
 
 _FRAGILITY_NAMES = {
     "theta": "median capacity",
+    "beta": "beta (MLE)",
     "theta_lo": "median capacity, lower",
     "theta_hi": "median capacity, upper",
     "beta_lo": "beta, lower",

@@ -19,9 +19,20 @@ from typing import Literal, NamedTuple
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import optimize, stats
+from scipy import special
 from scipy.spatial import cKDTree
 
+from .fragility_fit import (
+    BAND_COLUMNS,
+    binomial_covariance,
+    check_conf_level,
+    check_n_boot,
+    fit_binomial,
+    fragility_row,
+    percentile_intervals,
+    probability_band,
+    wald_intervals,
+)
 from .spec import Study
 
 FailedPolicy = Literal["error", "drop", "impute"]
@@ -149,26 +160,6 @@ def first_order_given_data(
 # ------------------------------------------------------------------------------ fragility
 
 
-def _fit_lognormal(im, y, start=None):
-    """Maximum-likelihood (theta, beta) of P = Phi(ln(im / theta) / beta), by BFGS on
-    (ln theta, ln beta) with the exact gradient of the Bernoulli log-likelihood."""
-    x = np.log(im)
-
-    def nll(q):
-        beta = np.exp(np.clip(q[1], -12.0, 6.0))
-        z = (x - q[0]) / beta
-        lp, lq, ld = stats.norm.logcdf(z), stats.norm.logsf(z), stats.norm.logpdf(z)
-        r = y * np.exp(ld - lp) - (1 - y) * np.exp(ld - lq)  # d loglik / dz (Mills ratios)
-        grad = np.array([np.sum(r) / beta, np.sum(r * z)])
-        return -np.sum(y * lp + (1 - y) * lq), grad
-
-    if start is None:
-        start = np.array([np.median(x), np.log(max(np.std(x), 0.1))])
-    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
-    with np.errstate(over="ignore"):  # a median far above the data: inf, flagged by the caller
-        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
-
-
 def fragility(
     ds: xr.Dataset,
     intensity: str,
@@ -182,6 +173,9 @@ def fragility(
 ) -> pd.DataFrame:
     """Lognormal fragility curves P(outcome | intensity) fitted by maximum likelihood.
 
+    The Bernoulli case of :func:`~rockstudy.study.fragility_fit.fit_binomial` (Baker 2015,
+    eq. 11): ``beta`` is the maximum-likelihood estimate.
+
     Parameters
     ----------
     intensity : str
@@ -191,21 +185,30 @@ def fragility(
     by : str, optional
         Fit one curve per group of this variable; with ``bins`` (edges) for continuous ones.
     n_boot : int
-        Bootstrap resamples for the confidence intervals of theta and beta.
+        Bootstrap resamples (of the samples, refitting both parameters) for the intervals of
+        theta and beta; 0 gives their Wald intervals from the information instead.
+    conf_level : float
+        Level of every band, in (0, 1).
 
     Returns
     -------
     pandas.DataFrame
-        One row per group: ``theta`` (median capacity), ``beta`` (log-standard deviation),
-        their bootstrap intervals, the number of samples ``n``, the observed intensity range
-        ``im_min``-``im_max`` of the group, and two flags: ``theta_in_range`` (the median lies
-        within the observed intensities) and ``band_in_range`` (so does its whole bootstrap
-        band). A median outside the data is an extrapolation of the lognormal shape, not a
+        One row per group: ``theta`` (median capacity), ``beta`` (log-standard deviation, the
+        MLE), their intervals, the number of samples ``n``, the observed intensity range
+        ``im_min``-``im_max`` of the group, two flags: ``theta_in_range`` (the median lies
+        within the observed intensities) and ``band_in_range`` (so does its whole band), and
+        the covariance of (ln theta, ln beta) from which :func:`fragility_curve` forms the
+        pointwise band of P over both parameters (``p_band`` "likelihood").
+        A median outside the data is an extrapolation of the lognormal shape, not a
         measurement: read it as "not reached within the sampled range" (or "below it").
         A group whose outcome never changes has no fit: its ``theta`` and band are ``inf``
         (the outcome never happened: not reached) or ``0`` (it always happened: below the
         sampled range), its ``beta`` NaN. Groups with fewer than 10 samples are left out.
     """
+    n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
+    for name in (intensity, outcome) + (() if by is None else (by,)):
+        if name not in ds:
+            raise ValueError(f"{name!r} is not a variable of the dataset")
     y, bad = _values(ds, outcome, failed)
     im = np.asarray(ds[intensity].values, float)
     keep = ~bad & np.isfinite(im) & (im > 0)
@@ -221,29 +224,10 @@ def fragility(
             groups = {v: keep & (g == v) for v in np.unique(g[keep])}
     rng = np.random.default_rng(seed)
     rows = []
-    lo_q, hi_q = 50 * (1 - conf_level), 50 * (1 + conf_level)
     for name, sel in groups.items():
         x, z = im[sel], y[sel]
-        if z.size < 10:
-            continue
-        if z.min() == z.max():  # no fit: the median lies beyond the data, on one side
-            theta = theta_lo = theta_hi = np.inf if z.max() == 0 else 0.0
-            beta = beta_lo = beta_hi = np.nan
-        else:
-            theta, beta = _fit_lognormal(x, z)
-            start = np.log([theta, beta])
-            boot = np.array(
-                [
-                    _fit_lognormal(x[k], z[k], start)
-                    for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
-                ]
-            )
-            # percentiles at bootstrap samples (no interpolation: an infinite median stays inf)
-            (theta_lo, beta_lo), (theta_hi, beta_hi) = np.percentile(
-                boot, [lo_q, hi_q], axis=0, method="inverted_cdf"
-            )
-        bands = ((theta_lo, theta_hi), (beta_lo, beta_hi))
-        rows.append(fragility_row(name, theta, beta, bands, z.size, x, by))
+        if z.size >= 10:
+            rows.append(_bernoulli_row(name, x, z, by, n_boot, conf_level, rng))
     if not rows:
         raise ValueError(
             f"no group has 10 samples with a finite, positive {intensity!r}: "
@@ -252,41 +236,60 @@ def fragility(
     return pd.DataFrame(rows).set_index(by or "group")
 
 
-def fragility_row(label, theta, beta, band, n, im, by=None) -> dict:
-    """One row of a fragility table: the fit, its bands, the sample count, the observed
-    intensity range of ``im`` and whether the median (``theta_in_range``) and its whole band
-    (``band_in_range``) lie inside it. ``band`` is ((theta_lo, theta_hi), (beta_lo, beta_hi))."""
-    (theta_lo, theta_hi), (beta_lo, beta_hi) = band
-    im_min, im_max = (float(np.min(im)), float(np.max(im))) if np.size(im) else (np.nan, np.nan)
-    return {
-        by or "group": label,
-        "theta": theta,
-        "beta": beta,
-        "theta_lo": theta_lo,
-        "theta_hi": theta_hi,
-        "beta_lo": beta_lo,
-        "beta_hi": beta_hi,
-        "n": int(n),
-        "im_min": im_min,
-        "im_max": im_max,
-        "theta_in_range": bool(im_min <= theta <= im_max),
-        "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
-    }
+def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
+    """The fragility row of one group of samples: fit, intervals, covariance."""
+    ones = np.ones(z.size)
+    theta, beta = fit_binomial(x, z, ones)
+    if not np.isfinite(beta):  # no fit: the median lies beyond the data, on one side
+        band = ((theta, theta), (np.nan, np.nan))
+        return fragility_row(name, theta, beta, band, z.size, x, by, None, "none", conf_level)
+    cov = binomial_covariance(x, ones, theta, beta)
+    if n_boot:
+        start = np.log([theta, beta])
+        boot = np.array(
+            [
+                fit_binomial(x[k], z[k], ones, start)
+                for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
+            ]
+        )
+        band = percentile_intervals(boot, conf_level)
+    else:
+        band = wald_intervals(theta, beta, cov, conf_level)
+    return fragility_row(name, theta, beta, band, z.size, x, by, cov, "likelihood", conf_level)
 
 
 def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:
-    """Evaluate fitted fragility curves (and their theta bands) at intensities ``im``."""
+    """Evaluate fitted fragility curves at intensities ``im``, with pointwise bands of P.
+
+    The bands vary both theta and beta: the method and level are the table's (``p_band``,
+    ``conf_level``; see :func:`~rockstudy.study.fragility_fit.probability_band`). A group
+    without a fit (beta NaN) gives NaN.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``probability``, ``lower`` and ``upper`` on (``group``, ``intensity``).
+    """
+    missing = [c for c in ("theta", "beta", "n", *BAND_COLUMNS) if c not in table]
+    if missing:
+        raise ValueError(f"table: not a fragility table (no columns {missing})")
     im = np.asarray(im, float)
-    # an infinite band limit (not reached) gives P = 0; a group without a fit (beta NaN), NaN
+    p, lower, upper = [], [], []
     with np.errstate(divide="ignore", invalid="ignore"):
-        p = {
-            k: np.array(
-                [stats.norm.cdf(np.log(im / r[t]) / r["beta"]) for _, r in table.iterrows()]
-            )
-            for k, t in (("probability", "theta"), ("lower", "theta_hi"), ("upper", "theta_lo"))
-        }
+        for _, r in table.iterrows():
+            cov = [
+                [r.var_ln_theta, r.cov_ln_theta_ln_beta],
+                [r.cov_ln_theta_ln_beta, r.var_ln_beta],
+            ]
+            lo, hi = probability_band(im, r.theta, r.beta, r.n, cov, r.p_band, r.conf_level)
+            p.append(special.ndtr(np.log(im / r.theta) / r.beta))
+            lower.append(lo)
+            upper.append(hi)
     coords = {"group": table.index.astype(str).values, "intensity": im}
-    return xr.Dataset({k: (("group", "intensity"), v) for k, v in p.items()}, coords=coords)
+    dims = ("group", "intensity")
+    return xr.Dataset(
+        {"probability": (dims, p), "lower": (dims, lower), "upper": (dims, upper)}, coords=coords
+    )
 
 
 # ------------------------------------------------------------------------------ collapse

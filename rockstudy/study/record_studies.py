@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ..motions.intensity import UNITS
+from ..motions.intensity import SCALING_POWER, UNITS
 from ..motions.suites import read_pair
 from . import records_designs as rd
 from .feasibility import record_pairs
@@ -380,8 +380,9 @@ def _uplift(ds):
 # ------------------------------------------------------------------ Monte Carlo rows
 
 
-#: Measures that scale as |scale| (the others: Arias as scale^2; durations and periods not).
-_LINEAR = ("pga", "pgv", "pgd", "cav", "spectrum_intensity", "pulse_amplitude")
+#: power of |scale| with which each stored measure follows the scale factor: the measures' own
+#: (:data:`~rockstudy.motions.intensity.SCALING_POWER`), and those of the velocity pulse.
+_POWER = {**SCALING_POWER, "pulse_amplitude": 1, "pulse_period": 0, "pulse_indicator": 0}
 
 
 def sample_outputs(study) -> dict:
@@ -412,8 +413,7 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     s = np.abs(np.asarray(scale, float))
     out = {}
     for k, v in ims.items():
-        factor = s if k in _LINEAR else s * s if k == "arias" else np.ones_like(s)
-        out[k] = float(v) * factor
+        out[k] = float(v) * s ** _POWER[k]
     w_p = 2.0 * np.pi / pulse.period if pulse.amplitude > 0 else np.nan
     out["pga_ratio"] = out["pga"] / uplift
     out["pgv_ratio"] = out["pgv"] * frequency_parameter / uplift

@@ -149,7 +149,7 @@ def _record_measure(record, im, period, damping, structures):
 def _scale_for(level, measure, im):
     """Scale factor(s) that bring ``measure`` to ``level`` (Arias goes as the square)."""
     ratio = level / measure
-    return np.sqrt(ratio) if im == "arias" else ratio
+    return ratio ** (1.0 / _im.SCALING_POWER[DIMENSIONLESS.get(im, im)])
 
 
 # ------------------------------------------------------------------------------ tables
@@ -185,6 +185,16 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     ds["pgv_ratio"] = ds["pgv"] * p / up
     ds["pulse_frequency_ratio"] = w_p / p
     ds["pulse_amplitude_ratio"] = w_p * ds["pulse_amplitude"] / up
+    ratios = ("pga_ratio", "pgv_ratio", "pulse_frequency_ratio", "pulse_amplitude_ratio")
+    units = {
+        **_im.UNITS,
+        "pulse_period": "s",
+        "pulse_amplitude": "m/s",
+        **dict.fromkeys(ratios, "1"),
+    }
+    for k, unit in units.items():  # every intensity measure carries its units
+        if k in ds:
+            ds[k].attrs["units"] = unit
     return ds
 
 
@@ -529,10 +539,14 @@ def incremental_dynamic_analysis(
     measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
     results = [_ida_record(r, st, options, method, rtol, max_steps) for r in records]
     ds = _ida_tables(ds, results)
-    power = 2.0 if im == "arias" else 1.0
+    power = _im.SCALING_POWER[DIMENSIONLESS.get(im, im)]
     ds["capacity"] = (
         ("record", "structure"),
         np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** power),
+        {
+            "units": "1" if im in DIMENSIONLESS else _im.UNITS[im],
+            "long_name": f"overturning {im} (first overturning level)",
+        },
     )
     ds["censored_reason"].attrs.update(
         flag_values=list(CENSORED_REASONS), flag_meanings=list(CENSORED_REASONS.values())

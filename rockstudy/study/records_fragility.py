@@ -19,10 +19,33 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy import optimize, special, stats
+from scipy import stats
 
 from ..constants import G
-from .analysis import fragility_row
+from ..motions.intensity import SCALING_POWER
+from .fragility_fit import (
+    binomial_covariance,
+    capacities_covariance,
+    check_conf_level,
+    check_n_boot,
+    fit_binomial,
+    fit_capacities,
+    fragility_row,
+    percentile_intervals,
+    wald_intervals,
+)
+
+__all__ = [
+    "DEFAULT_CANDIDATES",
+    "POWER",
+    "QUOTED_UNITS",
+    "fit_binomial",
+    "fit_capacities",
+    "ida_fragility",
+    "im_efficiency",
+    "intensity",
+    "stripe_fragility",
+]
 
 #: measure -> (quoted unit, factor from SI to it).
 QUOTED_UNITS = {
@@ -39,8 +62,15 @@ QUOTED_UNITS = {
     "pgv_ratio": ("-", 1.0),
     "pulse_amplitude_ratio": ("-", 1.0),
 }
+#: measure -> power with which it follows a scale factor of the record: the measures'
+#: own (:data:`rockstudy.motions.intensity.SCALING_POWER`); a ratio follows its measure.
+POWER = {
+    **{k: v for k, v in SCALING_POWER.items() if k in QUOTED_UNITS},
+    "pga_ratio": SCALING_POWER["pga"],
+    "pgv_ratio": SCALING_POWER["pgv"],
+    "pulse_amplitude_ratio": 1,  # omega_p A_p / (g tan alpha), A_p linear in the record
+}
 _SPECTRAL = ("sa", "psv", "sd")
-_LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: candidates of :func:`im_efficiency` (with ``sa`` at every stored period).
 DEFAULT_CANDIDATES = (
     "pga",
@@ -58,7 +88,8 @@ def intensity(ds: xr.Dataset, im: str, period=None, scale: str = "scale") -> xr.
     """The intensity measure ``im`` of each simulated point of a record design, in quoted units.
 
     The unscaled record's value (``ds[im]``, per record or per record and structure) times the
-    scale factor ``ds[scale]`` (squared for Arias intensity); for a cloud (no scale variable),
+    scale factor ``ds[scale]`` to the measure's power (:data:`POWER`: squared for Arias
+    intensity); for a cloud (no scale variable),
     the unscaled value. ``scale="capacity_scale"`` gives the IDA capacities in ``im``.
 
     Parameters
@@ -89,108 +120,12 @@ def intensity(ds: xr.Dataset, im: str, period=None, scale: str = "scale") -> xr.
         base = ds[im]
     value = base * factor
     if scale in ds:
-        value = value * ds[scale] ** (2.0 if im == "arias" else 1.0)
-    return value.rename(im).assign_attrs(unit=unit)
+        value = value * ds[scale] ** POWER[im]
+    return value.rename(im).assign_attrs(unit=unit, units=unit)
 
 
 def _label(im, period):
     return im if period is None else f"{im}(T={float(period):g} s)"
-
-
-# ------------------------------------------------------------------------------ fits
-
-
-def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
-    """Maximum-likelihood lognormal fragility of stripe data, eq. (11) of Baker (2015).
-
-    .. math:: \\max_{\\theta, \\beta} \\sum_j \\ln \\binom{n_j}{z_j}
-              + z_j \\ln \\Phi(\\ln(x_j / \\theta) / \\beta)
-              + (n_j - z_j) \\ln[1 - \\Phi(\\ln(x_j / \\theta) / \\beta)]
-
-    Parameters
-    ----------
-    im : array_like
-        Intensity levels x_j (> 0); single points (``n_total`` 1) make it the Bernoulli fit of
-        a cloud.
-    n_overturned, n_total : array_like
-        z_j overturned out of n_j.
-
-    Returns
-    -------
-    (theta, beta)
-        Median capacity in the units of ``im``, and dispersion. ``inf``/NaN or 0/NaN when the
-        outcome never or always happened (no fit).
-    """
-    x = np.log(np.asarray(im, float))
-    z = np.asarray(n_overturned, float)
-    n = np.asarray(n_total, float)
-    if not (x.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
-        raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
-    n_sum = n.sum()
-    if z.sum() == 0:
-        return np.inf, np.nan
-    if z.sum() == n.sum():
-        return 0.0, np.nan
-
-    def nll(q):
-        beta = np.exp(np.clip(q[1], -12.0, 6.0))
-        u = (x - q[0]) / beta
-        lp, lq, ld = special.log_ndtr(u), special.log_ndtr(-u), -0.5 * u * u - _LOG_SQRT_2PI
-        r = (z * np.exp(ld - lp) - (n - z) * np.exp(ld - lq)) / n_sum  # d loglik / du, per trial
-        return -np.sum(z * lp + (n - z) * lq) / n_sum, np.array([np.sum(r) / beta, np.sum(r * u)])
-
-    if start is None:
-        w = n / n.sum()
-        sd = np.sqrt(np.sum(w * (x - np.sum(w * x)) ** 2))
-        start = np.array([np.sum(w * x), np.log(max(sd, 0.1))])
-    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
-    with np.errstate(over="ignore"):
-        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
-
-
-def fit_capacities(capacities, censored_at=None, start=None) -> tuple[float, float]:
-    """Maximum-likelihood lognormal fit of IDA capacities.
-
-    Without censoring it is closed form: ln theta = mean(ln c), beta = std(ln c) (the MLE,
-    dividing by n). Capacities censored at ``censored_at`` (the block stood up to that level)
-    enter through the survival function, and the fit is numerical:
-
-    .. math:: \\max \\sum_{uncensored} \\ln \\phi(u_i) - \\ln\\beta
-              + \\sum_{censored} \\ln[1 - \\Phi(u_k)], \\quad u = (\\ln c - \\ln\\theta) / \\beta
-
-    ``start`` = (ln theta, ln beta) starts the numerical fit (default: the uncensored fit).
-
-    Returns
-    -------
-    (theta, beta)
-        ``inf``/NaN if every capacity is censored; NaN if fewer than 2 are not.
-    """
-    c = np.log(np.asarray(capacities, float))
-    cens = np.log(np.asarray([] if censored_at is None else censored_at, float))
-    if c.size + cens.size == 0:
-        raise ValueError("capacities: no capacity to fit")
-    if c.size == 0:
-        return np.inf, np.nan
-    if c.size < 2:
-        return float(np.exp(c[0])) if not cens.size else np.nan, np.nan
-    mu, beta = float(np.mean(c)), float(np.std(c))
-    if not cens.size:
-        return float(np.exp(mu)), beta
-
-    def nll(q):  # q = (ln theta, ln beta), with the exact gradient
-        b = np.exp(q[1])
-        u, v = (c - q[0]) / b, (cens - q[0]) / b
-        ls = special.log_ndtr(-v)
-        h = np.exp(-0.5 * v * v - _LOG_SQRT_2PI - ls)  # hazard of the censored terms
-        m = u.size + v.size  # mean over the points: a gradient tolerance independent of n
-        f = -(np.sum(-0.5 * u * u - q[1]) + np.sum(ls)) / m
-        grad = -np.array([(np.sum(u) + np.sum(h)) / b, np.sum(u * u - 1.0) + np.sum(h * v)]) / m
-        return f, grad
-
-    start = [mu, np.log(max(beta, 0.05))] if start is None else start
-    res = optimize.minimize(nll, start, jac=True, method="BFGS", options={"gtol": 1e-9})
-    with np.errstate(over="ignore"):
-        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
 
 
 # ------------------------------------------------------------------------------ tables
@@ -212,15 +147,33 @@ def _groups(ds, by, bins):
     return {f"{bins[i - 1]:g}-{bins[i]:g}": idx == i for i in range(1, len(bins))}
 
 
-def _row(label, theta, beta, band, n, x, unit, by):
-    return {**fragility_row(label, theta, beta, band, n, x, by), "unit": unit}
+def _row(label, theta, beta, band, n, x, unit, by, cov, method, conf_level):
+    row = fragility_row(label, theta, beta, band, n, x, by, cov, method, conf_level)
+    return {**row, "unit": unit}
 
 
-def _percentiles(boot, conf_level):
-    q = [50 * (1 - conf_level), 50 * (1 + conf_level)]
-    with np.errstate(invalid="ignore"):
-        (t_lo, b_lo), (t_hi, b_hi) = np.percentile(boot, q, axis=0, method="inverted_cdf")
-    return (t_lo, t_hi), (b_lo, b_hi)
+def _check(ds, design, conf_level, n_boot):
+    """Validated (conf_level, n_boot); a ValueError if ``ds`` is not of the ``design`` kind."""
+    conf_level, n_boot = check_conf_level(conf_level), check_n_boot(n_boot)
+    kind = ds.attrs.get("design")
+    if design == "ida" and kind != "ida":
+        raise ValueError(
+            f"ds: ida_fragility needs an IDA dataset (design 'ida'), got design {kind!r}; "
+            "use stripe_fragility for stripes and clouds"
+        )
+    if design != "ida" and (kind == "ida" or "overturned" not in ds):
+        raise ValueError(
+            f"ds: stripe_fragility needs a stripes or cloud dataset (with 'overturned'), got "
+            f"design {kind!r}; use ida_fragility for an IDA"
+        )
+    return conf_level, n_boot
+
+
+def _measure(ds, im, period):
+    im = ds.attrs.get("im", "pga") if im is None else im
+    if period is None and im in _SPECTRAL and np.isfinite(ds.attrs.get("im_period", np.nan)):
+        period = ds.attrs["im_period"]
+    return im, period
 
 
 def stripe_fragility(
@@ -235,6 +188,12 @@ def stripe_fragility(
 ) -> pd.DataFrame:
     """Lognormal fragility of a stripe (or cloud) design by the binomial MLE (Baker 2015).
 
+    ``beta`` is the maximum-likelihood estimate. The pointwise band of P(x)
+    (:func:`~rockstudy.study.analysis.fragility_curve`) comes from the covariance of
+    (ln theta, ln beta): the expected information where each record gives one point (a cloud
+    of one block), else the sandwich clustered by record (a record's points are not
+    independent); see :mod:`rockstudy.study.fragility_fit`.
+
     Parameters
     ----------
     ds : xarray.Dataset
@@ -247,37 +206,48 @@ def stripe_fragility(
         One curve per ``structure``, per value of a variable on ``structure`` (e.g.
         ``half_diagonal``), or per bin of it (edges); default one curve for all.
     n_boot, conf_level, seed
-        Bands of theta and beta by resampling records (with replacement).
+        Intervals of theta and beta by resampling records (with replacement) and refitting
+        both; ``n_boot=0`` gives their Wald intervals instead. ``conf_level`` in (0, 1).
 
     Returns
     -------
     pandas.DataFrame
-        One row per group: ``theta`` [quoted unit], ``beta``, their bands, ``n`` (points),
-        ``im_min``, ``im_max``, ``theta_in_range``, ``band_in_range`` and ``unit``. Points that
-        failed (``status`` != 0) or have no finite intensity are left out.
+        One row per group: ``theta`` [quoted unit], ``beta``, their intervals, ``n``
+        (points), ``im_min``, ``im_max``, ``theta_in_range``, ``band_in_range``, the band
+        columns of :func:`~rockstudy.study.fragility_fit.fragility_row` and ``unit``. Points
+        that failed (``status`` != 0) or have no finite intensity are left out.
     """
-    im = ds.attrs.get("im", "pga") if im is None else im
-    if period is None and im in _SPECTRAL and np.isfinite(ds.attrs.get("im_period", np.nan)):
-        period = ds.attrs["im_period"]
+    conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
+    im, period = _measure(ds, im, period)
     x_all = intensity(ds, im, period).broadcast_like(ds["overturned"])
     dims = ds["overturned"].dims
     x_all = x_all.transpose(*dims).values
-    y_all = ds["overturned"].values.astype(float)
+    y_all = ds["overturned"].transpose(*dims).values.astype(float)
     ok = np.isfinite(x_all) & (x_all > 0) & (ds["status"].transpose(*dims).values == 0)
+    record = np.broadcast_to(
+        np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (len(dims) - 1)), x_all.shape
+    )
     unit = QUOTED_UNITS[im][0]
     rng = np.random.default_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
     for label, mask in _groups(ds, by, bins).items():
-        x, y, keep = x_all[:, mask], y_all[:, mask], ok[:, mask]
-        fit = fit_binomial(x[keep], y[keep], np.ones(int(keep.sum())))
-        boot = []
-        for _ in range(n_boot if np.isfinite(fit[1]) else 0):
-            k = rng.integers(0, n_rec, n_rec)
-            kk = keep[k]
-            boot.append(fit_binomial(x[k][kk], y[k][kk], np.ones(int(kk.sum())), start=np.log(fit)))
-        band = _percentiles(np.array(boot), conf_level) if boot else ((fit[0],) * 2, (np.nan,) * 2)
-        rows.append(_row(label, *fit, band, keep.sum(), x[keep], unit, by))
+        x, y, keep, rec = x_all[:, mask], y_all[:, mask], ok[:, mask], record[:, mask]
+        ones = np.ones(int(keep.sum()))
+        fit = fit_binomial(x[keep], y[keep], ones)
+        cov = binomial_covariance(x[keep], ones, *fit, y[keep], rec[keep])
+        if not np.isfinite(fit[1]):
+            band, method = ((fit[0],) * 2, (np.nan,) * 2), "none"
+        elif n_boot:
+            boot = []
+            for _ in range(n_boot):
+                k = rng.integers(0, n_rec, n_rec)
+                kk = keep[k]
+                boot.append(fit_binomial(x[k][kk], y[k][kk], np.ones(int(kk.sum())), np.log(fit)))
+            band, method = percentile_intervals(np.array(boot), conf_level), "likelihood"
+        else:
+            band, method = wald_intervals(*fit, cov, conf_level), "likelihood"
+        rows.append(_row(label, *fit, band, keep.sum(), x[keep], unit, by, cov, method, conf_level))
     return pd.DataFrame(rows).set_index(by or "group")
 
 
@@ -286,6 +256,15 @@ def _fit_records(cap, top, censored, keep, rows, start=None):
     arrays: capacities where not censored, censoring levels where censored."""
     kk, cc = keep[rows], censored[rows]
     return fit_capacities(cap[rows][kk & ~cc], top[rows][kk & cc], start)
+
+
+def _exact_intervals(theta, beta, n, conf_level):
+    """Intervals of theta and beta of n uncensored capacities, on the MLE beta:
+    ln theta +- t_{n-1} beta / sqrt(n - 1), and sigma from n beta^2 / sigma^2 ~ chi2_{n-1}
+    (the same as with the n - 1 standard deviation s: n beta^2 = (n - 1) s^2)."""
+    half = stats.t.ppf(0.5 + conf_level / 2, n - 1) * beta / np.sqrt(n - 1)
+    chi = stats.chi2.ppf([0.5 + conf_level / 2, 0.5 - conf_level / 2], n - 1)
+    return (theta * np.exp(-half), theta * np.exp(half)), tuple(beta * np.sqrt(n / chi))
 
 
 def ida_fragility(
@@ -300,19 +279,22 @@ def ida_fragility(
 ) -> pd.DataFrame:
     """Lognormal fit of IDA capacities (first overturning levels) in any stored measure.
 
-    Without censored capacities the fit is closed form (:func:`fit_capacities`) and so are its
-    bands: ln theta +- t_{n-1} s / sqrt(n), and beta from the chi-square interval of the
-    variance (s the standard deviation with n - 1). With censored capacities (blocks still
-    standing at the top of the range) the fit is the censored MLE and the bands come from
-    resampling records. The fragility reads P(first overturning at or below x); a block that
+    ``beta`` is the maximum-likelihood estimate: without censored capacities, the standard
+    deviation of ln c dividing by n (:func:`fit_capacities`); every band is built on it.
+    Without censoring the bands are exact: ln theta +- t_{n-1} beta / sqrt(n - 1), beta from
+    the chi-square interval of n beta^2 / sigma^2, and the pointwise band of P(x) from the
+    noncentral t (``p_band`` "noncentral_t"). With censored capacities (blocks still standing
+    at the top of the range) the fit is the censored MLE, the intervals of theta and beta
+    come from resampling records (``n_boot=0``: Wald intervals) and the band of P(x) from
+    the observed information (``p_band`` "likelihood"). The capacities are treated as
+    independent. The fragility reads P(first overturning at or below x); a block that
     resurrects above it is counted as overturned (see ``resurrection`` in the dataset).
 
     Parameters and returns as in :func:`stripe_fragility` (``n`` counts capacities, censored
     ones included; ``im_min``/``im_max`` span capacities and censoring levels).
     """
-    im = ds.attrs.get("im", "pga") if im is None else im
-    if period is None and im in _SPECTRAL and np.isfinite(ds.attrs.get("im_period", np.nan)):
-        period = ds.attrs["im_period"]
+    conf_level, n_boot = _check(ds, "ida", conf_level, n_boot)
+    im, period = _measure(ds, im, period)
     cap = intensity(ds, im, period, scale="capacity_scale").transpose("record", "structure").values
     top = intensity(ds, im, period, scale="capacity_scale_lower")
     top = top.transpose("record", "structure").values
@@ -327,74 +309,95 @@ def ida_fragility(
     rows = []
     for label, mask in _groups(ds, by, bins).items():
         c, t, cens, keep = cap[:, mask], top[:, mask], cens_all[:, mask], ok[:, mask]
-
         theta, beta = _fit_records(c, t, cens, keep, slice(None))
+        cov = capacities_covariance(c[keep & ~cens], t[keep & cens], theta, beta)
         n_unc = int((keep & ~cens).sum())
-        if not cens[keep].any() and n_unc >= 2:
-            s = np.std(np.log(c[keep]), ddof=1)
-            half = stats.t.ppf(0.5 + conf_level / 2, n_unc - 1) * s / np.sqrt(n_unc)
-            chi = stats.chi2.ppf([0.5 + conf_level / 2, 0.5 - conf_level / 2], n_unc - 1)
-            band = (
-                (theta * np.exp(-half), theta * np.exp(half)),
-                tuple(np.sqrt((n_unc - 1) * s**2 / chi)),
-            )
-        elif np.isfinite(beta):
+        if not cens[keep].any() and n_unc >= 2 and beta > 0:
+            band, method = _exact_intervals(theta, beta, n_unc, conf_level), "noncentral_t"
+        elif not np.isfinite(beta):
+            band, method = ((theta, theta), (np.nan, np.nan)), "none"
+        elif n_boot:
             boot = [
                 _fit_records(c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta]))
                 for _ in range(n_boot)
             ]
-            band = _percentiles(np.array(boot), conf_level)
+            band, method = percentile_intervals(np.array(boot), conf_level), "likelihood"
         else:
-            band = (theta, theta), (np.nan, np.nan)
+            band, method = wald_intervals(theta, beta, cov, conf_level), "likelihood"
         x = np.where(cens, t, c)[keep]
-        rows.append(_row(label, theta, beta, band, keep.sum(), x, unit, by))
+        rows.append(
+            _row(label, theta, beta, band, keep.sum(), x, unit, by, cov, method, conf_level)
+        )
     return pd.DataFrame(rows).set_index(by or "group")
 
 
-def im_efficiency(
-    ds: xr.Dataset, candidates=DEFAULT_CANDIDATES, by=None, bins=None, n_boot: int = 100, **kw
-) -> pd.DataFrame:
-    """Which intensity measure predicts overturning best: the dispersion beta of each.
-
-    The smaller beta, the more efficient the measure (the less record-to-record scatter of the
-    overturning intensity). For an IDA the betas are those of the capacities expressed in each
-    measure (:func:`ida_fragility`); for stripes or a cloud, those of the binomial fit against
-    each measure (:func:`stripe_fragility`). Pooled over all structures by default: within one
-    block, a dimensional measure and its dimensionless ratio differ by a constant and share
-    their beta; across blocks of different sizes and slenderness only the groups of [000]
-    can collapse the capacities.
-
-    Parameters
-    ----------
-    candidates : sequence
-        Measure names (``"sa"`` expands to every stored period) or ``(name, period)`` pairs.
-    by, bins, n_boot, kw
-        Passed to the fit (``n_boot`` resamples for the bands, where they are bootstrapped).
-
-    Returns
-    -------
-    pandas.DataFrame
-        Index (``im``, ``group``), sorted by beta within each group; columns of the fit and
-        ``dimensionless``.
-    """
-    fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
+def _specs(ds, candidates):
+    """(name, period) of each candidate measure; a ValueError for none or an unknown one."""
+    if isinstance(candidates, str) or len(candidates) == 0:
+        raise ValueError(
+            f"candidates must be a non-empty sequence of measures of {sorted(QUOTED_UNITS)} "
+            f"or (name, period) pairs, got {candidates!r}"
+        )
     specs = []
     for c in candidates:
         if isinstance(c, tuple):
             specs.append(c)
         elif c in _SPECTRAL:
             specs.extend((c, float(t)) for t in np.asarray(ds["period"].values, float))
-        else:
+        elif c in QUOTED_UNITS:
             specs.append((c, None))
+        else:
+            raise ValueError(f"candidates: {c!r} is not one of {sorted(QUOTED_UNITS)}")
+    return specs
+
+
+def im_efficiency(
+    ds: xr.Dataset, candidates=DEFAULT_CANDIDATES, by=None, bins=None, n_boot: int = 100, **kw
+) -> pd.DataFrame:
+    """Which intensity measure predicts overturning best: the dispersion of each, per power.
+
+    A measure that goes as the k-th power of a scale factor of the record (:data:`POWER`:
+    Arias intensity k = 2) has, for the same information, k times the dispersion of one that
+    goes linearly: IM^(1/k) is an equally informative, linear measure, and the fragility
+    against it has exactly beta / k. So measures are compared by ``beta_linear`` = beta / k,
+    the dispersion of ln(IM) / k; the smaller, the more efficient (the less record-to-record
+    scatter of the overturning intensity). For an IDA the betas are those of the capacities
+    expressed in each measure (:func:`ida_fragility`); for stripes or a cloud, those of the
+    binomial fit against each measure (:func:`stripe_fragility`). Pooled over all
+    structures by default: within one block, a dimensional measure and its dimensionless
+    ratio differ by a constant and share their beta; across blocks of different sizes and
+    slenderness only the groups of [000] can collapse the capacities.
+
+    Parameters
+    ----------
+    candidates : sequence
+        Measure names (``"sa"`` expands to every stored period) or ``(name, period)`` pairs;
+        at least one.
+    by, bins, n_boot, kw
+        Passed to the fit (``n_boot`` resamples for the bands, where they are bootstrapped).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index (``im``, ``group``), sorted by ``beta_linear`` within each group; columns of
+        the fit, ``power``, ``beta_linear`` (with ``beta_linear_lo``/``_hi``) and
+        ``dimensionless``.
+    """
+    fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
     frames = []
-    for name, period in specs:
+    for name, period in _specs(ds, candidates):
         if name == "pulse_amplitude_ratio" and not np.isfinite(ds[name].values).any():
             continue  # no record has a pulse
         t = fit(ds, im=name, period=period, by=by, bins=bins, n_boot=n_boot, **kw)
         t.insert(0, "im", _label(name, period))
+        t["power"] = POWER[name]
+        for col in ("", "_lo", "_hi"):
+            t[f"beta_linear{col}"] = t[f"beta{col}"] / POWER[name]
         t["dimensionless"] = QUOTED_UNITS[name][0] == "-"
         frames.append(t.reset_index())
+    if not frames:
+        raise ValueError(f"candidates: none of {list(candidates)!r} is stored with a value")
     table = pd.concat(frames, ignore_index=True)
     group = by or "group"
-    table = table.sort_values([group, "beta"], kind="stable")
+    table = table.sort_values([group, "beta_linear"], kind="stable")
     return table.set_index(["im", group])

@@ -26,6 +26,7 @@ from ._page import (
     _plt,
     _shown,
 )
+from .fragility_fit import BAND_COLUMNS
 from .sampling import VARIABLES, target_attributes
 from .store import open_result
 
@@ -147,20 +148,27 @@ def _fragility(page, ds):
     page.figure(
         fig,
         "fragility",
-        "Lognormal fragility curves (MLE, 90 % bootstrap bands) by "
+        "Lognormal fragility curves (MLE, 90 % pointwise bands of the probability over both "
+        "the median and beta) by "
         "block size: in dimensional terms the sizes spread apart, in the groups they "
         "collapse (to the extent the groups make the response self-similar); dashed: the "
         "median lies outside the sampled intensities",
     )
     fit = pd.concat(tables)
     fit.to_csv(page.out / "fragility_fit.csv")
+    shown = _capacities_as_measured(fit).drop(columns=list(BAND_COLUMNS))
+    dimensional = (fit["intensity"] == "abs_amplitude").to_numpy()
+    shown.insert(  # g next to m/s^2
+        shown.columns.get_loc("theta") + 1,
+        "median capacity [g] (a_g only)",
+        np.where(dimensional, fit["theta"].to_numpy(float) / G, np.nan),
+    )
     page.table(
-        _capacities_as_measured(fit)
-        .replace({"intensity": _SHORT, "band": _BANDS})
-        .rename(columns=_FRAGILITY_NAMES),
+        shown.replace({"intensity": _SHORT, "band": _BANDS}).rename(columns=_FRAGILITY_NAMES),
         "fragility",
         "Fragility parameters (intensity: a_g [m/s^2] or a_g / (g tan alpha) [-]): median "
-        "capacity, its 90 % bootstrap band and the log-standard deviation beta; a median "
+        "capacity, its 90 % bootstrap band and the log-standard deviation beta (the MLE); a "
+        "median "
         f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
         f"'{NOT_REACHED}' (the fitted numbers and flags are in fragility_fit.csv)",
     )

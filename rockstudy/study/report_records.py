@@ -23,6 +23,7 @@ from . import records_fragility as rf
 from . import records_similarity as rsim
 from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
 from .analysis import fragility_curve
+from .fragility_fit import BAND_COLUMNS
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
@@ -163,6 +164,8 @@ def _record_list(page, ds):
     scalars = [k for k in _im.UNITS if k not in _im.SPECTRAL and k in ds]
     cols = {k: ds[k].values * (1.0 / G if k == "pga" else 1.0) for k in scalars}
     table = pd.DataFrame({IM_NAMES[k]: v for k, v in cols.items()}, index=_names(ds))
+    if "pga" in cols:  # g next to m/s^2
+        table.insert(table.columns.get_loc(IM_NAMES["pga"]) + 1, "PGA [m/s^2]", ds["pga"].values)
     for k, t in enumerate(np.asarray(ds["period"].values, float) if "period" in ds.coords else []):
         table[im_label("sa", t)] = ds["sa"].values[:, k] / G
     table["pulse period T_p [s]"] = ds["pulse_period"].values
@@ -217,7 +220,8 @@ def _fragility(page, ds, edges, n_boot):
     page.figure(
         fig,
         "record_fragility",
-        "Lognormal fragility curves with 90 % bands"
+        "Lognormal fragility curves with 90 % pointwise bands of the probability over both "
+        "the median and beta"
         + (" by block size" if edges is not None else "")
         + (
             ": the fit of the IDA capacities (first overturning levels)"
@@ -229,11 +233,14 @@ def _fragility(page, ds, edges, n_boot):
     fit = pd.concat(tables)
     fit.to_csv(page.out / "record_fragility_fit.csv")
     page.table(
-        _capacities_as_measured(fit).drop(columns="unit").rename(columns=_FRAGILITY_NAMES),
+        _capacities_as_measured(fit)
+        .drop(columns=["unit", *BAND_COLUMNS])
+        .rename(columns=_FRAGILITY_NAMES),
         "record_fragility",
         "Fragility parameters in each measure's units: median capacity, its 90 % band and "
-        "the log-standard deviation beta (the fitted numbers and flags are in "
-        "record_fragility_fit.csv)",
+        "the log-standard deviation beta (the maximum-likelihood estimate, dividing by n) "
+        "with its band (the fitted numbers, flags and the covariance behind the bands of the "
+        "curves are in record_fragility_fit.csv)",
     )
 
 
@@ -246,9 +253,11 @@ def _efficiency(page, ds, n_boot):
         rows.append(
             {
                 "intensity measure": im_label(name, period),
+                "dispersion per power beta / k [-]": r["beta_linear"],
+                "beta / k, lower": r["beta_linear_lo"],
+                "beta / k, upper": r["beta_linear_hi"],
+                "power k": int(r["power"]),
                 "dispersion beta [-]": r["beta"],
-                "beta, lower": r["beta_lo"],
-                "beta, upper": r["beta_hi"],
                 "median capacity": r["theta"],
                 "points": int(r["n"]),
                 "dimensionless": bool(r["dimensionless"]),
@@ -257,9 +266,11 @@ def _efficiency(page, ds, n_boot):
     page.table(
         pd.DataFrame(rows).set_index("intensity measure"),
         "im_efficiency",
-        "Which measure predicts overturning best: the dispersion beta of the fragility "
-        "against each measure, pooled over all blocks (smaller is better; 90 % bands), "
-        "dimensional and dimensionless",
+        "Which measure predicts overturning best: the dispersion beta (MLE) of the fragility "
+        "against each measure divided by the power k with which the measure follows a scale "
+        "factor of the record (Arias intensity k = 2: its k-th root is as informative and "
+        "linear), pooled over all blocks (smaller is better; 90 % bands), dimensional and "
+        "dimensionless",
     )
 
 

@@ -1,0 +1,316 @@
+"""Lognormal fragility fits, shared by the Monte Carlo analyses
+(:func:`rockstudy.study.analysis.fragility`) and the record designs
+(:mod:`rockstudy.study.records_fragility`), and pointwise bands of the fitted curve.
+
+A lognormal fragility is P(x) = Phi(ln(x / theta) / beta): theta the median capacity, beta the
+dispersion. **beta is the maximum-likelihood estimate everywhere**: for capacities (IDA), the
+standard deviation of ln c dividing by n, not n - 1; for outcomes (stripes, clouds, Monte Carlo
+samples), the binomial MLE of Baker (2015), eq. (11). Every band is built on the same estimate.
+
+Pointwise bands of P(x) vary **both** parameters (a band that moves theta alone and keeps the
+point beta is far too narrow in the tails, where the uncertainty of beta dominates):
+
+- ``"likelihood"`` (outcomes, and censored capacities): the Wald interval of the probit
+  u(x) = ln(x / theta) / beta, var u = g' C g with g = du / d(ln theta, ln beta) =
+  (-1 / beta, -u) and C the inverse information of (ln theta, ln beta) (the expected
+  information of the binomial likelihood; the observed information of the censored one);
+  the band is Phi(u -+ z se(u)), z the normal quantile of the level.
+- ``"noncentral_t"`` (uncensored capacities): exact. With s the standard deviation of ln c
+  (n - 1) and u = (ln x - mu) / sigma, sqrt(n) (ln x - mean ln c) / s follows the noncentral
+  t with n - 1 degrees of freedom and noncentrality sqrt(n) u (Owen 1968, sec. 3); inverting
+  it in the noncentrality gives the band of Phi(u) at every x with the nominal coverage.
+
+Measured coverage of the 90 % bands of the true P at x = theta e^{+-2 beta}:
+``benchmarks/bench_fragility_coverage.py``.
+
+Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural
+analysis. Earthquake Spectra 31(1), 579-599.
+Owen, D. B. (1968). A survey of properties and applications of the noncentral
+t-distribution. Technometrics 10(3), 445-478.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+from scipy import optimize, special
+
+_LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
+#: how the pointwise band of P(x) of a fitted row is formed (see the module docstring).
+BAND_METHODS = ("likelihood", "noncentral_t", "none")
+
+
+def check_conf_level(conf_level) -> float:
+    """``conf_level`` as a float strictly between 0 and 1, or a ValueError naming it."""
+    if isinstance(conf_level, bool) or not isinstance(conf_level, numbers.Real):
+        raise ValueError(f"conf_level must be a number in (0, 1), got {conf_level!r}")
+    if not 0.0 < float(conf_level) < 1.0:  # NaN fails too
+        raise ValueError(f"conf_level must be in (0, 1), got {conf_level!r}")
+    return float(conf_level)
+
+
+def check_n_boot(n_boot) -> int:
+    """``n_boot`` as a non-negative integer, or a ValueError naming it."""
+    if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or n_boot < 0:
+        raise ValueError(f"n_boot must be a non-negative integer, got {n_boot!r}")
+    return int(n_boot)
+
+
+# ------------------------------------------------------------------------------ fits
+
+
+def _binomial_nll(q, x, z, n):
+    """Negative binomial log-likelihood per trial of q = (ln theta, ln beta), and its exact
+    gradient (through the Mills ratios)."""
+    beta = np.exp(np.clip(q[1], -12.0, 6.0))
+    u = (x - q[0]) / beta
+    lp, lq, ld = special.log_ndtr(u), special.log_ndtr(-u), -0.5 * u * u - _LOG_SQRT_2PI
+    m = n.sum()
+    r = (z * np.exp(ld - lp) - (n - z) * np.exp(ld - lq)) / m  # d loglik / du, per trial
+    return -np.sum(z * lp + (n - z) * lq) / m, np.array([np.sum(r) / beta, np.sum(r * u)])
+
+
+def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
+    """Maximum-likelihood lognormal fragility of outcome data, eq. (11) of Baker (2015).
+
+    .. math:: \\max_{\\theta, \\beta} \\sum_j \\ln \\binom{n_j}{z_j}
+              + z_j \\ln \\Phi(\\ln(x_j / \\theta) / \\beta)
+              + (n_j - z_j) \\ln[1 - \\Phi(\\ln(x_j / \\theta) / \\beta)]
+
+    Parameters
+    ----------
+    im : array_like
+        Intensity levels x_j (> 0); single points (``n_total`` 1) make it the Bernoulli fit of
+        a cloud or of Monte Carlo samples.
+    n_overturned, n_total : array_like
+        z_j overturned out of n_j.
+    start : array_like, optional
+        (ln theta, ln beta) to start from.
+
+    Returns
+    -------
+    (theta, beta)
+        Median capacity in the units of ``im``, and dispersion (the MLE). ``inf``/NaN or
+        0/NaN when the outcome never or always happened (no fit).
+    """
+    x = np.log(np.asarray(im, float))
+    z = np.asarray(n_overturned, float)
+    n = np.asarray(n_total, float)
+    if not (x.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
+        raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
+    if z.sum() == 0:
+        return np.inf, np.nan
+    if z.sum() == n.sum():
+        return 0.0, np.nan
+    if start is None:
+        w = n / n.sum()
+        sd = np.sqrt(np.sum(w * (x - np.sum(w * x)) ** 2))
+        start = np.array([np.sum(w * x), np.log(max(sd, 0.1))])
+    res = optimize.minimize(
+        _binomial_nll, start, args=(x, z, n), jac=True, method="BFGS", options={"gtol": 1e-9}
+    )
+    with np.errstate(over="ignore"):  # a median far above the data: inf, flagged by callers
+        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+
+
+def _censored_nll(q, c, cens):
+    """Negative log-likelihood per point of q = (ln theta, ln beta) for log capacities ``c``
+    and log censoring levels ``cens``, with its exact gradient."""
+    b = np.exp(q[1])
+    u, v = (c - q[0]) / b, (cens - q[0]) / b
+    ls = special.log_ndtr(-v)
+    h = np.exp(-0.5 * v * v - _LOG_SQRT_2PI - ls)  # hazard of the censored terms
+    m = u.size + v.size  # mean over the points: a gradient tolerance independent of n
+    f = -(np.sum(-0.5 * u * u - q[1]) + np.sum(ls)) / m
+    grad = -np.array([(np.sum(u) + np.sum(h)) / b, np.sum(u * u - 1.0) + np.sum(h * v)]) / m
+    return f, grad
+
+
+def fit_capacities(capacities, censored_at=None, start=None) -> tuple[float, float]:
+    """Maximum-likelihood lognormal fit of IDA capacities.
+
+    Without censoring it is closed form: ln theta = mean(ln c), beta = std(ln c), the MLE
+    (dividing by n). Capacities censored at ``censored_at`` (the block stood up to that level)
+    enter through the survival function, and the fit is numerical:
+
+    .. math:: \\max \\sum_{uncensored} \\ln \\phi(u_i) - \\ln\\beta
+              + \\sum_{censored} \\ln[1 - \\Phi(u_k)], \\quad u = (\\ln c - \\ln\\theta) / \\beta
+
+    ``start`` = (ln theta, ln beta) starts the numerical fit (default: the uncensored fit).
+
+    Returns
+    -------
+    (theta, beta)
+        ``inf``/NaN if every capacity is censored; NaN if fewer than 2 are not.
+    """
+    c = np.log(np.asarray(capacities, float))
+    cens = np.log(np.asarray([] if censored_at is None else censored_at, float))
+    if c.size + cens.size == 0:
+        raise ValueError("capacities: no capacity to fit")
+    if c.size == 0:
+        return np.inf, np.nan
+    if c.size < 2:
+        return float(np.exp(c[0])) if not cens.size else np.nan, np.nan
+    mu, beta = float(np.mean(c)), float(np.std(c))
+    if not cens.size:
+        return float(np.exp(mu)), beta
+    start = [mu, np.log(max(beta, 0.05))] if start is None else start
+    res = optimize.minimize(
+        _censored_nll, start, args=(c, cens), jac=True, method="BFGS", options={"gtol": 1e-9}
+    )
+    with np.errstate(over="ignore"):
+        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+
+
+# ------------------------------------------------------------------------------ covariances
+
+
+def _inverse(info):
+    """Inverse of a 2x2 information matrix; NaN when it is not positive definite."""
+    if not np.all(np.isfinite(info)) or np.linalg.det(info) <= 0 or info[0, 0] <= 0:
+        return np.full((2, 2), np.nan)
+    return np.linalg.inv(info)
+
+
+def binomial_covariance(im, n_total, theta, beta, n_overturned=None, cluster=None):
+    """Covariance of (ln theta, ln beta) of :func:`fit_binomial` at the fit (NaN without one).
+
+    The inverse of the expected information, I = sum_j n_j phi(u_j)^2 / (P_j (1 - P_j))
+    g_j g_j', g_j = (-1 / beta, -u_j). Points that share a ``cluster`` label (the same record
+    at several levels or for several blocks: their outcomes are not independent) give the
+    cluster-robust sandwich I^-1 (sum_c s_c s_c') I^-1 c / (c - 1) instead, s_c the score
+    summed over cluster c (``n_overturned`` needed then).
+    """
+    if not (np.isfinite(beta) and 0.0 < theta < np.inf):
+        return np.full((2, 2), np.nan)
+    n = np.asarray(n_total, float)
+    u = np.log(np.asarray(im, float) / theta) / beta
+    lp, lq, ld = special.log_ndtr(u), special.log_ndtr(-u), -0.5 * u * u - _LOG_SQRT_2PI
+    g = np.stack([np.full(u.shape, -1.0 / beta), -u])
+    cov = _inverse((g * n * np.exp(2.0 * ld - lp - lq)) @ g.T)
+    if cluster is None:
+        return cov
+    _, inv = np.unique(np.asarray(cluster), return_inverse=True)
+    inv = inv.ravel()
+    m = int(inv.max()) + 1
+    if m == inv.size:  # one point per cluster: independent points
+        return cov
+    z = np.asarray(n_overturned, float)
+    r = z * np.exp(ld - lp) - (n - z) * np.exp(ld - lq)  # d loglik / du per point
+    score = np.stack([np.bincount(inv, r * g[0], m), np.bincount(inv, r * g[1], m)])
+    return cov @ (score @ score.T) @ cov * m / (m - 1)
+
+
+def capacities_covariance(capacities, censored_at, theta, beta) -> np.ndarray:
+    """Covariance of (ln theta, ln beta) of :func:`fit_capacities`: diag(beta^2 / n, 1 / 2n)
+    without censoring; with it, the inverse of the observed information (central differences
+    of the exact gradient of the censored likelihood). NaN without a fit."""
+    c = np.log(np.asarray(capacities, float))
+    cens = np.log(np.asarray([] if censored_at is None else censored_at, float))
+    if not (np.isfinite(beta) and 0.0 < theta < np.inf and beta > 0):
+        return np.full((2, 2), np.nan)
+    if not cens.size:
+        return np.diag([beta**2 / c.size, 0.5 / c.size])
+    q, h, m = np.log([theta, beta]), 1e-5, c.size + cens.size
+    cols = [
+        (_censored_nll(q + h * e, c, cens)[1] - _censored_nll(q - h * e, c, cens)[1]) / (2 * h)
+        for e in np.eye(2)
+    ]
+    info = m * np.column_stack(cols)
+    return _inverse(0.5 * (info + info.T))
+
+
+# ------------------------------------------------------------------------------ bands
+
+
+def probability_band(x, theta, beta, n, cov, method, conf_level):
+    """Pointwise band (lower, upper) of P(x) = Phi(ln(x / theta) / beta) at intensities ``x``.
+
+    ``method`` is one of :data:`BAND_METHODS` (module docstring); ``cov`` the covariance of
+    (ln theta, ln beta) (for ``"likelihood"``); ``n`` the number of capacities (for
+    ``"noncentral_t"``). NaN where there is no fit or no band.
+    """
+    x = np.asarray(x, float)
+    nan = np.full(x.shape, np.nan)
+    if method not in BAND_METHODS:
+        raise ValueError(f"method must be one of {BAND_METHODS}, got {method!r}")
+    if method == "none" or not (np.isfinite(beta) and beta > 0 and 0.0 < theta < np.inf):
+        return nan, nan
+    with np.errstate(divide="ignore"):
+        u = np.log(x / theta) / beta
+    if method == "noncentral_t":
+        n = int(n)
+        if n < 2:
+            return nan, nan
+        t = np.sqrt(n) * u * np.sqrt((n - 1) / n)  # sqrt(n) (ln x - mean) / s, s with n - 1
+        lo = special.nctdtrinc(n - 1, 0.5 + conf_level / 2, t)
+        hi = special.nctdtrinc(n - 1, 0.5 - conf_level / 2, t)
+        return special.ndtr(lo / np.sqrt(n)), special.ndtr(hi / np.sqrt(n))
+    cov = np.asarray(cov, float)
+    if not np.all(np.isfinite(cov)):
+        return nan, nan
+    var = cov[0, 0] / beta**2 + 2.0 * u * cov[0, 1] / beta + u * u * cov[1, 1]
+    half = special.ndtri(0.5 + conf_level / 2) * np.sqrt(np.maximum(var, 0.0))
+    return special.ndtr(u - half), special.ndtr(u + half)
+
+
+# ------------------------------------------------------------------------------ tables
+
+
+def fragility_row(
+    label, theta, beta, band, n, im, by=None, cov=None, method="none", conf_level=np.nan
+) -> dict:
+    """One row of a fragility table: the fit (``beta`` the MLE), the bands of theta and beta,
+    the sample count, the observed intensity range of ``im`` and whether the median
+    (``theta_in_range``) and its whole band (``band_in_range``) lie inside it; then what the
+    pointwise band of P(x) needs (:func:`probability_band`): the covariance of
+    (ln theta, ln beta) (``var_ln_theta``, ``cov_ln_theta_ln_beta``, ``var_ln_beta``), the
+    method (``p_band``) and ``conf_level``. ``band`` is ((theta_lo, theta_hi),
+    (beta_lo, beta_hi))."""
+    (theta_lo, theta_hi), (beta_lo, beta_hi) = band
+    im_min, im_max = (float(np.min(im)), float(np.max(im))) if np.size(im) else (np.nan, np.nan)
+    cov = np.full((2, 2), np.nan) if cov is None else np.asarray(cov, float)
+    return {
+        by or "group": label,
+        "theta": theta,
+        "beta": beta,
+        "theta_lo": theta_lo,
+        "theta_hi": theta_hi,
+        "beta_lo": beta_lo,
+        "beta_hi": beta_hi,
+        "n": int(n),
+        "im_min": im_min,
+        "im_max": im_max,
+        "theta_in_range": bool(im_min <= theta <= im_max),
+        "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
+        "var_ln_theta": cov[0, 0],
+        "cov_ln_theta_ln_beta": cov[0, 1],
+        "var_ln_beta": cov[1, 1],
+        "p_band": method,
+        "conf_level": conf_level,
+    }
+
+
+#: columns of a fragility row that only serve the pointwise band of P(x).
+BAND_COLUMNS = ("var_ln_theta", "cov_ln_theta_ln_beta", "var_ln_beta", "p_band", "conf_level")
+
+
+def wald_intervals(theta, beta, cov, conf_level):
+    """Wald intervals ((theta_lo, theta_hi), (beta_lo, beta_hi)) on the log scale from the
+    covariance of (ln theta, ln beta); NaN without a covariance."""
+    z = special.ndtri(0.5 + conf_level / 2)
+    cov = np.asarray(cov, float)
+    with np.errstate(invalid="ignore", over="ignore"):  # no information: an infinite band
+        dt, db = z * np.sqrt(cov[0, 0]), z * np.sqrt(cov[1, 1])
+        return (theta * np.exp(-dt), theta * np.exp(dt)), (beta * np.exp(-db), beta * np.exp(db))
+
+
+def percentile_intervals(boot, conf_level):
+    """((theta_lo, theta_hi), (beta_lo, beta_hi)) from bootstrap fits ``boot`` (rows of
+    (theta, beta)): percentiles at bootstrap samples, without interpolation, so that an
+    infinite median (not reached in a resample) stays infinite."""
+    q = [50 * (1 - conf_level), 50 * (1 + conf_level)]
+    with np.errstate(invalid="ignore"):
+        (t_lo, b_lo), (t_hi, b_hi) = np.percentile(boot, q, axis=0, method="inverted_cdf")
+    return (t_lo, t_hi), (b_lo, b_hi)
