@@ -8,7 +8,9 @@ two-column text files); any other file must be named by a glob or a list.
 from __future__ import annotations
 
 import glob
+import os
 import re
+import stat
 from pathlib import Path
 
 from .records import Record
@@ -21,25 +23,68 @@ def _is_glob(text: str) -> bool:
     return any(c in text for c in "*?[")
 
 
+def not_a_file(path) -> str | None:
+    """What ``path`` is if it is not a regular file (following symbolic links), e.g. "a FIFO
+    (named pipe)" or "a dangling symbolic link to 'x'"; None for a regular file."""
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        if path.is_symlink():
+            return f"a dangling symbolic link to {os.readlink(path)!r}"
+        return "missing"
+    except OSError as exc:
+        return f"unreadable ({exc.strerror or type(exc).__name__})"
+    if stat.S_ISREG(mode):
+        return None
+    kinds = (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    what = next((name for test, name in kinds if test(mode)), "not a regular file")
+    if path.is_symlink():
+        what += f" (a symbolic link to {os.readlink(path)!r})"
+    return what
+
+
+def _refuse_non_files(paths, field: str, how: str) -> list[Path]:
+    """``paths`` if every one is a regular file, else a ValueError naming the first that is
+    not and what it is: a glob or folder that finds one never skips it silently."""
+    for p in paths:
+        what = not_a_file(p)
+        if what:
+            raise ValueError(
+                f"{field}: {how} finds {str(p)!r}, which is {what}, not a record file; "
+                "remove it or name the record files one by one"
+            )
+    return paths
+
+
 def _expand(item, field: str = "source") -> list[Path]:
     """The record files named by one source item: a file, a folder or a glob."""
     text = str(item)
     if _is_glob(text):
-        paths = sorted(Path(p) for p in glob.glob(text) if Path(p).is_file())
+        paths = sorted(Path(p) for p in glob.glob(text))
         if not paths:
             raise ValueError(f"{field}: the glob {text!r} matches no file")
-        return paths
+        return _refuse_non_files(paths, field, f"the glob {text!r}")
     path = Path(item)
     if path.is_dir():
-        paths = sorted(p for p in path.iterdir() if p.is_file() and _suffix_ok(p))
+        paths = sorted(p for p in path.iterdir() if _suffix_ok(p))
         if not paths:
             raise ValueError(
                 f"{field}: the folder {str(path)!r} holds no record files "
                 f"(suffixes {', '.join(RECORD_SUFFIXES)}, any case)"
             )
-        return paths
-    if not path.is_file():
+        return _refuse_non_files(paths, field, f"the folder {str(path)!r}")
+    what = not_a_file(path)
+    if what == "missing":
         raise ValueError(f"{field}: {text!r} is neither a file, a folder nor a glob that matches")
+    if what:
+        raise ValueError(f"{field}: {text!r} is {what}, not a record file")
     return [path]
 
 
@@ -182,6 +227,11 @@ def _pair_by_name(pairs, rule, field="vertical"):
             )
     out = [(h, v) for h, v in out if h.resolve() not in verticals]
     for h, v in out:
-        if not v.is_file():
+        what = not_a_file(v)
+        if what == "missing":
             raise ValueError(f"{field}: the vertical file {str(v)!r} of {str(h)!r} is missing")
+        if what:
+            raise ValueError(
+                f"{field}: the vertical file {str(v)!r} of {str(h)!r} is {what}, not a file"
+            )
     return out
