@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import re
 import stat
 from dataclasses import dataclass, field
@@ -507,6 +508,33 @@ def _build(path, make) -> Record:
         raise ValueError(f"{path}: {exc}") from None
 
 
+def not_a_file(path) -> str | None:
+    """What ``path`` is if it is not a regular file (following symbolic links), e.g. "a FIFO
+    (named pipe)" or "a dangling symbolic link to 'x'"; None for a regular file."""
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        if path.is_symlink():
+            return f"a dangling symbolic link to {os.readlink(path)!r}"
+        return "missing"
+    except OSError as exc:
+        return f"unreadable ({exc.strerror or type(exc).__name__})"
+    if stat.S_ISREG(mode):
+        return None
+    kinds = (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    what = next((name for test, name in kinds if test(mode)), "not a regular file")
+    if path.is_symlink():
+        what += f" (a symbolic link to {os.readlink(path)!r})"
+    return what
+
+
 def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
     """The text of a regular file of at most ``max_bytes``, refusing anything else.
 
@@ -521,10 +549,8 @@ def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
         raise FileNotFoundError(f"{path}: no such file") from None
     except OSError as exc:
         raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise ValueError(f"{path}: is a folder, not a file")
     if not stat.S_ISREG(info.st_mode):
-        raise ValueError(f"{path}: is not a regular file (a device, pipe or socket)")
+        raise ValueError(f"{path}: is {not_a_file(path)}, not a file")
     if info.st_size == 0:
         raise ValueError(f"{path}: is empty (or a pseudo-file of the system)")
     if info.st_size > max_bytes:

@@ -8,12 +8,10 @@ two-column text files); any other file must be named by a glob or a list.
 from __future__ import annotations
 
 import glob
-import os
 import re
-import stat
 from pathlib import Path
 
-from .records import Record
+from .records import Record, not_a_file
 
 #: Suffixes (case-insensitive) of the files read from a folder.
 RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
@@ -21,33 +19,6 @@ RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
 
 def _is_glob(text: str) -> bool:
     return any(c in text for c in "*?[")
-
-
-def not_a_file(path) -> str | None:
-    """What ``path`` is if it is not a regular file (following symbolic links), e.g. "a FIFO
-    (named pipe)" or "a dangling symbolic link to 'x'"; None for a regular file."""
-    path = Path(path)
-    try:
-        mode = path.stat().st_mode
-    except FileNotFoundError:
-        if path.is_symlink():
-            return f"a dangling symbolic link to {os.readlink(path)!r}"
-        return "missing"
-    except OSError as exc:
-        return f"unreadable ({exc.strerror or type(exc).__name__})"
-    if stat.S_ISREG(mode):
-        return None
-    kinds = (
-        (stat.S_ISDIR, "a folder"),
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    )
-    what = next((name for test, name in kinds if test(mode)), "not a regular file")
-    if path.is_symlink():
-        what += f" (a symbolic link to {os.readlink(path)!r})"
-    return what
 
 
 def _refuse_non_files(paths, field: str, how: str) -> list[Path]:

@@ -124,7 +124,12 @@ class Block:
         """
         b = _validate.positive("width", width) / 2.0
         h = _validate.positive("height", height) / 2.0
-        return cls(math.hypot(b, h), math.atan2(b, h), restitution)
+        try:
+            return cls(math.hypot(b, h), math.atan2(b, h), restitution)
+        except ValueError as exc:
+            if "restitution" in str(exc).split(" ")[0]:
+                raise
+            raise ValueError(f"width = {width!r} m and height = {height!r} m: {exc}") from None
 
     @property
     def frequency_parameter(self) -> float:

@@ -187,8 +187,12 @@ class EquivalentBlockSpec(_Model):
 #: frequency ratio omega_g / p taken; the amplitudes and periods they give are then checked
 #: against the solver's ranges (:meth:`Study._engine_ranges`).
 MAX_RATIO = 1e4
-#: Largest |scale| of a record (its scaled peak is then checked against MAX_ACCELERATION).
-MAX_SCALE = 1e6
+#: Smallest ratio taken (a millionth: the motions they give must not vanish into subnormals).
+MIN_RATIO = 1e-6
+_RATIO_LABEL = f"[{MIN_RATIO:g}, {MAX_RATIO:g}]"
+#: Largest |scale| of a record (its scaled peak is then checked against MAX_ACCELERATION),
+#: and the smallest.
+MAX_SCALE, MIN_SCALE = 1e6, 1e-6
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_SIZE = 10**7
 
@@ -288,14 +292,14 @@ class PulseSpec(_Model):
             raise ValueError("give exactly one of period [s] or frequency_ratio")
         for name in ("amplitude", "amplitude_ratio", "amplitude_a", "period", "frequency_ratio"):
             _check_positive(name, getattr(self, name))
-        for name, top in (
-            ("amplitude", _validate.MAX_ACCELERATION),
-            ("amplitude_ratio", MAX_RATIO),
-            ("amplitude_a", MAX_RATIO),
-            ("frequency_ratio", MAX_RATIO),
+        for name, low, top in (
+            ("amplitude", 0.0, _validate.MAX_ACCELERATION),
+            ("amplitude_ratio", MIN_RATIO, MAX_RATIO),
+            ("amplitude_a", MIN_RATIO, MAX_RATIO),
+            ("frequency_ratio", MIN_RATIO, MAX_RATIO),
         ):
             if getattr(self, name) is not None:
-                _span(name, getattr(self, name), 0.0, top, f"(0, {top:g}]")
+                _span(name, getattr(self, name), low, top, f"[{low:g}, {top:g}]")
         if self.period is not None:
             _span("period", self.period, *PERIOD_RANGE, "[{:g}, {:g}] s".format(*PERIOD_RANGE))
         if self.cycles != 1 and self.shape not in ("sine", "cosine"):
@@ -341,7 +345,7 @@ class ScaleTo(_Model):
         _check_period(self.im, self.period, "period")
         _check_positive("value", self.value)
         if self.value is not None and self.im in ("pga_ratio", "pgv_ratio"):
-            _span("value", self.value, 0.0, MAX_RATIO, f"(0, {MAX_RATIO:g}]")
+            _span("value", self.value, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         return self
 
 
@@ -411,10 +415,15 @@ class RecordSpec(_Model):
             raise ValueError("give at most one of scale, pga_ratio or scale_to")
         if self.pga_ratio is not None:
             _check_positive("pga_ratio", self.pga_ratio)
-            _span("pga_ratio", self.pga_ratio, 0.0, MAX_RATIO, f"(0, {MAX_RATIO:g}]")
+            _span("pga_ratio", self.pga_ratio, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         elif self.scale is not None:
             _nonzero("scale", self.scale)
             _span("scale", self.scale, -MAX_SCALE, MAX_SCALE, f"[-{MAX_SCALE:g}, {MAX_SCALE:g}]")
+            lo, hi = _draw_span(self.scale)
+            if min(abs(lo), abs(hi)) < MIN_SCALE:
+                raise FieldError(
+                    "scale", f"must be at least {MIN_SCALE:g} in magnitude; it reaches {lo:g}"
+                )
         if isinstance(self.vertical, list):
             if isinstance(self.files, str):
                 raise FieldError(
@@ -496,7 +505,7 @@ class StochasticSpec(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("pga_ratio", self.pga_ratio)
-        _span("pga_ratio", self.pga_ratio, 0.0, MAX_RATIO, f"(0, {MAX_RATIO:g}]")
+        _span("pga_ratio", self.pga_ratio, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         if not self.ground_frequency * self.dt < 1.0:
             raise FieldError(
                 "dt",
