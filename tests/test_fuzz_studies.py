@@ -923,3 +923,38 @@ def test_fuzz_record_studies_refused_by_field_or_run_with_nothing_dropped(tmp_pa
     assert not failures, "\n".join(failures)
     assert len(files) >= 300 and designs > len(files) / 2
     assert counts["refused"] >= 100 and counts["succeeded"] >= 50
+
+
+def _cli_block(stderr: str, path: str) -> str:
+    """The problems the command line printed for ``path`` (its line and the indented ones)."""
+    lines = stderr.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith(f"{path}: "):
+            block = [line]
+            for more in lines[i + 1 :]:
+                if not more.startswith("  "):
+                    break
+                block.append(more)
+            return "\n".join(block)
+    return ""
+
+
+def test_record_study_files_through_the_real_cli(tmp_path):
+    """One record study of each category through ``rockstudy validate``: exit 2 with the
+    problems naming the field and the file, or ok; never a traceback."""
+    files = record_corpus(tmp_path, 120)
+    picked = {}
+    for path, cat, words in files:
+        picked.setdefault(cat.split(":")[0] if words is None else cat, (path, words))
+    paths = [str(p) for p, _ in picked.values()]
+    out = subprocess.run(
+        [ROCKSTUDY, "validate", *paths], capture_output=True, text=True, timeout=300
+    )
+    assert "Traceback" not in out.stderr, out.stderr[-3000:]
+    for path, words in picked.values():
+        if words is None:
+            assert f"{path}: ok" in out.stdout, (path, out.stdout, out.stderr[-2000:])
+        else:
+            block = _cli_block(out.stderr, str(path))
+            assert block and all(w in block for w in words), (path, words, out.stderr[-3000:])
+    assert out.returncode == 2 and len(picked) >= 8

@@ -106,12 +106,24 @@ def _record_problems(study, pairs) -> list[str]:
     return found
 
 
+def draw_span(value) -> tuple[float, float]:
+    """The smallest and largest value a fixed parameter or a distribution can give: its
+    support, or where that is infinite (normal, lognormal) its values at the extreme
+    probabilities the samplers draw."""
+    if isinstance(value, (int, float)):
+        return float(value), float(value)
+    lo, hi = value.support()
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        ends = value.ppf(np.array([2.0**-53, 1.0 - 2.0**-53]))
+        lo = lo if math.isfinite(lo) and lo > 0 else float(ends[0])
+        hi = hi if math.isfinite(hi) else float(ends[1])
+    return float(lo), float(hi)
+
+
 def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     """(field, the largest peak [m/s^2] of ``rec`` once scaled as the study asks), over the
     whole support of the study's distributions; None for an unscaled record or a measure of
     0 (refused on its own)."""
-    from .spec import _draw_span
-
     mo, de = study.motion, study.design
     peak = float(np.max(np.abs(rec.acceleration)))
     if rec.vertical is not None:
@@ -121,12 +133,12 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
         top = de.ida_options()["max_pga_ratio"] * uplift
         return "design.max_pga_ratio", top * peak / rec.peak if rec.peak > 0 else 0.0
     if mo.scale is not None:
-        lo, hi = _draw_span(mo.scale)
+        lo, hi = draw_span(mo.scale)
         return "motion.scale", max(abs(lo), abs(hi)) * peak
     target = mo.target()
     if target is None or target.value is None:
         return None
-    value = _draw_span(target.value)[1]
+    value = draw_span(target.value)[1]
     field = "motion.pga_ratio" if mo.pga_ratio is not None else "motion.scale_to.value"
     if target.im == "pga_ratio":
         value, base = value * uplift, rec.peak

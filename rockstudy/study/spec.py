@@ -46,7 +46,6 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Literal
 
-import numpy as np
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -64,6 +63,7 @@ from ..constants import G
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
+from .feasibility import draw_span as _draw_span
 from .feasibility import problems
 
 
@@ -203,20 +203,6 @@ def _span(name, value, low, high, label):
     if not (low <= lo and hi <= high):
         got = f"got {value}" if lo == hi else f"it spans {lo:g} to {hi:g}"
         raise FieldError(name, f"must lie in {label}; {got}")
-
-
-def _draw_span(value) -> tuple[float, float]:
-    """The smallest and largest value a fixed parameter or a distribution can give: its
-    support, or where that is infinite (normal, lognormal) its values at the extreme
-    probabilities the samplers draw."""
-    if isinstance(value, (int, float)):
-        return float(value), float(value)
-    lo, hi = value.support()
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        ends = value.ppf(np.array([2.0**-53, 1.0 - 2.0**-53]))
-        lo = lo if math.isfinite(lo) and lo > 0 else float(ends[0])
-        hi = hi if math.isfinite(hi) else float(ends[1])
-    return float(lo), float(hi)
 
 
 def _smallest(value) -> float:
