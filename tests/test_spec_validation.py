@@ -436,3 +436,28 @@ def test_pulse_settings_the_solvers_would_refuse_are_refused(motion, field):
     )
     message = refused(text)
     assert f"{field}:" in message, message
+
+
+@pytest.mark.parametrize(
+    "scaling, field",
+    [
+        ('scale_to = { im = "pgv", value = 1e300 }', "motion.scale_to.value"),
+        ('scale_to = { im = "pga", value = 2e7 }', "motion.scale_to.value"),
+        ("scale = 1e300", "motion.scale"),
+        ("scale = 1e-300", "motion.scale"),
+        ("pga_ratio = 1e300", "motion.pga_ratio"),
+    ],
+)
+def test_a_scaled_record_beyond_the_solvers_range_is_refused(tmp_path, scaling, field):
+    """Issue 26: a target that scales a record past 1e7 m/s^2 (or a scale that makes its
+    samples vanish) failed at run time; validate refuses it, naming the field."""
+    t = [0.0, 0.01, 0.02, 0.03]
+    rec = write_csv(tmp_path / "r.csv", t, [0.0, 0.1, -0.1, 0.0])
+    message = refused(record_study([rec], scaling))
+    assert f"{field}:" in message, message
+
+
+def test_a_scaled_record_within_range_is_accepted(tmp_path):
+    """Not a refusal too many: a PGA target of 1e6 m/s^2 (about 1e5 g) is taken."""
+    rec = write_csv(tmp_path / "r.csv", [0.0, 0.01, 0.02, 0.03], [0.0, 0.1, -0.1, 0.0])
+    validate_text(record_study([rec], 'scale_to = { im = "pga", value = 1e6 }'))
