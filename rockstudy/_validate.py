@@ -3,13 +3,75 @@
 from __future__ import annotations
 
 import math
+import numbers
+import os
 
 import numpy as np
+
+GIB = 2.0**30
+#: Share of this machine's memory that the whole design of a study (the client) and that one
+#: sample (a record's measures, a synthesized record, a simulated history) may take.
+DESIGN_SHARE, SAMPLE_SHARE = 0.5, 0.25
+
+#: Largest |ground acceleration| [m/s^2] of a record or pulse: 1e7 m/s^2, about a million g,
+#: more than 200,000 times the largest peak ever recorded (about 4.4 g) and beyond any record
+#: an IDA scales (max_pga_ratio <= 1e4 times g tan(alpha)). The bound keeps every measure
+#: finite: squares and integrals of the samples (Arias intensity, the pulse fit's least
+#: squares) overflow near 1e154 m/s^2, and a value of 1e300 made the run fail.
+MAX_ACCELERATION = 1e7
+#: Smallest sample step of a record [s]: 1 MHz, a thousand times the sampling rate of any
+#: accelerograph (the mean period's spectrum alone needs 20 / dt points: 256 GiB at 1e-9 s).
+MIN_STEP = 1e-6
+#: Longest record [s]: 1e6 s, about 11.6 days; strong motion lasts minutes, a day-long
+#: seismometer file 86,400 s.
+MAX_DURATION = 1e6
+
+
+def machine_memory() -> float:
+    """Physical memory of this machine [bytes]."""
+    return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+
+
+def memory_problem(name: str, nbytes: float, what: str, advice: str, share=SAMPLE_SHARE):
+    """A sentence naming ``name`` if ``nbytes`` is more than ``share`` of this machine's
+    memory, else None. ``what`` says what takes it (e.g. "a record of 2e10 points")."""
+    memory = machine_memory()
+    if nbytes <= share * memory:
+        return None
+    return (
+        f"{name}: {what}, about {nbytes / GIB:.3g} GiB in memory, more than {share:.0%} of "
+        f"this machine's {memory / GIB:.3g} GiB; {advice}"
+    )
+
+
+def check_memory(name: str, nbytes: float, what: str, advice: str, share=SAMPLE_SHARE):
+    """Raise the ValueError of :func:`memory_problem` if there is one."""
+    problem = memory_problem(name, nbytes, what, advice, share)
+    if problem:
+        raise ValueError(problem)
+
+
+def number(name: str, value) -> float:
+    """``value`` as a float, or a ValueError naming ``name`` if it is not a real number: a
+    string (``"0.1"``), a boolean (``True``) or anything else is not taken for one."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a number, got {_what(value)}")
+    return float(value)
+
+
+def _what(value) -> str:
+    """A short description of a wrong value for a message."""
+    if isinstance(value, (bool, np.bool_)):
+        return f"the boolean {bool(value)}"
+    text = repr(value)
+    return f"{type(value).__name__} {text[:40] + '...' if len(text) > 40 else text}"
 
 
 def positive(name: str, value: float) -> float:
     """Return ``value`` as a float, or raise if it is not finite and > 0."""
-    value = float(value)
+    value = number(name, value)
     if not math.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return value
@@ -17,7 +79,7 @@ def positive(name: str, value: float) -> float:
 
 def in_open_interval(name: str, value: float, low: float, high: float, label: str) -> float:
     """Return ``value`` as a float, or raise if it is outside ``(low, high)``."""
-    value = float(value)
+    value = number(name, value)
     if not math.isfinite(value) or not low < value < high:
         raise ValueError(f"{name} must lie in {label}, got {value!r}")
     return value
@@ -25,7 +87,7 @@ def in_open_interval(name: str, value: float, low: float, high: float, label: st
 
 def restitution(value: float) -> float:
     """Return a coefficient of restitution, or raise if it is outside (0, 1]."""
-    value = float(value)
+    value = number("restitution", value)
     if not math.isfinite(value) or not 0.0 < value <= 1.0:
         raise ValueError(f"restitution must lie in (0, 1], got {value!r}")
     return value
@@ -34,7 +96,10 @@ def restitution(value: float) -> float:
 def finite_array(name: str, values) -> np.ndarray:
     """Return a 1-D float array (a contiguous, writable copy: the numba kernels that read it
     are compiled for that layout only), or raise if it is empty or holds NaN/inf."""
-    arr = np.array(values, dtype=float)
+    raw = values if isinstance(values, np.ndarray) else _as_array(name, values)
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be a 1-D sequence of numbers, got {_what(values)}")
+    arr = np.array(raw, dtype=float)
     if arr.ndim != 1 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 1-D sequence of numbers")
     bad = np.flatnonzero(~np.isfinite(arr))
@@ -44,6 +109,13 @@ def finite_array(name: str, values) -> np.ndarray:
             f"first at index {bad[0]}"
         )
     return arr
+
+
+def _as_array(name, values) -> np.ndarray:
+    try:
+        return np.asarray(values)
+    except (TypeError, ValueError):  # ragged nesting
+        raise ValueError(f"{name} must be a 1-D sequence of numbers, got {_what(values)}") from None
 
 
 #: The tightest rtol offered. The kernels' local error target is 0.1 rtol, which as rtol -> 0
@@ -64,7 +136,7 @@ def rtol(value: float) -> float:
 
 def in_range(name, value, low, high, label, high_open=False) -> float:
     """Return ``value`` as a float, or raise if it is outside [low, high] (or [low, high))."""
-    value = float(value)
+    value = number(name, value)
     above = value >= high if high_open else value > high
     if not math.isfinite(value) or value < low or above:
         raise ValueError(f"{name} must lie in {label}, got {value!r}")
@@ -107,6 +179,19 @@ def output_times(t_eval, dt_out, t_max) -> np.ndarray | None:
     return arr
 
 
+#: Float arrays of the output grid's length a simulation holds (times, theta, theta_dot and
+#: the kernel's dense-output work arrays).
+OUTPUT_ARRAYS = 6
+
+
 def uniform_times(dt_out: float, end: float) -> np.ndarray:
-    """The times k dt_out [s] in [0, end]."""
+    """The times k dt_out [s] in [0, end]; a ValueError naming ``dt_out`` if that grid would
+    not fit in memory (see :func:`check_memory`)."""
+    points = end / dt_out + 1.0
+    check_memory(
+        "dt_out",
+        8.0 * OUTPUT_ARRAYS * points,
+        f"dt_out = {dt_out:g} s asks for {points:.3g} output times up to {end:g} s",
+        "give a larger dt_out, or t_eval",
+    )
     return np.minimum(dt_out * np.arange(int(math.floor(end / dt_out)) + 1), end)

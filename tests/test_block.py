@@ -69,6 +69,14 @@ def test_user_restitution_is_kept():
         ({"half_diagonal": 1.0, "slenderness": -0.1}, "slenderness"),
         ({"half_diagonal": 1.0, "slenderness": 0.2, "restitution": 0.0}, "restitution"),
         ({"half_diagonal": 1.0, "slenderness": 0.2, "restitution": 1.2}, "restitution"),
+        # issue 26: beyond the ranges (the kernels divided by zero at alpha = 1e-300), and
+        # values that are no numbers
+        ({"half_diagonal": 1.0, "slenderness": 1e-300}, "slenderness"),
+        ({"half_diagonal": 1e-300, "slenderness": 0.2}, "half_diagonal"),
+        ({"half_diagonal": 1e300, "slenderness": 0.2}, "half_diagonal"),
+        ({"half_diagonal": "1", "slenderness": 0.2}, "half_diagonal"),
+        ({"half_diagonal": True, "slenderness": 0.2}, "half_diagonal"),
+        ({"half_diagonal": 1.0, "slenderness": 0.2, "restitution": "0.5"}, "restitution"),
     ],
 )
 def test_bad_block_input_names_the_argument(kwargs, field):
@@ -81,3 +89,45 @@ def test_bad_dimensions_name_the_argument():
         rs.Block.from_dimensions(width=-0.1, height=1.0)
     with pytest.raises(ValueError, match="height"):
         rs.Block.from_dimensions(width=0.1, height=0.0)
+
+
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda: rs.motions.SinePulse(amplitude=5.0, period=1e-300), "period"),
+        (lambda: rs.motions.RickerWavelet(amplitude=5.0, period=1e300), "period"),
+        (lambda: rs.motions.SinePulse(amplitude=1e300, period=0.5), "amplitude"),
+        (lambda: rs.motions.SinePulse(amplitude="5", period=0.5), "amplitude"),
+        (lambda: rs.motions.SinePulse(amplitude=5.0, period=0.5, cycles=10**9), "cycles"),
+        (lambda: rs.motions.synthetic_near_fault(pulse_period=1e6, pga=4.0), "pulse_period"),
+        (lambda: rs.motions.synthetic_near_fault(1.0, 4.0, duration=1e6, dt=1e-5), "duration"),
+        (lambda: rs.motions.synthetic_near_fault(1.0, 4.0, vertical="yes"), "vertical"),
+    ],
+)
+def test_pulses_and_synthetic_records_refuse_naming_the_argument(make, field):
+    """Issue 26: SinePulse(period=1e-300) gave a ZeroDivisionError in the kernel, and
+    synthetic_near_fault(pulse_period=1e6) ran a minute in 8 GB; both are range errors now."""
+    with pytest.raises(ValueError, match=rf"^{field}"):
+        make()
+
+
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"dt_out": "0.1"}, "dt_out"),
+        ({"dt_out": True}, "dt_out"),
+        ({"dt_out": 1e-12}, "dt_out"),  # 5e11 output times: refused with a memory estimate
+    ],
+)
+def test_simulate_refuses_output_grids_naming_the_argument(kwargs, field):
+    blk, pulse = rs.Block(1.0, 0.2), rs.motions.SinePulse(0.5, 0.5)
+    with pytest.raises(ValueError, match=rf"^{field}") as err:
+        rs.simulate(blk, pulse, t_max=1.0, **kwargs)
+    if kwargs["dt_out"] == 1e-12:
+        assert "GiB" in str(err.value)
+
+
+def test_simulate_batch_refuses_a_record_with_pulse_arguments():
+    rec = rs.motions.Record([0.0, 1.0, -1.0, 0.0], dt=0.01)
+    with pytest.raises(ValueError, match="record= takes no amplitude, period"):
+        rs.simulate_batch(half_diagonal=1.0, slenderness=0.2, record=rec, amplitude=1.0, period=0.5)

@@ -23,6 +23,7 @@ from typing import get_args
 import numpy as np
 import pytest
 
+from rockstudy.motions.suites import RECORD_SUFFIXES
 from rockstudy.study import StudyError, load_study
 from rockstudy.study.evaluate import STATUS_OK, evaluate_chunk
 from rockstudy.study.sampling import make_design
@@ -407,7 +408,10 @@ def mutate(g: Gen, study: dict, bad_records):
         )
         return text, cat, "nest"
     if cat == "hostile":  # valid: strings are data, escaped where shown
-        study[r.choice(["name", "description"])] = r.choice(HOSTILE)
+        key, text = r.choice(["name", "description"]), r.choice(HOSTILE)
+        study[key] = text
+        if key == "name" and "\0" in text:  # a NUL is no name (issue 26)
+            return study, "hostile", "name"
         return study, "hostile", None
     if cat == "structural":
         choice = r.randrange(4)
@@ -464,15 +468,18 @@ def run_in_process(study, base_dir):
     cols["sample"] = design["sample"].values
     n = cols["sample"].size
     problems = []
-    for a in range(0, n, study.chunk_size):
-        part = {k: v[a : a + study.chunk_size] for k, v in cols.items()}
+    size = study.rows_per_chunk()
+    for a in range(0, n, size):
+        part = {k: v[a : a + size] for k, v in cols.items()}
         out = evaluate_chunk(study.normalized(), part, base_dir)
         bad = out["status"] != STATUS_OK
         if bad.any():
             problems.append(f"{int(bad.sum())} failed: {set(out['error'][bad].tolist())}")
         for name in study.run.outputs:
-            if name in ("max_rotation", "max_rotation_ratio") and not np.all(
-                np.isfinite(out[name])
+            if (
+                name in out
+                and name in ("max_rotation", "max_rotation_ratio")
+                and not np.all(np.isfinite(out[name]))
             ):
                 problems.append(f"{name} not finite")
     for name, var in design.data_vars.items():
@@ -553,17 +560,401 @@ def test_fuzz_files_through_the_real_cli(corpus):
     """A handful of the same files through ``rockstudy validate``: exit 2 with the problems,
     or 0 with ok; never a traceback."""
     folder, files = corpus
-    picked = {}
-    for path, cat, _ in files:  # one file of each category
-        picked.setdefault(cat, path)
+    picked, valid = {}, set()
+    for path, cat, field in files:  # one file of each category
+        if cat not in picked:
+            picked[cat] = path
+            if field is None:
+                valid.add(cat)
     paths = [str(p) for p in picked.values()]
     out = subprocess.run(
         [ROCKSTUDY, "validate", *paths], capture_output=True, text=True, timeout=300
     )
     assert "Traceback" not in out.stderr, out.stderr[-3000:]
     for cat, path in picked.items():
-        if cat in ("valid", "hostile"):
+        if cat in valid:
             assert f"{path}: ok" in out.stdout, (cat, out.stdout, out.stderr[-2000:])
         else:
             assert f"{path}: " in out.stderr and "problem(s)" in out.stderr, (cat, out.stderr)
     assert out.returncode == 2
+
+
+# ====================================================================== record studies
+#
+# A second generator (issue 26): record studies, most of them [design]s (cloud, stripes,
+# IDA), over record files the test writes: good ones in every format (both .AT2 headers,
+# two- and three-column text, H/V pairs, folders, globs) and pathological ones (extreme
+# steps and values, a time column to 1.7e308, subnormals, a FIFO, a link to /dev/zero, a
+# dangling link, a folder named x.AT2). Each file must be refused naming the field (and the
+# file), or run with every record and every sample present and ok.
+
+N_RECORD_FILES = 300
+RECORD_SEED = 20261127
+AT2_HEAD = "PEER NGA RECORD\nsynthetic\nACCELERATION TIME SERIES IN UNITS OF G\n"
+
+
+def _wave(seed, n=200, dt=0.01):
+    """A short pulse-like motion in g: a decaying sine plus a little noise."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    f = 1.0 + seed % 3
+    return 0.3 * np.sin(2 * np.pi * f * t) * np.exp(-t) + 0.01 * rng.standard_normal(n)
+
+
+def _at2(path, values, dt="0.0100", old_header=False):
+    body = "\n".join(
+        " ".join(f"{x:.6E}" for x in values[i : i + 5]) for i in range(0, len(values), 5)
+    )
+    head = (
+        f"  {len(values)}   {dt}   NPTS, DT" if old_header else f"NPTS= {len(values)}, DT= {dt} SEC"
+    )
+    path.write_text(AT2_HEAD + head + "\n" + body + "\n")
+
+
+def _csv(path, t, values, vertical=None):
+    cols = [t, values] if vertical is None else [t, values, vertical]
+    path.write_text(
+        "".join(", ".join(f"{float(c[i])!r}" for c in cols) + "\n" for i in range(len(t)))
+    )
+
+
+#: Pathological record files: name -> (how to make it in a folder, words the refusal names).
+def _pathological():
+    import os
+
+    t = np.arange(200) * 0.01
+    w = _wave(99)
+    big, tiny, huge_t = w.copy(), w.copy(), t.copy()
+    big[7], tiny[3], huge_t[-1] = 1e300, 1e-320, 1.7e308
+    return {
+        "dt_huge.AT2": (lambda p: _at2(p, w, "1e300"), "duration"),
+        "dt_tiny.AT2": (lambda p: _at2(p, w, "1e-300"), "dt"),
+        "dt_nano.AT2": (lambda p: _at2(p, w, "1e-9"), "dt"),
+        "value_huge.AT2": (lambda p: _at2(p, big, ".01"), "acceleration[7]"),
+        "subnormal.AT2": (lambda p: _at2(p, tiny * 1e-3, ".01"), "subnormal"),
+        "time_huge.csv": (lambda p: _csv(p, huge_t, w), "duration"),
+        "nan.csv": (lambda p: p.write_text("0.0, 0.1\n0.01, nan\n0.02, 0.1\n"), "finite"),
+        "empty.csv": (lambda p: p.write_text(""), "empty"),
+        "fifo.AT2": (lambda p: os.mkfifo(p), "FIFO"),
+        "zero_link.AT2": (lambda p: p.symlink_to("/dev/zero"), "device"),
+        "dangling.AT2": (lambda p: p.symlink_to(p.with_name("nowhere.AT2")), "dangling"),
+        "folder.AT2": (lambda p: p.mkdir(), "folder"),
+        "short.AT2": (lambda p: p.write_text(AT2_HEAD + "NPTS= 500, DT= .01 SEC\n0.1\n"), "NPTS"),
+    }
+
+
+def write_record_suite(root: Path):
+    """Good and pathological record files under ``root``; returns what the generator needs."""
+    root.mkdir()
+    good = []
+    for i in range(4):
+        _at2(root / f"g{i}.AT2", _wave(i), old_header=i % 2 == 1)
+        good.append(f"g{i}.AT2")
+    t = np.arange(200) * 0.01
+    _csv(root / "g4.csv", t, _wave(4))
+    good.append("g4.csv")
+    _at2(root / "hv0_H.AT2", _wave(5))
+    _at2(root / "hv0_UP.AT2", 0.2 * _wave(6))
+    _at2(root / "hv1_H.AT2", _wave(7))
+    _at2(root / "hv1_UP.AT2", 0.2 * _wave(8))
+    (root / "suite").mkdir()
+    for i in range(3):
+        _at2(root / "suite" / f"s{i}.AT2", _wave(10 + i))
+    bad = {}
+    for name, (make, words) in _pathological().items():
+        make(root / name)
+        folder = root / f"bad_{Path(name).stem}"
+        folder.mkdir()
+        for i in range(2):
+            _at2(folder / f"ok{i}.AT2", _wave(20 + i))
+        make(folder / name)
+        bad[name] = (words, folder)
+    return good, bad
+
+
+class RecordGen:
+    """Record studies: valid ones, and one mutation each for the broken ones."""
+
+    def __init__(self, rng, good, bad):
+        self.r, self.good, self.bad = rng, good, bad
+
+    def structure(self):
+        r = self.r
+        if r.random() < 0.8:
+            s = {
+                "kind": "block",
+                "half_diagonal": {"dist": "uniform", "low": 0.5, "high": r.choice([1.0, 3.0])},
+                "slenderness": {"dist": "uniform", "low": 0.1, "high": 0.3},
+            }
+            if r.random() < 0.3:
+                s["restitution"] = 0.9
+            return s
+        return {
+            "kind": "equivalent_block",
+            "frequency_parameter": {"dist": "uniform", "low": 1.5, "high": 4.0},
+            "critical_rotation": {"dist": "uniform", "low": 0.1, "high": 0.3},
+            "restitution": 0.9,
+        }
+
+    def files(self):
+        r = self.r
+        way = r.random()
+        if way < 0.5:
+            return r.sample(self.good, r.randint(1, 3)), None, None
+        if way < 0.65:
+            return "suite", None, None
+        if way < 0.8:
+            return "suite/*.AT2", None, None
+        if way < 0.9:
+            return "hv*_H.AT2", {"match": "_H\\.AT2$", "replace": "_UP.AT2"}, None
+        pairs = [{"horizontal": "hv0_H.AT2", "vertical": "hv0_UP.AT2"}]
+        return pairs, None, None
+
+    def study(self):
+        r = self.r
+        files, vertical, _ = self.files()
+        motion = {"kind": "record", "files": files}
+        if vertical:
+            motion["vertical"] = vertical
+        design_kind = r.choice(["cloud", "stripes", "ida", "ida", None])
+        study = {
+            "name": f"rec{r.randint(0, 10**6)}",
+            "seed": r.randint(0, 2**31 - 1),
+            "sampler": {"kind": r.choice(["monte_carlo", "lhs"]), "n": r.randint(1, 3)},
+            "structure": self.structure(),
+            "motion": motion,
+            "run": {"method": r.choice(["nonlinear", "nonlinear", "auto"]), "rtol": 1e-6,
+                    "outputs": ["max_rotation", "overturned"]},
+        }  # fmt: skip
+        if study["run"]["method"] == "auto":
+            study["run"]["rtol"] = 1e-2
+        if design_kind is None:
+            study["sampler"]["n"] = r.randint(2, 6)
+            study["chunk_size"] = r.choice([2, 16])
+            way = r.random()
+            if way < 0.35:
+                motion["scale"] = {"dist": "uniform", "low": 0.5, "high": 2.0}
+            elif way < 0.7:
+                motion["pga_ratio"] = {"dist": "uniform", "low": 0.8, "high": 3.0}
+            else:
+                motion["scale_to"] = {
+                    "im": "pga",
+                    "value": {"dist": "uniform", "low": 1.0, "high": 6.0},
+                }
+            return study
+        design = {"kind": design_kind, "periods": r.sample([0.2, 0.5, 1.0], r.randint(0, 2))}
+        if design_kind == "stripes":
+            levels = sorted(r.sample([1.0, 1.5, 2.0, 3.0, 4.5], r.randint(1, 3)))
+            motion["scale_to"] = {"im": "pga_ratio", "value": {"dist": "grid", "values": levels}}
+        if design_kind == "ida":  # a short ladder (its options are checked elsewhere)
+            design.update(tolerance=0.1, growth=2.0, max_pga_ratio=8.0, scan=1)
+        study["design"] = design
+        return study
+
+
+def mutate_record_study(g: RecordGen, study: dict):
+    """A broken (or hostile but valid) variant: (text or dict, category, words it must name)."""
+    r = g.r
+    mo = study["motion"]
+    cat = r.choice(
+        ["file", "file", "folder", "glob", "range", "range", "counts", "name", "hostile"]
+    )
+    if cat in ("file", "folder", "glob"):
+        name = r.choice(sorted(g.bad))
+        words, folder = g.bad[name]
+        mo.pop("vertical", None)
+        if cat == "file":
+            files = r.sample(g.good, r.randint(1, 2))
+            i = r.randrange(len(files) + 1)
+            files.insert(i, name)
+            mo["files"] = files
+            return study, f"{cat}:{name}", [f"motion.files[{i}]", name, words]
+        mo["files"] = folder.name if cat == "folder" else f"{folder.name}/*"
+        return study, f"{cat}:{name}", ["motion.files", name, words]
+    if cat == "range":
+        de = study.get("design")
+        choices = ["name"]
+        if de is not None:
+            choices += ["damping", "periods"]
+        if de is None:
+            choices += ["scale", "pga_ratio", "target"]
+        if de is not None and de["kind"] == "stripes":
+            choices += ["levels"]
+        what = r.choice(choices)
+        if what == "damping":
+            de["damping"] = r.choice([1.5, -0.1])
+            return study, "range:damping", ["design.damping"]
+        if what == "periods":
+            de["periods"] = [r.choice([1e-300, 1e300, 0.0, -1.0])]
+            return study, "range:periods", ["design.periods"]
+        if what == "levels":
+            mo["scale_to"]["value"]["values"] = [1.0, r.choice([1e300, 1e6])]
+            return study, "range:levels", ["motion.scale_to.value"]
+        if what in ("scale", "pga_ratio", "target"):
+            for k in ("scale", "pga_ratio", "scale_to"):
+                mo.pop(k, None)
+            value = r.choice([1e300, 1e12])
+            if what == "target":
+                mo["scale_to"] = {"im": r.choice(["pga", "pgv"]), "value": value}
+                return study, "range:target", ["motion.scale_to.value"]
+            mo[what] = value
+            return study, f"range:{what}", [f"motion.{what}"]
+        study["run"]["max_steps"] = r.choice([0, 10**13])
+        return study, "range:max_steps", ["run.max_steps"]
+    if cat == "counts":
+        what = r.choice(["n", "seed", "chunk"])
+        if what == "n":
+            study["sampler"]["n"] = r.choice([0, -3])
+            return study, "counts:n", ["sampler.n"]
+        if what == "seed":
+            study["seed"] = -1
+            return study, "counts:seed", ["seed"]
+        study["chunk_size"] = r.choice([0, 10**12])
+        return study, "counts:chunk", ["chunk_size"]
+    if cat == "name":
+        study["name"] = "a\0b"
+        return study, "name:nul", ["name"]
+    study["name"] = r.choice(HOSTILE[:3])  # markup and paths are data: valid
+    return study, "hostile", None
+
+
+def record_corpus(folder: Path, n_files: int, seed: int = RECORD_SEED):
+    """Write ``n_files`` record studies under ``folder``: [(path, category, words)]."""
+    good, bad = write_record_suite(folder / "recs")
+    rng = random.Random(seed)
+    g = RecordGen(rng, good, bad)
+    files = []
+    for i in range(n_files):
+        study = g.study()
+        if rng.random() < 0.4:
+            content, cat, words = study, "valid", None
+        else:
+            content, cat, words = mutate_record_study(g, study)
+        path = folder / "recs" / f"study_{i:03d}.toml"
+        path.write_text(to_toml(content))
+        files.append((path, cat, words))
+    return files
+
+
+def expected_records(study, base_dir) -> int:
+    """How many records a study names, counted independently of the design code: the files
+    of its list, or the entries its folder or glob finds (verticals not counted)."""
+    import glob as _glob
+
+    files = study.motion.files
+    if isinstance(files, list):
+        return len(files)
+    path = Path(base_dir) / files
+    names = (
+        _glob.glob(str(path))
+        if any(c in files for c in "*?[")
+        else [str(p) for p in path.iterdir() if p.suffix.lower() in RECORD_SUFFIXES]
+    )
+    if study.motion.vertical is not None:
+        names = [n for n in names if "_UP" not in n]
+    return len(names)
+
+
+def judge_record_study(path, cat, words, run=True):
+    """One outcome for one file: (kind, detail) with kind refused / succeeded / a failure:
+    traceback, hang, unclear, accepted-broken, dropped, failed-run."""
+    try:
+        with time_limit(60, f"validate {path.name}"):
+            study = load_study(path)
+    except StudyError as exc:
+        message = str(exc)
+        if any(w in message for w in PLUMBING) or not all(": " in p for p in exc.problems):
+            return "unclear", message[:600]
+        missing = [w for w in words or [] if w not in message]
+        if words is None or missing:
+            return "unclear", f"expected {words}, missing {missing}: {message[:600]}"
+        return "refused", None
+    except TimeoutError as exc:
+        return "hang", str(exc)
+    except Exception as exc:
+        return "traceback", f"{type(exc).__name__}: {exc}"[:600]
+    if words is not None:
+        return "accepted-broken", f"accepted although it breaks {words}"
+    if not run:
+        return "succeeded", None
+    try:
+        with time_limit(60, f"run {path.name}"):
+            design = make_design(study, path.parent)
+            problems = run_in_process(study, path.parent)
+    except TimeoutError as exc:
+        return "hang", str(exc)
+    except Exception as exc:
+        return "traceback", f"run: {type(exc).__name__}: {exc}"[:600]
+    if problems:
+        return "failed-run", str(problems)[:600]
+    if study.design is not None:
+        n_rec = expected_records(study, path.parent)
+        rows = n_rec * study.samples()
+        found = np.unique(design["record"].values).size
+        if found != n_rec or design["sample"].size != rows:
+            return "dropped", f"{found} of {n_rec} records, {design['sample'].size} of {rows} rows"
+    elif design["sample"].size != study.samples():
+        return "dropped", f"{design['sample'].size} of {study.samples()} samples"
+    return "succeeded", None
+
+
+def fuzz_record_studies(folder: Path, n_files: int = N_RECORD_FILES, seed: int = RECORD_SEED):
+    """Counts of outcomes (overall and by category) and the failures, for the test and for
+    benchmarks/fuzz_report.py."""
+    files = record_corpus(folder, n_files, seed)
+    counts, by_category, failures = Counter(), Counter(), []
+    for path, cat, words in files:
+        kind, detail = judge_record_study(path, cat, words)
+        counts[kind] += 1
+        by_category[f"{cat.split(':')[0]}: {kind}"] += 1
+        if kind not in ("refused", "succeeded"):
+            failures.append(f"{path.name} ({cat}): {kind}: {detail}")
+    return files, counts, by_category, failures
+
+
+def test_fuzz_record_studies_refused_by_field_or_run_with_nothing_dropped(tmp_path, capsys):
+    files, counts, by_category, failures = fuzz_record_studies(tmp_path)
+    designs = sum(1 for p, _, _ in files if "[design]" in p.read_text())
+    with capsys.disabled():
+        print(
+            f"\nfuzz of {len(files)} record study files ({designs} designs): {dict(counts)}; "
+            f"by category: {dict(sorted(by_category.items()))}"
+        )
+    assert not failures, "\n".join(failures)
+    assert len(files) >= 300 and designs > len(files) / 2
+    assert counts["refused"] >= 100 and counts["succeeded"] >= 50
+
+
+def _cli_block(stderr: str, path: str) -> str:
+    """The problems the command line printed for ``path`` (its line and the indented ones)."""
+    lines = stderr.splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith(f"{path}: "):
+            block = [line]
+            for more in lines[i + 1 :]:
+                if not more.startswith("  "):
+                    break
+                block.append(more)
+            return "\n".join(block)
+    return ""
+
+
+def test_record_study_files_through_the_real_cli(tmp_path):
+    """One record study of each category through ``rockstudy validate``: exit 2 with the
+    problems naming the field and the file, or ok; never a traceback."""
+    files = record_corpus(tmp_path, 120)
+    picked = {}
+    for path, cat, words in files:
+        picked.setdefault(cat.split(":")[0] if words is None else cat, (path, words))
+    paths = [str(p) for p, _ in picked.values()]
+    out = subprocess.run(
+        [ROCKSTUDY, "validate", *paths], capture_output=True, text=True, timeout=300
+    )
+    assert "Traceback" not in out.stderr, out.stderr[-3000:]
+    for path, words in picked.values():
+        if words is None:
+            assert f"{path}: ok" in out.stdout, (path, out.stdout, out.stderr[-2000:])
+        else:
+            block = _cli_block(out.stderr, str(path))
+            assert block and all(w in block for w in words), (path, words, out.stderr[-3000:])
+    assert out.returncode == 2 and len(picked) >= 8

@@ -141,3 +141,122 @@ def test_two_column_errors_name_the_problem(tmp_path):
     backwards.write_text("0,0.1\n0.02,0.2\n0.01,0.3\n")
     with pytest.raises(ValueError, match="time must be strictly increasing"):
         Record.from_csv(backwards)
+
+
+# ------------------------------------------------------------------ extreme records (issue 26)
+
+AT2_HEAD = "PEER NGA RECORD\nsynthetic\nACCELERATION TIME SERIES IN UNITS OF G\n"
+WAVE = [0.01, -0.02, 0.03, -0.01, 0.0, 0.02]
+
+
+def at2_file(path, values, dt):
+    body = "\n".join(f"{v:.6E}" for v in values)
+    path.write_text(AT2_HEAD + f"NPTS= {len(values)}, DT= {dt} SEC\n" + body + "\n")
+    return path
+
+
+@pytest.mark.parametrize(
+    "dt, values, field",
+    [
+        ("1e300", WAVE, "duration"),  # 5e300 s: no record lasts that long
+        ("1e-300", WAVE, "dt"),
+        ("1e-9", WAVE, "dt"),  # the mean period's spectrum alone would need 256 GiB
+        (".01", [*WAVE[:3], 1e300, *WAVE[3:]], "acceleration[3]"),
+        (".01", [*WAVE[:2], 1e-311, *WAVE[2:]], "acceleration[2]"),  # subnormal
+    ],
+)
+def test_extreme_at2_files_are_refused_naming_file_and_field(tmp_path, dt, values, field):
+    path = at2_file(tmp_path / "x.AT2", values, dt)
+    with pytest.raises(ValueError) as err:
+        Record.from_at2(path)
+    assert str(path) in str(err.value) and f"{field}" in str(err.value), str(err.value)
+
+
+def test_a_time_column_reaching_the_largest_float_is_refused(tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_text("0.0, 0.1\n0.01, 0.2\n1.7e308, 0.1\n")
+    with pytest.raises(ValueError, match=r"t\.csv: duration: .*1\.7e\+308 s"):
+        Record.from_csv(path)
+
+
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        (dict(dt=1e308), "duration"),  # 2e308 s: inf
+        (dict(dt="0.01"), "dt"),
+        (dict(dt=True), "dt"),
+        (dict(dt=0.01, vertical="yes"), "vertical"),
+        (dict(time=[0.0, 1e-9, 2e-9]), "time"),
+    ],
+)
+def test_record_constructor_refuses_naming_the_argument(kwargs, field):
+    with pytest.raises(ValueError, match=rf"^{field}"):
+        Record(np.array([0.1, -0.2, 0.1]), **kwargs)
+
+
+def test_records_at_the_edges_of_the_ranges_still_read():
+    """Not a refusal too many: a 1e6 g-free record at the 1 MHz step, and a peak of 1e7."""
+    fine = Record(np.array([0.1, -0.2, 0.1]), dt=1e-6)
+    assert fine.duration == pytest.approx(2e-6)
+    big = Record(np.array([0.0, 1e7, -1e7]), dt=0.01)
+    assert big.peak == 1e7
+    with pytest.raises(ValueError, match="factor = 2"):
+        big.scaled(2.0)
+
+
+# ------------------------------------------------------------------ special files (issue 26 §5)
+
+
+def _special(tmp_path, kind):
+    """A good record file and, beside it, the special file ``kind``; returns its path."""
+    import os
+
+    at2_file(tmp_path / "good.AT2", WAVE, ".01")
+    bad = tmp_path / "x.AT2"
+    if kind == "fifo":
+        os.mkfifo(bad)
+    elif kind == "dev-zero":
+        bad.symlink_to("/dev/zero")
+    elif kind == "dangling":
+        bad.symlink_to(tmp_path / "nowhere.AT2")
+    else:
+        bad.mkdir()
+    return bad
+
+
+WHAT = {
+    "fifo": "FIFO",
+    "dev-zero": "character device",
+    "dangling": "dangling symbolic link",
+    "folder": "folder",
+}
+
+
+@pytest.mark.parametrize("kind", sorted(WHAT))
+@pytest.mark.parametrize("how", ["glob", "folder", "list"])
+def test_a_suite_never_skips_a_special_file(tmp_path, kind, how):
+    """A glob, a folder or a list that finds a FIFO, a link to /dev/zero, a dangling link or a
+    folder named x.AT2 is refused, naming the path and what it is (it used to be skipped)."""
+    from rockstudy.motions import load_suite
+
+    bad = _special(tmp_path, kind)
+    source = {"glob": str(tmp_path / "*.AT2"), "folder": tmp_path, "list": [bad]}[how]
+    with pytest.raises(ValueError) as err:
+        load_suite(source)
+    assert str(bad) in str(err.value) and WHAT[kind] in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("kind", sorted(WHAT))
+def test_validate_refuses_a_study_whose_glob_finds_a_special_file(tmp_path, kind):
+    from rockstudy.study import StudyError, validate_text
+
+    bad = _special(tmp_path, kind)
+    text = (
+        'name = "s"\nseed = 1\n[sampler]\nkind = "monte_carlo"\nn = 2\n[structure]\n'
+        'kind = "block"\nhalf_diagonal = { dist = "uniform", low = 1.0, high = 2.0 }\n'
+        'slenderness = 0.2\n[motion]\nkind = "record"\nfiles = "*.AT2"\nscale = 1.0\n'
+    )
+    with pytest.raises(StudyError) as err:
+        validate_text(text, base_dir=tmp_path)
+    message = str(err.value)
+    assert "motion.files" in message and str(bad) in message and WHAT[kind] in message, message

@@ -226,8 +226,8 @@ def test_every_value_the_samplers_draw_is_finite_at_the_limits():
     """The bounds allowed by the checks above give finite designs at the extreme draws."""
     text = PULSE.replace(
         '{ dist = "loguniform", low = 0.1, high = 2.0 }',
-        '{ dist = "lognormal", median = 1.0, sigma = 5.0 }',
-    )
+        '{ dist = "lognormal", median = 1.0, sigma = 1.0 }',
+    )  # sigma 1: draws e^(+-8.1) s, within the solvers' periods (sigma 5 reaches 1e-18 s)
     design = make_design(validate_text(text))
     assert all(np.all(np.isfinite(design[v].values)) for v in design.data_vars)
 
@@ -337,14 +337,15 @@ def test_shipped_record_study_in_a_clone_without_records(tmp_path, capsys):
         ("dt = 1.0", "motion.dt"),
         ("decay = -1.0", "motion.decay"),
         ("duration = 0.01", "motion.duration"),
-        ("duration = 1e7", "motion.duration"),  # 10^9 points
+        ("duration = 1e7", "motion.duration"),  # beyond the 1e6 s of any record
+        ("duration = 1e6\ndt = 1e-5", "motion.duration"),  # 10^11 points
         ("duration = 20000.0", "motion.duration"),  # 2e6 points > max_steps
     ],
 )
 def test_stochastic_settings_that_cannot_work(setting, field):
     message = refused(STOCHASTIC + setting + "\n")
     assert f"{field}:" in message, message
-    if setting == "duration = 1e7":
+    if "1e-5" in setting:
         assert "GiB per sample" in message
 
 
@@ -385,10 +386,12 @@ def test_validate_refuses_a_study_file_that_is_not_a_file(tmp_path, capsys):
     assert os.path.isdir(tmp_path)
 
 
-@pytest.mark.parametrize("rtol", ["1e-15", "1e-300"])
-def test_rtol_beyond_double_precision_is_refused(rtol):
+@pytest.mark.parametrize("rtol", ["1e-13", "1e-15", "1e-300"])
+def test_rtol_below_what_the_solvers_take_is_refused(rtol):
+    """The floor is the solvers' own (simulate_batch refuses below 1e-12): a study that
+    validates must not fail at run time on its rtol."""
     message = refused(PULSE.replace("rtol = 1e-8", f"rtol = {rtol}"))
-    assert "run.rtol: must be >= 2.2e-14" in message
+    assert "run.rtol: must be >= 1e-12" in message
 
 
 def test_pulse_cycles_beyond_max_steps_are_refused():
@@ -397,3 +400,64 @@ def test_pulse_cycles_beyond_max_steps_are_refused():
     message = refused(text)
     assert "motion.cycles" in message and "run.max_steps = 1000000" in message
     validate_text(PULSE.replace('shape = "sine"', 'shape = "sine"\ncycles = 1000'))
+
+
+# ------------------------------------------------------------------ ranges (issue 26)
+
+
+@pytest.mark.parametrize(
+    "old, new, field",
+    [
+        ('name = "', 'name = "a\\u0000', "name"),  # a NUL character
+        ("rtol = 1e-8", "rtol = 1e-8\nmax_steps = 10000000000000", "run.max_steps"),
+        ("n = 50", "n = 50\nreplicates = 10000000", "sampler.replicates"),
+    ],
+)
+def test_settings_beyond_their_range_are_refused(old, new, field):
+    assert old in PULSE
+    message = refused(PULSE.replace(old, new, 1))
+    assert f"{field}:" in message, message
+
+
+@pytest.mark.parametrize(
+    "motion, field",
+    [
+        ("amplitude = 1e300\nperiod = 0.5", "motion.amplitude"),
+        ("amplitude = 5.0\nperiod = 1e-300", "motion.period"),
+        ("amplitude_ratio = 2.0\nfrequency_ratio = 1e-9", "motion.frequency_ratio"),
+        ("amplitude_ratio = 9000.0\nperiod = 0.5", "motion.amplitude_ratio"),
+    ],
+)
+def test_pulse_settings_the_solvers_would_refuse_are_refused(motion, field):
+    text = (
+        'name = "p"\nseed = 1\n[sampler]\nkind = "monte_carlo"\nn = 4\n[structure]\n'
+        'kind = "block"\nhalf_diagonal = { dist = "uniform", low = 0.5, high = 2.0 }\n'
+        f'slenderness = 1.5707\nrestitution = 0.9\n[motion]\nkind = "pulse"\n{motion}\n'
+    )
+    message = refused(text)
+    assert f"{field}:" in message, message
+
+
+@pytest.mark.parametrize(
+    "scaling, field",
+    [
+        ('scale_to = { im = "pgv", value = 1e300 }', "motion.scale_to.value"),
+        ('scale_to = { im = "pga", value = 2e7 }', "motion.scale_to.value"),
+        ("scale = 1e300", "motion.scale"),
+        ("scale = 1e-300", "motion.scale"),
+        ("pga_ratio = 1e300", "motion.pga_ratio"),
+    ],
+)
+def test_a_scaled_record_beyond_the_solvers_range_is_refused(tmp_path, scaling, field):
+    """Issue 26: a target that scales a record past 1e7 m/s^2 (or a scale that makes its
+    samples vanish) failed at run time; validate refuses it, naming the field."""
+    t = [0.0, 0.01, 0.02, 0.03]
+    rec = write_csv(tmp_path / "r.csv", t, [0.0, 0.1, -0.1, 0.0])
+    message = refused(record_study([rec], scaling))
+    assert f"{field}:" in message, message
+
+
+def test_a_scaled_record_within_range_is_accepted(tmp_path):
+    """Not a refusal too many: a PGA target of 1e6 m/s^2 (about 1e5 g) is taken."""
+    rec = write_csv(tmp_path / "r.csv", [0.0, 0.01, 0.02, 0.03], [0.0, 0.1, -0.1, 0.0])
+    validate_text(record_study([rec], 'scale_to = { im = "pga", value = 1e6 }'))

@@ -15,7 +15,8 @@ from .. import _validate
 from ..constants import G
 from ..motions import Record
 from ..motions import _kernels as mk
-from ..motions.pulses import PULSES, pulse_kernel_rows
+from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
+from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from . import _auto, _linear, _linear_record, _rocking
 from ._vertical import refuse_free_fall, uplift_ratio
 
@@ -41,7 +42,7 @@ _BATCH_KERNELS = {
 
 
 def _column(name, values, n, low=None, high=None, low_open=True, high_open=True):
-    arr = np.broadcast_to(np.asarray(values, dtype=float), (n,))
+    arr = np.broadcast_to(np.asarray(_numbers(name, values), dtype=float), (n,))
     bad = ~np.isfinite(arr)
     if low is not None:
         bad |= arr <= low if low_open else arr < low
@@ -51,7 +52,7 @@ def _column(name, values, n, low=None, high=None, low_open=True, high_open=True)
         i = int(np.flatnonzero(bad)[0])
         lo = "-inf" if low is None else ("(" if low_open else "[") + f"{low:g}"
         hi = "inf" if high is None else f"{high:g}" + (")" if high_open else "]")
-        raise ValueError(f"{name}[{i}] = {arr[i]!r} is outside the allowed range {lo}, {hi}")
+        raise ValueError(f"{name}[{i}] = {float(arr[i])!r} is outside the allowed range {lo}, {hi}")
     return np.ascontiguousarray(arr)
 
 
@@ -77,17 +78,48 @@ def _common_length(**columns) -> int:
     return max(max(lengths.values(), default=1), 1)
 
 
+def _numbers(name, values):
+    """``values`` as an array of numbers, or a ValueError naming ``name`` (strings, booleans
+    and objects are not numbers)."""
+    arr = np.asarray(values)
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(f"{name} must be a number or an array of numbers, got {values!r:.60}")
+    return arr
+
+
 def _pulse_params(pulse, amplitude, period, cycles, n):
     if pulse not in PULSES:
         raise ValueError(f"pulse must be one of {sorted(PULSES)}, got {pulse!r}")
-    amp = _column("amplitude", amplitude, n)
+    if amplitude is None or period is None:
+        raise ValueError("a pulse needs amplitude [m/s^2] and period [s] (or give record=)")
+    top = _validate.MAX_ACCELERATION
+    amp = _column("amplitude", amplitude, n, -top, top, False, False)
     if np.any(amp == 0.0):
         raise ValueError(f"amplitude[{int(np.flatnonzero(amp == 0)[0])}] must be non-zero")
-    per = _column("period", period, n, 0.0)
-    cyc = np.broadcast_to(np.asarray(cycles), (n,))
-    if np.any(cyc < 1) or np.any(cyc != np.round(cyc)):
+    per = _column("period", period, n, *PERIOD_RANGE, False, False)
+    cyc = _column("cycles", cycles, n, 1, MAX_CYCLES, False, False)
+    if np.any(cyc != np.round(cyc)):
         raise ValueError("cycles must be whole numbers >= 1")
     return pulse_kernel_rows(pulse, amp, per, cyc)
+
+
+def _record_params(record, scale, amplitude, period, cycles, n):
+    """The kernel rows of ``record`` scaled row by row by ``scale``; the pulse's arguments
+    are refused beside it, and so is a scaled peak beyond MAX_ACCELERATION."""
+    if not isinstance(record, Record):
+        raise TypeError(f"record must be a rockstudy Record, got {type(record).__name__}")
+    given = [k for k, v in (("amplitude", amplitude), ("period", period)) if v is not None]
+    if given or not np.all(np.asarray(cycles) == 1):
+        raise ValueError(
+            f"record= takes no {', '.join(given) or 'cycles'}: those describe a pulse; scale "
+            "the record with scale="
+        )
+    vpeak = 0.0 if record.vertical is None else float(np.max(np.abs(record.vertical)))
+    top = _validate.MAX_ACCELERATION / max(record.peak, vpeak, 1e-300)
+    kind, p1, times, samples, vsamples = record.kernel_spec()
+    mp = np.tile(p1, (n, 1))
+    mp[:, 0] = _column("scale", scale, n, -top, top, False, False)
+    return kind, mp, times, samples, vsamples
 
 
 def simulate_batch(
@@ -202,20 +234,21 @@ def simulate_batch(
         scale=scale,
         cycles=cycles,
     )
-    alpha = _column("slenderness", slenderness, n, 0.0, np.pi / 2)
+    alpha = _column("slenderness", slenderness, n, MIN_SLENDERNESS, np.pi / 2, False)
     if half_diagonal is not None:
-        R = _column("half_diagonal", half_diagonal, n, 0.0)
+        R = _column("half_diagonal", half_diagonal, n, *HALF_DIAGONAL_RANGE, False, False)
         p = np.sqrt(3.0 * G / (4.0 * R))  # eq. (2.2) of [000], as block.frequency_parameter
     else:
-        p = _column("frequency_parameter", frequency_parameter, n, 0.0)
+        p_range = FREQUENCY_PARAMETER_RANGE
+        p = _column("frequency_parameter", frequency_parameter, n, *p_range, False, False)
     if restitution is None:
         eta = 1.0 - 1.5 * np.sin(alpha) ** 2  # eq. (2.4), as block.restitution_housner
     else:
         eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
     if record is not None:
-        kind, p1, times, samples, vsamples = record.kernel_spec()
-        mp = np.tile(p1, (n, 1))
-        mp[:, 0] = _column("scale", scale, n)
+        kind, mp, times, samples, vsamples = _record_params(
+            record, scale, amplitude, period, cycles, n
+        )
         refuse_free_fall(vsamples, mp[:, 0], batch=True)
     else:
         kind, mp = _pulse_params(pulse, amplitude, period, cycles, n)

@@ -445,7 +445,7 @@ def simulate(
     th0 = _validate.in_open_interval(
         "initial_rotation", initial_rotation, -FALL_ROTATION, FALL_ROTATION, "(-pi/2, pi/2) rad"
     )
-    om0 = float(initial_velocity)
+    om0 = _validate.number("initial_velocity", initial_velocity)
     if not math.isfinite(om0):
         raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
     if method in ("nonlinear", "mechanism"):

@@ -15,17 +15,39 @@ from .. import _validate
 from . import _kernels
 from .base import Motion
 
+#: Pulse periods T_p [s] taken: a microsecond to about 11.6 days (far beyond any ground
+#: motion at both ends; below ~1e-160 s the kernels' divisions by omega_g underflow).
+PERIOD_RANGE = (1e-6, 1e6)
+#: Most cycles of a sine or cosine pulse.
+MAX_CYCLES = 10**6
+
 
 def _amplitude(value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value) or value == 0.0:
-        raise ValueError(f"amplitude must be a finite, non-zero number [m/s^2], got {value!r}")
+    value = _validate.number("amplitude", value)
+    top = _validate.MAX_ACCELERATION
+    if not math.isfinite(value) or value == 0.0 or abs(value) > top:
+        raise ValueError(
+            f"amplitude must be a non-zero number [m/s^2] within +-{top:.0e} (about a "
+            f"million g), got {value!r}"
+        )
     return value
 
 
+def check_period(value) -> float:
+    """T_p [s] as a float, or a ValueError naming ``period`` and :data:`PERIOD_RANGE`."""
+    lo, hi = PERIOD_RANGE
+    return _validate.in_range("period", value, lo, hi, f"[{lo:g}, {hi:g}] s")
+
+
 def _cycles(value) -> int:
-    if isinstance(value, bool) or int(value) != value or int(value) < 1:
-        raise ValueError(f"cycles must be a whole number >= 1, got {value!r}")
+    if (
+        isinstance(value, (bool, np.bool_))
+        or not isinstance(value, (int, float, np.integer, np.floating))
+        or not math.isfinite(value)
+        or int(value) != value
+        or not 1 <= int(value) <= MAX_CYCLES
+    ):
+        raise ValueError(f"cycles must be a whole number in [1, {MAX_CYCLES}], got {value!r}")
     return int(value)
 
 
@@ -40,7 +62,7 @@ class _TrigPulse(Motion):
 
     def __post_init__(self):
         object.__setattr__(self, "amplitude", _amplitude(self.amplitude))
-        object.__setattr__(self, "period", _validate.positive("period", self.period))
+        object.__setattr__(self, "period", check_period(self.period))
         object.__setattr__(self, "cycles", _cycles(self.cycles))
 
     @property
@@ -135,7 +157,7 @@ class RickerWavelet(Motion):
 
     def __post_init__(self):
         object.__setattr__(self, "amplitude", _amplitude(self.amplitude))
-        object.__setattr__(self, "period", _validate.positive("period", self.period))
+        object.__setattr__(self, "period", check_period(self.period))
 
     @property
     def center(self) -> float:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import re
 import stat
 from dataclasses import dataclass, field
@@ -86,13 +87,16 @@ class Record(Motion):
     _cache: dict = field(init=False, repr=False)
 
     def __post_init__(self):
-        acc = _validate.finite_array("acceleration", self.acceleration)
+        if not isinstance(self.name, str):
+            raise ValueError(f"name must be a string, got {type(self.name).__name__}")
+        acc = _samples("acceleration", self.acceleration)
         if acc.size < 2:
             raise ValueError("acceleration must hold at least 2 samples")
         if (self.dt is None) == (self.time is None):
             raise ValueError("give exactly one of dt (uniform step) or time (sample times)")
         if self.dt is not None:
             dt = _validate.positive("dt", self.dt)
+            _check_timing(acc.size, dt * (acc.size - 1), dt, dt, "dt")
             times = dt * np.arange(acc.size)
         else:
             times = _validate.finite_array("time", self.time)
@@ -110,8 +114,9 @@ class Record(Motion):
                 )
             times = times - times[0]
             dt = float(np.median(steps))
+            _check_timing(acc.size, float(times[-1]), dt, float(np.min(steps)), "time")
         if self.vertical is not None:
-            vert = _validate.finite_array("vertical", self.vertical)
+            vert = _samples("vertical", self.vertical)
             if vert.size != acc.size:
                 raise ValueError(
                     f"vertical has {vert.size} samples but acceleration has {acc.size}; "
@@ -144,13 +149,16 @@ class Record(Motion):
         A vertical component is multiplied by ``|factor|``: mirroring the horizontal direction
         does not turn the vertical upside down.
         """
-        factor = float(factor)
+        factor = _validate.number("factor", factor)
         if not math.isfinite(factor):
             raise ValueError(f"factor must be a finite number, got {factor!r}")
-        vertical = None if self.vertical is None else self.vertical * abs(factor)
-        return Record(
-            self.acceleration * factor, time=self._times, name=self.name, vertical=vertical
-        )
+        with np.errstate(over="ignore", under="ignore"):  # refused below, naming the factor
+            acc = self.acceleration * factor
+            vertical = None if self.vertical is None else self.vertical * abs(factor)
+        try:
+            return Record(acc, time=self._times, name=self.name, vertical=vertical)
+        except ValueError as exc:
+            raise ValueError(f"factor = {factor:g} on the record {self.name!r}: {exc}") from None
 
     def scaled_to(self, value: float, im: str = "pga", period=None, damping: float = 0.05):
         """The record scaled so that its intensity measure ``im`` equals ``value``.
@@ -437,6 +445,59 @@ class Record(Motion):
         )
 
 
+#: Float arrays of a record's working length that its measures hold at once: the uniform
+#: resampling, the mean period's zero-padded spectrum (complex: two each, and a power of 2
+#: above its length) and the pulse scan's convolutions.
+_WORK_ARRAYS = 12
+
+
+def _samples(name: str, values) -> np.ndarray:
+    """Finite samples [m/s^2] within +-MAX_ACCELERATION, none of them subnormal."""
+    arr = _validate.finite_array(name, values)
+    big = np.flatnonzero(np.abs(arr) > _validate.MAX_ACCELERATION)
+    if big.size:
+        i = int(big[0])
+        raise ValueError(
+            f"{name}[{i}] = {float(arr[i]):.4g} m/s^2 is beyond the +-"
+            f"{_validate.MAX_ACCELERATION:.0e} m/s^2 allowed (about a million g; no ground "
+            "motion comes near it): a wrong unit or a corrupt value?"
+        )
+    tiny = np.flatnonzero((arr != 0.0) & (np.abs(arr) < np.finfo(float).tiny))
+    if tiny.size:
+        i = int(tiny[0])
+        raise ValueError(
+            f"{name}[{i}] = {float(arr[i]):.4g} m/s^2 is subnormal (nonzero but below "
+            f"{np.finfo(float).tiny:.3g}): it has lost its precision, and no scale factor "
+            "brings it to a finite target; write it as 0 or check the file"
+        )
+    return arr
+
+
+def _check_timing(n: int, duration: float, dt: float, smallest: float, field: str):
+    """Refuse a record whose duration [s] or steps [s] are beyond :data:`MAX_DURATION` and
+    :data:`MIN_STEP`, or whose measures would not fit in memory (``field`` is ``dt`` or
+    ``time``; ``dt`` is the median step)."""
+    if not (math.isfinite(duration) and duration <= _validate.MAX_DURATION):
+        raise ValueError(
+            f"duration: {n} samples at a step of {dt:.4g} s last {duration:.4g} s, "
+            f"beyond the {_validate.MAX_DURATION:.0e} s allowed for a record (about 11.6 "
+            "days; a wrong time unit or a corrupt value?)"
+        )
+    if smallest < _validate.MIN_STEP:
+        raise ValueError(
+            f"{field}: a step of {smallest:.4g} s is below the {_validate.MIN_STEP:.0e} s "
+            "allowed (1 MHz, a thousand times any accelerograph's sampling rate)"
+        )
+    points = max(n, duration / dt + 1.0, 2.0 / (intensity.MEAN_PERIOD_DF * dt))
+    _validate.check_memory(
+        field,
+        8.0 * _WORK_ARRAYS * points,
+        f"the record's intensity measures work on {points:.4g} points ({n} samples over "
+        f"{duration:.4g} s at a step of {dt:.4g} s)",
+        "resample the record to a coarser step",
+    )
+
+
 def _column_hint(columns) -> str:
     """A hint for a file whose column count does not match ``columns``."""
     if columns == ("time", "horizontal"):
@@ -476,6 +537,33 @@ def _build(path, make) -> Record:
         raise ValueError(f"{path}: {exc}") from None
 
 
+def not_a_file(path) -> str | None:
+    """What ``path`` is if it is not a regular file (following symbolic links), e.g. "a FIFO
+    (named pipe)" or "a dangling symbolic link to 'x'"; None for a regular file."""
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        if path.is_symlink():
+            return f"a dangling symbolic link to {os.readlink(path)!r}"
+        return "missing"
+    except OSError as exc:
+        return f"unreadable ({exc.strerror or type(exc).__name__})"
+    if stat.S_ISREG(mode):
+        return None
+    kinds = (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    what = next((name for test, name in kinds if test(mode)), "not a regular file")
+    if path.is_symlink():
+        what += f" (a symbolic link to {os.readlink(path)!r})"
+    return what
+
+
 def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
     """The text of a regular file of at most ``max_bytes``, refusing anything else.
 
@@ -490,10 +578,8 @@ def read_text_file(path, max_bytes: int = MAX_RECORD_BYTES) -> str:
         raise FileNotFoundError(f"{path}: no such file") from None
     except OSError as exc:
         raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise ValueError(f"{path}: is a folder, not a file")
     if not stat.S_ISREG(info.st_mode):
-        raise ValueError(f"{path}: is not a regular file (a device, pipe or socket)")
+        raise ValueError(f"{path}: is {not_a_file(path)}, not a file")
     if info.st_size == 0:
         raise ValueError(f"{path}: is empty (or a pseudo-file of the system)")
     if info.st_size > max_bytes:

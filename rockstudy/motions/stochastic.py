@@ -82,11 +82,22 @@ def stochastic_record(
     seed : int or numpy.random.SeedSequence
         Seed of the white noise.
     """
-    peak = _validate.positive("peak", peak)
-    duration = _validate.positive("duration", duration)
-    dt = _validate.positive("dt", dt)
-    ground_frequency = _validate.positive("ground_frequency", ground_frequency)
-    ground_damping = _validate.positive("ground_damping", ground_damping)
+    top = _validate.MAX_ACCELERATION
+    peak = _validate.in_range("peak", peak, 1e-12, top, f"[1e-12, {top:.0e}] m/s^2")
+    dt = _validate.in_range("dt", dt, _validate.MIN_STEP, 1.0, f"[{_validate.MIN_STEP:g}, 1] s")
+    longest = _validate.MAX_DURATION
+    duration = _validate.in_range("duration", duration, 2 * dt, longest, f"[2 dt, {longest:g}] s")
+    ground_frequency = _validate.in_range(
+        "ground_frequency", ground_frequency, 1e-2, 1e4, "[0.01, 1e4] rad/s"
+    )
+    ground_damping = _validate.in_range("ground_damping", ground_damping, 1e-3, 10.0, "[1e-3, 10]")
+    points = duration / dt + 1.0
+    _validate.check_memory(
+        "duration",
+        8.0 * 6 * points,
+        f"{duration:g} s at dt = {dt:g} s is a record of {points:.4g} points",
+        "shorten duration or coarsen dt",
+    )
     if ground_frequency * dt >= 1.0:
         raise ValueError("dt must resolve the ground frequency: ground_frequency * dt < 1")
     rise = 0.1 * duration if rise is None else _validate.positive("rise", rise)

@@ -11,7 +11,7 @@ import glob
 import re
 from pathlib import Path
 
-from .records import Record
+from .records import Record, not_a_file
 
 #: Suffixes (case-insensitive) of the files read from a folder.
 RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
@@ -21,25 +21,41 @@ def _is_glob(text: str) -> bool:
     return any(c in text for c in "*?[")
 
 
+def _refuse_non_files(paths, field: str, how: str) -> list[Path]:
+    """``paths`` if every one is a regular file, else a ValueError naming the first that is
+    not and what it is: a glob or folder that finds one never skips it silently."""
+    for p in paths:
+        what = not_a_file(p)
+        if what:
+            raise ValueError(
+                f"{field}: {how} finds {str(p)!r}, which is {what}, not a record file; "
+                "remove it or name the record files one by one"
+            )
+    return paths
+
+
 def _expand(item, field: str = "source") -> list[Path]:
     """The record files named by one source item: a file, a folder or a glob."""
     text = str(item)
     if _is_glob(text):
-        paths = sorted(Path(p) for p in glob.glob(text) if Path(p).is_file())
+        paths = sorted(Path(p) for p in glob.glob(text))
         if not paths:
             raise ValueError(f"{field}: the glob {text!r} matches no file")
-        return paths
+        return _refuse_non_files(paths, field, f"the glob {text!r}")
     path = Path(item)
     if path.is_dir():
-        paths = sorted(p for p in path.iterdir() if p.is_file() and _suffix_ok(p))
+        paths = sorted(p for p in path.iterdir() if _suffix_ok(p))
         if not paths:
             raise ValueError(
                 f"{field}: the folder {str(path)!r} holds no record files "
                 f"(suffixes {', '.join(RECORD_SUFFIXES)}, any case)"
             )
-        return paths
-    if not path.is_file():
+        return _refuse_non_files(paths, field, f"the folder {str(path)!r}")
+    what = not_a_file(path)
+    if what == "missing":
         raise ValueError(f"{field}: {text!r} is neither a file, a folder nor a glob that matches")
+    if what:
+        raise ValueError(f"{field}: {text!r} is {what}, not a record file")
     return [path]
 
 
@@ -182,6 +198,11 @@ def _pair_by_name(pairs, rule, field="vertical"):
             )
     out = [(h, v) for h, v in out if h.resolve() not in verticals]
     for h, v in out:
-        if not v.is_file():
+        what = not_a_file(v)
+        if what == "missing":
             raise ValueError(f"{field}: the vertical file {str(v)!r} of {str(h)!r} is missing")
+        if what:
+            raise ValueError(
+                f"{field}: the vertical file {str(v)!r} of {str(h)!r} is {what}, not a file"
+            )
     return out

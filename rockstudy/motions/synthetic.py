@@ -16,6 +16,16 @@ from .stochastic import stochastic_record
 
 #: Order of the Butterworth high-pass that keeps the stochastic part out of the pulse's band.
 HIGH_PASS_ORDER = 4
+#: Pulse periods T_p [s] taken: near-fault velocity pulses last 0.3 to about 15 s (the
+#: longest recorded); 1e-3 to 100 s covers them with margin. T_p = 1e6 s made a record of
+#: 1.2e9 points (8 GB, over a minute).
+PULSE_PERIOD_RANGE = (1e-3, 100.0)
+#: Largest envelope parameter gamma (M-P 2003 fit 1 to about 5; the record holds 1.5 gamma
+#: T_p).
+MAX_GAMMA = 100.0
+#: Float arrays of the record's length held at once (noise, its filtered copy, envelope,
+#: times, pulse, vertical and the filter's work arrays).
+_ARRAYS = 10
 
 
 def _high_frequency(peak, duration, dt, corner, seed, ground_frequency):
@@ -73,21 +83,45 @@ def synthetic_near_fault(
     dt : float
         Time step [s]; must resolve the pulse (dt < T_p / 20).
     """
-    period = _validate.positive("pulse_period", pulse_period)
-    pga = _validate.positive("pga", pga)
-    dt = _validate.positive("dt", dt)
+    period = _validate.in_range(
+        "pulse_period",
+        pulse_period,
+        *PULSE_PERIOD_RANGE,
+        "[{:g}, {:g}] s".format(*PULSE_PERIOD_RANGE),
+    )
+    top = _validate.MAX_ACCELERATION
+    pga = _validate.in_range("pga", pga, 0.0, top, f"(0, {top:.0e}] m/s^2")
+    if pga == 0.0:
+        raise ValueError("pga must be > 0 [m/s^2], got 0.0")
+    dt = _validate.in_range("dt", dt, _validate.MIN_STEP, 1.0, f"[{_validate.MIN_STEP:g}, 1] s")
     if not dt < period / 20.0:
         raise ValueError(f"dt must be < pulse_period / 20 = {period / 20.0!r} s, got {dt!r}")
-    if not (math.isfinite(gamma) and gamma > 1.0):
-        raise ValueError(f"gamma must be a finite number > 1, got {gamma!r}")
-    if not (math.isfinite(noise_ratio) and noise_ratio >= 0.0):
-        raise ValueError(f"noise_ratio must be a finite number >= 0, got {noise_ratio!r}")
-    duration = max(20.0, 6.0 * period) if duration is None else float(duration)
-    if not (math.isfinite(duration) and duration >= 1.5 * gamma * period):
+    gamma = _validate.in_range("gamma", gamma, 1.0, MAX_GAMMA, f"(1, {MAX_GAMMA:g}]")
+    if gamma == 1.0:
+        raise ValueError("gamma must be > 1, got 1.0")
+    phase = _validate.in_range("phase", phase, -1e3, 1e3, "[-1000, 1000] rad")
+    noise_ratio = _validate.in_range("noise_ratio", noise_ratio, 0.0, 1e3, "[0, 1000]")
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
+    if not isinstance(vertical, (bool, np.bool_)):
+        raise ValueError(f"vertical must be True or False, got {vertical!r}")
+    if duration is None:
+        duration = max(20.0, 6.0 * period)
+    duration = _validate.in_range(
+        "duration", duration, 0.0, _validate.MAX_DURATION, f"[0, {_validate.MAX_DURATION:g}] s"
+    )
+    if not duration >= 1.5 * gamma * period:
         raise ValueError(
             f"duration must hold the pulse: >= 1.5 gamma pulse_period = "
             f"{1.5 * gamma * period!r} s, got {duration!r}"
         )
+    points = duration / dt + 1.0
+    _validate.check_memory(
+        "duration",
+        8.0 * _ARRAYS * points,
+        f"{duration:g} s at dt = {dt:g} s is a record of {points:.4g} points",
+        "shorten duration or coarsen dt",
+    )
     if vertical:
         vertical_ratio = _validate.positive("vertical_ratio", vertical_ratio)
         if not vertical_ratio * pga < G:

@@ -8,6 +8,35 @@ from dataclasses import dataclass
 from .. import _validate
 from ..constants import G
 
+#: Half-diagonals R [m] taken: a micrometre to a thousand kilometres, beyond any rocking
+#: object at both ends (the kernels divide by powers of p = sqrt(3 g / 4 R)).
+HALF_DIAGONAL_RANGE = (1e-6, 1e6)
+#: Smallest slenderness alpha [rad] taken: a needle a million times taller than wide. Below
+#: ~1e-200 the kernels' divisions by powers of alpha underflow to zero.
+MIN_SLENDERNESS = 1e-6
+#: Frequency parameters p [rad/s] taken where p is given directly (equivalent blocks): those
+#: of HALF_DIAGONAL_RANGE, widened to whole decades.
+FREQUENCY_PARAMETER_RANGE = (1e-3, 1e4)
+
+
+def check_half_diagonal(value) -> float:
+    """R [m] as a float, or a ValueError naming ``half_diagonal`` and HALF_DIAGONAL_RANGE."""
+    lo, hi = HALF_DIAGONAL_RANGE
+    return _validate.in_range("half_diagonal", value, lo, hi, f"[{lo:g}, {hi:g}] m")
+
+
+def check_slenderness(value) -> float:
+    """alpha [rad] as a float, or a ValueError naming ``slenderness``: [MIN_SLENDERNESS,
+    pi/2)."""
+    return _validate.in_range(
+        "slenderness",
+        value,
+        MIN_SLENDERNESS,
+        math.pi / 2,
+        f"[{MIN_SLENDERNESS:g}, pi/2) rad",
+        high_open=True,
+    )
+
 
 def frequency_parameter(half_diagonal: float) -> float:
     r"""Frequency parameter of a rectangular block, p [rad/s].
@@ -65,10 +94,8 @@ class Block:
     restitution: float | None = None
 
     def __post_init__(self):
-        R = _validate.positive("half_diagonal", self.half_diagonal)
-        alpha = _validate.in_open_interval(
-            "slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad"
-        )
+        R = check_half_diagonal(self.half_diagonal)
+        alpha = check_slenderness(self.slenderness)
         if self.restitution is None:
             eta = restitution_housner(alpha)
             if not eta > 0.0:  # sin^2(alpha) >= 2/3: width / height >= sqrt(2)
@@ -97,7 +124,12 @@ class Block:
         """
         b = _validate.positive("width", width) / 2.0
         h = _validate.positive("height", height) / 2.0
-        return cls(math.hypot(b, h), math.atan2(b, h), restitution)
+        try:
+            return cls(math.hypot(b, h), math.atan2(b, h), restitution)
+        except ValueError as exc:
+            if "restitution" in str(exc).split(" ")[0]:
+                raise
+            raise ValueError(f"width = {width!r} m and height = {height!r} m: {exc}") from None
 
     @property
     def frequency_parameter(self) -> float:

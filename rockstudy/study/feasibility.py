@@ -7,27 +7,20 @@ problem is one sentence naming the field, the quantity and what is allowed.
 
 from __future__ import annotations
 
-import os
+import math
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
+from .._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
+from ..constants import G
 from ..motions.suites import read_pair, suite_pairs
 
-GIB = 2.0**30
-#: Bytes per design row: the ~20 design columns, the unit samples and the outputs (8 bytes
 #: each), the status and the error message.
 _ROW_BYTES = 8 * 20 + 128
 #: Arrays of one synthesized record held at once (noise, filtered, envelope, times, samples).
 _STOCHASTIC_ARRAYS = 6
-#: Share of the memory the design (client) and one sample (worker) may take.
-DESIGN_SHARE, SAMPLE_SHARE = 0.5, 0.25
-
-
-def machine_memory() -> float:
-    """Physical memory of this machine [bytes]."""
-    return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
 def design_bytes(study) -> float:
@@ -95,6 +88,12 @@ def _record_problems(study, pairs) -> list[str]:
             continue
         if rec.acceleration.size > max_steps:
             found.append(_too_long(field, rec.acceleration.size, max_steps))
+        scaled = _largest_scaled_peak(study, rec)
+        if scaled is not None and not scaled[1] <= MAX_ACCELERATION:
+            found.append(
+                f"{scaled[0]}: scales {h} to a peak of {scaled[1]:.4g} m/s^2, beyond the "
+                f"{MAX_ACCELERATION:.0e} m/s^2 the solvers take (about a million g)"
+            )
         for im, period, damping in _scaled_measures(study):
             base = {"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(im, im)
             value = rec.intensity_measure(base, period=period, damping=damping)
@@ -105,6 +104,53 @@ def _record_problems(study, pairs) -> list[str]:
                 )
                 break
     return found
+
+
+def draw_span(value) -> tuple[float, float]:
+    """The smallest and largest value a fixed parameter or a distribution can give: its
+    support, or where that is infinite (normal, lognormal) its values at the extreme
+    probabilities the samplers draw."""
+    if isinstance(value, (int, float)):
+        return float(value), float(value)
+    lo, hi = value.support()
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        ends = value.ppf(np.array([2.0**-53, 1.0 - 2.0**-53]))
+        lo = lo if math.isfinite(lo) and lo > 0 else float(ends[0])
+        hi = hi if math.isfinite(hi) else float(ends[1])
+    return float(lo), float(hi)
+
+
+def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
+    """(field, the largest peak [m/s^2] of ``rec`` once scaled as the study asks), over the
+    whole support of the study's distributions; None for an unscaled record or a measure of
+    0 (refused on its own)."""
+    mo, de = study.motion, study.design
+    peak = float(np.max(np.abs(rec.acceleration)))
+    if rec.vertical is not None:
+        peak = max(peak, float(np.max(np.abs(rec.vertical))))
+    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
+    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio g tan
+        top = de.ida_options()["max_pga_ratio"] * uplift
+        return "design.max_pga_ratio", top * peak / rec.peak if rec.peak > 0 else 0.0
+    if mo.scale is not None:
+        lo, hi = draw_span(mo.scale)
+        return "motion.scale", max(abs(lo), abs(hi)) * peak
+    target = mo.target()
+    if target is None or target.value is None:
+        return None
+    value = draw_span(target.value)[1]
+    field = "motion.pga_ratio" if mo.pga_ratio is not None else "motion.scale_to.value"
+    if target.im == "pga_ratio":
+        value, base = value * uplift, rec.peak
+    elif target.im == "pgv_ratio":
+        value = value * uplift / study.frequency_parameter_span()[0]
+        base = rec.intensity_measure("pgv")
+    else:
+        base = rec.intensity_measure(target.im, period=target.period, damping=target.damping)
+    if not base > 0:
+        return None
+    ratio = value / base
+    return field, (math.sqrt(ratio) if target.im == "arias" else ratio) * peak
 
 
 @lru_cache(maxsize=1)

@@ -59,7 +59,12 @@ from pydantic import (
     model_validator,
 )
 
+from .. import _validate
+from ..constants import G
+from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
+from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
+from .feasibility import draw_span as _draw_span
 from .feasibility import problems
 from .records_designs import IdaOptionError, IdaOptions
 
@@ -85,6 +90,8 @@ _Restitution = Annotated[
 #: Housner's restitution 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], is > 0 only below this
 #: slenderness [rad] (sin^2 alpha = 2/3).
 HOUSNER_MAX_SLENDERNESS = math.asin(math.sqrt(2.0 / 3.0))
+_R_LABEL = "[{:g}, {:g}] m".format(*HALF_DIAGONAL_RANGE)
+_ALPHA_LABEL = f"[{MIN_SLENDERNESS:g}, pi/2) rad"
 
 
 class FieldError(ValueError):
@@ -121,7 +128,9 @@ class BlockSpec(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("half_diagonal", self.half_diagonal)
+        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
         _within("slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad")
+        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 2, _ALPHA_LABEL)
         if self.restitution != "housner":
             _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         else:  # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
@@ -150,7 +159,9 @@ class WallSpec(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("half_diagonal", self.half_diagonal)
+        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
         _within("slenderness", self.slenderness, 0.0, math.pi / 4, "(0, pi/4) rad")
+        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 4, "[1e-06, pi/4) rad")
         _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         return self
 
@@ -166,14 +177,44 @@ class EquivalentBlockSpec(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("frequency_parameter", self.frequency_parameter)
+        lo, hi = FREQUENCY_PARAMETER_RANGE
+        _span("frequency_parameter", self.frequency_parameter, lo, hi, f"[{lo:g}, {hi:g}] rad/s")
         _within("critical_rotation", self.critical_rotation, 0.0, math.pi / 2, "(0, pi/2) rad")
+        _span("critical_rotation", self.critical_rotation, MIN_SLENDERNESS, 2, _ALPHA_LABEL)
         _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         return self
 
 
+#: Largest dimensionless intensity (amplitude_ratio, amplitude_a, pga_ratio, pgv_ratio) and
+#: frequency ratio omega_g / p taken; the amplitudes and periods they give are then checked
+#: against the solver's ranges (:meth:`Study._engine_ranges`).
+MAX_RATIO = 1e4
+#: Smallest ratio taken (a millionth: the motions they give must not vanish into subnormals).
+MIN_RATIO = 1e-6
+_RATIO_LABEL = f"[{MIN_RATIO:g}, {MAX_RATIO:g}]"
+#: Largest |scale| of a record (its scaled peak is then checked against MAX_ACCELERATION),
+#: and the smallest.
+MAX_SCALE, MIN_SCALE = 1e6, 1e-6
+#: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
+MAX_CHUNK_SIZE = 10**7
+
+
+def _span(name, value, low, high, label):
+    """A fixed value or a distribution's support must lie in the closed [low, high]."""
+    lo, hi = _draw_span(value)
+    if not (low <= lo and hi <= high):
+        got = f"got {value}" if lo == hi else f"it spans {lo:g} to {hi:g}"
+        raise FieldError(name, f"must lie in {label}; {got}")
+
+
+def _smallest(value) -> float:
+    """The smallest value a fixed parameter or a distribution can give."""
+    return _draw_span(value)[0]
+
+
 def _largest(value) -> float:
     """The largest value a fixed parameter or a distribution can give."""
-    return float(value) if isinstance(value, (int, float)) else float(value.support()[1])
+    return _draw_span(value)[1]
 
 
 def _within(name, value, low, high, label):
@@ -212,7 +253,7 @@ class PulseSpec(_Model):
 
     kind: Literal["pulse"]
     shape: Literal["sine", "cosine", "half-sine", "ricker"] = "sine"
-    cycles: int = Field(default=1, ge=1)
+    cycles: int = Field(default=1, ge=1, le=MAX_CYCLES)
     amplitude: Param | None = None
     amplitude_ratio: Param | None = None
     amplitude_a: Param | None = None
@@ -239,6 +280,16 @@ class PulseSpec(_Model):
             raise ValueError("give exactly one of period [s] or frequency_ratio")
         for name in ("amplitude", "amplitude_ratio", "amplitude_a", "period", "frequency_ratio"):
             _check_positive(name, getattr(self, name))
+        for name, low, top in (
+            ("amplitude", 0.0, _validate.MAX_ACCELERATION),
+            ("amplitude_ratio", MIN_RATIO, MAX_RATIO),
+            ("amplitude_a", MIN_RATIO, MAX_RATIO),
+            ("frequency_ratio", MIN_RATIO, MAX_RATIO),
+        ):
+            if getattr(self, name) is not None:
+                _span(name, getattr(self, name), low, top, f"[{low:g}, {top:g}]")
+        if self.period is not None:
+            _span("period", self.period, *PERIOD_RANGE, "[{:g}, {:g}] s".format(*PERIOD_RANGE))
         if self.cycles != 1 and self.shape not in ("sine", "cosine"):
             raise FieldError("cycles", f"applies to sine and cosine pulses, not {self.shape}")
         return self
@@ -254,7 +305,8 @@ ScaleIM = Literal[
 _SPECTRAL_IMS = ("sa", "psv", "sd")
 #: The damping ratio of ``sa``, ``psv``, ``sd`` and the spectrum intensity in record studies.
 _Damping = Annotated[float, Field(ge=0.0, lt=1.0)]
-_Period = Annotated[float, Field(gt=0.0)]
+#: Periods of spectral measures [s]: 1 ms to 100 s, the span of response spectra.
+_Period = Annotated[float, Field(ge=1e-3, le=100.0)]
 
 
 def _check_period(im, period, field):
@@ -280,6 +332,8 @@ class ScaleTo(_Model):
     def _ranges(self):
         _check_period(self.im, self.period, "period")
         _check_positive("value", self.value)
+        if self.value is not None and self.im in ("pga_ratio", "pgv_ratio"):
+            _span("value", self.value, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         return self
 
 
@@ -349,8 +403,15 @@ class RecordSpec(_Model):
             raise ValueError("give at most one of scale, pga_ratio or scale_to")
         if self.pga_ratio is not None:
             _check_positive("pga_ratio", self.pga_ratio)
+            _span("pga_ratio", self.pga_ratio, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         elif self.scale is not None:
             _nonzero("scale", self.scale)
+            _span("scale", self.scale, -MAX_SCALE, MAX_SCALE, f"[-{MAX_SCALE:g}, {MAX_SCALE:g}]")
+            lo, hi = _draw_span(self.scale)
+            if min(abs(lo), abs(hi)) < MIN_SCALE:
+                raise FieldError(
+                    "scale", f"must be at least {MIN_SCALE:g} in magnitude; it reaches {lo:g}"
+                )
         if isinstance(self.vertical, list):
             if isinstance(self.files, str):
                 raise FieldError(
@@ -386,7 +447,7 @@ class DesignSpec(_Model):
     record, ``damping`` their damping ratio."""
 
     kind: Literal["cloud", "stripes", "ida"]
-    periods: list[_Period] = []
+    periods: list[_Period] = Field(default=[], max_length=1000)
     damping: _Damping = 0.05
     im: ScaleIM | None = None
     period: _Period | None = None
@@ -431,14 +492,15 @@ class StochasticSpec(_Model):
 
     kind: Literal["stochastic"]
     pga_ratio: Param
-    duration: float = Field(default=20.0, gt=0)
-    dt: float = Field(default=0.01, gt=0)
-    ground_frequency: float = Field(default=5 * math.pi, gt=0)
-    ground_damping: float = Field(default=0.6, gt=0)
+    duration: float = Field(default=20.0, gt=0, le=_validate.MAX_DURATION)
+    dt: float = Field(default=0.01, ge=_validate.MIN_STEP, le=1.0)
+    ground_frequency: float = Field(default=5 * math.pi, gt=0, le=1e4)
+    ground_damping: float = Field(default=0.6, gt=0, le=10.0)
 
     @model_validator(mode="after")
     def _ranges(self):
         _check_positive("pga_ratio", self.pga_ratio)
+        _span("pga_ratio", self.pga_ratio, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         if not self.ground_frequency * self.dt < 1.0:
             raise FieldError(
                 "dt",
@@ -458,9 +520,9 @@ class SamplerSpec(_Model):
     """Monte Carlo, Latin hypercube, Sobol' (Saltelli layout, n = 2^k) or a full grid."""
 
     kind: Literal["monte_carlo", "lhs", "sobol", "grid"]
-    n: int | None = Field(default=None, ge=1)
+    n: int | None = Field(default=None, ge=1, le=2**53)
     second_order: bool = False
-    replicates: int = Field(default=1, ge=1)
+    replicates: int = Field(default=1, ge=1, le=10**6)
 
     @model_validator(mode="after")
     def _n(self):
@@ -490,8 +552,9 @@ Output = Literal[
 ]
 
 
-#: Smallest relative tolerance a double-precision solver can deliver.
-MIN_RTOL = 100 * 2.0**-52
+#: Smallest relative tolerance taken: that of the solvers (:data:`rockstudy._validate.RTOL_MIN`,
+#: where their error target stops drowning in rounding).
+MIN_RTOL = _validate.RTOL_MIN
 #: Solver steps per cycle of a rocking block under a sine or cosine pulse: at most 322 in
 #: 200 random blocks and pulses at rtol 1e-8 (median 14), rounded up.
 STEPS_PER_CYCLE = 400
@@ -502,7 +565,7 @@ class RunSpec(_Model):
 
     method: Literal["nonlinear", "linear", "auto"] = "nonlinear"
     rtol: float = Field(default=1e-8, gt=0, lt=1)  # for "auto": accuracy of the max rotation
-    max_steps: int = Field(default=1_000_000, ge=1)
+    max_steps: int = Field(default=1_000_000, ge=1, le=_validate.MAX_STEPS_MAX)
     outputs: list[Output] = Field(default=["max_rotation", "overturned"], min_length=1)
 
     @model_validator(mode="after")
@@ -512,8 +575,8 @@ class RunSpec(_Model):
         if self.rtol < MIN_RTOL:  # scipy's solve_ivp raises smaller ones to this floor
             raise FieldError(
                 "rtol",
-                f"must be >= {MIN_RTOL:.2g} (100 x the double-precision epsilon): no solver "
-                f"delivers a tighter relative tolerance, got {self.rtol:g}",
+                f"must be >= {MIN_RTOL:.2g}: below it the solvers' error target drowns in "
+                f"rounding, got {self.rtol:g}",
             )
         return self
 
@@ -528,7 +591,7 @@ class Study(_Model):
     name: str = Field(min_length=1)
     description: str = ""
     seed: int = Field(ge=0)
-    chunk_size: int = Field(default=4096, ge=1)
+    chunk_size: int = Field(default=4096, ge=1, le=MAX_CHUNK_SIZE)
     sampler: SamplerSpec
     structure: Structure
     motion: MotionSpec
@@ -536,6 +599,13 @@ class Study(_Model):
     run: RunSpec = RunSpec()
     #: The study file's text as read (None for a study not read from text).
     _text: str | None = PrivateAttr(default=None)
+
+    @field_validator("name")
+    @classmethod
+    def _printable(cls, value):
+        if "\0" in value or not value.strip():
+            raise ValueError("must be a name: not blank, no NUL character")
+        return value
 
     @property
     def source_text(self) -> str | None:
@@ -649,6 +719,49 @@ class Study(_Model):
                 f"{self.run.max_steps // STEPS_PER_CYCLE} cycles or raise run.max_steps",
             )
         return self
+
+    @model_validator(mode="after")
+    def _engine_ranges(self):
+        """The amplitudes and periods that the ratios give must lie in the solver's ranges
+        (over the whole support of the structure's distributions)."""
+        mo, top = self.motion, _validate.MAX_ACCELERATION
+        tan_max = math.tan(min(self.largest_critical_rotation(), math.pi / 2 - 1e-9))
+        for name, uplift in (
+            ("amplitude_ratio", G * tan_max),
+            ("amplitude_a", G * self.largest_critical_rotation()),
+            ("pga_ratio", G * tan_max),
+        ):
+            value = getattr(mo, name, None)
+            if value is not None and _largest(value) * uplift > top:
+                raise FieldError(
+                    f"motion.{name}",
+                    f"reaches {_largest(value):g} x {uplift:.4g} m/s^2 = "
+                    f"{_largest(value) * uplift:.4g} m/s^2 with the largest critical rotation, "
+                    f"beyond the {top:.0e} m/s^2 the solvers take",
+                )
+        ratio = getattr(mo, "frequency_ratio", None)
+        if ratio is not None:
+            p_lo, p_hi = self.frequency_parameter_span()
+            longest = 2.0 * math.pi / (_smallest(ratio) * p_lo)
+            shortest = 2.0 * math.pi / (_largest(ratio) * p_hi)
+            lo, hi = PERIOD_RANGE
+            if not (lo <= shortest and longest <= hi):
+                raise FieldError(
+                    "motion.frequency_ratio",
+                    f"gives pulse periods 2 pi / (omega_g / p x p) from {shortest:.4g} to "
+                    f"{longest:.4g} s over the structures' p of {p_lo:.4g} to {p_hi:.4g} rad/s; "
+                    f"the solvers take [{lo:g}, {hi:g}] s",
+                )
+        return self
+
+    def frequency_parameter_span(self) -> tuple[float, float]:
+        """The smallest and largest p [rad/s] the structures can have."""
+        st = self.structure
+        if st.kind == "equivalent_block":
+            return _smallest(st.frequency_parameter), _largest(st.frequency_parameter)
+        factor = math.sqrt(2.0) if st.kind == "rocking_wall" else 1.0  # eq. (23) of [003]
+        R_lo, R_hi = _smallest(st.half_diagonal), _largest(st.half_diagonal)
+        return factor * math.sqrt(0.75 * G / R_hi), factor * math.sqrt(0.75 * G / R_lo)
 
     def largest_critical_rotation(self) -> float:
         """The largest critical rotation theta_cr [rad] the structures can have."""
