@@ -1,4 +1,4 @@
-"""Both fuzzers of issue 26 at full size, with the counts for the closing note.
+"""Both fuzzers at full size, with their counts.
 
     python benchmarks/fuzz_report.py [--study-files 300] [--cli 12] [--json out.json]
 
@@ -12,7 +12,7 @@
 (b) Public API calls (tests/test_fuzz_api.py): each must give a ValueError or TypeError
     naming its argument, or a finite answer, within 30 s. Counted: refused, answered, and the
     failures: traceback, unnamed refusal, non-finite answer, hang; each failure by category
-    (the entry point), with the entries of KNOWN_FAILURES (other work's scope) apart.
+    (the entry point).
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def study_fuzz(n_files: int, n_cli: int) -> dict:
     }
 
 
-def api_fuzz(run_hangs: bool = False) -> dict:
+def api_fuzz() -> dict:
     import warnings
 
     import test_fuzz_api as fa
@@ -73,16 +73,11 @@ def api_fuzz(run_hangs: bool = False) -> dict:
     counts, by_category, failures = Counter(), Counter(), []
     t0 = time.perf_counter()
     for label, call, name in fa.CALLS:
-        if label in fa.KNOWN_HANGS and not run_hangs:
-            counts["hang (known, other scope; not run)"] += 1
-            failures.append(f"{label}: hang [known, not run]")
-            continue
         outcome, why = fa.judge(call, name, nan_documented=label.startswith(fa.NAN_DOCUMENTED))
-        known = label in fa.KNOWN_FAILURES
-        counts[outcome + (" (known, other scope)" if known and why else "")] += 1
+        counts[outcome] += 1
         if why:
             by_category[f"{label.split('(')[0]}: {outcome}"] += 1
-            failures.append(f"{label}: {outcome}: {why}" + (" [known]" if known else ""))
+            failures.append(f"{label}: {outcome}: {why}")
     return {
         "calls": len(fa.CALLS),
         "counts": dict(counts),
@@ -97,11 +92,10 @@ def main(argv=None) -> int:
     parser.add_argument("--study-files", type=int, default=300)
     parser.add_argument("--cli", type=int, default=12)
     parser.add_argument("--json", type=Path, default=None)
-    parser.add_argument("--run-known-hangs", action="store_true")
     args = parser.parse_args(argv)
     report = {
         "studies": study_fuzz(args.study_files, args.cli),
-        "api": api_fuzz(args.run_known_hangs),
+        "api": api_fuzz(),
     }
     for part, result in report.items():
         summary = {k: v for k, v in result.items() if k != "failures"}

@@ -111,6 +111,22 @@ def finite_array(name: str, values) -> np.ndarray:
     return arr
 
 
+def real_array(name: str, values, low=-math.inf, high=math.inf, label="") -> np.ndarray:
+    """``values`` as a float array of any shape, or a ValueError naming ``name``: not numbers
+    (strings, None, booleans), NaN, infinite, or outside [low, high] (``label`` says the
+    allowed range in the message)."""
+    raw = _as_array(name, values)
+    if raw.dtype.kind not in "iuf" or raw.size == 0:
+        raise ValueError(f"{name} must be a number or an array of numbers, got {_what(values)}")
+    arr = raw.astype(float)
+    bad = ~np.isfinite(arr) | (arr < low) | (arr > high)
+    if bad.any():
+        first = float(arr.flat[int(np.flatnonzero(bad)[0])])
+        allowed = label or "finite numbers"
+        raise ValueError(f"{name} must be {allowed}, got {first!r}")
+    return arr
+
+
 def _as_array(name, values) -> np.ndarray:
     try:
         return np.asarray(values)

@@ -1,14 +1,12 @@
-"""Fuzz of the public Python API (issue 26): every call gives a ValueError or TypeError that
+"""Fuzz of the public Python API: every call gives a ValueError or TypeError that
 names the argument, or a finite answer, within a time bound. Never another exception, a NaN
 or an infinity handed back without a word, or a hang.
 
 A seeded generator takes each public entry point with sane arguments and replaces one
 argument at a time by a hostile value (0, negative, 1e-300, 1e300, NaN, inf, a string, a
-boolean, None, a list, a subnormal), plus a few hand-written cases from the issue. Each call
-is one test (its id is the reproducer), so a failure names the call.
-
-:data:`KNOWN_FAILURES` lists the calls that fail today in code that other work owns; they
-are marked xfail (not strict) with the owner, to be removed when that work is merged.
+boolean, None, a list, a subnormal), plus hand-written cases of reported failures and the
+extremes of the ranges. Each call is one test (its id is the reproducer), so a failure names
+the call. No call is exempt.
 """
 
 from __future__ import annotations
@@ -34,50 +32,6 @@ from rockstudy.motions import (
 )
 from rockstudy.motions.stochastic import stochastic_record
 
-# ----------------------------------------------------------------------------------------
-# KNOWN FAILURES in other helpers' scopes: call id -> owner and reason. Each is an xfail
-# (strict=False); remove an entry once the owner's fix is merged.
-# ----------------------------------------------------------------------------------------
-_MEASURES = "helper measures: intensity-measure arguments (check_periods, check_damping, pulse)"
-_FRAGILITY = "helper fragility: fragility and im_efficiency arguments"
-_LADDER = "helper ladder: IDA and stripes arguments"
-_CLOSEDFORM = "unassigned (lead): closed-form ufuncs take no type check"
-KNOWN_FAILURES: dict[str, str] = {
-    "Record.intensity_measures(periods=tiny)": _MEASURES,
-    "Record.intensity_measures(periods=huge)": _MEASURES,
-    "Record.intensity_measures(damping=none)": _MEASURES,
-    "cloud(periods=huge)": _MEASURES,
-    "cloud(periods=tiny)": _MEASURES,
-    "cloud(periods=subnormal)": _MEASURES,
-    "cloud(damping=list)": _MEASURES,
-    "issue:intensity_measures(periods=[1e300])": _MEASURES,
-    "issue:sa at period 1e-300": _MEASURES,
-    "issue:pulse() of white noise": _MEASURES,
-    "stripe_fragility(n_boot=negative)": _FRAGILITY,
-    "stripe_fragility(n_boot=string)": _FRAGILITY,
-    "stripe_fragility(n_boot=inf)": _FRAGILITY,
-    "stripe_fragility(n_boot=zero)": _FRAGILITY,
-    "stripe_fragility(n_boot=huge)": _FRAGILITY,
-    "stripe_fragility(conf_level=list)": _FRAGILITY,
-    "stripe_fragility(conf_level=none)": _FRAGILITY,
-    "stripe_fragility(conf_level=inf)": _FRAGILITY,
-    "stripe_fragility(conf_level=nan)": _FRAGILITY,
-    "stripe_fragility(conf_level=string)": _FRAGILITY,
-    "ida_fragility(conf_level=none)": _FRAGILITY,
-    "issue:stripe_fragility on an IDA": _FRAGILITY,
-    "issue:ida_fragility on stripes": _FRAGILITY,
-    "issue:im_efficiency(candidates=[])": _FRAGILITY,
-    "issue:stripe_fragility(conf_level=1.5)": _FRAGILITY,
-    "issue:stripe_fragility(conf_level=nan)": _FRAGILITY,
-    "issue:multiple_stripes(levels=[])": _LADDER,
-    "issue:ida scan=10**6": _LADDER,
-    "issue:ida tolerance=1e-300": _LADDER,
-    "closedform.max_rotation(omega=string)": _CLOSEDFORM,
-    "closedform.max_rotation(eta=none)": _CLOSEDFORM,
-    "closedform.free_rocking_period(frequency_parameter=subnormal)": _CLOSEDFORM + " (4/p = inf)",
-}
-#: Known hangs: not run at all (a numba call is not interrupted by the alarm), until fixed.
-KNOWN_HANGS = ("issue:ida scan=10**6", "issue:ida tolerance=1e-300")
 #: Entry points whose docstrings promise NaN outside their domain (a marked answer).
 NAN_DOCUMENTED = ("closedform.",)
 
@@ -281,95 +235,95 @@ def _fill(target, kwargs):
     return kwargs
 
 
-#: Hand-written cases from issue 26 and the extremes of the ranges: (id, call, argument).
+#: Hand-written cases of reported failures and the extremes of the ranges: (id, call, argument).
 EXTRA = [
-    ("issue:SinePulse(period=1e-300)", lambda: SinePulse(5.0, period=1e-300), "period"),
-    ("issue:Block(1, 1e-300)", lambda: rs.Block(1, 1e-300), "slenderness"),
-    ("issue:simulate(dt_out=1e-12)", lambda: _simulate(dt_out=1e-12), "dt_out"),
+    ("case:SinePulse(period=1e-300)", lambda: SinePulse(5.0, period=1e-300), "period"),
+    ("case:Block(1, 1e-300)", lambda: rs.Block(1, 1e-300), "slenderness"),
+    ("case:simulate(dt_out=1e-12)", lambda: _simulate(dt_out=1e-12), "dt_out"),
     (
-        "issue:simulate_batch(record, amplitude, period)",
+        "case:simulate_batch(record, amplitude, period)",
         lambda: rs.simulate_batch(
             half_diagonal=1.0, slenderness=0.2, record=record(), amplitude=1.0, period=0.5
         ),
         "record",
     ),
-    ("issue:simulate(dt_out='0.1')", lambda: _simulate(dt_out="0.1"), "dt_out"),
-    ("issue:simulate(dt_out=True)", lambda: _simulate(dt_out=True), "dt_out"),
-    ("issue:Block('1', 0.2)", lambda: rs.Block("1", 0.2), "half_diagonal"),
+    ("case:simulate(dt_out='0.1')", lambda: _simulate(dt_out="0.1"), "dt_out"),
+    ("case:simulate(dt_out=True)", lambda: _simulate(dt_out=True), "dt_out"),
+    ("case:Block('1', 0.2)", lambda: rs.Block("1", 0.2), "half_diagonal"),
     (
-        "issue:Record(vertical='yes')",
+        "case:Record(vertical='yes')",
         lambda: Record(np.ones(3), dt=0.01, vertical="yes"),
         "vertical",
     ),
-    ("issue:Record(dt=1e308)", lambda: Record(np.ones(3), dt=1e308), "duration"),
+    ("case:Record(dt=1e308)", lambda: Record(np.ones(3), dt=1e308), "duration"),
     (
-        "issue:synthetic_near_fault(pulse_period=1e6, pga=4.0)",
+        "case:synthetic_near_fault(pulse_period=1e6, pga=4.0)",
         lambda: synthetic_near_fault(pulse_period=1e6, pga=4.0),
         "pulse_period",
     ),
     (
-        "issue:intensity_measures(periods=[1e300])",
+        "case:intensity_measures(periods=[1e300])",
         lambda: record().intensity_measures(periods=[1e300]),
         "periods",
     ),
     (
-        "issue:sa at period 1e-300",
+        "case:sa at period 1e-300",
         lambda: record().intensity_measure("sa", period=1e-300),
         "period",
     ),
-    ("issue:arias of a record scaled by 1e300", lambda: record().scaled(1e300), "factor"),
-    ("issue:pulse() of white noise", lambda: _pulse_inside(noise()), "pulse"),
+    ("case:arias of a record scaled by 1e300", lambda: record().scaled(1e300), "factor"),
+    ("case:pulse() of white noise", lambda: _pulse_inside(noise()), "pulse"),
     (
-        "issue:multiple_stripes(levels=[])",
+        "case:multiple_stripes(levels=[])",
         lambda: _design("multiple_stripes")(**_fill("multiple_stripes", {"levels": []})),
         "levels",
     ),
     (
-        "issue:ida scan=-1",
+        "case:ida scan=-1",
         lambda: study_api.incremental_dynamic_analysis([record()], [rs.Block(1.0, 0.2)], scan=-1),
         "scan",
     ),
     (
-        "issue:ida scan=10**6",
+        "case:ida scan=10**6",
         lambda: study_api.incremental_dynamic_analysis(
             [record()], [rs.Block(1.0, 0.2)], scan=10**6
         ),
         "scan",
     ),
     (
-        "issue:ida tolerance=1e-300",
+        "case:ida tolerance=1e-300",
         lambda: study_api.incremental_dynamic_analysis(
             [record()], [rs.Block(1.0, 0.2)], tolerance=1e-300
         ),
         "tolerance",
     ),
     (
-        "issue:stripe_fragility on an IDA",
+        "case:stripe_fragility on an IDA",
         lambda: study_api.stripe_fragility(designs()["ida"]),
         "ds",
     ),
     (
-        "issue:ida_fragility on stripes",
+        "case:ida_fragility on stripes",
         lambda: study_api.ida_fragility(designs()["stripes"]),
         "ds",
     ),
     (
-        "issue:im_efficiency(candidates=[])",
+        "case:im_efficiency(candidates=[])",
         lambda: study_api.im_efficiency(designs()["stripes"], candidates=[]),
         "candidates",
     ),
     (
-        "issue:stripe_fragility(conf_level=1.5)",
+        "case:stripe_fragility(conf_level=1.5)",
         lambda: study_api.stripe_fragility(designs()["stripes"], conf_level=1.5),
         "conf_level",
     ),
     (
-        "issue:stripe_fragility(n_boot=-1)",
+        "case:stripe_fragility(n_boot=-1)",
         lambda: study_api.stripe_fragility(designs()["stripes"], n_boot=-1),
         "n_boot",
     ),
     (
-        "issue:stripe_fragility(conf_level=nan)",
+        "case:stripe_fragility(conf_level=nan)",
         lambda: study_api.stripe_fragility(designs()["stripes"], conf_level=math.nan),
         "conf_level",
     ),
@@ -487,23 +441,7 @@ def test_the_fuzz_is_large_enough():
     assert len({c[0] for c in CALLS}) == len(CALLS)
 
 
-@pytest.mark.parametrize(
-    "case",
-    [
-        pytest.param(
-            c,
-            id=c[0],
-            marks=[
-                pytest.mark.xfail(
-                    reason=KNOWN_FAILURES[c[0]], strict=False, run=c[0] not in KNOWN_HANGS
-                )
-            ]
-            if c[0] in KNOWN_FAILURES
-            else [],
-        )
-        for c in CALLS
-    ],
-)
+@pytest.mark.parametrize("case", [pytest.param(c, id=c[0]) for c in CALLS])
 def test_each_call_refuses_by_name_or_answers_finitely(case):
     label, call, name = case
     outcome, why = judge(call, name, nan_documented=label.startswith(NAN_DOCUMENTED))

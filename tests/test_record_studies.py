@@ -234,6 +234,23 @@ def test_stripes_levels_at_free_fall_are_stored_censored_and_the_others_run(
         assert bool(cube["overturned"][i, 0, 1]) == one.overturned
 
 
+def test_validate_notes_the_levels_that_free_fall_censors(suite, tmp_path):
+    """validate says, before the run, which records' verticals reach free fall at a level of
+    the design (the free-fall scale computed here from the samples: g / max(-u_v''))."""
+    records = load_suite(suite, vertical=(r"_H\.AT2$", "_UP.AT2"))
+    falls = [G / -float(np.min(r.vertical)) * r.peak for r in records]  # PGA at free fall
+    for levels, expected in (([0.5 * min(falls), 0.9 * min(falls)], 0), ([1.5 * max(falls)], 3)):
+        grid = ", ".join(f"{v!r}" for v in levels)
+        text = HEAD + HV.replace("RECORDS", str(suite))
+        text += f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = [{grid}] }} }}\n'
+        text += '[design]\nkind = "stripes"\n'
+        path = tmp_path / f"notes{expected}.toml"
+        path.write_text(text)
+        notes = load_study(path).notes
+        assert len(notes) == expected, notes
+        assert all("free fall" in n and "censored" in n and "_UP.AT2" in n for n in notes)
+
+
 def test_an_interrupted_design_study_resumes_at_the_records_not_done(suite, client, tmp_path):
     import zarr
 

@@ -22,6 +22,7 @@ import warnings
 import numpy as np
 from numba import float64, int8, njit, vectorize
 
+from .. import _validate
 from .._roots import newton_bisect
 from .._warnings import ClosedFormValidityWarning
 
@@ -478,6 +479,16 @@ def overturning_mode(a, omega, eta):
     return np.asarray(MODES)[overturning_mode_code(a, omega, eta)]
 
 
+def _control_point(a, omega, eta):
+    """(a, omega, eta) as float arrays, or a ValueError naming the one that is not a finite
+    number in its range: a real, omega > 0, eta in [0, 1]."""
+    return (
+        _validate.real_array("a", a),
+        _validate.real_array("omega", omega, 1e-300, label="finite and > 0"),
+        _validate.real_array("eta", eta, 0.0, 1.0, label="in [0, 1]"),
+    )
+
+
 def max_rotation(a, omega, eta, *, check=True):
     r"""Peak rotation after the first impact, theta_max / alpha, eq. (4.13) of [000].
 
@@ -489,13 +500,20 @@ def max_rotation(a, omega, eta, *, check=True):
     Parameters
     ----------
     a, omega, eta : array_like
-        a_g / (g alpha), omega_g / p and the restitution, broadcast together.
+        a_g / (g alpha) (finite; NaN results where a <= 1: no uplift), omega_g / p (> 0) and
+        the restitution (in [0, 1]), broadcast together.
     check : bool
         Warn (:class:`rockstudy.ClosedFormValidityWarning`) when points lie below the (3.31)
         curve, where the first impact comes during the pulse and (4.13) is an approximation
         (median error 16 %, unbounded near the overturning boundaries; see
         :mod:`rockstudy.verification.validity`).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument that is not a finite number in its range.
     """
+    a, omega, eta = _control_point(a, omega, eta)
     out = _max_rotation(a, omega, eta)
     if check:
         during = np.broadcast_to(limit_residual(a, omega) > 0.0, np.shape(out))

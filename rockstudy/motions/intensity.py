@@ -32,6 +32,7 @@ import math
 import numpy as np
 from scipy.integrate import simpson
 
+from .. import _validate
 from ..constants import G
 from . import _spectrum
 
@@ -273,8 +274,8 @@ def _check_long_periods(periods, steps) -> None:
 
 
 def check_damping(damping) -> float:
-    """Damping ratio zeta in [0, 1), or ValueError."""
-    value = float(damping)
+    """Damping ratio zeta in [0, 1), or ValueError naming ``damping``."""
+    value = _validate.number("damping", damping)
     if not math.isfinite(value) or not 0.0 <= value < 1.0:
         raise ValueError(f"damping must lie in [0, 1), got {damping!r}")
     return value

@@ -15,6 +15,7 @@ import numpy as np
 
 from .._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
 from ..constants import G
+from ..motions.intensity import SCALING_POWER
 from ..motions.suites import read_pair, suite_pairs
 
 #: each), the status and the error message.
@@ -72,6 +73,35 @@ def problems(study, base_dir=None) -> list[str]:
                     f"structures and levels, about {need / GIB:.3g} GiB in memory, more than "
                     f"{DESIGN_SHARE:.0%} of this machine's {memory / GIB:.3g} GiB; reduce it"
                 )
+    return found
+
+
+def notes(study, base_dir=None) -> list[str]:
+    """What a runnable study will do that its author should know before the run: the records
+    of a design whose vertical component reaches free fall (u_v'' = -g, where the block
+    model no longer holds) at a scale the design reaches. Those points are stored as
+    censored, with their reason; the record's other points run."""
+    mo, found = study.motion, []
+    if mo.kind != "record" or study.design is None:
+        return found
+    from .records_designs import free_fall_scale
+
+    for field, h, v in record_pairs(mo, base_dir):
+        if v is None:
+            continue
+        vfield = field.replace("files", "vertical") if isinstance(mo.vertical, list) else field
+        rec = read_pair(h, v, mo.units, field, vfield)
+        scaled = _largest_scaled_peak(study, rec)
+        if scaled is None:
+            continue
+        peak = max(float(np.max(np.abs(rec.acceleration))), float(np.max(np.abs(rec.vertical))))
+        free_fall, top = free_fall_scale(rec), scaled[1] / peak
+        if top >= free_fall:
+            found.append(
+                f"{vfield}: {v.name} reaches free fall (u_v'' = -g) at scale {free_fall:.4g}, "
+                f"and {scaled[0]} scales the pair up to {top:.4g}: the design's points at or "
+                "above free fall are stored as censored (reason: free fall); the others run"
+            )
     return found
 
 
@@ -149,8 +179,8 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
         base = rec.intensity_measure(target.im, period=target.period, damping=target.damping)
     if not base > 0:
         return None
-    ratio = value / base
-    return field, (math.sqrt(ratio) if target.im == "arias" else ratio) * peak
+    power = SCALING_POWER[{"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(target.im, target.im)]
+    return field, (value / base) ** (1.0 / power) * peak
 
 
 @lru_cache(maxsize=1)

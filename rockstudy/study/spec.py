@@ -65,7 +65,7 @@ from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
 from .feasibility import draw_span as _draw_span
-from .feasibility import problems
+from .feasibility import notes, problems
 from .records_designs import IdaOptionError, IdaOptions
 
 
@@ -599,6 +599,9 @@ class Study(_Model):
     run: RunSpec = RunSpec()
     #: The study file's text as read (None for a study not read from text).
     _text: str | None = PrivateAttr(default=None)
+    #: What will happen that the user should know before the run (not a problem): e.g. the
+    #: points of a design that free fall censors (:func:`.feasibility.notes`).
+    _notes: list = PrivateAttr(default_factory=list)
 
     @field_validator("name")
     @classmethod
@@ -611,6 +614,12 @@ class Study(_Model):
     def source_text(self) -> str | None:
         """The TOML text the study was validated from, as read (stored with its run)."""
         return self._text
+
+    @property
+    def notes(self) -> list[str]:
+        """What the run will do that the user should know (one line each, naming the field):
+        the levels a vertical component censors at free fall."""
+        return list(self._notes)
 
     @model_validator(mode="after")
     def _design(self):
@@ -1014,6 +1023,7 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     if found:
         raise StudyError(source, found)
     study._text = text
+    study._notes = notes(study, base_dir)
     return study
 
 
