@@ -67,6 +67,8 @@ def problems(study, base_dir=None) -> list[str]:
         except ValueError as exc:
             return [*found, str(exc)]
         found += _record_problems(study, pairs)
+        if study.design is not None:
+            found += _named_twice(pairs)
         refusal = None if all(v is None for _, _, v in pairs) else vertical_refusal()
         if refusal:
             found.append(f"motion.vertical: {refusal}; give horizontal records only")
@@ -79,6 +81,22 @@ def problems(study, base_dir=None) -> list[str]:
                     f"structures and levels, about {need / GIB:.3g} GiB in memory, more than "
                     f"{DESIGN_SHARE:.0%} of this machine's {memory / GIB:.3g} GiB; reduce it"
                 )
+    return found
+
+
+def _named_twice(pairs) -> list[str]:
+    """A design runs every record it lists once per structure and level: a file listed twice
+    would count twice in its fragility, so it is refused (Monte Carlo rows may repeat one, to
+    draw it more often)."""
+    first, found = {}, []
+    for field, h, _ in pairs:
+        key = h.resolve()
+        if key in first:
+            found.append(
+                f"{field}: names the file {str(h)!r} again (already {first[key]}); a design runs "
+                "each record once: list it once"
+            )
+        first.setdefault(key, field)
     return found
 
 
