@@ -401,8 +401,11 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
     own = client is None
     cluster = None
     if todo:
+        remote = where[1] is not None or where[2] is not None
+        if own and remote:  # reached (or refused in one line) before anything is compiled
+            client = _client(*where)[0]
         priming = _start_prime(study_json, columns, base_dir, progress)
-        if own:  # the workers start, and import the study's modules, while the client compiles
+        if own and not remote:  # the local workers start while the client compiles
             client, cluster = _client(*where)
         try:
             if own:

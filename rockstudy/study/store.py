@@ -124,11 +124,14 @@ def read_marker(path) -> dict | None:
     try:
         data = json.loads(marker.read_text())
     except (OSError, ValueError) as exc:
-        raise StoreError(f"{marker} is damaged ({exc}); nothing was changed") from None
+        raise StoreError(
+            f"{marker} is damaged ({exc}); nothing was changed. The store cannot be checked: "
+            "run into a new --out"
+        ) from None
     if not isinstance(data, dict):
         raise StoreError(
             f"{marker} is damaged (a JSON {type(data).__name__}, not an object); nothing was "
-            "changed"
+            "changed. The store cannot be checked: run into a new --out"
         )
     return data
 
@@ -528,6 +531,33 @@ def template_complete(path) -> bool:
         raise StoreError(f"{path}/.zmetadata is damaged ({exc}); nothing was changed") from None
 
 
+def stop_zarr_io(timeout: float = 60.0) -> None:
+    """Stop zarr's IO event loop and wait for its thread, before the process exits.
+
+    zarr runs its IO on an event loop in a thread, and stops it at exit (``atexit``) by joining
+    that thread for 0.2 s only, then closing the loop: on a busy machine the thread has not
+    stopped yet and exit prints ``RuntimeError: Cannot close a running event loop`` (issue 24).
+    This waits up to ``timeout`` seconds instead; zarr's own clean-up then has nothing left to
+    do. Does nothing if zarr never started its loop.
+    """
+    import sys
+
+    sync = sys.modules.get("zarr.core.sync")
+    if sync is None:
+        return
+    with sync._get_lock():  # noqa: SLF001 - the lock zarr's own clean-up takes
+        loop, thread = sync.loop[0], sync.iothread[0]
+        if loop is None:
+            return
+        loop.call_soon_threadsafe(loop.stop)
+        if thread is not None:
+            thread.join(timeout)
+        if loop.is_running():  # still stuck after the timeout: left to zarr's clean-up
+            return
+        loop.close()
+        sync.loop[0] = sync.iothread[0] = None
+
+
 class ChunkWriter:
     """Writes finished chunks straight into the zarr arrays of a cube: the outputs, their
     checksums, and ``status`` last.
@@ -671,6 +701,20 @@ def _verify_chunk(path, ndim, k, rows) -> int:
     return len(sums)
 
 
+def written_by_run(path) -> bool:
+    """Whether a zarr folder was written by a run (:func:`run_study`): it has the marker, the
+    checksums, or the attribute ``template_complete`` that only a run's template sets. A
+    dataset saved with ``to_zarr`` has none of them."""
+    path = Path(path)
+    if (path / MARKER).exists() or (path / CHECKSUMS).exists():
+        return True
+    try:
+        attrs = json.loads((path / ".zmetadata").read_text())["metadata"][".zattrs"]
+        return "template_complete" in attrs
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
 def verify_cube(path) -> dict:
     """Check a zarr cube written by a run against the sha256 recorded when it was written.
 
@@ -683,15 +727,19 @@ def verify_cube(path) -> dict:
     import zarr
 
     path = Path(path)
-    if not (path / ".zmetadata").is_file():
-        raise StoreError(f"{path} is not a rockstudy cube (no .zmetadata): nothing to verify")
+    if not written_by_run(path):
+        raise StoreError(
+            f"{path} was not written by rockstudy run (no marker, checksums or template "
+            "attribute): it carries no checksums to verify"
+        )
     try:
         sums = json.loads((path / CHECKSUMS / TEMPLATE_SUMS).read_text())
     except (OSError, ValueError):
         raise _damaged(
             path,
             f"the sums of its metadata and design ({CHECKSUMS}/{TEMPLATE_SUMS}) are "
-            "missing or unreadable",
+            "missing or unreadable (a copy saved with to_zarr has none: open_result(..., "
+            "verify=False) reads it unchecked)",
             ".zmetadata (the cube's metadata)",
         ) from None
     files = _verify_template(path, sums)
@@ -805,14 +853,14 @@ def open_result(path, verify: bool = True) -> xr.Dataset:
 
     A zarr cube is first checked against the sha256 recorded when it was written
     (:func:`verify_cube`): a damaged one raises :class:`DamagedCube` naming the variable and
-    chunk. ``verify=False`` skips the check (to look at a damaged cube). A netCDF export
-    carries no checksums and is read as it is.
+    chunk. ``verify=False`` skips the check (to look at a damaged cube). A netCDF export, and a
+    dataset saved with ``to_zarr``, carry no checksums and are read as they are.
     """
     path = Path(path)
     if path.suffix == ".nc":
         ds = xr.open_dataset(path)
     else:
-        if verify:
+        if verify and written_by_run(path):  # a dataset saved with to_zarr has no sums
             verify_cube(path)
         ds = xr.open_zarr(path, consolidated=True)
     if "record_design" in ds.attrs and "sample" in ds.dims:
