@@ -6,14 +6,17 @@ study's chunks, so no two writers ever share a zarr chunk), outputs first and ``
 a chunk whose status is not pending is complete. A killed run resumes from the pending chunks.
 
 The store never destroys what it did not write. A run claims a folder only if it is new (or
-empty), and writes a marker file ``.rockstudy`` into it first (the study's sha256, the sha256
-of every input file, the package version, and whether the template is complete); a folder
-without that marker is never written to. A run holds an exclusive lock (``.rockstudy.lock``,
-``fcntl.flock``, naming its PID and host) for its whole life: a second run on the same store is
-refused at once, and the lock of a killed run vanishes with its process, so ``--resume`` after
-SIGKILL just works. Each finished chunk records the sha256 of its files
-(``.rockstudy-chunks/<k>``); on resume a chunk marked done whose files are missing or differ is
-computed again.
+empty: nothing in it but, at most, a lock file), and writes a marker file ``.rockstudy`` into
+it first (the study's sha256, the sha256 of every input file, the package version, and whether
+the template is complete). Only that marker identifies a store: a lock file never does, and a
+store whose marker is lost is resumed only if its cube's own attributes pass the marker's
+checks. A run holds an exclusive lock (``.rockstudy.lock``, ``fcntl.flock``, naming its PID and
+host once the run is accepted) for its whole life: a second run on the same store is refused
+at once, and the lock of a killed run vanishes with its process, so ``--resume`` after SIGKILL
+just works. The template records the sha256 of ``.zmetadata`` and of the design's files, and
+each finished chunk those of its outputs (``.rockstudy-chunks/``): on resume a chunk marked
+done whose files are missing or differ is computed again, and a reader
+(:func:`open_result`, :func:`verify_cube`) refuses a cube whose files differ.
 """
 
 from __future__ import annotations
@@ -341,7 +344,7 @@ def _identity(study, inputs) -> dict:
 def _check_same(path, marker, sha, inputs) -> None:
     """Refuse to resume across a change of study, input file or rockstudy version."""
     if marker.get("study_sha256") != sha:
-        raise StoreError(f"{path} holds a different study (sha256 mismatch); cannot resume")
+        raise ValueError(f"{path} holds a different study (sha256 mismatch); cannot resume")
     before = marker.get("inputs_sha256")
     if not isinstance(before, dict):
         raise StoreError(
