@@ -161,12 +161,12 @@ def _saved(out) -> tuple[str, bool]:
 
 
 def _stopped(args, head, advice="fix the cause, then run again") -> str:
-    """The line of a run that stopped: ``head``, what was saved, and how to continue (the
-    ``--resume`` command if anything was saved, else ``advice``)."""
+    """The line of a run that stopped: ``head`` (ending in its separator), what was saved, and
+    how to continue (the ``--resume`` command if anything was saved, else ``advice``)."""
     saved, resumable = _saved(args.out)
     if resumable:
-        return f"{head}; {saved}; continue with: {_resume_command(args)}"
-    return f"{head}; {saved}" + (f"; {advice}" if advice else "")
+        return f"{head}{saved}; continue with: {_resume_command(args)}"
+    return f"{head}{saved}" + (f"; {advice}" if advice else "")
 
 
 def _security(args):
@@ -252,7 +252,7 @@ def _run(args) -> int:
         print(f"error: {exc}", file=sys.stderr)  # refused: nothing was written
         return 2
     except KeyboardInterrupt:
-        print("\n" + _stopped(args, "interrupted", None), file=sys.stderr)
+        print("\n" + _stopped(args, "interrupted: ", None), file=sys.stderr)
         return 130
     except SchedulerError as exc:  # the cluster was not reached: nothing ran
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
@@ -260,7 +260,7 @@ def _run(args) -> int:
     except (OSError, CancelledError, TimeoutError) as exc:
         # disk full, read-only file system, scheduler lost
         message = " ".join(str(exc).split())  # dask's messages span lines
-        print(_stopped(args, f"error: {type(exc).__name__}: {message}"), file=sys.stderr)
+        print(_stopped(args, f"error: {type(exc).__name__}: {message}; "), file=sys.stderr)
         return 1
     print(
         f"{study.name}: {report.samples} samples in {report.chunks_total} chunks; computed "

@@ -114,3 +114,17 @@ def test_a_metadata_byte_flip_on_resume_is_one_line(finished, tmp_path):
     assert code == 2
     assert ".zmetadata is damaged" in one_line(err)
     assert tree(out) == before
+
+
+def test_what_a_run_did_not_write_has_nothing_to_verify(tmp_path):
+    """A dataset saved with to_zarr carries no sums: open_result reads it as it is, and
+    `rockstudy verify` says it cannot check it (exit 2), as for a path that is no folder."""
+    import numpy as np
+    import xarray as xr
+
+    saved = tmp_path / "mine.zarr"
+    xr.Dataset({"x": ("sample", np.arange(5.0))}).to_zarr(saved, consolidated=True)
+    np.testing.assert_array_equal(open_result(saved)["x"].values, np.arange(5.0))
+    for path, words in ((saved, "not written by rockstudy run"), (tmp_path / "no", "not a folder")):
+        code, _, err = cli("verify", path)
+        assert code == 2 and words in one_line(err)

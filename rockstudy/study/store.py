@@ -730,6 +730,8 @@ def verify_cube(path) -> dict:
     import zarr
 
     path = Path(path)
+    if not path.is_dir():
+        raise StoreError(f"{path} is not a folder: a zarr cube is a folder written by a run")
     if not written_by_run(path):
         raise StoreError(
             f"{path} was not written by rockstudy run (no marker, checksums or template "
