@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import shlex
 import sys
 from pathlib import Path
@@ -115,8 +116,22 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    """A finite, positive number of seconds (``--timeout``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: give seconds > 0")
+    return value
+
+
 def _share(text: str) -> float:
-    value = float(text)
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not 0.0 <= value <= 1.0:
         raise argparse.ArgumentTypeError(f"{text} is not a share in [0, 1]")
     return value
@@ -130,17 +145,28 @@ def _resume_command(args) -> str:
     return shlex.join(words)
 
 
-def _saved(out) -> str:
-    """What a stopped run kept, read from its store."""
+def _saved(out) -> tuple[str, bool]:
+    """What a stopped run kept, read from its store, and whether ``--resume`` can continue it."""
     import numpy as np
 
-    from .study.store import read_status
+    from .study.store import read_marker, read_status
 
     try:
+        if not (read_marker(out) or {}).get("template_complete"):
+            raise FileNotFoundError
         status = read_status(out)
     except Exception:  # noqa: BLE001 - a store that does not open has kept nothing readable
-        return f"nothing readable is saved in {out}"
-    return f"{np.count_nonzero(status)} of {status.size} samples are saved in {out}"
+        return f"nothing was saved in {out}", False
+    return f"{np.count_nonzero(status)} of {status.size} samples are saved in {out}", True
+
+
+def _stopped(args, head, advice="fix the cause, then run again") -> str:
+    """The line of a run that stopped: ``head`` (ending in its separator), what was saved, and
+    how to continue (the ``--resume`` command if anything was saved, else ``advice``)."""
+    saved, resumable = _saved(args.out)
+    if resumable:
+        return f"{head}{saved}; continue with: {_resume_command(args)}"
+    return f"{head}{saved}" + (f"; {advice}" if advice else "")
 
 
 def _security(args):
@@ -182,6 +208,14 @@ def _write_history(result, path: Path):
         raise ValueError(f"--out must end in .csv or .nc, got {str(path)!r}")
 
 
+def _np_plain_numbers() -> None:
+    """Numbers in messages as numbers: numpy 2 spells a scalar ``np.float64(-13.45)`` in a
+    message built with ``{value!r}``; this process spells it ``-13.45``."""
+    import numpy as np
+
+    np.set_printoptions(legacy="1.25")
+
+
 def _usage(message) -> int:
     print(f"error: {message}", file=sys.stderr)
     return 2
@@ -218,19 +252,15 @@ def _run(args) -> int:
         print(f"error: {exc}", file=sys.stderr)  # refused: nothing was written
         return 2
     except KeyboardInterrupt:
-        print(
-            f"\ninterrupted: {_saved(args.out)}; continue with: {_resume_command(args)}",
-            file=sys.stderr,
-        )
+        print("\n" + _stopped(args, "interrupted: ", None), file=sys.stderr)
         return 130
-    except (OSError, SchedulerError, CancelledError, TimeoutError) as exc:
-        # disk full, read-only file system, scheduler lost or unreachable
+    except SchedulerError as exc:  # the cluster was not reached: nothing ran
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
+    except (OSError, CancelledError, TimeoutError) as exc:
+        # disk full, read-only file system, scheduler lost
         message = " ".join(str(exc).split())  # dask's messages span lines
-        print(
-            f"error: {type(exc).__name__}: {message}; {_saved(args.out)}; continue with: "
-            f"{_resume_command(args)}",
-            file=sys.stderr,
-        )
+        print(_stopped(args, f"error: {type(exc).__name__}: {message}; "), file=sys.stderr)
         return 1
     print(
         f"{study.name}: {report.samples} samples in {report.chunks_total} chunks; computed "
@@ -276,6 +306,13 @@ def _validate(args) -> int:
     return status
 
 
+class _Parser(argparse.ArgumentParser):
+    """A wrong option is one line (not the usage block), exit 2."""
+
+    def error(self, message):
+        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
 class _Help(argparse.HelpFormatter):
     """Help that shows an option's default where it has one (not None or a flag's False) and
     its text does not already say it."""
@@ -293,8 +330,23 @@ class _Help(argparse.HelpFormatter):
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``rockstudy`` command."""
-    parser = argparse.ArgumentParser(
+    """Entry point of the ``rockstudy`` command: Ctrl-C at any point (also while a command's
+    modules load) is one line and exit 130; zarr's IO thread is stopped before exit."""
+    try:
+        return _dispatch(_parser().parse_args(argv))
+    except KeyboardInterrupt:
+        print("\nrockstudy: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        if "zarr.core.sync" in sys.modules:  # else exit may print a zarr RuntimeError
+            from .study.store import stop_zarr_io
+
+            stop_zarr_io()
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The parser of the ``rockstudy`` command and its subcommands."""
+    parser = _Parser(
         prog="rockstudy",
         description="Rocking blocks and structures in earthquakes: simulate one, run a study "
         "file on dask, report on its results.",
@@ -384,7 +436,7 @@ def main(argv=None) -> int:
     )
     run.add_argument(
         "--timeout",
-        type=float,
+        type=_seconds,
         default=60.0,
         help="seconds to wait for a remote scheduler and its first worker (default 60)",
     )
@@ -404,7 +456,59 @@ def main(argv=None) -> int:
     )
     rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
     rep.add_argument("--out", help="directory (default: RESULT_report)")
-    args = parser.parse_args(argv)
+    ver = sub.add_parser(
+        "verify",
+        help="check a result cube against the checksums written with it",
+        formatter_class=_Help,
+        description="Check a zarr cube written by 'rockstudy run': its metadata, design and "
+        "every finished chunk against the sha256 recorded when they were written. Exit 0 and "
+        "one line if it is intact; else one line naming the damaged variable and chunk, exit 1.",
+    )
+    ver.add_argument("cube", help="a zarr store written by 'rockstudy run'")
+    return parser
+
+
+def _verify(args) -> int:
+    import time
+
+    import zarr  # noqa: F401 - loaded before the clock starts: the time is the check's
+
+    from .study.store import StoreError, verify_cube
+
+    t0 = time.perf_counter()
+    try:
+        found = verify_cube(args.cube)
+    except StoreError as exc:
+        return _refused(exc)
+    print(
+        f"{args.cube}: intact: {found['done']} of {found['chunks']} chunks finished, "
+        f"{found['files']} files match their sha256 ({time.perf_counter() - t0:.2f} s)"
+    )
+    return 0
+
+
+def _report(args) -> int:
+    from .study.report import make_report
+    from .study.store import StoreError
+
+    try:
+        print(f"wrote {make_report(args.result, args.out)}")
+    except StoreError as exc:
+        return _refused(exc)
+    return 0
+
+
+def _refused(exc) -> int:
+    """One line for a cube that is refused: exit 1 if it is damaged, 2 if it is not a cube."""
+    from .study.store import DamagedCube
+
+    print(f"error: {exc}", file=sys.stderr)
+    return 1 if isinstance(exc, DamagedCube) else 2
+
+
+def _dispatch(args) -> int:
+    """Run the command ``args.command``; a refusal is one line and exit 2."""
+    _np_plain_numbers()
     try:
         if args.command == "simulate":
             return _simulate(args)
@@ -415,10 +519,9 @@ def main(argv=None) -> int:
         if args.command == "compile":
             return _compile(args)
         if args.command == "report":
-            from .study.report import make_report
-
-            print(f"wrote {make_report(args.result, args.out)}")
-            return 0
+            return _report(args)
+        if args.command == "verify":
+            return _verify(args)
         if args.command == "schema":
             from .study import json_schema
 

@@ -315,3 +315,98 @@ def test_large_seed_and_chunk_and_all_fixed_parameters(tmp_path):
     assert int(nc.attrs["seed"]) == 3_000_000_000 and int(nc.attrs["chunk_size"]) == 3_000_000_000
     assert nc.sizes["sample"] == 4
     assert_engine_results(nc)
+
+
+# ------------------------------------------------------------------ issue 26, section 1
+
+
+def _lock_bytes(folder):
+    lock = Path(folder) / ".rockstudy.lock"
+    return lock.read_bytes() if lock.exists() else None
+
+
+@pytest.mark.parametrize("extra", [["--resume"], []])
+def test_a_stray_lock_never_makes_a_folder_of_user_files_a_store(tmp_path, extra):
+    study = write_study(tmp_path, n=20)
+    demo = tmp_path / "demo"
+    demo.mkdir()
+    (demo / "thesis.tex").write_text("precious")
+    (demo / ".rockstudy.lock").touch()
+    code, _, err = rockstudy_run(study, demo, *extra)
+    assert code != 0
+    assert_one_error_line(err)
+    assert (demo / "thesis.tex").read_text() == "precious"
+    assert sorted(p.name for p in demo.iterdir()) == [".rockstudy.lock", "thesis.tex"]
+    assert _lock_bytes(demo) == b""  # not even the lock was written to
+    assert "resume=True" not in err
+
+
+def _set_pending(out, stop):
+    import zarr
+
+    zarr.open_group(str(out), mode="r+", zarr_format=2)["status"][0:stop] = 0
+
+
+def test_a_store_without_its_marker_is_adopted_only_if_its_cube_checks(tmp_path):
+    _record(tmp_path / "rec.txt", 0.3)
+    study = tmp_path / "records.toml"
+    study.write_text(RECORD_STUDY.format())
+    out = tmp_path / "cube.zarr"
+    code, _, err = rockstudy_run(study, out)
+    assert code == 0, err
+    whole = xr.open_zarr(out)["max_rotation"].values
+    _set_pending(out, 10)
+    (out / ".rockstudy").unlink()
+    _record(tmp_path / "rec.txt", 0.9)  # the record multiplied by 3
+    before, lock = tree(out), _lock_bytes(out)
+    code, _, err = rockstudy_run(study, out, "--resume")
+    assert code != 0
+    assert_one_error_line(err)
+    assert "rec.txt" in err and "changed" in err
+    assert tree(out) == before and _lock_bytes(out) == lock  # nothing changed, lock included
+    _record(tmp_path / "rec.txt", 0.3)  # restored: the cube's own hashes now agree
+    code, stdout, err = rockstudy_run(study, out, "--resume")
+    assert code == 0 and "computed 1 chunks" in stdout, err
+    assert (out / ".rockstudy").is_file()
+    np.testing.assert_array_equal(xr.open_zarr(out)["max_rotation"].values, whole)
+
+
+@pytest.mark.parametrize("lost", ["inputs_sha256", "versions", "template_complete"])
+def test_a_store_without_marker_whose_cube_cannot_be_checked_is_refused(finished, tmp_path, lost):
+    folder, study, src = finished
+    out = tmp_path / "cube.zarr"
+    shutil.copytree(src, out)
+    (out / ".rockstudy").unlink()
+    meta = json.loads((out / ".zmetadata").read_text())
+    del meta["metadata"][".zattrs"][lost]
+    (out / ".zmetadata").write_text(json.dumps(meta))
+    before = tree(out)
+    code, _, err = rockstudy_run(study, out, "--resume")
+    assert code != 0
+    assert_one_error_line(err)
+    assert "new --out" in err and "afresh" in err
+    assert tree(out) == before
+
+
+def test_a_refused_run_leaves_the_lock_as_it_was(finished, tmp_path):
+    folder, study, src = finished
+    out = tmp_path / "cube.zarr"
+    shutil.copytree(src, out)
+    lock = _lock_bytes(out)
+    assert lock  # the finished run named itself
+    other = write_study(tmp_path, seed=8, name="other.toml")
+    for args in ((study, out), (other, out, "--resume")):
+        code, _, err = rockstudy_run(*args)
+        assert code != 0
+        assert_one_error_line(err)
+        assert "resume=True" not in err
+        assert _lock_bytes(out) == lock
+
+
+def test_an_existing_empty_folder_is_accepted(tmp_path):
+    study = write_study(tmp_path, n=20)
+    out = tmp_path / "empty"
+    out.mkdir()
+    code, _, err = rockstudy_run(study, out)
+    assert code == 0, err
+    assert_engine_results(xr.open_zarr(out).load())

@@ -34,9 +34,10 @@ def refuse_free_fall(vsamples, scale, batch=False) -> None:
     bad = np.flatnonzero(~(lowest > -G))
     if bad.size:
         i = int(bad[0])
-        where = f" at scale[{i}] = {np.atleast_1d(scale)[i]!r}" if batch else ""
+        where = f" at scale[{i}] = {float(np.atleast_1d(scale)[i])!r}" if batch else ""
         raise ValueError(
-            f"vertical: the vertical ground acceleration reaches {lowest[i]!r} m/s^2{where}, "
+            f"vertical: the vertical ground acceleration reaches {float(lowest[i])!r} m/s^2"
+            f"{where}, "
             f"at or below -g = {-G!r} m/s^2 (free fall: the base no longer carries the "
             "structure, which Housner's model does not describe); scale the record down"
         )

@@ -61,6 +61,8 @@ def problems(study, base_dir=None) -> list[str]:
         except ValueError as exc:
             return [*found, str(exc)]
         found += _record_problems(study, pairs)
+        if study.design is not None:
+            found += _named_twice(pairs)
         refusal = None if all(v is None for _, _, v in pairs) else vertical_refusal()
         if refusal:
             found.append(f"motion.vertical: {refusal}; give horizontal records only")
@@ -102,6 +104,22 @@ def notes(study, base_dir=None) -> list[str]:
                 f"and {scaled[0]} scales the pair up to {top:.4g}: the design's points at or "
                 "above free fall are stored as censored (reason: free fall); the others run"
             )
+    return found
+
+
+def _named_twice(pairs) -> list[str]:
+    """A design runs every record it lists once per structure and level: a file listed twice
+    would count twice in its fragility, so it is refused (Monte Carlo rows may repeat one, to
+    draw it more often)."""
+    first, found = {}, []
+    for field, h, _ in pairs:
+        key = h.resolve()
+        if key in first:
+            found.append(
+                f"{field}: names the file {str(h)!r} again (already {first[key]}); a design runs "
+                "each record once: list it once"
+            )
+        first.setdefault(key, field)
     return found
 
 

@@ -8,7 +8,9 @@ nothing finished: ``resume=True`` computes only the chunks whose status is still
 
 from __future__ import annotations
 
+import json
 import logging
+import math
 import multiprocessing
 import sys
 import threading
@@ -61,8 +63,12 @@ class _Progress:
         sys.stderr.flush()
 
 
-def _imported() -> None:
-    """Nothing: a worker that runs it has imported this module and the engine's (no kernel)."""
+def _imported(plain_numbers=False) -> None:
+    """A worker that runs it has imported this module and the engine's (no kernel); with
+    ``plain_numbers`` (a worker of our own local cluster) numpy scalars in its messages read
+    as numbers (``-13.45``, not ``np.float64(-13.45)``)."""
+    if plain_numbers:
+        np.set_printoptions(legacy="1.25")
 
 
 def _close(client, cluster):
@@ -141,20 +147,55 @@ def _check_workers(workers) -> None:
         raise ValueError(f"workers: {workers!r} is not allowed; give a whole number >= 1")
 
 
+def _scheduler_address(scheduler_file, timeout) -> str:
+    """The address in a dask scheduler file, waiting up to ``timeout`` seconds for the file to
+    appear (a scheduler that is starting writes it); SchedulerError if it does not, or if it is
+    not a scheduler file."""
+    path = Path(scheduler_file)
+    deadline = time.monotonic() + timeout
+    while not path.exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    if not path.exists():
+        raise SchedulerError(
+            f"the scheduler file {path} does not exist (waited {timeout:g} s): start the "
+            "scheduler with --scheduler-file, or check the path"
+        )
+    try:
+        address = json.loads(path.read_text())["address"]
+        if not isinstance(address, str) or "://" not in address:
+            raise TypeError
+    except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError):
+        raise SchedulerError(
+            f"{path} is not a dask scheduler file (a JSON object whose 'address' is like "
+            "tcp://HOST:PORT)"
+        ) from None
+    return address
+
+
 def _remote_client(scheduler, scheduler_file, security, timeout):
     """A client of a running cluster that has at least one worker, or SchedulerError."""
     from distributed import Client
 
     where = scheduler or f"the scheduler file {scheduler_file}"
+    if scheduler is None:
+        scheduler = _scheduler_address(scheduler_file, timeout)
     kw = {"timeout": timeout} if security is None else {"timeout": timeout, "security": security}
     try:
-        if scheduler is not None:
-            client = Client(scheduler, **kw)
-        else:
-            client = Client(scheduler_file=str(scheduler_file), **kw)
+        client = Client(scheduler, **kw)
     except (OSError, TimeoutError) as exc:
         raise SchedulerError(
             f"cannot reach the dask scheduler at {where} within {timeout:g} s ({exc})"
+        ) from None
+    except (TypeError, ValueError) as exc:  # distributed's word for missing TLS credentials
+        tls = "tls" in str(exc).lower() or "ssl" in str(exc).lower()
+        raise SchedulerError(
+            f"cannot connect to the dask scheduler at {where}: "
+            + (
+                "a tls:// scheduler needs certificates: give --tls-ca-file, --tls-cert and "
+                "--tls-key (or set distributed.comm.tls in dask's configuration)"
+                if tls
+                else f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+            )
         ) from None
     try:
         client.wait_for_workers(1, timeout=timeout)
@@ -179,7 +220,10 @@ def _local_cluster(workers):
     main_thread = threading.current_thread() is threading.main_thread()
     old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
     try:
-        with dask.config.set({"distributed.scheduler.http.routes": []}):
+        # no HTTP routes anywhere: the scheduler's and the workers' servers (which dask always
+        # starts) answer 404 to everything, /metrics and /health included
+        routes = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
+        with dask.config.set(routes):
             return LocalCluster(
                 n_workers=workers or 2,
                 threads_per_worker=1,
@@ -276,6 +320,10 @@ def run_study(
     t0 = time.perf_counter()
     out = Path(out)
     _check_workers(workers)
+    if isinstance(timeout, bool) or not (isinstance(timeout, (int, float)) and timeout > 0):
+        raise ValueError(f"timeout: {timeout!r} is not allowed; give seconds > 0")
+    if not math.isfinite(timeout):
+        raise ValueError(f"timeout: {timeout!r} is not allowed; give a finite number of seconds")
     if not 0.0 <= max_failed <= 1.0:
         raise ValueError(f"max_failed: {max_failed!r} is not a share in [0, 1]")
     nc = out.with_suffix(".nc") if netcdf else None
@@ -307,7 +355,7 @@ def run_study(
             report.netcdf = store.export_netcdf(out, nc)
     except BaseException:
         if not complete:  # failed before its template was written: leave no trace
-            store.discard_if_unused(out)
+            store.discard_if_unused(out, lock.made_folder)
         raise
     finally:
         lock.release()
@@ -353,12 +401,15 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
     own = client is None
     cluster = None
     if todo:
+        remote = where[1] is not None or where[2] is not None
+        if own and remote:  # reached (or refused in one line) before anything is compiled
+            client = _client(*where)[0]
         priming = _start_prime(study_json, columns, base_dir, progress)
-        if own:  # the workers start, and import the study's modules, while the client compiles
+        if own and not remote:  # the local workers start while the client compiles
             client, cluster = _client(*where)
         try:
             if own:
-                client.run(_imported)
+                client.run(_imported, cluster is not None)
             priming.join()  # only then do the workers get a chunk: they load the kernels
             if priming.error is not None:
                 raise priming.error

@@ -6,14 +6,17 @@ study's chunks, so no two writers ever share a zarr chunk), outputs first and ``
 a chunk whose status is not pending is complete. A killed run resumes from the pending chunks.
 
 The store never destroys what it did not write. A run claims a folder only if it is new (or
-empty), and writes a marker file ``.rockstudy`` into it first (the study's sha256, the sha256
-of every input file, the package version, and whether the template is complete); a folder
-without that marker is never written to. A run holds an exclusive lock (``.rockstudy.lock``,
-``fcntl.flock``, naming its PID and host) for its whole life: a second run on the same store is
-refused at once, and the lock of a killed run vanishes with its process, so ``--resume`` after
-SIGKILL just works. Each finished chunk records the sha256 of its files
-(``.rockstudy-chunks/<k>``); on resume a chunk marked done whose files are missing or differ is
-computed again.
+empty: nothing in it but, at most, a lock file), and writes a marker file ``.rockstudy`` into
+it first (the study's sha256, the sha256 of every input file, the package version, and whether
+the template is complete). Only that marker identifies a store: a lock file never does, and a
+store whose marker is lost is resumed only if its cube's own attributes pass the marker's
+checks. A run holds an exclusive lock (``.rockstudy.lock``, ``fcntl.flock``, naming its PID and
+host once the run is accepted) for its whole life: a second run on the same store is refused
+at once, and the lock of a killed run vanishes with its process, so ``--resume`` after SIGKILL
+just works. The template records the sha256 of ``.zmetadata`` and of the design's files, and
+each finished chunk those of its outputs (``.rockstudy-chunks/``): on resume a chunk marked
+done whose files are missing or differ is computed again, and a reader
+(:func:`open_result`, :func:`verify_cube`) refuses a cube whose files differ.
 """
 
 from __future__ import annotations
@@ -110,14 +113,31 @@ def input_hashes(study: Study, base_dir=None) -> dict:
 
 
 def read_marker(path) -> dict | None:
-    """The marker of a store made by rockstudy, or None if the folder has none."""
+    """The marker of a store made by rockstudy, or None if the folder has none.
+
+    Raises StoreError if ``.rockstudy`` is there but is not a marker (a folder, unreadable, not
+    JSON, not a JSON object)."""
     marker = Path(path) / MARKER
-    if not marker.is_file():
+    if not (marker.exists() or marker.is_symlink()):
         return None
+    if not marker.is_file():
+        raise StoreError(
+            f"{marker} is not a rockstudy marker (not a regular file): {Path(path)} is not a "
+            "store rockstudy can use; nothing was changed. Choose a new --out"
+        )
     try:
-        return json.loads(marker.read_text())
+        data = json.loads(marker.read_text())
     except (OSError, ValueError) as exc:
-        raise StoreError(f"{marker} is damaged ({exc}); nothing was changed") from None
+        raise StoreError(
+            f"{marker} is damaged ({exc}); nothing was changed. The store cannot be checked: "
+            "run into a new --out"
+        ) from None
+    if not isinstance(data, dict):
+        raise StoreError(
+            f"{marker} is damaged (a JSON {type(data).__name__}, not an object); nothing was "
+            "changed. The store cannot be checked: run into a new --out"
+        )
+    return data
 
 
 def write_marker(path, **fields) -> None:
@@ -129,13 +149,48 @@ def write_marker(path, **fields) -> None:
     os.replace(tmp, marker)
 
 
-def _legacy_store(path) -> bool:
-    """A store written before markers existed: its consolidated metadata names a study."""
+def _cube_attrs(path) -> dict | None:
+    """The cube's own attributes, from its consolidated metadata; None if it has none."""
     try:
-        meta = json.loads((Path(path) / ".zmetadata").read_text())
-        return "study_sha256" in meta["metadata"][".zattrs"]
+        attrs = json.loads((Path(path) / ".zmetadata").read_text())["metadata"][".zattrs"]
     except (OSError, ValueError, KeyError, TypeError):
-        return False
+        return None
+    return attrs if isinstance(attrs, dict) and "study_sha256" in attrs else None
+
+
+def _legacy_marker(path, attrs) -> dict:
+    """The marker of a store whose marker is gone, rebuilt from what its cube records: the
+    study's sha256, its input files' sha256 and the rockstudy version. Raises StoreError where
+    the cube does not record one of them (it cannot be checked, so it is not resumed)."""
+    missing = []
+    try:
+        inputs = json.loads(attrs["inputs_sha256"])
+        if not isinstance(inputs, dict):
+            raise TypeError
+    except (KeyError, TypeError, ValueError):
+        missing.append("the sha256 of its input files")
+        inputs = None
+    try:
+        version = json.loads(attrs["versions"])["rockstudy"]
+    except (KeyError, TypeError, ValueError):
+        missing.append("the rockstudy version that wrote it")
+        version = None
+    if not isinstance(attrs.get("study_sha256"), str):
+        missing.append("its study's sha256")
+    if not attrs.get("template_complete"):
+        missing.append("a complete template")
+    if missing:
+        raise StoreError(
+            f"{path} has no {MARKER} marker and its cube does not record {' or '.join(missing)}: "
+            "resuming it cannot be checked, so it is refused; nothing was changed. Start afresh: "
+            "run into a new --out (or move this folder away)"
+        )
+    return {
+        "study_sha256": attrs["study_sha256"],
+        "inputs_sha256": inputs,
+        "rockstudy": version,
+        "template_complete": True,
+    }
 
 
 class StoreLock:
@@ -143,14 +198,17 @@ class StoreLock:
 
     The kernel drops the lock when its process dies (even by SIGKILL), so a lock file left by a
     killed run is stale by construction and the next run takes it over. The file names the
-    holder (PID, host, start time) for the message that refuses a second run.
+    holder (PID, host, start time) for the message that refuses a second run; it is written
+    only by :meth:`announce`, once the run is accepted: a refused run leaves it as it was.
     """
 
     def __init__(self, folder):
         self.path = Path(folder) / LOCK
         self.fd = None
+        self.made_folder = False  # set by claim() when it created the folder
 
     def acquire(self) -> None:
+        """Take the lock (creating its file), or raise StoreError naming its holder."""
         import fcntl
 
         fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -168,14 +226,17 @@ class StoreLock:
                 f"{self.path.parent} is in use by another rockstudy run, {who}: refused; wait "
                 "for it to end (or stop it), then --resume"
             ) from None
-        os.ftruncate(fd, 0)
+        self.fd = fd
+
+    def announce(self) -> None:
+        """Write this process as the holder into the lock file (the lock is held)."""
+        os.ftruncate(self.fd, 0)
         holder = {
             "pid": os.getpid(),
             "host": socket.gethostname(),
             "since": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         }
-        os.write(fd, json.dumps(holder).encode())
-        self.fd = fd
+        os.pwrite(self.fd, json.dumps(holder).encode(), 0)
 
     def release(self) -> None:
         if self.fd is not None:
@@ -190,55 +251,87 @@ class StoreLock:
         self.release()
 
 
+def _refuse_if_held(path) -> None:
+    """Raise StoreError naming the holder if a run holds the lock of ``path``; changes nothing
+    (a lock file that is not there is not created)."""
+    if (Path(path) / LOCK).is_file():
+        with StoreLock(path):  # released at once, never announced
+            pass
+
+
+def _user_entries(path) -> list[str]:
+    """What a folder holds besides a lock file (a lock alone holds nothing of anyone's)."""
+    return sorted(p.name for p in Path(path).iterdir() if p.name != LOCK)
+
+
 def claim(path, study: Study, inputs: dict, resume: bool) -> tuple[StoreLock, bool]:
     """Take the folder ``path`` for a run of ``study``, or raise without changing anything.
 
-    A new (or empty) folder is created, locked and marked. An existing one is used only with
-    ``resume`` and only if it holds a rockstudy store of the same study, with the same input
-    files and package version. Returns the held lock and whether the store's template is
+    A new or empty folder (nothing in it but, at most, a lock file) is created, locked and
+    marked. Anything else is used only with ``resume``, and only if its marker ``.rockstudy``
+    (the one thing that identifies a store: a lock file never does) names the same study, input
+    files and package version. A store whose marker is lost is resumed only if its cube's own
+    attributes pass the same checks. Returns the held lock and whether the store's template is
     complete (False: nothing finished yet, the template is (re)written).
     """
     path = Path(path)
-    sha = study.sha256()
+    lock = StoreLock(path)
     try:
         path.mkdir(parents=True)
-        fresh = True
+        lock.made_folder = True
     except FileExistsError:
-        fresh = False
-    if not fresh:
         if not path.is_dir():
-            raise StoreError(f"{path} exists and is not a folder: choose a new --out")
-        if not resume:
-            if (path / LOCK).is_file():
-                with StoreLock(path):  # raises, naming the holder, if a run holds it
-                    pass
-            raise FileExistsError(f"{path} exists: pass resume=True (--resume) or a new path")
-        entries = sorted(p.name for p in path.iterdir())
-        if entries and MARKER not in entries and LOCK not in entries and not _legacy_store(path):
-            shown = ", ".join(entries[:5]) + (", ..." if len(entries) > 5 else "")
-            raise StoreError(
-                f"{path} is not a rockstudy store (it holds {shown}): nothing was written; "
-                "choose a new --out"
-            )
-    lock = StoreLock(path)
+            raise StoreError(f"{path} exists and is not a folder: choose a new --out") from None
+    if not _user_entries(path):  # new or empty: ours, once locked (a racing run is refused)
+        lock.acquire()
+        try:
+            if _user_entries(path):  # filled since it was listed: look again, from the start
+                lock.release()
+                return claim(path, study, inputs, resume)
+            lock.announce()
+            write_marker(path, **_identity(study, inputs), template_complete=False)
+        except BaseException:
+            lock.release()
+            raise
+        return lock, False
+    marker = _marker_or_legacy(path)
+    if not resume:
+        _refuse_if_held(path)
+        raise FileExistsError(
+            f"{path} holds a rockstudy store: continue it with --resume, or choose a new --out"
+        )
+    _check_same(path, marker, study.sha256(), inputs)  # read only: nothing is touched yet
     lock.acquire()
     try:
-        marker = read_marker(path)
-        if marker is None and _legacy_store(path):  # written before markers: adopt it
-            attrs = json.loads((path / ".zmetadata").read_text())["metadata"][".zattrs"]
-            marker = {"study_sha256": attrs["study_sha256"], "template_complete": True}
+        marker = _marker_or_legacy(path)  # again, under the lock
+        _check_same(path, marker, study.sha256(), inputs)
+        complete = bool(marker.get("template_complete"))
+        if complete:
+            _check_metadata(path)
+        lock.announce()
+        if read_marker(path) is None:  # a store that lost its marker, checked: marked again
             write_marker(path, **marker)
-        if marker is None:  # new, or emptied: ours from here on
-            write_marker(path, **_identity(study, inputs), template_complete=False)
-            return lock, False
-        _check_same(path, marker, sha, inputs)
-        if not marker.get("template_complete"):
-            return lock, False
-        _check_metadata(path)
-        return lock, True
+        return lock, complete
     except BaseException:
         lock.release()
         raise
+
+
+def _marker_or_legacy(path) -> dict:
+    """The marker of the store in ``path``, or one rebuilt from its cube (see
+    :func:`_legacy_marker`); StoreError if the folder is not a rockstudy store."""
+    marker = read_marker(path)
+    if marker is not None:
+        return marker
+    attrs = _cube_attrs(path)
+    if attrs is None:
+        entries = _user_entries(path)
+        shown = ", ".join(entries[:5]) + (", ..." if len(entries) > 5 else "")
+        raise StoreError(
+            f"{path} is not a rockstudy store (it holds {shown}): nothing was written; "
+            "choose a new --out"
+        )
+    return _legacy_marker(path, attrs)
 
 
 def _identity(study, inputs) -> dict:
@@ -254,7 +347,12 @@ def _check_same(path, marker, sha, inputs) -> None:
     if marker.get("study_sha256") != sha:
         raise ValueError(f"{path} holds a different study (sha256 mismatch); cannot resume")
     before = marker.get("inputs_sha256")
-    if before is not None and before != inputs:
+    if not isinstance(before, dict):
+        raise StoreError(
+            f"{path}: its marker does not record the sha256 of the input files, so resuming "
+            "cannot be checked; nothing was changed. Start afresh: run into a new --out"
+        )
+    if before != inputs:
         changed = sorted(k for k in set(before) | set(inputs) if before.get(k) != inputs.get(k))
         raise StoreError(
             f"{path}: input file(s) {', '.join(changed)} changed since this store was started; "
@@ -262,39 +360,73 @@ def _check_same(path, marker, sha, inputs) -> None:
             "--out"
         )
     version = package_versions()["rockstudy"]
-    if marker.get("rockstudy", version) != version:
+    if marker.get("rockstudy") != version:
         raise StoreError(
-            f"{path} was started by rockstudy {marker['rockstudy']}, this is {version}: "
+            f"{path} was started by rockstudy {marker.get('rockstudy')}, this is {version}: "
             "resuming would mix results of two versions; run into a new --out"
         )
 
 
 def _check_metadata(path) -> None:
-    """The consolidated metadata of a complete template must read; else report, never rebuild."""
+    """The consolidated metadata of a complete template must be the one written (its sha256,
+    where recorded) and must open; else report, never rebuild."""
+    import zarr
+
+    path = Path(path)
+    advice = (
+        "If the arrays' own metadata are intact, rebuild it with python -c \"import zarr; "
+        f"zarr.consolidate_metadata('{path}', zarr_format=2)\" and --resume again"
+    )
     try:
-        json.loads((Path(path) / ".zmetadata").read_text())["metadata"]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
+        want = json.loads((path / CHECKSUMS / TEMPLATE_SUMS).read_text())[".zmetadata"]
+    except (OSError, ValueError, KeyError, TypeError):
+        want = None  # a store written before these sums: what opens is all that is checked
+    try:
+        json.loads((path / ".zmetadata").read_text())["metadata"]
+        if want is not None and file_sha256(path / ".zmetadata") != want:
+            advice = "The cube cannot be trusted: run the study into a new --out"
+            raise ValueError("it differs from the file written: its sha256 changed")
+        group = zarr.open_group(str(path), mode="r", zarr_format=2, use_consolidated=True)
+        for _, array in group.arrays():
+            array.metadata  # noqa: B018 - decoding each array's metadata is the check
+    except Exception as exc:  # noqa: BLE001 - whatever does not open: one line, nothing changed
         raise StoreError(
-            f"{path}/.zmetadata is damaged ({type(exc).__name__}: {exc}); nothing was changed. "
-            "If the arrays' own metadata are intact, rebuild it with python -c \"import zarr; "
-            f"zarr.consolidate_metadata('{path}', zarr_format=2)\" and --resume again"
+            f"{path}/.zmetadata is damaged ({type(exc).__name__}: {' '.join(str(exc).split())}); "
+            f"nothing was changed. {advice}"
         ) from None
 
 
-def discard_if_unused(path) -> None:
-    """Remove a folder this run created if nothing but its marker and lock got into it."""
+def discard_if_unused(path, made_folder=True) -> None:
+    """Undo a claim that nothing got into: remove the folder if this run made it, else only
+    the marker and lock it wrote (the folder was empty before)."""
     path = Path(path)
     marker = read_marker(path)
     if marker is not None and not marker.get("template_complete"):
         if {entry.name for entry in path.iterdir()} <= _OWN:
-            shutil.rmtree(path)
+            if made_folder:
+                shutil.rmtree(path)
+            else:
+                for name in _OWN:
+                    (path / name).unlink(missing_ok=True)
 
 
-def clear_template(path) -> None:
-    """Remove a partly written template from a folder this run owns (its marker says so)."""
+def clear_template(path, names) -> None:
+    """Remove a partly written template from a folder this run owns (its marker says so).
+
+    ``names`` are the entries a template writes; anything else in the folder was not written by
+    rockstudy, so the folder is refused whole (StoreError) and nothing is removed.
+    """
     path = Path(path)
     if read_marker(path) is None:
         raise StoreError(f"{path} has no rockstudy marker: refusing to clear it")
+    allowed = set(names) | _OWN | {".zattrs", ".zgroup", ".zmetadata", CHECKSUMS, MARKER + ".tmp"}
+    foreign = sorted(entry.name for entry in path.iterdir() if entry.name not in allowed)
+    if foreign:
+        shown = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
+        raise StoreError(
+            f"{path} holds {shown}, which rockstudy did not write: nothing was removed; move "
+            "them away, or run into a new --out"
+        )
     for entry in path.iterdir():
         if entry.name in _OWN:
             continue
@@ -314,7 +446,8 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
     import dask.array as da
     import zarr
 
-    clear_template(path)
+    table = output_table(study)
+    clear_template(path, [*design.variables, *table, "status", "error"])
     n = design.sizes["sample"]
     size = min(study.rows_per_chunk(), n)
     ds = design.copy()
@@ -325,7 +458,7 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         width = ds.attrs["ida_steps"] if extra == "step" else ds.sizes[extra]
         return (("sample", extra), da.full((n, width), fill, dtype=dtype, chunks=(size, width)))
 
-    for name, (long_name, units, dtype, fill, extra) in output_table(study).items():
+    for name, (long_name, units, dtype, fill, extra) in table.items():
         ds[name] = lazy(fill, dtype, extra)
         ds[name].attrs.update(long_name=long_name, units=units)
     ds["status"] = lazy(STATUS_PENDING, np.int8)
@@ -357,6 +490,7 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         )
         group.attrs["template_complete"] = 1
         zarr.consolidate_metadata(str(path), zarr_format=2)
+    write_template_sums(path, design.variables)
     write_marker(path, template_complete=True)
 
 
@@ -401,6 +535,33 @@ def template_complete(path) -> bool:
         return bool(json.loads(meta)["metadata"][".zattrs"].get("template_complete"))
     except (ValueError, KeyError, TypeError) as exc:
         raise StoreError(f"{path}/.zmetadata is damaged ({exc}); nothing was changed") from None
+
+
+def stop_zarr_io(timeout: float = 60.0) -> None:
+    """Stop zarr's IO event loop and wait for its thread, before the process exits.
+
+    zarr runs its IO on an event loop in a thread, and stops it at exit (``atexit``) by joining
+    that thread for 0.2 s only, then closing the loop: on a busy machine the thread has not
+    stopped yet and exit prints ``RuntimeError: Cannot close a running event loop`` (issue 24).
+    This waits up to ``timeout`` seconds instead; zarr's own clean-up then has nothing left to
+    do. Does nothing if zarr never started its loop.
+    """
+    import sys
+
+    sync = sys.modules.get("zarr.core.sync")
+    if sync is None:
+        return
+    with sync._get_lock():  # noqa: SLF001 - the lock zarr's own clean-up takes
+        loop, thread = sync.loop[0], sync.iothread[0]
+        if loop is None:
+            return
+        loop.call_soon_threadsafe(loop.stop)
+        if thread is not None:
+            thread.join(timeout)
+        if loop.is_running():  # still stuck after the timeout: left to zarr's clean-up
+            return
+        loop.close()
+        sync.loop[0] = sync.iothread[0] = None
 
 
 class ChunkWriter:
@@ -456,6 +617,173 @@ def _chunk_intact(path, group, names, k) -> bool:
         return False
 
 
+TEMPLATE_SUMS = "template"  # in CHECKSUMS: the sha256 of .zmetadata and of the design's files
+
+
+def _files_of(path, name) -> list[Path]:
+    """The chunk files of the array ``name`` (its metadata files left out)."""
+    folder = Path(path) / name
+    return sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith("."))
+
+
+def write_template_sums(path, names) -> None:
+    """Record the sha256 of the consolidated metadata and of every chunk file of the design
+    variables ``names``: what a reader checks besides the finished chunks' own sums."""
+    path = Path(path)
+    sums = {".zmetadata": file_sha256(path / ".zmetadata")}
+    for name in names:
+        for file in _files_of(path, name):
+            sums[f"{name}/{file.name}"] = file_sha256(file)
+    (path / CHECKSUMS).mkdir(exist_ok=True)
+    target = path / CHECKSUMS / TEMPLATE_SUMS
+    tmp = target.with_name(TEMPLATE_SUMS + ".tmp")
+    tmp.write_text(json.dumps(sums))
+    os.replace(tmp, target)
+
+
+class DamagedCube(StoreError):
+    """A cube whose files differ from what was written: ``variable`` and ``chunk`` (None for
+    the metadata or the design) name the first damage found."""
+
+    def __init__(self, message, variable, chunk=None):
+        super().__init__(message)
+        self.variable, self.chunk = variable, chunk
+
+
+def _damaged(path, what, variable, chunk=None, rows=None):
+    where = f"variable {variable!r}" + ("" if chunk is None else f", chunk {chunk}")
+    where += "" if rows is None else f" (samples {rows[0]} to {rows[1] - 1})"
+    advice = (
+        "rockstudy run ... --resume computes it again"
+        if chunk is not None and variable != "status"
+        else "run the study again into a new --out"
+    )
+    return DamagedCube(
+        f"{path} is damaged: {where}: {what}; it is not read. {advice}", variable, chunk
+    )
+
+
+def _verify_template(path, sums) -> int:
+    """Check the files recorded at template time; the count checked."""
+    for key, want in sums.items():
+        variable, _, file = key.partition("/")
+        try:
+            same = file_sha256(Path(path) / key) == want
+        except OSError:
+            same = False
+        if not same:
+            what = "its file is missing or differs from the one written"
+            if key == ".zmetadata":
+                raise _damaged(path, what, ".zmetadata (the cube's metadata)")
+            raise _damaged(path, f"{what} (chunk file {file})", variable)
+    return len(sums)
+
+
+def _verify_chunk(path, ndim, k, rows) -> int:
+    """Check chunk ``k`` of every output (``ndim``: name -> its dimensions) against the sums
+    written with it; the count."""
+    try:
+        sums = json.loads((Path(path) / CHECKSUMS / str(k)).read_text())
+        if not isinstance(sums, dict):
+            raise ValueError
+    except (OSError, ValueError):
+        raise _damaged(
+            path,
+            f"the checksums of a finished chunk ({CHECKSUMS}/{k}) are missing or unreadable",
+            "status",
+            k,
+            rows,
+        ) from None
+    for name, want in sums.items():
+        try:
+            file = str(k) + ".0" * (ndim[name] - 1)
+            same = file_sha256(Path(path) / name / file) == want
+        except (OSError, KeyError):
+            same = False
+        if not same:
+            raise _damaged(
+                path, "its file is missing or differs from the one written", name, k, rows
+            )
+    return len(sums)
+
+
+def written_by_run(path) -> bool:
+    """Whether a zarr folder was written by a run (:func:`run_study`): it has the marker, the
+    checksums, or the attribute ``template_complete`` that only a run's template sets. A
+    dataset saved with ``to_zarr`` has none of them."""
+    path = Path(path)
+    if (path / MARKER).exists() or (path / CHECKSUMS).exists():
+        return True
+    try:
+        attrs = json.loads((path / ".zmetadata").read_text())["metadata"][".zattrs"]
+        return "template_complete" in attrs
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+def verify_cube(path) -> dict:
+    """Check a zarr cube written by a run against the sha256 recorded when it was written.
+
+    Checked: the consolidated metadata and the design's files (recorded with the template),
+    the ``status`` of every chunk (it must decode to 0, 1 or 2), and the files of every output
+    of each finished chunk. Returns ``{"chunks", "done", "files"}``; raises
+    :class:`DamagedCube` (a StoreError) naming the first damaged variable and chunk, or
+    StoreError for a folder that is not a cube a run wrote.
+    """
+    import zarr
+
+    path = Path(path)
+    if not path.is_dir():
+        raise StoreError(f"{path} is not a folder: a zarr cube is a folder written by a run")
+    if not written_by_run(path):
+        raise StoreError(
+            f"{path} was not written by rockstudy run (no marker, checksums or template "
+            "attribute): it carries no checksums to verify"
+        )
+    try:
+        sums = json.loads((path / CHECKSUMS / TEMPLATE_SUMS).read_text())
+    except (OSError, ValueError):
+        raise _damaged(
+            path,
+            f"the sums of its metadata and design ({CHECKSUMS}/{TEMPLATE_SUMS}) are "
+            "missing or unreadable (a copy saved with to_zarr has none: open_result(..., "
+            "verify=False) reads it unchecked)",
+            ".zmetadata (the cube's metadata)",
+        ) from None
+    files = _verify_template(path, sums)
+    try:
+        group = zarr.open_group(str(path), mode="r", zarr_format=2, use_consolidated=True)
+        status = group["status"]
+        size = status.chunks[0]
+        ndim = {
+            key.split("/")[0]: len(value["shape"])
+            for key, value in _consolidated(path).items()
+            if key.endswith("/.zarray")
+        }
+    except Exception as exc:  # noqa: BLE001 - metadata that does not open: one line
+        raise _damaged(path, f"it does not open ({type(exc).__name__})", "status") from None
+    bounds = chunk_bounds(status.shape[0], size)
+    try:
+        whole = status[:]  # one read; chunk by chunk only to find the one that does not decode
+    except Exception:  # noqa: BLE001
+        whole = None
+    done = 0
+    for k, rows in enumerate(bounds):
+        try:
+            values = status[rows[0] : rows[1]] if whole is None else whole[rows[0] : rows[1]]
+        except Exception:  # noqa: BLE001 - a status chunk that does not decode
+            values = None
+        if values is None or not np.all(np.isin(values, (STATUS_PENDING, *DONE))):
+            raise _damaged(path, "it does not decode to 0, 1 or 2", "status", k, rows)
+        if np.all(values == STATUS_PENDING):
+            continue
+        if np.any(values == STATUS_PENDING):
+            raise _damaged(path, "it is partly pending, partly done", "status", k, rows)
+        files += _verify_chunk(path, ndim, k, rows)
+        done += 1
+    return {"chunks": len(bounds), "done": done, "files": files}
+
+
 def read_status(path) -> np.ndarray:
     """The per-sample status array of a store (0 pending, 1 ok, 2 failed)."""
     return xr.open_zarr(Path(path), consolidated=True)["status"].values
@@ -501,7 +829,9 @@ def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
         except Exception:  # noqa: BLE001 - any unreadable design chunk is written again
             same = False
         if not same:
-            group[name][:] = want
+            with zarr.config.set({"array.write_empty_chunks": True}):
+                group[name][:] = want
+    write_template_sums(path, design.variables)  # the design as it now reads
     results = sorted(
         key.split("/")[0]
         for key in meta
@@ -526,12 +856,20 @@ def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
     return pending, damaged
 
 
-def open_result(path) -> xr.Dataset:
-    """Open a result cube (zarr or netCDF); grid studies come back on their grid dimensions."""
+def open_result(path, verify: bool = True) -> xr.Dataset:
+    """Open a result cube (zarr or netCDF); grid studies come back on their grid dimensions.
+
+    A zarr cube is first checked against the sha256 recorded when it was written
+    (:func:`verify_cube`): a damaged one raises :class:`DamagedCube` naming the variable and
+    chunk. ``verify=False`` skips the check (to look at a damaged cube). A netCDF export, and a
+    dataset saved with ``to_zarr``, carry no checksums and are read as they are.
+    """
     path = Path(path)
     if path.suffix == ".nc":
         ds = xr.open_dataset(path)
     else:
+        if verify and written_by_run(path):  # a dataset saved with to_zarr has no sums
+            verify_cube(path)
         ds = xr.open_zarr(path, consolidated=True)
     if "record_design" in ds.attrs and "sample" in ds.dims:
         from .record_studies import design_dataset
