@@ -347,23 +347,33 @@ def _from_openquake(path, lines, im, units, site) -> HazardCurve:
         poe = np.array([float(cells[j]) for j in cols])
     except (ValueError, IndexError):
         raise ValueError(f"path: {path.name}: site row {rows[i]!r} is not numbers") from None
-    if np.any(~(poe >= 0.0) | ~(poe < 1.0)):
+    if np.any(~(poe >= 0.0) | ~(poe <= 1.0)):
         raise ValueError(
-            f"path: {path.name}: probabilities of exceedance must lie in [0, 1); got {poe!r}"
+            f"path: {path.name}: probabilities of exceedance must lie in [0, 1]; got {poe!r}"
         )
+    first = int(np.count_nonzero(np.cumprod(poe == 1.0)))  # leading certain exceedances
     keep = poe.size
-    while keep > 0 and poe[keep - 1] == 0.0:
+    while keep > first and poe[keep - 1] == 0.0:
         keep -= 1
-    if keep < poe.size:
-        warnings.warn(
-            f"{path.name}: {poe.size - keep} highest level(s) have poe 0 and were dropped; the "
-            "curve is extrapolated there as the power law of its last interval",
-            UserWarning,
-            stacklevel=3,
+    for count, what in (
+        (first, "lowest level(s) have poe 1"),
+        (poe.size - keep, "highest level(s) have poe 0"),
+    ):
+        if count:
+            warnings.warn(
+                f"{path.name}: {count} {what} (no positive finite rate) and were dropped; the "
+                "curve is extrapolated there as the power law of its nearest interval",
+                UserWarning,
+                stacklevel=3,
+            )
+    if first == poe.size or np.any(poe[first:keep] >= 1.0):
+        raise ValueError(
+            f"path: {path.name}: probabilities of exceedance of 1 stand above lower levels "
+            f"with less: {poe!r}"
         )
-    rates = -np.log1p(-poe[:keep]) / years
+    rates = -np.log1p(-poe[first:keep]) / years
     source = f"{path} (OpenQuake, {imt}, investigation_time {years:g} yr, site {i})"
-    return HazardCurve(oq_im, levels[:keep], rates, units or oq_units, period, source)
+    return HazardCurve(oq_im, levels[first:keep], rates, units or oq_units, period, source)
 
 
 def _fragility(median, dispersion, hazard, units):

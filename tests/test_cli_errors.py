@@ -180,9 +180,12 @@ periods = [0.5]
 def test_a_design_that_lists_a_file_twice_is_refused(tmp_path):
     """A record design runs each record once: the same file under two spellings is refused,
     naming the second entry and the first."""
-    shared = [p for p in (ROOT / "../shared/records").resolve().glob("*.AT2")][:2]
-    again = shared[0].parent / ".." / shared[0].parent.name / shared[0].name
-    files = ", ".join(f'"{p}"' for p in (shared[0], shared[1], again))
+    folder = tmp_path / "records"
+    folder.mkdir()
+    shipped = [shutil.copy(p, folder) for p in sorted((ROOT / "data/records").glob("*_H.AT2"))[:2]]
+    first, second = (Path(p) for p in shipped)
+    again = first.parent / ".." / first.parent.name / first.name
+    files = ", ".join(f'"{p}"' for p in (first, second, again))
     study = tmp_path / "dup.toml"
     study.write_text(DUPLICATE.format(files=files))
     proc = subprocess.run(

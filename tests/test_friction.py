@@ -310,3 +310,24 @@ def test_batch_lift_off_and_vertical_rows():
         rs.simulate_batch(
             half_diagonal=R, slenderness=ALPHA, amplitude=1.0, period=0.5, outputs=["friction"]
         )
+
+
+def test_batch_linear_rows_between_the_two_uplift_levels_rock():
+    """The linearized model lifts at g alpha, below the nonlinear g tan(alpha): a linear row
+    with g alpha < a_g < g tan(alpha) rocks, so its demand is not the at-rest a_g / g (the
+    demand of its simulated rocking history, max rotation > 0)."""
+    alpha = 0.2
+    amplitude = 1.005 * G * alpha  # above g alpha, below g tan(alpha) = 1.0135 g alpha
+    out = rs.simulate_batch(
+        half_diagonal=1.0,
+        slenderness=alpha,
+        pulse="sine",
+        amplitude=amplitude,
+        period=1.0,
+        method="linear",
+        outputs=["max_rotation", "friction_demand", "lift_off"],
+    )
+    res = rs.simulate(rs.Block(1.0, alpha), SinePulse(amplitude, 1.0), method="linear")
+    assert out["max_rotation"][0] > 0.0 and res.max_rotation > 0.0
+    assert out["friction_demand"][0] != pytest.approx(amplitude / G, rel=1e-6)
+    assert out["friction_demand"][0] == pytest.approx(res.friction_demand, rel=1e-12)

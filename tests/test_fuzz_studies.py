@@ -809,7 +809,7 @@ def mutate_record_study(g: RecordGen, study: dict):
         if what == "seed":
             study["seed"] = -1
             return study, "counts:seed", ["seed"]
-        study["chunk_size"] = r.choice([0, 10**12])
+        study["chunk_size"] = r.choice([0, 10**13])
         return study, "counts:chunk", ["chunk_size"]
     if cat == "name":
         study["name"] = "a\0b"

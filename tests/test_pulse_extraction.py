@@ -177,9 +177,8 @@ def test_shared_records(records_dir):
     orientation of the strongest pulse (rotated; Baker 2007 used fault-normal components). Our
     record is the 292 degree component as recorded, which carries a shorter pulse: the test
     can only check that its T_p lies below the rotated one and within a factor 2.5 of it,
-    not the value. The two far records (Arcadia, El Centro 1940) are not pulse-like; neither
-    is the 0 degree component of Gazli by this method (its pulse lies in the other
-    component). Prints what each method finds."""
+    not the value. The two far records (Arcadia, El Centro 1940) are not pulse-like. Prints what
+    each method finds."""
     found = {}
     for path in sorted(records_dir.glob("*.AT2")):
         found[path.stem] = Record.from_at2(path)
@@ -193,3 +192,20 @@ def test_shared_records(records_dir):
     assert 3.16 / 2.5 < jensen.period < 3.16
     assert not found["RSN948_NORTHR_CAM009"].pulse().pulse_like
     assert not found["elcentro_NS"].pulse().pulse_like
+
+
+@pytest.mark.parametrize("centre", [2.0, 4.0, 12.0])
+def test_an_early_pulse_is_found_and_quiet_ground_around_the_record_changes_nothing(centre):
+    """A long M-P pulse (T_p = 3 s) that arrives in the first seconds of a record, as in
+    near-fault records, is found as well as a later one (T_p about 1.13 times the M-P period
+    for gamma = 2, pulse-like); adding 15 s of ground at rest before and after the record
+    (the same motion) leaves T_p and the indicator unchanged."""
+    t = DT * np.arange(int(25.0 / DT) + 1)
+    acc = mp_pulse_acceleration(t, 0.6, 3.0, 2.0, 0.0, centre)
+    acc += 0.05 * np.max(np.abs(acc)) * _noise(25.0, 4, 0.5)[: t.size]
+    quiet = np.zeros(int(15.0 / DT))
+    found = Record(acc, dt=DT).pulse()
+    padded = Record(np.concatenate([quiet, acc, quiet]), dt=DT).pulse()
+    assert found.pulse_like and found.period == pytest.approx(1.13 * 3.0, rel=0.05)
+    assert found.period == pytest.approx(padded.period, rel=1e-9)
+    assert found.indicator == pytest.approx(padded.indicator, abs=0.02)

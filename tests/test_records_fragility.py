@@ -393,3 +393,22 @@ def test_record_designs_carry_units():
     for k in ("pga", "pgv", "arias", "sa", "cav"):
         assert ds[k].attrs["units"] == UNITS[k]
     assert ds["pga_ratio"].attrs["units"] == "1"
+
+
+def test_capacities_that_share_a_record_are_not_counted_as_independent():
+    """Six nearly equal blocks under each record: their capacities carry the record-to-record
+    spread only once per record. Under one record there is no band at all; under 12 records
+    drawn from a known lognormal, the 90 % band of the median covers the true median in about
+    90 % of suites (the independent noncentral t over 72 capacities covered far less)."""
+    blocks = np.linspace(1.0, 1.02, 6)
+    one = _ida_dataset([2.0 * blocks], [1.0], [1.0], [1.0] * 6, [1.0] * 6)
+    row = rf.ida_fragility(one, im="pga").loc["all"]
+    assert row["p_band"] == "none" and np.isnan(row["theta_lo"])
+    hits, runs = 0, 120
+    for seed in range(runs):
+        c = np.random.default_rng(seed).lognormal(np.log(0.5), 0.3, 12)  # per record [g]
+        ds = _ida_dataset((c * G)[:, None] * blocks, np.ones(12), np.ones(12), [1.0] * 6, [1.0] * 6)
+        r = rf.ida_fragility(ds, n_boot=200, seed=seed).loc["all"]
+        assert r["p_band"] == "record_bootstrap"
+        hits += r["theta_lo"] <= 0.5 * 1.01 <= r["theta_hi"]
+    assert hits / runs >= 0.8

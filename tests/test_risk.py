@@ -245,9 +245,26 @@ def test_openquake_csv_refuses_what_it_cannot_read(tmp_path):
     path.write_text("# investigation_time=1.0, imt='MMI'\nlon,lat,poe-5\n0,0,0.1\n")
     with pytest.raises(ValueError, match="imt 'MMI'; rockstudy reads PGA, PGV, PGD and SA"):
         HazardCurve.from_csv(path)
-    path.write_text("# investigation_time=1.0, imt='PGA'\nlon,lat,poe-0.1,poe-0.2\n0,0,1.0,0.5\n")
-    with pytest.raises(ValueError, match=r"must lie in \[0, 1\)"):
+    path.write_text("# investigation_time=1.0, imt='PGA'\nlon,lat,poe-0.1,poe-0.2\n0,0,1.5,0.5\n")
+    with pytest.raises(ValueError, match=r"must lie in \[0, 1\]"):
         HazardCurve.from_csv(path)
+    path.write_text("# investigation_time=1.0, imt='PGA'\nlon,lat,poe-0.1,poe-0.2\n0,0,0.5,1.0\n")
+    with pytest.raises(ValueError, match="of 1 stand above lower levels"):
+        HazardCurve.from_csv(path)
+
+
+def test_openquake_csv_certain_exceedance_at_the_lowest_levels(tmp_path):
+    """A 50-year export at a high-hazard site prints poe 1 at its lowest levels (no finite
+    rate): those levels are dropped with a warning, the others read as -ln(1 - poe) / T."""
+    path = tmp_path / "hazard_curve-PGA.csv"
+    path.write_text(
+        "# investigation_time=50.0, imt='PGA'\nlon,lat,poe-0.05,poe-0.1,poe-0.2,poe-0.4\n"
+        "0,0,1.0E+00,9.0E-01,4.0E-01,5.0E-02\n"
+    )
+    with pytest.warns(UserWarning, match="1 lowest level"):
+        hazard = HazardCurve.from_csv(path)
+    np.testing.assert_array_equal(hazard.levels, [0.1, 0.2, 0.4])
+    np.testing.assert_allclose(hazard.rates, -np.log([0.1, 0.6, 0.95]) / 50.0, rtol=1e-14)
     path.write_text("# investigation_time=1.0, imt='PGV'\nlon,lat,poe-5,poe-10\n0,0,0.1,0.01\n")
     pgv = HazardCurve.from_csv(path)
     assert (pgv.im, pgv.units) == ("pgv", "cm/s")

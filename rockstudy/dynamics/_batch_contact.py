@@ -47,7 +47,9 @@ def contact_rows(rows, codes, method, rtol, max_steps):
         psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
     demand = psi * np.tan(alpha)  # at rest throughout: max |u_h''| / (g + u_v'')
     lift_off = np.zeros(p.size, bool)
-    for i in np.flatnonzero(psi >= 1.0):
+    linear_rows = codes == _auto.MODEL_LINEAR  # lift at g alpha, below g tan(alpha)
+    lifts = psi >= np.where(linear_rows, alpha / np.tan(alpha), 1.0)
+    for i in np.flatnonzero(lifts):
         motion = _RowMotion((kind, mp[i], times, samples, vsamples))
         linear = codes[i] == _auto.MODEL_LINEAR
         run = _linear_exact if linear else _kernel

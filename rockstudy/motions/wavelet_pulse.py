@@ -8,9 +8,12 @@ Method (Baker 2007, BSSA 97(5); Shahi & Baker 2014, BSSA 104(5)):
    .. math:: C(s, l) = \\frac{1}{\\sqrt{s}} \\int v(t) \\, \\psi\\left(\\frac{t - l}{s}\\right) dt,
 
    over scales s whose pseudo-period T = s / F_c (F_c = 0.714, db4's centre frequency) runs
-   from :data:`PERIOD_RANGE` [0] to the smaller of :data:`PERIOD_RANGE` [1] and what fits in the
-   record, and over positions l where the whole wavelet lies inside the record: a pulse that
-   starts before the record, ends after it, or is longer than it is not a pulse.
+   from :data:`PERIOD_RANGE` [0] to the smaller of :data:`PERIOD_RANGE` [1] and the record's
+   duration, over the record padded with ground at rest (zero velocity) before and after it,
+   as the authors' continuous transform pads it: a wavelet may reach past the record's ends,
+   so a long pulse early in a near-fault record is found. Its centre (the centroid of psi^2)
+   must lie inside the record, and the extracted pulse is the part inside the record: a
+   pulse centred outside the record, or longer than it, is not a pulse.
 2. The wavelet of largest |C| is the first one. :data:`WAVELETS` wavelets at its scale, each
    the largest of the residual within :data:`NEIGHBOURHOOD` scales of the first, are removed
    one after the other (Baker 2007: ten); their sum is the extracted pulse.
@@ -117,38 +120,49 @@ def _kernel(scale: float, x, psi):
 
 
 def _correlate(v, kernel):
-    """C[l] = sum_k v[l + k] kernel[k] for every l with the kernel inside the record."""
+    """C[l] = sum_k v[l + k] kernel[k] for every l with the kernel inside ``v``."""
     return signal.fftconvolve(v, kernel[::-1], mode="valid")
 
 
-def _scales(n: int, dt: float, centre: float, support: float):
+def _scales(n: int, dt: float, centre: float):
     """Scales [samples] of the scan: a fixed geometric ladder in samples (so a record slowed
     down is scanned alike: T_p scales with it), those whose pseudo-period s dt / F_c lies in
-    PERIOD_RANGE and whose wavelet fits in the record."""
+    PERIOD_RANGE and is no longer than the record."""
     ladder = SMALLEST_SCALE * SCALE_RATIO ** np.arange(int(math.log(n) / math.log(SCALE_RATIO)))
     period = ladder * dt / centre
-    keep = (period >= PERIOD_RANGE[0]) & (period <= PERIOD_RANGE[1])
-    return ladder[keep & (support * ladder <= n - 1)]
+    keep = (period >= PERIOD_RANGE[0]) & (period <= min(PERIOD_RANGE[1], (n - 1) * dt))
+    return ladder[keep]
 
 
-def _largest(v, scales, x, psi):
-    """(|C|, scale, position) of the largest |C| over ``scales``."""
-    best = (-1.0, 0.0, 0)
+def _centroid(x, psi) -> float:
+    """The centroid of psi^2 on db4's support [units of the support]."""
+    weight = psi * psi
+    return float((x * weight).sum() / weight.sum())
+
+
+def _largest(v, scales, x, psi, record):
+    """(|C|, scale, position) of the largest |C| over ``scales``, among the positions whose
+    wavelet has its centroid inside ``record`` = (first, last) sample of the record in ``v``."""
+    best, centre = (-1.0, 0.0, 0), _centroid(x, psi)
     for s in scales:
         c = np.abs(_correlate(v, _kernel(s, x, psi)))
-        i = int(np.argmax(c))
+        lo = max(0, int(math.ceil(record[0] - centre * s)))
+        hi = min(c.size, int(math.floor(record[1] - centre * s)) + 1)
+        if hi <= lo:
+            continue
+        i = lo + int(np.argmax(c[lo:hi]))
         if c[i] > best[0]:
             best = (float(c[i]), float(s), i)
     return best
 
 
-def _first_wavelet(v, scales, x, psi):
+def _first_wavelet(v, scales, x, psi, record):
     """(scale, position) of the largest |C|: over the ladder, then on a 20 times finer ladder
     between the best rung's neighbours (the zoom of Shahi & Baker's scan)."""
-    _, scale, _ = _largest(v, scales, x, psi)
+    _, scale, _ = _largest(v, scales, x, psi, record)
     fine = scale * SCALE_RATIO ** np.linspace(-1.0, 1.0, 41)
     fine = fine[(fine >= scales[0]) & (fine <= scales[-1])]
-    _, scale, position = _largest(v, fine, x, psi)
+    _, scale, position = _largest(v, fine, x, psi, record)
     return scale, position
 
 
@@ -179,15 +193,18 @@ def extract_wavelet_pulse(t, acc) -> WaveletPulse:
     grid, v, dt = uniform_samples(t, ground_velocity(t, acc))
     x, psi = _db4()
     centre = pywt.central_frequency("db4")
-    scales = _scales(v.size, dt, centre, float(x[-1]))
+    scales = _scales(v.size, dt, centre)
     pgv = float(np.max(np.abs(v)))
     if pgv == 0.0 or scales.size == 0:
         empty = np.zeros(0)
         return WaveletPulse(
             math.nan, 0.0, 0.0, math.nan, math.nan, math.nan, 1.0, 1.0, empty, empty
         )
-    scale, position = _first_wavelet(v, scales, x, psi)
-    pulse, residual = _extract(v, scale, position, x, psi)
+    pad = int(math.ceil(float(x[-1]) * scales[-1] * SCALE_RATIO)) + 1  # the longest wavelet
+    padded = np.concatenate([np.zeros(pad), v, np.zeros(pad)])  # ground at rest around it
+    scale, position = _first_wavelet(padded, scales, x, psi, (pad, pad + v.size - 1))
+    pulse = _extract(padded, scale, position, x, psi)[0][pad : pad + v.size]
+    residual = v - pulse
     pgv_ratio = float(np.max(np.abs(residual))) / pgv
     energy_ratio = float(residual @ residual) / float(v @ v)
     inside = np.flatnonzero(pulse)
@@ -199,7 +216,7 @@ def extract_wavelet_pulse(t, acc) -> WaveletPulse:
         amplitude=float(np.max(np.abs(pulse))),
         psv_period=pseudo_velocity_peak_period(grid, pulse_acc, period, DAMPING),
         start=float(grid[inside[0]]),
-        end=float(grid[inside[-1]]),
+        end=min(float(grid[inside[-1]]), float(t[-1])),  # the grid's last time, not beyond
         pgv_ratio=pgv_ratio,
         energy_ratio=energy_ratio,
         _times=grid,

@@ -18,6 +18,9 @@ from ..constants import G
 from ..motions.intensity import SCALING_POWER
 from ..motions.suites import read_pair, suite_pairs
 
+#: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
+MAX_CHUNK_ROWS = 10**7
+
 #: each), the status and the error message.
 _ROW_BYTES = 8 * 20 + 128
 #: Arrays of one synthesized record held at once (noise, filtered, envelope, times, samples).
@@ -41,6 +44,12 @@ def problems(study, base_dir=None) -> list[str]:
             f"sampler: the design has {study.samples():.4g} samples, about {need / GIB:.3g} GiB "
             f"in memory, more than {DESIGN_SHARE:.0%} of this machine's {memory / GIB:.3g} GiB; "
             f"reduce {where}"
+        )
+    rows = min(study.rows_per_chunk(), study.samples())
+    if study.design is None and rows > MAX_CHUNK_ROWS:
+        found.append(
+            f"chunk_size: each chunk would hold {rows:.4g} rows (min(chunk_size, n)), more "
+            f"than the {MAX_CHUNK_ROWS:.0e} one dask task takes (about 3 GB); lower chunk_size"
         )
     mo, max_steps = study.motion, study.run.max_steps
     if mo.kind == "stochastic":

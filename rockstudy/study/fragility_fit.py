@@ -15,10 +15,14 @@ point beta is far too narrow in the tails, where the uncertainty of beta dominat
   (-1 / beta, -u) and C the inverse information of (ln theta, ln beta) (the expected
   information of the binomial likelihood; the observed information of the censored one);
   the band is Phi(u -+ z se(u)), z the normal quantile of the level.
-- ``"noncentral_t"`` (uncensored capacities): exact. With s the standard deviation of ln c
-  (n - 1) and u = (ln x - mu) / sigma, sqrt(n) (ln x - mean ln c) / s follows the noncentral
-  t with n - 1 degrees of freedom and noncentrality sqrt(n) u (Owen 1968, sec. 3); inverting
-  it in the noncentrality gives the band of Phi(u) at every x with the nominal coverage.
+- ``"record_bootstrap"`` (IDA capacities of several structures per record, which share
+  their record and are not independent): the same probit interval, with C the covariance
+  of (ln theta, ln beta) over fits to records resampled with replacement.
+- ``"noncentral_t"`` (uncensored capacities, one per record): exact. With s the standard
+  deviation of ln c (n - 1) and u = (ln x - mu) / sigma, sqrt(n) (ln x - mean ln c) / s
+  follows the noncentral t with n - 1 degrees of freedom and noncentrality sqrt(n) u (Owen
+  1968, sec. 3); inverting it in the noncentrality gives the band of Phi(u) at every x with
+  the nominal coverage.
 
 Measured coverage of the 90 % bands of the true P at x = theta e^{+-2 beta}:
 ``benchmarks/bench_fragility_coverage.py``.
@@ -38,7 +42,7 @@ from scipy import optimize, special
 
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: how the pointwise band of P(x) of a fitted row is formed (see the module docstring).
-BAND_METHODS = ("likelihood", "noncentral_t", "none")
+BAND_METHODS = ("likelihood", "record_bootstrap", "noncentral_t", "none")
 
 
 def check_conf_level(conf_level) -> float:
@@ -228,8 +232,8 @@ def probability_band(x, theta, beta, n, cov, method, conf_level):
     """Pointwise band (lower, upper) of P(x) = Phi(ln(x / theta) / beta) at intensities ``x``.
 
     ``method`` is one of :data:`BAND_METHODS` (module docstring); ``cov`` the covariance of
-    (ln theta, ln beta) (for ``"likelihood"``); ``n`` the number of capacities (for
-    ``"noncentral_t"``). NaN where there is no fit or no band.
+    (ln theta, ln beta) (for ``"likelihood"`` and ``"record_bootstrap"``); ``n`` the number
+    of capacities (for ``"noncentral_t"``). NaN where there is no fit or no band.
     """
     x = np.asarray(x, float)
     nan = np.full(x.shape, np.nan)

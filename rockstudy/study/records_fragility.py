@@ -16,6 +16,8 @@ analysis. Earthquake Spectra 31(1), 579-599.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -286,9 +288,12 @@ def ida_fragility(
     noncentral t (``p_band`` "noncentral_t"). With censored capacities (blocks still standing
     at the top of the range) the fit is the censored MLE, the intervals of theta and beta
     come from resampling records (``n_boot=0``: Wald intervals) and the band of P(x) from
-    the observed information (``p_band`` "likelihood"). The capacities are treated as
-    independent. The fragility reads P(first overturning at or below x); a block that
-    resurrects above it is counted as overturned (see ``resurrection`` in the dataset).
+    the observed information (``p_band`` "likelihood"). Where a group pools several
+    structures, their capacities under one record are not independent: the intervals and
+    the band of P(x) then come from resampling records (``p_band`` "record_bootstrap"; with
+    ``n_boot=0`` the independent bands, with a warning). The fragility reads P(first
+    overturning at or below x); a block that survives above it is counted as overturned (see
+    ``survives_above_capacity`` in the dataset).
 
     Parameters and returns as in :func:`stripe_fragility` (``n`` counts capacities, censored
     ones included; ``im_min``/``im_max`` span capacities and censoring levels).
@@ -312,18 +317,37 @@ def ida_fragility(
         theta, beta = _fit_records(c, t, cens, keep, slice(None))
         cov = capacities_covariance(c[keep & ~cens], t[keep & cens], theta, beta)
         n_unc = int((keep & ~cens).sum())
-        if not cens[keep].any() and n_unc >= 2 and beta > 0:
+        pooled = int(mask.sum()) > 1  # several structures share each record
+        if not cens[keep].any() and n_unc >= 2 and beta > 0 and not pooled:
             band, method = _exact_intervals(theta, beta, n_unc, conf_level), "noncentral_t"
         elif not np.isfinite(beta):
             band, method = ((theta, theta), (np.nan, np.nan)), "none"
+        elif pooled and int(keep.any(axis=1).sum()) < 2:  # one record: no record-to-record
+            band, method = ((np.nan, np.nan), (np.nan, np.nan)), "none"  # spread to see
         elif n_boot:
-            boot = [
-                _fit_records(c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta]))
-                for _ in range(n_boot)
-            ]
-            band, method = percentile_intervals(np.array(boot), conf_level), "likelihood"
+            boot = np.array(
+                [
+                    _fit_records(
+                        c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta])
+                    )
+                    for _ in range(n_boot)
+                ]
+            )
+            band, method = percentile_intervals(boot, conf_level), "likelihood"
+            if pooled:  # the capacities of one record are not independent: its resamples say
+                good = np.all(np.isfinite(boot) & (boot > 0), axis=1)
+                cov, method = np.cov(np.log(boot[good]).T), "record_bootstrap"
         else:
             band, method = wald_intervals(theta, beta, cov, conf_level), "likelihood"
+            if pooled:
+                warnings.warn(
+                    f"ida_fragility: group {label!r} pools {int(mask.sum())} structures per "
+                    "record and n_boot=0: its bands treat their capacities as independent, "
+                    "which they are not (they share the record); give n_boot > 0 to resample "
+                    "records",
+                    UserWarning,
+                    stacklevel=2,
+                )
         x = np.where(cens, t, c)[keep]
         rows.append(
             _row(label, theta, beta, band, keep.sum(), x, unit, by, cov, method, conf_level)

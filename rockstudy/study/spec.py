@@ -195,8 +195,9 @@ _RATIO_LABEL = f"[{MIN_RATIO:g}, {MAX_RATIO:g}]"
 #: Largest |scale| of a record (its scaled peak is then checked against MAX_ACCELERATION),
 #: and the smallest.
 MAX_SCALE, MIN_SCALE = 1e6, 1e-6
-#: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
-MAX_CHUNK_SIZE = 10**7
+#: The largest chunk_size written (a count, as max_steps); a chunk holds min(chunk_size, n)
+#: rows, at most :data:`.feasibility.MAX_CHUNK_ROWS` (checked with the design).
+MAX_CHUNK_SIZE = 10**12
 
 
 def _span(name, value, low, high, label):
