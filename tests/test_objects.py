@@ -108,3 +108,135 @@ def test_named_objects_bad_input(records):
     for name, block in OBJECTS.items():
         expect = G * math.tan(block.slenderness)
         assert float(ds["uplift_acceleration"].sel(structure=name)) == pytest.approx(expect)
+
+
+# ------------------------------------------------------------------------------ study files
+
+import test_record_studies  # noqa: E402
+
+from rockstudy.motions import load_suite  # noqa: E402
+from rockstudy.study import StudyError, load_study, run_study  # noqa: E402
+from rockstudy.study.store import open_result  # noqa: E402
+
+client = test_record_studies.client  # the one-worker cluster fixture
+write_at2 = test_record_studies.write_at2
+
+
+@pytest.fixture(scope="module")
+def suite(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("records")
+    for i, tp in enumerate((0.5, 1.0)):
+        rec = synthetic_near_fault(pulse_period=tp, pga=3.0, seed=20 + i, duration=4.0)
+        write_at2(folder / f"r{i}.AT2", rec)
+    return folder
+
+
+STUDY_OBJECTS = """
+name = "museum"
+seed = 1
+[structure]
+kind = "objects"
+{objects}
+[motion]
+kind = "record"
+files = "{folder}"
+scale_to = {{ im = "pga", value = {{ dist = "grid", values = [2.0, 5.0] }} }}
+[design]
+kind = "stripes"
+"""
+LISTED = """objects = [
+  { name = "Statue A", width = 0.45, height = 1.9 },
+  { name = "Column B", half_diagonal = 1.2, slenderness = 0.18 },
+  { name = "Vase", half_diagonal = 0.4, slenderness = 0.3, restitution = 0.85 },
+]"""
+CSV = """name,width,height,half_diagonal,slenderness,restitution
+Statue A,0.45,1.9,,,
+Column B,,,1.2,0.18,
+Vase,,,0.4,0.3,0.85
+"""
+
+
+@pytest.mark.parametrize("where", ["listed", "csv"])
+def test_objects_study_cube_equals_the_python_api_with_the_same_dict(
+    suite, client, tmp_path, where
+):
+    if where == "csv":
+        (tmp_path / "objects.csv").write_text(CSV)
+        objects = 'file = "objects.csv"'
+    else:
+        objects = LISTED
+    path = tmp_path / "museum.toml"
+    path.write_text(STUDY_OBJECTS.format(objects=objects, folder=suite))
+    study = load_study(path)
+    out = tmp_path / "cube.zarr"
+    report = run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    assert report.failed_samples == 0
+    cube = open_result(out).load()
+    assert list(cube["structure"].values) == list(OBJECTS)
+    api = rd.multiple_stripes(load_suite(suite), OBJECTS, [2.0, 5.0])
+    for name in ("scale", "max_rotation", "overturned", "half_diagonal", "slenderness"):
+        np.testing.assert_allclose(
+            np.asarray(cube[name].transpose(*api[name].dims).values, float),
+            np.asarray(api[name].values, float),
+            rtol=1e-12,
+            equal_nan=True,
+            err_msg=name,
+        )
+    table = rf.stripe_fragility(cube, by="structure", n_boot=0)
+    assert list(table.index) == list(OBJECTS)
+
+
+def _problems(tmp_path, suite, objects, extra=""):
+    path = tmp_path / "bad.toml"
+    path.write_text(STUDY_OBJECTS.format(objects=objects, folder=suite) + extra)
+    with pytest.raises(StudyError) as err:
+        load_study(path)
+    return "\n".join(err.value.problems)
+
+
+def test_objects_study_errors_name_the_object_and_the_field(suite, tmp_path):
+    text = _problems(
+        tmp_path,
+        suite,
+        'objects = [{ name = "A", width = 0.4, height = 2.0 }, '
+        '{ name = "Urn", width = -0.4, height = 2.0 }]',
+    )
+    assert "structure.objects[1]" in text and "'Urn'" in text and "width" in text
+    text = _problems(tmp_path, suite, 'objects = [{ name = "A", width = "wide", height = 2.0 }]')
+    assert "structure.objects[0] ('A').width" in text
+    text = _problems(tmp_path, suite, 'objects = [{ name = "A", width = 0.4 }]')
+    assert "'A'" in text and "width and height" in text
+    text = _problems(
+        tmp_path, suite, 'objects = [{ name = "A", kind = "arch", width = 0.4, height = 2.0 }]'
+    )
+    assert "'A'" in text and "Python API" in text
+    text = _problems(
+        tmp_path,
+        suite,
+        'objects = [{ name = "A", width = 0.4, height = 2.0 }, '
+        '{ name = "A", width = 0.5, height = 2.0 }]',
+    )
+    assert "named 'A' like object 0" in text
+    text = _problems(tmp_path, suite, LISTED, extra='[sampler]\nkind = "lhs"\nn = 4\n')
+    assert "sampler.kind" in text
+    text = _problems(tmp_path, suite, 'file = "missing.csv"')
+    assert "structure.file" in text and "missing.csv" in text
+    (tmp_path / "o.csv").write_text("name,colour\nA,red\n")
+    text = _problems(tmp_path, suite, 'file = "o.csv"')
+    assert "unknown columns ['colour']" in text
+
+
+def test_objects_geometry_is_that_of_the_block():
+    from rockstudy.study.spec import ObjectSpec
+
+    o = ObjectSpec(name="S", width=0.45, height=1.9)
+    b = rs.Block.from_dimensions(width=0.45, height=1.9)
+    p, theta, eta = o.rocking()
+    assert (p, theta, eta) == pytest.approx(
+        (b.frequency_parameter, b.slenderness, b.restitution), rel=1e-12
+    )
+    wall = ObjectSpec(
+        name="W", kind="rocking_wall", half_diagonal=1.0, slenderness=0.1, restitution=0.9
+    )
+    # eq. (23) of [003]: the wall's equivalent block has p sqrt(2) and theta_cr 2 alpha
+    assert wall.rocking() == pytest.approx((math.sqrt(2) * frequency_parameter(1.0), 0.2, 0.9))

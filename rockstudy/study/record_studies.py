@@ -184,6 +184,8 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
         record_design=study.design.kind,
         structures=n_st,
     )
+    if study.structure.kind == "objects":
+        ds.attrs["structure_names"] = json.dumps([o.name for o in study.structure.objects])
     if study.design.kind == "ida":
         ds.attrs["ida_steps"] = ida_steps(study)
     return ds
@@ -327,7 +329,11 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             out[new] = (("record", "structure", "level"), values, var.attrs)
     coords = {
         "record": np.arange(n_rec),
-        "structure": np.arange(n_st),
+        "structure": (
+            np.array(json.loads(cube.attrs["structure_names"]), dtype=object)
+            if "structure_names" in cube.attrs
+            else np.arange(n_st)
+        ),
         "period": cube["period"].values,
         "record_name": ("record", np.array(names, dtype=object)),
     }

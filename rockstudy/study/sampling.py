@@ -121,6 +121,10 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         cols["group_point"] = np.repeat(np.arange(n // reps), reps)
     st, mo = study.structure, study.motion
     data = {}
+    if st.kind == "objects":
+        from .record_studies import design_rows
+
+        return _attributes(design_rows(study, _object_columns(st), base_dir))
     if st.kind == "equivalent_block":
         p = _value(cols, st, "frequency_parameter", n)
         alpha = _value(cols, st, "critical_rotation", n)
@@ -203,6 +207,20 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     if "target" in ds:  # in the units of the measure it targets
         ds["target"].attrs.update(target_attributes(mo.scale_to))
     return ds
+
+
+def _object_columns(objects) -> dict:
+    """The structure columns of named objects (one row each, in order; their names go to the
+    design's ``structure_names`` attribute)."""
+    geometry = np.array([o.geometry() for o in objects.objects], float)
+    p, theta_cr, eta = objects.rocking().T
+    return dict(
+        half_diagonal=geometry[:, 0],
+        slenderness=geometry[:, 1],
+        restitution=eta,
+        frequency_parameter=p,
+        critical_rotation=theta_cr,
+    )
 
 
 def target_attributes(scale_to) -> dict:
