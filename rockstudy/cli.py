@@ -229,6 +229,8 @@ def _run(args) -> int:
     from .study.store import StoreError
 
     study = load_study(args.study)
+    for note in study.notes:
+        print(f"note: {note}", file=sys.stderr)
     _quiet_dask()
     try:
         report = run_study(
@@ -300,6 +302,8 @@ def _validate(args) -> int:
                 f"{path}: ok ({study.sampler.kind}, {size}, "
                 f"{len(study.parameters())} distributed parameters, sha256 {study.sha256()[:12]})"
             )
+            for note in study.notes:
+                print(f"  note: {note}")
         except StudyError as exc:
             print(exc, file=sys.stderr)
             status = 2

@@ -190,8 +190,8 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         elif mo.pga_ratio is not None:
             data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
         else:
-            value = mo.scale_to.value
-            data["target"] = cols["target"] if "target" in cols else np.full(n, float(value))
+            value, si = mo.scale_to.value, mo.scale_to.si_factor()  # written in units: to SI
+            data["target"] = si * (cols["target"] if "target" in cols else np.full(n, float(value)))
     else:
         data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
     data["cos_alpha"] = np.cos(alpha)
@@ -228,7 +228,8 @@ def target_attributes(scale_to) -> dict:
     from ..motions.intensity import UNITS
 
     what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
-    return {"long_name": f"scale target {what}", "units": UNITS.get(scale_to.im, "1")}
+    written = "" if scale_to.units is None else f", written in {scale_to.units}"
+    return {"long_name": f"scale target {what}{written}", "units": UNITS.get(scale_to.im, "1")}
 
 
 def _attributes(ds):

@@ -63,7 +63,7 @@ from pydantic import (
 )
 
 from .. import _validate
-from ..constants import G
+from ..constants import STANDARD_GRAVITY, G
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
@@ -435,24 +435,62 @@ def _check_period(im, period, field):
         raise FieldError(field, f"applies to im = 'sa', 'psv' or 'sd' only, not {im!r}")
 
 
+_ACCELERATION = {"m/s^2": 1.0, "m/s2": 1.0, "g": STANDARD_GRAVITY, "cm/s^2": 0.01, "cm/s2": 0.01}
+#: Units ``value`` may be written in, per scaling measure: name -> factor to SI (the first is
+#: the SI unit, the default). ``g`` is the standard gravity 9.80665 m/s^2, as for records.
+SCALE_UNITS = {
+    "pga": _ACCELERATION,
+    "sa": _ACCELERATION,
+    "pgv": {"m/s": 1.0, "cm/s": 0.01},
+    "psv": {"m/s": 1.0, "cm/s": 0.01},
+    "pgd": {"m": 1.0, "cm": 0.01},
+    "sd": {"m": 1.0, "cm": 0.01},
+    "spectrum_intensity": {"m": 1.0, "cm": 0.01},
+    "arias": {"m/s": 1.0},
+    "cav": {"m/s": 1.0, "g s": STANDARD_GRAVITY},
+    "pga_ratio": {"1": 1.0},
+    "pgv_ratio": {"1": 1.0},
+}
+
+
 class ScaleTo(_Model):
-    """Scale each record so that its measure ``im`` equals ``value`` (in the units of ``im``:
-    ``pga``, ``sa`` [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and
-    ``pgv_ratio``). ``value`` is a number or a distribution (Monte Carlo rows), or a grid (the
-    levels of a stripes design)."""
+    """Scale each record so that its measure ``im`` equals ``value``, in ``units`` (one of
+    :data:`SCALE_UNITS` of ``im``; by default the SI units of ``im``: ``pga``, ``sa``
+    [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and ``pgv_ratio``). ``value``
+    is a number or a distribution (Monte Carlo rows), or a grid (the levels of a stripes
+    design); it is converted to SI before the run (:meth:`si_factor`)."""
 
     im: ScaleIM
     period: _Period | None = None
     damping: _Damping = 0.05
     value: Param | None = None
+    units: str | None = None
 
     @model_validator(mode="after")
     def _ranges(self):
         _check_period(self.im, self.period, "period")
+        allowed = SCALE_UNITS[self.im]
+        if self.units is not None and self.units not in allowed:
+            raise FieldError(
+                "units", f"for im = {self.im!r} must be one of {list(allowed)}, got {self.units!r}"
+            )
         _check_positive("value", self.value)
         if self.value is not None and self.im in ("pga_ratio", "pgv_ratio"):
             _span("value", self.value, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         return self
+
+    @property
+    def unit_label(self) -> str:
+        """The units ``value`` is written in (the SI unit of ``im`` when none is given)."""
+        return self.units or next(iter(SCALE_UNITS[self.im]))
+
+    def si_factor(self) -> float:
+        """The factor that turns ``value`` (in :attr:`unit_label`) into SI."""
+        return SCALE_UNITS[self.im][self.unit_label]
+
+    def levels(self) -> np.ndarray:
+        """The levels of a stripes design (the grid of ``value``) in SI."""
+        return np.asarray(self.value.points(), float) * self.si_factor()
 
 
 class HVPair(_Model):
@@ -554,6 +592,11 @@ class RecordSpec(_Model):
         return self.scale_to
 
 
+#: Default of ``[design] max_scale_factor`` (and the bound of Monte Carlo rows scaled to a
+#: target): larger scale factors are noted by validate.
+DEFAULT_MAX_SCALE_FACTOR = 5.0
+
+
 class DesignSpec(_Model):
     """A record design over records x structures (``sampler.n`` structures drawn by the
     sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
@@ -574,6 +617,9 @@ class DesignSpec(_Model):
     max_pga_ratio: float | None = None
     scan: int | None = None
     growth: float | None = None  # replaced by step: refused with a message saying so
+    #: Scale factors above this are noted by validate (records scaled far from what they
+    #: recorded; cloud and stripes designs).
+    max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
 
     @model_validator(mode="after")
     def _ida_keys(self):
@@ -1182,12 +1228,15 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
             source, [f"not a study file: its tables or lists nest deeper than {MAX_DEPTH} levels"]
         )
     file_problem = _read_objects_file(data, base_dir)
-    if file_problem:
-        raise StudyError(source, [file_problem])
     try:
         study = Study.model_validate(data)
-    except ValidationError as exc:
-        raise StudyError(source, _format_errors(exc, data)) from None
+    except ValidationError as exc:  # with the problems of the parts that are valid alone
+        found = _format_errors(exc, data)
+        if file_problem:
+            found = [file_problem] + [x for x in found if not x.startswith("structure.objects")]
+        raise StudyError(source, found + _motion_problems(data, base_dir)) from None
+    if file_problem:
+        raise StudyError(source, [file_problem])
 
     if study.design is not None and "chunk_size" in data:
         raise StudyError(
@@ -1199,6 +1248,26 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     study._text = text
     study._notes = notes(study, base_dir)
     return study
+
+
+def _motion_problems(data, base_dir) -> list[str]:
+    """The record files' problems of a study that does not validate, when its ``files`` and
+    ``vertical`` do alone (a misspelt folder is reported beside a bad ``units``)."""
+    motion = data.get("motion")
+    if not (isinstance(motion, dict) and motion.get("kind") == "record"):
+        return []
+    files = {k: motion[k] for k in ("kind", "files", "vertical") if k in motion}
+    try:  # the paths alone: another field of [motion] may be what is wrong
+        spec = RecordSpec.model_validate(files)
+    except ValidationError:
+        return []  # reported by the whole study's validation
+    from .feasibility import record_pairs
+
+    try:
+        record_pairs(spec, base_dir)
+    except ValueError as exc:
+        return [str(exc)]
+    return []
 
 
 #: Columns of an objects CSV file (``[structure] kind = "objects"``, ``file = ...``).
