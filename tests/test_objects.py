@@ -186,6 +186,30 @@ def test_objects_study_cube_equals_the_python_api_with_the_same_dict(
     assert list(table.index) == list(OBJECTS)
 
 
+def test_objects_ida_study_equals_the_python_api(suite, client, tmp_path):
+    text = STUDY_OBJECTS.format(objects=LISTED, folder=suite).replace(
+        'scale_to = { im = "pga", value = { dist = "grid", values = [2.0, 5.0] } }\n', ""
+    )
+    text = text.replace('kind = "stripes"', 'kind = "ida"\ntolerance = 0.02\nscan = 2')
+    path = tmp_path / "ida.toml"
+    path.write_text(text)
+    out = tmp_path / "ida.zarr"
+    run_study(load_study(path), out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    assert list(cube["structure"].values) == list(OBJECTS)
+    api = rd.incremental_dynamic_analysis(load_suite(suite), OBJECTS, tolerance=0.02, scan=2)
+    for name in ("capacity", "capacity_scale", "censored"):
+        np.testing.assert_allclose(
+            np.asarray(cube[name].values, float),
+            np.asarray(api[name].values, float),
+            rtol=1e-12,
+            equal_nan=True,
+            err_msg=name,
+        )
+    table = rf.ida_fragility(cube, by="structure", n_boot=0)
+    assert list(table.index) == list(OBJECTS)
+
+
 def _problems(tmp_path, suite, objects, extra=""):
     path = tmp_path / "bad.toml"
     path.write_text(STUDY_OBJECTS.format(objects=objects, folder=suite) + extra)
