@@ -629,3 +629,19 @@ def test_cli_validate_prints_the_notes(suite, tmp_path, capsys):
     (tmp_path / "n.toml").write_text(text)
     assert main(["validate", str(tmp_path / "n.toml")]) == 0
     assert "note: motion.scale_to.value: nothing can rock" in capsys.readouterr().out
+
+
+def test_validate_notes_a_cloud_of_records_that_cannot_rock_the_objects(suite, tmp_path):
+    """A cloud: the records as recorded. Objects whose uplift g tan(alpha) exceeds every
+    record's PGA cannot rock (noted); an object below some record's PGA can (no note)."""
+    top = max(float(r.peak) for r in load_suite(str(suite / "*_H.AT2")))
+    for pga_ratio, noted in ((1.2, True), (0.8, False)):
+        alpha = math.atan(pga_ratio * top / G)  # uplift g tan(alpha) = pga_ratio x top
+        text = (
+            'name = "cloud"\nseed = 1\n[structure]\nkind = "objects"\n'
+            f'objects = [{{ name = "A", half_diagonal = 1.0, slenderness = {alpha!r} }}]\n'
+            + MOTION.replace("RECORDS", str(suite))
+            + '[design]\nkind = "cloud"\n'
+        )
+        notes = _notes(tmp_path, text)
+        assert noted == any("nothing can rock" in n for n in notes), notes

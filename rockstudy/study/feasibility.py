@@ -114,20 +114,22 @@ def notes(study, base_dir=None) -> list[str]:
 
 def _scaling_notes(study, base_dir) -> list[str]:
     """Notes on a record study scaled to a target (``scale_to`` or ``pga_ratio``; a stripes
-    design or Monte Carlo rows): the records whose largest scale factor exceeds
-    ``design.max_scale_factor`` (5 by default), and, when every record is horizontal only and
-    even the highest target leaves every record's PGA below the lowest uplift acceleration
-    g tan(theta_cr) of the structures, that nothing can rock (every point stays at rest)."""
+    design or Monte Carlo rows) or run unscaled (a cloud design): the records whose largest
+    scale factor exceeds ``design.max_scale_factor`` (5 by default), and, when every record
+    is horizontal only and even the highest level leaves every record's PGA below the lowest
+    uplift acceleration g tan(theta_cr) of the structures, that nothing can rock (every
+    point stays at rest)."""
     from .spec import DEFAULT_MAX_SCALE_FACTOR
 
     de = study.design
-    if study.motion.target() is None or (de is not None and de.kind != "stripes"):
+    cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
+    if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):
         return []
     limit = DEFAULT_MAX_SCALE_FACTOR if de is None else de.max_scale_factor
     found, top_pga, horizontal = [], 0.0, True
     for field, h, v in record_pairs(study.motion, base_dir):
         rec = read_pair(h, v, study.motion.units, field, field)
-        scaled = _largest_scale(study, rec)
+        scaled = ("motion.files", 1.0) if cloud else _largest_scale(study, rec)
         if scaled is None:
             return found
         horizontal = horizontal and v is None
@@ -141,7 +143,7 @@ def _scaling_notes(study, base_dir) -> list[str]:
     uplift = G * math.tan(_smallest_critical_rotation(study))
     if horizontal and top_pga < uplift:
         found.append(
-            f"{scaled[0]}: nothing can rock: the highest target scales every record to a PGA "
+            f"{scaled[0]}: nothing can rock: the highest level brings every record to a PGA "
             f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration g tan(alpha) "
             f"= {uplift:.4g} m/s^2 of the structures (check the value and its units)"
         )

@@ -784,7 +784,9 @@ class Study(_Model):
     @property
     def notes(self) -> list[str]:
         """What the run will do that the user should know (one line each, naming the field):
-        the levels a vertical component censors at free fall."""
+        the levels a vertical component censors at free fall, records scaled beyond
+        ``design.max_scale_factor`` and targets at which nothing can rock
+        (:func:`.feasibility.notes`)."""
         return list(self._notes)
 
     @model_validator(mode="before")
