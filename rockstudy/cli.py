@@ -15,7 +15,7 @@ from . import __version__
 
 def _simulate(args) -> int:
     from . import Block, simulate
-    from .motions import PULSES, Record
+    from .motions import PULSES
 
     if (args.half_diagonal is None) != (args.slenderness is None) or (args.width is None) != (
         args.height is None
@@ -39,12 +39,17 @@ def _simulate(args) -> int:
         block = Block.from_dimensions(args.width, args.height, args.restitution)
     else:
         block = Block(args.half_diagonal, args.slenderness, args.restitution)
+    if args.units is not None and not args.record:
+        return _usage("--units applies to a --record only")
     if args.record:
         path = args.record
-        motion = Record.from_at2(path) if path.lower().endswith(".at2") else Record.from_csv(path)
+        if path.lower().endswith(".at2") and args.units not in (None, "g"):
+            return _usage(f"--units {args.units}: a PEER .AT2 file is in g; leave --units out")
+        motion = _read_record(path, args.units or "g")
         if args.scale is not None:
             motion = motion.scaled(args.scale)
-        described = {"record": path, "scale": 1.0 if args.scale is None else args.scale}
+        described = {"record": path, "units": args.units or "g"}
+        described["scale"] = 1.0 if args.scale is None else args.scale
     else:
         if args.amplitude is None or args.period is None:
             return _usage("a pulse needs --amplitude and --period (or give --record)")
@@ -73,12 +78,25 @@ def _simulate(args) -> int:
         "last": float(impacts[-1]) if impacts.size else None,
     }
     summary["peaks"] = _peaks_summary(res)
-    inputs = {
-        "half_diagonal": block.half_diagonal,
-        "slenderness": block.slenderness,
-        "width": block.width,
-        "height": block.height,
-        "restitution": block_restitution(block),
+    inputs = _inputs(args, block, described)
+    if args.json:
+        print(json.dumps({"inputs": inputs, "result": summary}, indent=2))
+    else:
+        for key, value in {**inputs, **summary}.items():
+            print(f"{key:18s} {_text(value)}")
+        if args.out:
+            print(f"wrote {args.out}")
+    return 0
+
+
+def _inputs(args, block, described) -> dict:
+    """The inputs of ``rockstudy simulate`` as echoed: as given, or derived."""
+    return {
+        "half_diagonal": _plain(block.half_diagonal, args.half_diagonal),
+        "slenderness": _plain(block.slenderness, args.slenderness),
+        "width": _plain(block.width, args.width),
+        "height": _plain(block.height, args.height),
+        "restitution": _plain(block_restitution(block), args.restitution),
         **described,
         "method": args.method,
         "rtol": args.rtol,
@@ -86,14 +104,40 @@ def _simulate(args) -> int:
         "initial_velocity": args.initial_velocity,
         "dt_out": args.dt_out,
     }
-    if args.json:
-        print(json.dumps({"inputs": inputs, "result": summary}, indent=2))
-    else:
-        for key, value in {**inputs, **summary}.items():
-            print(f"{key:18s} {value}")
-        if args.out:
-            print(f"wrote {args.out}")
-    return 0
+
+
+def _plain(value, given=None) -> float:
+    """An input as the user gave it (a width of 0.45, not the 0.44999999999999996 derived
+    back from R and alpha), else the derived value."""
+    return float(given) if given is not None else float(value)
+
+
+def _text(value) -> str:
+    """A value for the text output: floats to 12 significant digits (no float noise)."""
+    if isinstance(value, float):
+        return f"{value:.12g}"
+    return str(value)
+
+
+def _read_record(path, units):
+    """A record file (PEER .AT2, or two columns: time [s] and acceleration in ``units``), with
+    the reader's hints in the command's terms."""
+    from .motions import Record
+    from .motions.records import _column_hint
+
+    if path.lower().endswith(".at2"):
+        return Record.from_at2(path)
+    try:
+        return Record.from_csv(path, units=units)
+    except ValueError as exc:
+        hint = _column_hint(("time", "horizontal"))
+        message = str(exc).replace(hint, "") if hint else str(exc)
+        if message != str(exc):
+            message += (
+                "; rockstudy simulate reads two columns, time [s] and the horizontal "
+                "acceleration in --units (g, m/s2 or cm/s2)"
+            )
+        raise ValueError(message) from None
 
 
 def _peaks_summary(res) -> dict:
@@ -384,7 +428,13 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument("--period", type=float, help="pulse period T_p [s]")
     sim.add_argument("--cycles", type=int, help="cycles of a sine or cosine pulse (default: 1)")
     sim.add_argument(
-        "--record", help="a PEER .AT2 file or a two-column file (t [s], a [g]) instead of a pulse"
+        "--record",
+        help="a PEER .AT2 file or a two-column file (t [s], a in --units) instead of a pulse",
+    )
+    sim.add_argument(
+        "--units",
+        choices=["g", "m/s2", "cm/s2"],
+        help="acceleration units of a two-column --record (default: g; a .AT2 file is in g)",
     )
     sim.add_argument("--scale", type=float, help="factor on the record (default: 1)")
     sim.add_argument("--initial-rotation", type=float, default=0.0, help="theta at t = 0 [rad]")

@@ -118,3 +118,29 @@ def test_contradictory_options_are_errors(tmp_path):
     out = cli(*block, "--width", "1", "--height", "2", *PULSE)
     assert out.returncode == 2 and "not both" in out.stderr
     assert cli(*block, "--record", str(record), "--json").returncode == 0
+
+
+def test_units_of_a_text_record_hints_in_cli_terms_and_inputs_without_noise(tmp_path):
+    # 0.3 sin: in m/s^2 below the uplift g tan(0.2) = 1.99 m/s^2 (the block stays at rest);
+    # in g (2.94 m/s^2) above it (the block rocks)
+    record = tmp_path / "r.txt"
+    t = np.arange(0, 2, 0.01)
+    np.savetxt(record, np.column_stack([t, 0.3 * np.sin(2 * np.pi * t)]))
+    block = ["simulate", "--half-diagonal", "1", "--slenderness", "0.2", "--record", str(record)]
+    si = json.loads(cli(*block, "--units", "m/s2", "--json").stdout)
+    in_g = json.loads(cli(*block, "--json").stdout)
+    assert si["inputs"]["units"] == "m/s2" and in_g["inputs"]["units"] == "g"
+    assert si["result"]["max_rotation"] == 0.0 and in_g["result"]["max_rotation"] > 0.0
+    at2 = tmp_path / "r.AT2"
+    at2.write_text("x\n")
+    out = cli(*block[:-1], str(at2), "--units", "m/s2")
+    assert out.returncode == 2 and "in g" in out.stderr
+    three = tmp_path / "hv.txt"
+    np.savetxt(three, np.column_stack([t, t, t]))
+    out = cli(*block[:-1], str(three))
+    assert out.returncode != 0 and "columns=(" not in out.stderr and "--units" in out.stderr
+    text = cli("simulate", "--width", "0.45", "--height", "1.9", *PULSE).stdout
+    lines = dict(line.split(None, 1) for line in text.splitlines() if line.strip())
+    assert lines["width"] == "0.45" and lines["height"] == "1.9"
+    assert lines["half_diagonal"] == f"{math.hypot(0.45, 1.9) / 2:.12g}"
+    assert float(lines["slenderness"]) == pytest.approx(math.atan2(0.45, 1.9), rel=1e-11)

@@ -6,6 +6,7 @@ dask tasks -> zarr store -> folding; the function through none of them).
 """
 
 import html
+import math
 import shutil
 
 import numpy as np
@@ -246,7 +247,7 @@ def test_validate_notes_the_levels_that_free_fall_censors(suite, tmp_path):
         text += '[design]\nkind = "stripes"\n'
         path = tmp_path / f"notes{expected}.toml"
         path.write_text(text)
-        notes = load_study(path).notes
+        notes = [n for n in load_study(path).notes if "free fall" in n]
         assert len(notes) == expected, notes
         assert all("free fall" in n and "censored" in n and "_UP.AT2" in n for n in notes)
 
@@ -528,3 +529,119 @@ def test_report_of_a_record_study_shows_its_file_and_target_units(suite, client,
     text = page.read_text()
     for line in (tmp_path / "rows.toml").read_text().splitlines():
         assert html.escape(line) in text, line
+
+
+# ------------------------------------------------------------------------------ units and notes
+
+
+def test_scale_to_in_g_runs_in_g(suite, tmp_path):
+    """scale_to = { im = "pga", units = "g" }: each row's record, read afresh and scaled by the
+    factor the run applied, has PGA = value x 9.80665 m/s^2 (the standard g)."""
+    study = rows_study(
+        suite,
+        tmp_path,
+        'scale_to = { im = "pga", units = "g", value = { dist = "uniform", '
+        "low = 0.2, high = 0.4 } }",
+    )
+    design, out = run_rows(study, tmp_path)
+    files = sorted(suite.glob("*_H.AT2"))
+    for i in range(3):
+        rec = Record.from_at2(files[design["record"].values[i]])
+        pga_g = np.max(np.abs(rec.acceleration * out["scale"][i])) / STANDARD_GRAVITY
+        assert 0.2 <= pga_g <= 0.4
+        assert pga_g * STANDARD_GRAVITY == pytest.approx(design["target"].values[i], rel=1e-12)
+    assert "written in g" in design["target"].attrs["long_name"]
+    # stripes levels in g are the same design as levels in m/s^2
+    levels = [0.3, 0.6]
+    text = (
+        HEAD
+        + MOTION.replace("RECORDS", str(suite))
+        + 'scale_to = { im = "pga", units = "g", value = { dist = "grid", values = [0.3, 0.6] } }\n'
+        + '[design]\nkind = "stripes"\n'
+    )
+    (tmp_path / "g.toml").write_text(text)
+    rows = make_design(load_study(tmp_path / "g.toml"), tmp_path)
+    np.testing.assert_allclose(rows["level"].values, np.array(levels) * STANDARD_GRAVITY)
+
+
+def _notes(tmp_path, text):
+    path = tmp_path / "notes.toml"
+    path.write_text(text)
+    return load_study(path).notes
+
+
+def test_validate_notes_big_scale_factors_and_levels_where_nothing_rocks(suite, tmp_path):
+    records = load_suite(str(suite / "*_H.AT2"))
+    pgas = np.array([float(r.peak) for r in records])
+    base = HEAD + MOTION.replace("RECORDS", str(suite))
+    # levels far above every PGA: every record is scaled beyond 5 (and beyond 2 if set)
+    grid = f"[{float(6.0 * pgas.max())!r}]"
+    stripes = f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = {grid} }} }}\n'
+    notes = _notes(tmp_path, base + stripes + '[design]\nkind = "stripes"\n')
+    assert sum("max_scale_factor = 5" in n for n in notes) == len(records), notes
+    lower = f"[{float(1.5 * pgas.max())!r}]"
+    stripes = f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = {lower} }} }}\n'
+    notes = _notes(tmp_path, base + stripes + '[design]\nkind = "stripes"\n')
+    assert not any("max_scale_factor" in n for n in notes)
+    notes = _notes(
+        tmp_path, base + stripes + '[design]\nkind = "stripes"\nmax_scale_factor = 1.2\n'
+    )
+    expect = int(np.sum(1.5 * pgas.max() / pgas > 1.2))
+    assert sum("max_scale_factor = 1.2" in n for n in notes) == expect > 0
+    # the slenderness of HEAD is in [0.15, 0.25]: g tan(0.15) = 1.48 m/s^2 is the lowest uplift
+    uplift = G * math.tan(0.15)
+    for level, silent in ((0.9 * uplift, False), (1.1 * uplift, True)):
+        stripes = (
+            f'scale_to = {{ im = "pga", value = {{ dist = "grid", values = [{level!r}] }} }}\n'
+        )
+        notes = _notes(tmp_path, base + stripes + '[design]\nkind = "stripes"\n')
+        assert silent != any("nothing can rock" in n for n in notes), notes
+    # 0.1 written in g: 0.98 m/s^2, below the uplift: the trap of values in g read as m/s^2
+    stripes = 'scale_to = { im = "pga", units = "g", value = { dist = "grid", values = [0.1] } }\n'
+    notes = _notes(tmp_path, base + stripes + '[design]\nkind = "stripes"\n')
+    assert any("nothing can rock" in n for n in notes)
+
+
+def test_validate_reports_a_bad_units_and_a_misspelt_folder_together(suite, tmp_path):
+    text = (
+        HEAD
+        + MOTION.replace("RECORDS", str(suite) + "_misspelt")
+        + (
+            'scale_to = { im = "pga", units = "furlongs", '
+            'value = { dist = "grid", values = [1.0] } }\n'
+            '[design]\nkind = "stripes"\n'
+        )
+    )
+    (tmp_path / "two.toml").write_text(text)
+    with pytest.raises(StudyError) as err:
+        load_study(tmp_path / "two.toml")
+    problems = "\n".join(err.value.problems)
+    assert "motion.scale_to.units" in problems and "furlongs" in problems
+    assert "motion.files" in problems and "_misspelt" in problems
+
+
+def test_cli_validate_prints_the_notes(suite, tmp_path, capsys):
+    from rockstudy.cli import main
+
+    text = HEAD + MOTION.replace("RECORDS", str(suite))
+    text += 'scale_to = { im = "pga", units = "g", value = { dist = "grid", values = [0.1] } }\n'
+    text += '[design]\nkind = "stripes"\n'
+    (tmp_path / "n.toml").write_text(text)
+    assert main(["validate", str(tmp_path / "n.toml")]) == 0
+    assert "note: motion.scale_to.value: nothing can rock" in capsys.readouterr().out
+
+
+def test_validate_notes_a_cloud_of_records_that_cannot_rock_the_objects(suite, tmp_path):
+    """A cloud: the records as recorded. Objects whose uplift g tan(alpha) exceeds every
+    record's PGA cannot rock (noted); an object below some record's PGA can (no note)."""
+    top = max(float(r.peak) for r in load_suite(str(suite / "*_H.AT2")))
+    for pga_ratio, noted in ((1.2, True), (0.8, False)):
+        alpha = math.atan(pga_ratio * top / G)  # uplift g tan(alpha) = pga_ratio x top
+        text = (
+            'name = "cloud"\nseed = 1\n[structure]\nkind = "objects"\n'
+            f'objects = [{{ name = "A", half_diagonal = 1.0, slenderness = {alpha!r} }}]\n'
+            + MOTION.replace("RECORDS", str(suite))
+            + '[design]\nkind = "cloud"\n'
+        )
+        notes = _notes(tmp_path, text)
+        assert noted == any("nothing can rock" in n for n in notes), notes

@@ -90,10 +90,15 @@ def problems(study, base_dir=None) -> list[str]:
 def notes(study, base_dir=None) -> list[str]:
     """What a runnable study will do that its author should know before the run: the records
     of a design whose vertical component reaches free fall (u_v'' = -g, where the block
-    model no longer holds) at a scale the design reaches. Those points are stored as
-    censored, with their reason; the record's other points run."""
-    mo, found = study.motion, []
-    if mo.kind != "record" or study.design is None:
+    model no longer holds) at a scale the design reaches (those points are stored as
+    censored, with their reason; the record's other points run); records scaled by more than
+    ``design.max_scale_factor``; and targets so low that nothing can rock
+    (:func:`_scaling_notes`)."""
+    mo = study.motion
+    if mo.kind != "record":
+        return []
+    found = _scaling_notes(study, base_dir)
+    if study.design is None:
         return found
     from .records_designs import free_fall_scale
 
@@ -114,6 +119,54 @@ def notes(study, base_dir=None) -> list[str]:
                 "above free fall are stored as censored (reason: free fall); the others run"
             )
     return found
+
+
+def _scaling_notes(study, base_dir) -> list[str]:
+    """Notes on a record study scaled to a target (``scale_to`` or ``pga_ratio``; a stripes
+    design or Monte Carlo rows) or run unscaled (a cloud design): the records whose largest
+    scale factor exceeds ``design.max_scale_factor`` (5 by default), and, when every record
+    is horizontal only and even the highest level leaves every record's PGA below the lowest
+    uplift acceleration g tan(theta_cr) of the structures, that nothing can rock (every
+    point stays at rest)."""
+    from .spec import DEFAULT_MAX_SCALE_FACTOR
+
+    de = study.design
+    cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
+    if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):
+        return []
+    limit = DEFAULT_MAX_SCALE_FACTOR if de is None else de.max_scale_factor
+    found, top_pga, horizontal = [], 0.0, True
+    for field, h, v in record_pairs(study.motion, base_dir):
+        rec = read_pair(h, v, study.motion.units, field, field)
+        scaled = ("motion.files", 1.0) if cloud else _largest_scale(study, rec)
+        if scaled is None:
+            return found
+        horizontal = horizontal and v is None
+        top_pga = max(top_pga, scaled[1] * rec.peak)
+        if scaled[1] > limit:
+            found.append(
+                f"{scaled[0]}: {h.name} is scaled by up to {scaled[1]:.3g}, more than "
+                f"{'design.' if de else ''}max_scale_factor = {limit:g} (a record scaled far "
+                "from what it recorded)"
+            )
+    uplift = G * math.tan(_smallest_critical_rotation(study))
+    if horizontal and top_pga < uplift:
+        found.append(
+            f"{scaled[0]}: nothing can rock: the highest level brings every record to a PGA "
+            f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration g tan(alpha) "
+            f"= {uplift:.4g} m/s^2 of the structures (check the value and its units)"
+        )
+    return found
+
+
+def _smallest_critical_rotation(study) -> float:
+    """The smallest critical rotation theta_cr [rad] the study's structures can have."""
+    st = study.structure
+    if st.kind == "objects":
+        return float(st.rocking()[:, 1].min())
+    if st.kind == "equivalent_block":
+        return draw_span(st.critical_rotation)[0]
+    return (2.0 if st.kind == "rocking_wall" else 1.0) * draw_span(st.slenderness)[0]
 
 
 def _named_twice(pairs) -> list[str]:
@@ -192,10 +245,19 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     if mo.scale is not None:
         lo, hi = draw_span(mo.scale)
         return "motion.scale", max(abs(lo), abs(hi)) * peak
+    scaled = _largest_scale(study, rec)
+    return None if scaled is None else (scaled[0], scaled[1] * peak)
+
+
+def _largest_scale(study, rec) -> tuple[str, float] | None:
+    """(field, the largest factor on ``rec`` that its target asks), over the whole support of
+    the study's distributions and structures; None without a target or for a measure of 0."""
+    mo = study.motion
+    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
     target = mo.target()
     if target is None or target.value is None:
         return None
-    value = draw_span(target.value)[1]
+    value = draw_span(target.value)[1] * target.si_factor()
     field = "motion.pga_ratio" if mo.pga_ratio is not None else "motion.scale_to.value"
     if target.im == "pga_ratio":
         value, base = value * uplift, rec.peak
@@ -207,7 +269,7 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     if not base > 0:
         return None
     power = SCALING_POWER[{"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(target.im, target.im)]
-    return field, (value / base) ** (1.0 / power) * peak
+    return field, (value / base) ** (1.0 / power)
 
 
 @lru_cache(maxsize=1)

@@ -174,7 +174,7 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     data.update(record=("sample", rec), structure=("sample", st), level_index=("sample", lev))
     coords = {"sample": np.arange(rec.size)}
     if study.design.kind == "stripes":
-        coords["level"] = ("level", study.motion.scale_to.value.points())
+        coords["level"] = ("level", study.motion.scale_to.levels())
     coords["period"] = ("period", stored_periods(study))
     ds = xr.Dataset(data, coords=coords)
     names = [str(h) if v is None else [str(h), str(v)] for _, h, v in pairs]
@@ -184,6 +184,8 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
         record_design=study.design.kind,
         structures=n_st,
     )
+    if study.structure.kind == "objects":
+        ds.attrs["structure_names"] = json.dumps([o.name for o in study.structure.objects])
     if study.design.kind == "ida":
         ds.attrs["ida_steps"] = ida_steps(study)
     return ds
@@ -257,9 +259,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     width = _widths(study)
     result = empty_rows(study, cols["sample"].size)
     motion_json = study.motion.model_dump_json()
-    levels_all = (
-        study.motion.scale_to.value.points() if study.design.kind == "stripes" else np.ones(1)
-    )
+    levels_all = study.motion.scale_to.levels() if study.design.kind == "stripes" else np.ones(1)
     for r in np.unique(cols["record"]):
         rows = np.flatnonzero(cols["record"] == r)
         rec = load_record(motion_json, base_dir, int(r))
@@ -327,7 +327,11 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             out[new] = (("record", "structure", "level"), values, var.attrs)
     coords = {
         "record": np.arange(n_rec),
-        "structure": np.arange(n_st),
+        "structure": (
+            np.array(json.loads(cube.attrs["structure_names"]), dtype=object)
+            if "structure_names" in cube.attrs
+            else np.arange(n_st)
+        ),
         "period": cube["period"].values,
         "record_name": ("record", np.array(names, dtype=object)),
     }

@@ -57,9 +57,32 @@ def _records(records) -> list[Record]:
     return records
 
 
+def _is_structure(value) -> bool:
+    return hasattr(value, "equivalent_block") or hasattr(value, "frequency_parameter")
+
+
+def _named(structures: dict) -> tuple[list[str], list]:
+    """The names and structures of a dict ``{name: structure}`` (names: non-empty strings)."""
+    for i, (name, value) in enumerate(structures.items()):
+        if not isinstance(name, str) or not name.strip():
+            raise ValueError(f"structures: object {i} has the name {name!r}; give a non-empty str")
+        if not _is_structure(value):
+            raise TypeError(
+                f"structures[{name!r}] must be a rockstudy Block or provide equivalent_block() "
+                f"(a dict of names -> structures), got {type(value).__name__}"
+            )
+    return list(structures), list(structures.values())
+
+
 def _structures(structures) -> dict:
     """Arrays over ``structure``: p [rad/s], alpha [rad], eta, R [m] (NaN if unknown) and the
-    uplift acceleration [m/s^2] (:func:`rockstudy.similarity.uplift_acceleration`)."""
+    uplift acceleration [m/s^2] (:func:`rockstudy.similarity.uplift_acceleration`); and
+    ``names`` (a list of str, or None) for a dict ``{name: structure}``."""
+    names = None
+    if isinstance(structures, dict) and not structures:
+        raise ValueError("structures: give at least one structure")
+    if isinstance(structures, dict) and any(_is_structure(v) for v in structures.values()):
+        names, structures = _named(structures)
     if isinstance(structures, dict):
         unknown = set(structures) - set(_STRUCTURE_KEYS)
         if unknown:
@@ -103,6 +126,7 @@ def _structures(structures) -> dict:
         "restitution": eta,
         "half_diagonal": R,
         "uplift_acceleration": uplift,
+        "names": names,
     }
 
 
@@ -168,12 +192,16 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
     for k, v in structures.items():
-        data[k] = ("structure", v)
+        if k != "names":
+            data[k] = ("structure", v)
+    names = structures["names"]
     ds = xr.Dataset(
         data,
         coords={
             "record": np.arange(len(records)),
-            "structure": np.arange(structures["slenderness"].size),
+            "structure": np.arange(structures["slenderness"].size)
+            if names is None
+            else np.array(names, dtype=object),
             "period": periods,
             "record_name": ("record", np.array([r.name for r in records], dtype=object)),
         },
@@ -257,9 +285,11 @@ def cloud(
     records : Record or sequence of Record
         E.g. from :func:`rockstudy.motions.load_suite`.
     structures : sequence or dict
-        Blocks or structures with ``equivalent_block()``; or a dict of arrays (broadcast) with
-        ``slenderness`` [rad], one of ``half_diagonal`` [m] or ``frequency_parameter``
-        [rad/s], and optionally ``restitution`` (default Housner's).
+        Blocks or structures with ``equivalent_block()``; or a dict ``{name: structure}`` of
+        them (named objects: the ``structure`` coordinate then carries the names, str, and
+        every output keeps them); or a dict of arrays (broadcast) with ``slenderness``
+        [rad], one of ``half_diagonal`` [m] or ``frequency_parameter`` [rad/s], and
+        optionally ``restitution`` (default Housner's).
     periods : array_like
         Periods T [s] of the stored spectral accelerations ``sa``.
     damping : float

@@ -139,7 +139,8 @@ def _groups(ds, by, bins):
     if by is None:
         return {"all": np.ones(n, bool)}
     if by == "structure":
-        return {int(s): np.arange(n) == k for k, s in enumerate(ds["structure"].values)}
+        labels = [s if isinstance(s, str) else int(s) for s in ds["structure"].values]
+        return {s: np.arange(n) == k for k, s in enumerate(labels)}
     if by not in ds or ds[by].dims != ("structure",):
         raise ValueError(f"by must be None, 'structure' or a variable on structure, got {by!r}")
     g = np.asarray(ds[by].values)

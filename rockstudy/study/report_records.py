@@ -287,7 +287,9 @@ def _structure_title(ds, j) -> str:
     alpha = float(ds["slenderness"].values[j])
     R = float(ds["half_diagonal"].values[j]) if "half_diagonal" in ds else np.nan
     size = f"R = {R:.3g} m, " if np.isfinite(R) else ""
-    return f"block {j}: {size}alpha = {alpha:.3g} rad"
+    name = ds["structure"].values[j]
+    label = name if isinstance(name, str) else f"block {j}"
+    return f"{label}: {size}alpha = {alpha:.3g} rad"
 
 
 def _responses(page, ds):

@@ -121,6 +121,10 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         cols["group_point"] = np.repeat(np.arange(n // reps), reps)
     st, mo = study.structure, study.motion
     data = {}
+    if st.kind == "objects":
+        from .record_studies import design_rows
+
+        return _attributes(design_rows(study, _object_columns(st), base_dir))
     if st.kind == "equivalent_block":
         p = _value(cols, st, "frequency_parameter", n)
         alpha = _value(cols, st, "critical_rotation", n)
@@ -186,8 +190,8 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         elif mo.pga_ratio is not None:
             data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
         else:
-            value = mo.scale_to.value
-            data["target"] = cols["target"] if "target" in cols else np.full(n, float(value))
+            value, si = mo.scale_to.value, mo.scale_to.si_factor()  # written in units: to SI
+            data["target"] = si * (cols["target"] if "target" in cols else np.full(n, float(value)))
     else:
         data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
     data["cos_alpha"] = np.cos(alpha)
@@ -205,12 +209,27 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     return ds
 
 
+def _object_columns(objects) -> dict:
+    """The structure columns of named objects (one row each, in order; their names go to the
+    design's ``structure_names`` attribute)."""
+    geometry = np.array([o.geometry() for o in objects.objects], float)
+    p, theta_cr, eta = objects.rocking().T
+    return dict(
+        half_diagonal=geometry[:, 0],
+        slenderness=geometry[:, 1],
+        restitution=eta,
+        frequency_parameter=p,
+        critical_rotation=theta_cr,
+    )
+
+
 def target_attributes(scale_to) -> dict:
     """long_name and units of a record scale target ``scale_to``."""
     from ..motions.intensity import UNITS
 
     what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
-    return {"long_name": f"scale target {what}", "units": UNITS.get(scale_to.im, "1")}
+    written = "" if scale_to.units is None else f", written in {scale_to.units}"
+    return {"long_name": f"scale target {what}{written}", "units": UNITS.get(scale_to.im, "1")}
 
 
 def _attributes(ds):

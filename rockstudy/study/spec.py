@@ -37,7 +37,9 @@ Example (``studies/quickstart.toml``)::
 
 from __future__ import annotations
 
+import csv
 import hashlib
+import io
 import json
 import math
 import re
@@ -47,6 +49,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -60,7 +63,7 @@ from pydantic import (
 )
 
 from .. import _validate
-from ..constants import G
+from ..constants import STANDARD_GRAVITY, G
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
@@ -183,6 +186,121 @@ class EquivalentBlockSpec(_Model):
         _span("critical_rotation", self.critical_rotation, MIN_SLENDERNESS, 2, _ALPHA_LABEL)
         _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         return self
+
+
+#: Kinds an object of ``[structure] kind = "objects"`` may be (frames and arches have no study
+#: spec: give them through the Python API, :func:`.records_designs.cloud` and the others).
+OBJECT_KINDS = ("block", "rocking_wall")
+
+
+class ObjectSpec(_Model):
+    """One named object: a block (by ``width`` and ``height`` [m], or ``half_diagonal`` [m] and
+    ``slenderness`` [rad]; restitution by default Housner's) or an out-of-plane rocking wall
+    (``half_diagonal``, ``slenderness`` and ``restitution``, as ``kind = "rocking_wall"``)."""
+
+    name: str = Field(min_length=1)
+    kind: str = "block"
+    width: float | None = None
+    height: float | None = None
+    half_diagonal: float | None = None
+    slenderness: float | None = None
+    restitution: float | None = None
+
+    @model_validator(mode="after")
+    def _shape(self):
+        who = f"object {self.name!r}"
+        if self.kind not in OBJECT_KINDS:
+            raise FieldError(
+                "kind",
+                f"{who}: kind must be one of {list(OBJECT_KINDS)}, got {self.kind!r} (frames "
+                "and arches are studied through the Python API, with a dict of named structures)",
+            )
+        sizes, polar = (self.width, self.height), (self.half_diagonal, self.slenderness)
+        given = [
+            f
+            for f in ("width", "height", "half_diagonal", "slenderness")
+            if getattr(self, f) is not None
+        ]
+        if (None in sizes) == (None in polar) or (self.kind != "block" and None not in sizes):
+            raise FieldError(
+                given[0] if given else "half_diagonal",
+                f"{who}: give width and height, or half_diagonal and slenderness"
+                + (
+                    " (a rocking_wall: half_diagonal and slenderness)"
+                    if self.kind != "block"
+                    else ""
+                )
+                + f"; got {given or 'none'}",
+            )
+        for field in given + (["restitution"] if self.restitution is not None else []):
+            if not getattr(self, field) > 0:
+                raise FieldError(field, f"{who}: {field} must be > 0, got {getattr(self, field)!r}")
+        R, alpha = self.geometry()
+        lo, hi = HALF_DIAGONAL_RANGE
+        if not lo <= R <= hi:
+            raise FieldError(given[0], f"{who}: the half-diagonal {R:.4g} m is outside {_R_LABEL}")
+        top = math.pi / 4 if self.kind == "rocking_wall" else math.pi / 2
+        if not MIN_SLENDERNESS <= alpha < top:
+            label = "[1e-06, pi/4) rad" if top < 1 else _ALPHA_LABEL
+            raise FieldError(
+                given[-1], f"{who}: the slenderness {alpha:.4g} rad is outside {label}"
+            )
+        if self.restitution is not None and self.restitution > 1:
+            raise FieldError(
+                "restitution", f"{who}: restitution must be in (0, 1], got {self.restitution!r}"
+            )
+        if self.restitution is None and self.kind == "rocking_wall":
+            raise FieldError("restitution", f"{who}: a rocking_wall needs restitution in (0, 1]")
+        if self.restitution is None and not alpha < HOUSNER_MAX_SLENDERNESS:
+            raise FieldError(
+                given[-1],
+                f"{who}: Housner's restitution 1 - 1.5 sin^2(alpha) (eq. 2.4 of [000]) needs "
+                f"slenderness < {HOUSNER_MAX_SLENDERNESS:.4f} rad, got {alpha:.4g}; "
+                "give restitution",
+            )
+        return self
+
+    def geometry(self) -> tuple[float, float]:
+        """(half-diagonal R [m], slenderness alpha [rad]) of the block (of each of the wall's)."""
+        if self.half_diagonal is not None:
+            return self.half_diagonal, self.slenderness
+        return 0.5 * math.hypot(self.width, self.height), math.atan2(self.width, self.height)
+
+    def rocking(self) -> tuple[float, float, float]:
+        """(p [rad/s], theta_cr [rad], eta): a block's, or the wall's linearized equivalent
+        block, p = sqrt(2) p_block and theta_cr = 2 alpha (eq. (23) of [003])."""
+        R, alpha = self.geometry()
+        p = math.sqrt(0.75 * G / R)
+        eta = 1.0 - 1.5 * math.sin(alpha) ** 2 if self.restitution is None else self.restitution
+        if self.kind == "rocking_wall":
+            return math.sqrt(2.0) * p, 2.0 * alpha, eta
+        return p, alpha, eta
+
+
+class ObjectsSpec(_Model):
+    """Named objects studied one by one in a record ``[design]``: ``objects`` lists them (the
+    ``structure`` coordinate of the result carries their names), or ``file`` names a CSV file
+    of the same columns (read relative to the study file's folder into ``objects`` when the
+    study is validated)."""
+
+    kind: Literal["objects"]
+    objects: list[ObjectSpec] = Field(min_length=1)
+    file: str | None = None
+
+    @model_validator(mode="after")
+    def _unique(self):
+        seen = {}
+        for i, o in enumerate(self.objects):
+            if o.name in seen:
+                raise ValueError(
+                    f"object {i} is named {o.name!r} like object {seen[o.name]}; names must differ"
+                )
+            seen[o.name] = i
+        return self
+
+    def rocking(self) -> np.ndarray:
+        """(n, 3) array of (p [rad/s], theta_cr [rad], eta) of the objects, in order."""
+        return np.array([o.rocking() for o in self.objects], float)
 
 
 #: Largest dimensionless intensity (amplitude_ratio, amplitude_a, pga_ratio, pgv_ratio) and
@@ -318,24 +436,62 @@ def _check_period(im, period, field):
         raise FieldError(field, f"applies to im = 'sa', 'psv' or 'sd' only, not {im!r}")
 
 
+_ACCELERATION = {"m/s^2": 1.0, "m/s2": 1.0, "g": STANDARD_GRAVITY, "cm/s^2": 0.01, "cm/s2": 0.01}
+#: Units ``value`` may be written in, per scaling measure: name -> factor to SI (the first is
+#: the SI unit, the default). ``g`` is the standard gravity 9.80665 m/s^2, as for records.
+SCALE_UNITS = {
+    "pga": _ACCELERATION,
+    "sa": _ACCELERATION,
+    "pgv": {"m/s": 1.0, "cm/s": 0.01},
+    "psv": {"m/s": 1.0, "cm/s": 0.01},
+    "pgd": {"m": 1.0, "cm": 0.01},
+    "sd": {"m": 1.0, "cm": 0.01},
+    "spectrum_intensity": {"m": 1.0, "cm": 0.01},
+    "arias": {"m/s": 1.0},
+    "cav": {"m/s": 1.0, "g s": STANDARD_GRAVITY},
+    "pga_ratio": {"1": 1.0},
+    "pgv_ratio": {"1": 1.0},
+}
+
+
 class ScaleTo(_Model):
-    """Scale each record so that its measure ``im`` equals ``value`` (in the units of ``im``:
-    ``pga``, ``sa`` [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and
-    ``pgv_ratio``). ``value`` is a number or a distribution (Monte Carlo rows), or a grid (the
-    levels of a stripes design)."""
+    """Scale each record so that its measure ``im`` equals ``value``, in ``units`` (one of
+    :data:`SCALE_UNITS` of ``im``; by default the SI units of ``im``: ``pga``, ``sa``
+    [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and ``pgv_ratio``). ``value``
+    is a number or a distribution (Monte Carlo rows), or a grid (the levels of a stripes
+    design); it is converted to SI before the run (:meth:`si_factor`)."""
 
     im: ScaleIM
     period: _Period | None = None
     damping: _Damping = 0.05
     value: Param | None = None
+    units: str | None = None
 
     @model_validator(mode="after")
     def _ranges(self):
         _check_period(self.im, self.period, "period")
+        allowed = SCALE_UNITS[self.im]
+        if self.units is not None and self.units not in allowed:
+            raise FieldError(
+                "units", f"for im = {self.im!r} must be one of {list(allowed)}, got {self.units!r}"
+            )
         _check_positive("value", self.value)
         if self.value is not None and self.im in ("pga_ratio", "pgv_ratio"):
             _span("value", self.value, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         return self
+
+    @property
+    def unit_label(self) -> str:
+        """The units ``value`` is written in (the SI unit of ``im`` when none is given)."""
+        return self.units or next(iter(SCALE_UNITS[self.im]))
+
+    def si_factor(self) -> float:
+        """The factor that turns ``value`` (in :attr:`unit_label`) into SI."""
+        return SCALE_UNITS[self.im][self.unit_label]
+
+    def levels(self) -> np.ndarray:
+        """The levels of a stripes design (the grid of ``value``) in SI."""
+        return np.asarray(self.value.points(), float) * self.si_factor()
 
 
 class HVPair(_Model):
@@ -437,6 +593,11 @@ class RecordSpec(_Model):
         return self.scale_to
 
 
+#: Default of ``[design] max_scale_factor`` (and the bound of Monte Carlo rows scaled to a
+#: target): larger scale factors are noted by validate.
+DEFAULT_MAX_SCALE_FACTOR = 5.0
+
+
 class DesignSpec(_Model):
     """A record design over records x structures (``sampler.n`` structures drawn by the
     sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
@@ -457,6 +618,9 @@ class DesignSpec(_Model):
     max_pga_ratio: float | None = None
     scan: int | None = None
     growth: float | None = None  # replaced by step: refused with a message saying so
+    #: Scale factors above this are noted by validate (records scaled far from what they
+    #: recorded; cloud and stripes designs).
+    max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
 
     @model_validator(mode="after")
     def _ida_keys(self):
@@ -582,7 +746,9 @@ class RunSpec(_Model):
         return self
 
 
-Structure = Annotated[BlockSpec | WallSpec | EquivalentBlockSpec, Field(discriminator="kind")]
+Structure = Annotated[
+    BlockSpec | WallSpec | EquivalentBlockSpec | ObjectsSpec, Field(discriminator="kind")
+]
 MotionSpec = Annotated[PulseSpec | RecordSpec | StochasticSpec, Field(discriminator="kind")]
 
 
@@ -619,8 +785,38 @@ class Study(_Model):
     @property
     def notes(self) -> list[str]:
         """What the run will do that the user should know (one line each, naming the field):
-        the levels a vertical component censors at free fall."""
+        the levels a vertical component censors at free fall, records scaled beyond
+        ``design.max_scale_factor`` and targets at which nothing can rock
+        (:func:`.feasibility.notes`)."""
         return list(self._notes)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _objects_sampler(cls, data):
+        """Named objects are the structures themselves: ``[sampler]`` may be left out (it is
+        then ``kind = "grid"``: one row per object, record and level)."""
+        if isinstance(data, dict) and "sampler" not in data:
+            st = data.get("structure")
+            if isinstance(st, dict) and st.get("kind") == "objects":
+                return {**data, "sampler": {"kind": "grid"}}
+        return data
+
+    @model_validator(mode="after")
+    def _objects(self):
+        if self.structure.kind != "objects":
+            return self
+        if self.design is None:
+            raise FieldError(
+                "structure.kind",
+                "named objects are studied in a record [design] (cloud, stripes or ida); add one",
+            )
+        if self.sampler.kind != "grid":
+            raise FieldError(
+                "sampler.kind",
+                "named objects are the structures of the design, not drawn: leave [sampler] out "
+                f"or give kind = 'grid', not {self.sampler.kind!r}",
+            )
+        return self
 
     @model_validator(mode="after")
     def _design(self):
@@ -681,7 +877,9 @@ class Study(_Model):
     @model_validator(mode="after")
     def _grid(self):
         grid_params = [n for n, d in self.parameters().items() if d.dist == "grid"]
-        if self.sampler.kind == "grid":
+        if self.structure.kind == "objects":
+            pass  # the objects are the grid (checked in _objects)
+        elif self.sampler.kind == "grid":
             if not grid_params:
                 raise FieldError(
                     "sampler.kind", "a grid sampler needs at least one parameter with dist = 'grid'"
@@ -767,6 +965,9 @@ class Study(_Model):
     def frequency_parameter_span(self) -> tuple[float, float]:
         """The smallest and largest p [rad/s] the structures can have."""
         st = self.structure
+        if st.kind == "objects":
+            p = st.rocking()[:, 0]
+            return float(p.min()), float(p.max())
         if st.kind == "equivalent_block":
             return _smallest(st.frequency_parameter), _largest(st.frequency_parameter)
         factor = math.sqrt(2.0) if st.kind == "rocking_wall" else 1.0  # eq. (23) of [003]
@@ -776,6 +977,8 @@ class Study(_Model):
     def largest_critical_rotation(self) -> float:
         """The largest critical rotation theta_cr [rad] the structures can have."""
         st = self.structure
+        if st.kind == "objects":
+            return float(st.rocking()[:, 1].max())
         if st.kind == "equivalent_block":
             return _largest(st.critical_rotation)
         return (2.0 if st.kind == "rocking_wall" else 1.0) * _largest(st.slenderness)
@@ -795,6 +998,8 @@ class Study(_Model):
         """Number of rows of the design (without making it); for a ``[design]``, the number of
         structures times :meth:`levels` (each record adds as many)."""
         s, params = self.sampler, self.parameters()
+        if self.structure.kind == "objects":
+            return len(self.structure.objects) * self.levels()
         if self.design is not None and s.kind != "grid":
             return s.n * self.levels()
         if self.design is not None:
@@ -934,13 +1139,27 @@ def _sentence(e: dict, keys: list) -> str:
     return e["msg"]
 
 
+def _object_name(data, keys) -> str:
+    """`` ("Statue A")`` after a path into ``structure.objects[i]`` naming the object."""
+    if len(keys) > 2 and keys[:2] == ["structure", "objects"] and isinstance(keys[2], int):
+        item = data["structure"]["objects"][keys[2]]
+        if isinstance(item, dict) and isinstance(item.get("name"), str):
+            return f" ({item['name']!r})"
+    return ""
+
+
 def _format_errors(err: ValidationError, data) -> list[str]:
     lines = []
     for e in err.errors():
         loc = e["loc"][:-1] if e["type"] == "missing" else e["loc"]
         keys = _path(data, loc)
         message = _sentence(e, keys)
-        line = f"{_dotted(keys)}: {message}"
+        where = _dotted(keys)
+        name = _object_name(data, keys)
+        if name:  # after the index: structure.objects[1] ('Urn').width
+            head = _dotted(keys[:3])
+            where = head + name + where[len(head) :]
+        line = f"{where}: {message}"
         if line not in lines:
             lines.append(line)
     return lines
@@ -1011,10 +1230,16 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
         raise StudyError(
             source, [f"not a study file: its tables or lists nest deeper than {MAX_DEPTH} levels"]
         )
+    file_problem = _read_objects_file(data, base_dir)
     try:
         study = Study.model_validate(data)
-    except ValidationError as exc:
-        raise StudyError(source, _format_errors(exc, data)) from None
+    except ValidationError as exc:  # with the problems of the parts that are valid alone
+        found = _format_errors(exc, data)
+        if file_problem:
+            found = [file_problem] + [x for x in found if not x.startswith("structure.objects")]
+        raise StudyError(source, found + _motion_problems(data, base_dir)) from None
+    if file_problem:
+        raise StudyError(source, [file_problem])
 
     if study.design is not None and "chunk_size" in data:
         raise StudyError(
@@ -1026,6 +1251,79 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     study._text = text
     study._notes = notes(study, base_dir)
     return study
+
+
+def _motion_problems(data, base_dir) -> list[str]:
+    """The record files' problems of a study that does not validate, when its ``files`` and
+    ``vertical`` do alone (a misspelt folder is reported beside a bad ``units``)."""
+    motion = data.get("motion")
+    if not (isinstance(motion, dict) and motion.get("kind") == "record"):
+        return []
+    files = {k: motion[k] for k in ("kind", "files", "vertical") if k in motion}
+    try:  # the paths alone: another field of [motion] may be what is wrong
+        spec = RecordSpec.model_validate(files)
+    except ValidationError:
+        return []  # reported by the whole study's validation
+    from .feasibility import record_pairs
+
+    try:
+        record_pairs(spec, base_dir)
+    except ValueError as exc:
+        return [str(exc)]
+    return []
+
+
+#: Columns of an objects CSV file (``[structure] kind = "objects"``, ``file = ...``).
+OBJECT_COLUMNS = tuple(ObjectSpec.model_fields)
+
+
+def _read_objects_file(data, base_dir) -> str | None:
+    """Read ``structure.file`` (a CSV of :data:`OBJECT_COLUMNS`, a header line then one object a
+    line; empty cells are left out) into ``structure.objects`` of ``data``, in place; the
+    problem as one line, or None."""
+    st = data.get("structure")
+    if not (isinstance(st, dict) and st.get("kind") == "objects" and "file" in st):
+        return None
+    name = st["file"]
+    if "objects" in st:
+        return "structure.file: give objects or file, not both"
+    if not isinstance(name, str) or not name.strip():
+        return f"structure.file: must be the path of a CSV file, got {_describe(name)}"
+    from ..motions.records import read_text_file
+    from .feasibility import record_path
+
+    path = record_path(name, base_dir)
+    try:
+        text = read_text_file(path, MAX_STUDY_BYTES)
+    except (OSError, ValueError) as exc:
+        return f"structure.file: cannot read {str(path)!r} ({exc})"
+    rows = list(csv.DictReader(io.StringIO(text)))
+    header = list(rows[0]) if rows else []
+    unknown = [c for c in header if c is None or c.strip() not in OBJECT_COLUMNS]
+    if not rows or unknown:
+        return (
+            f"structure.file: {str(path)!r} must hold a header line of columns among "
+            f"{list(OBJECT_COLUMNS)} and one object a line"
+            + (f"; unknown columns {unknown}" if unknown else "; it holds no object")
+        )
+    st["objects"] = [
+        {
+            k.strip(): v.strip() if k.strip() in ("name", "kind") else _cell(v)
+            for k, v in row.items()
+            if v is not None and v.strip()
+        }
+        for row in rows
+    ]
+    return None
+
+
+def _cell(text: str):
+    """A CSV cell: a number if it reads as one, else the text (the schema then names it)."""
+    text = text.strip()
+    try:
+        return float(text)
+    except ValueError:
+        return text
 
 
 def load_study(path) -> Study:
