@@ -747,7 +747,7 @@ class RecordGen:
             levels = sorted(r.sample([1.0, 1.5, 2.0, 3.0, 4.5], r.randint(1, 3)))
             motion["scale_to"] = {"im": "pga_ratio", "value": {"dist": "grid", "values": levels}}
         if design_kind == "ida":  # a short ladder (its options are checked elsewhere)
-            design.update(tolerance=0.1, growth=2.0, max_pga_ratio=8.0, scan=1)
+            design.update(step=0.25, tolerance=0.1, max_pga_ratio=8.0, scan=1)
         study["design"] = design
         return study
 
