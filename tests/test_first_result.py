@@ -231,7 +231,8 @@ def test_dask_workers_load_the_kernels_the_client_primed(tmp_path):
     hits = {name: sum(h.values()) for name, h, _ in rows}
     misses = {name: sum(m.values()) for name, _, m in rows if m}
     assert misses == {}
-    assert hits["scene_batch_trig"] >= 1  # the sine-pulse kernel (pruned branches)
+    # the sine-pulse kernel (pruned branches), serial: a worker runs one thread
+    assert hits["scene_batch_trig_serial"] >= 1
 
 
 def test_a_cold_run_compiles_in_the_client_only(tmp_path):
@@ -335,8 +336,8 @@ def test_compile_counter_sees_compilation_and_not_cache_hits():
 def test_a_sine_pulse_batch_compiles_no_step_it_cannot_take(tmp_path):
     """From an empty cache, a batch of sine-pulse scenes compiles the Taylor steps it runs and
     none of the others (the DOP853 step of Ricker wavelets and mechanisms, the record step,
-    the mechanism's free-rocking map): ``scene_batch_trig``, whose pruned branches halve the
-    compile of a pulse study. Its results are the scipy reference's (tests of the kernel)."""
+    the mechanism's free-rocking map): ``scene_batch_trig_serial`` on one thread, whose
+    pruned branches halve the compile of a pulse study. Its results are the scipy reference's (tests of the kernel)."""
     code = (
         COUNTER
         + """
@@ -350,6 +351,7 @@ print(json.dumps(counts["compiled"]))
     env = dict(ENV, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"), NUMBA_NUM_THREADS="1")
     compiled = json.loads(run(["-c", code], tmp_path, env).strip().splitlines()[-1])
     names = {name.rsplit(".", 1)[-1] for name in compiled}
-    assert {"scene_batch_trig", "scene_trig", "phase_trig", "_taylor_trig_attempt"} <= names
+    assert {"scene_batch_trig_serial", "scene_trig", "phase_trig", "_taylor_trig_attempt"} <= names
     assert not names & {"_dop853_attempt", "step", "_taylor_attempt", "_free_map_table"}
-    assert not names & {"scene_batch", "scene", "phase"}  # the general variants
+    assert not names & {"scene_batch", "scene_batch_serial", "scene", "phase"}  # general ones
+    assert "scene_batch_trig" not in names  # the parallel loop is not compiled for one thread

@@ -334,7 +334,7 @@ def _pulse_inside(rec):
     """A pulse() that is a pulse: inside the record and shorter than it (else a refusal)."""
     p = rec.pulse()
     if p.amplitude > 0 and p.indicator > 0.5:
-        inside = 0.0 <= p.start and p.start + p.gamma * p.period <= rec.duration + 1e-9
+        inside = 0.0 <= p.start <= p.end <= rec.duration and p.period <= rec.duration
         if not inside:
             return math.nan  # reported as a non-finite answer
     return p.period if p.amplitude > 0 else 0.0

@@ -16,7 +16,7 @@ from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
 import rockstudy as rs
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record
 
 ALPHA = 0.15
@@ -342,8 +342,9 @@ def test_three_column_text_record(tmp_path):
     rows = zip(t, h, v, strict=True)
     path.write_text("# t h v\n" + "".join(f"{a}, {b}, {c}\n" for a, b, c in rows))
     rec = Record.from_csv(path, columns=("time", "horizontal", "vertical"))
-    np.testing.assert_allclose(rec.acceleration, h * G, rtol=1e-15)
-    np.testing.assert_allclose(rec.vertical, v * G, rtol=1e-15)
+    # a record in g is read with standard gravity (the PEER files' convention)
+    np.testing.assert_allclose(rec.acceleration, h * STANDARD_GRAVITY, rtol=1e-15)
+    np.testing.assert_allclose(rec.vertical, v * STANDARD_GRAVITY, rtol=1e-15)
     np.testing.assert_allclose(rec.time, t, rtol=1e-15)
     same = rs.motions.records.read_record(path, columns=("time", "horizontal", "vertical"))
     np.testing.assert_array_equal(same.vertical, rec.vertical)

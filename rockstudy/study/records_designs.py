@@ -508,7 +508,7 @@ def incremental_dynamic_analysis(
 
     1. **Ladder.** The lowest rung is the scale below which the block cannot leave rest
        (PGA = g alpha without a vertical component; with one, the exact scale at which
-       |u_h''| first reaches (g + u_v'') alpha, lower under a downward vertical); it is
+       abs(u_h'') first reaches (g + u_v'') alpha, lower under a downward vertical); it is
        simulated like every other rung. Successive rungs differ by the factor ``1 + step``
        (1 % by default) up to PGA = ``max_pga_ratio`` g tan(alpha). The climb stops at the
        first rung that overturns; a block standing on every rung is *censored* (reason 1).
@@ -518,7 +518,7 @@ def incremental_dynamic_analysis(
        survivals above the capacity (the *switch band*, from the capacity to the highest
        scale seen to survive).
 
-    **Vertical component.** The vertical is scaled by |scale| and acts as gravity g + u_v''.
+    **Vertical component.** The vertical is scaled by abs(scale) and acts as gravity g + u_v''.
     At scales where u_v'' reaches -g (free fall) Housner's model does not apply: the ladder
     stops below that scale, and a block that has not overturned there is censored (reason
     2) at its highest surviving rung; the censored fit of
