@@ -13,10 +13,7 @@ from numba import njit
 
 from .._roots import newton_bisect
 from ._dop853 import hermite5
-from ._logs import (
-    _push,
-    tally_impact,
-)
+from ._logs import _push, tally_impact
 from ._rhs import _lift, _rhs, _step
 from ._taylor import (
     FMA,

@@ -14,11 +14,7 @@ import numpy as np
 from numba import njit
 
 from ..constants import FALL_ROTATION
-from .constants import (
-    MODEL_LINEAR,
-    NEVER_AT_REST,
-    UNDAMPED_WINDOW,
-)
+from .constants import MODEL_LINEAR, NEVER_AT_REST, UNDAMPED_WINDOW
 
 
 @njit(cache=True)

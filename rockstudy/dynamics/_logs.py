@@ -8,10 +8,7 @@ import numpy as np
 from numba import njit
 
 from ._rhs import _step
-from ._taylor import (
-    NO_REFCOUNT,
-    poly_value,
-)
+from ._taylor import NO_REFCOUNT, poly_value
 
 #: The running tallies of one scene, one record updated in place by the kernel and the exact
 #: linear solvers: max |theta| [rad], the first impact time [s] (NaN before it), impacts,

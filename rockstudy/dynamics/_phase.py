@@ -13,43 +13,13 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ..motions._kernels import (
-    KIND_RECORD,
-    KIND_TRIG,
-    segment_index,
-)
-from ._events import (
-    EV_NONE,
-    EV_OVER,
-    EV_REJECT,
-    _impact,
-    _zeno,
-)
-from ._logs import (
-    _log_dop853_step,
-    _log_peak,
-    _log_poly_step,
-    _push,
-)
+from ..motions._kernels import KIND_RECORD, KIND_TRIG, segment_index
+from ._events import EV_NONE, EV_OVER, EV_REJECT, _impact, _zeno
+from ._logs import _log_dop853_step, _log_peak, _log_poly_step, _push
 from ._rhs import _accel, _ground_after, _vertical_after
-from ._steps import (
-    _dop853_attempt,
-    _taylor_attempt,
-    _taylor_trig_attempt,
-)
-from ._taylor import (
-    NO_REFCOUNT,
-    work_arrays,
-)
-from .constants import (
-    FIRST,
-    MODEL_TABLE,
-    PH_END,
-    PH_FAIL,
-    PH_IMPACT,
-    PH_OVER,
-    PH_REST,
-)
+from ._steps import _dop853_attempt, _taylor_attempt, _taylor_trig_attempt
+from ._taylor import NO_REFCOUNT, work_arrays
+from .constants import FIRST, MODEL_TABLE, PH_END, PH_FAIL, PH_IMPACT, PH_OVER, PH_REST
 
 PhaseState = namedtuple("PhaseState", ("t", "theta", "theta_dot", "side", "h"))
 

@@ -12,20 +12,11 @@ import math
 from numba import njit
 
 from ..constants import G
-from ..motions._kernels import (
-    KIND_RECORD,
-    ground_acceleration,
-    vertical_acceleration,
-)
+from ..motions._kernels import KIND_RECORD, ground_acceleration, vertical_acceleration
 from ._dop853 import make_dop853_step
 from ._tables import _mechanism_accel
-from ._taylor import (
-    NO_REFCOUNT,
-)
-from .constants import (
-    MODEL_LINEAR,
-    MODEL_TABLE,
-)
+from ._taylor import NO_REFCOUNT
+from .constants import MODEL_LINEAR, MODEL_TABLE
 
 
 @njit(cache=True, **NO_REFCOUNT)

@@ -11,31 +11,12 @@ import numpy as np
 from numba import njit, prange
 
 from ..constants import FALL_ROTATION
-from ..motions._kernels import (
-    KIND_RECORD,
-    ground_acceleration,
-    segment_index,
-)
-from ._free_map import (
-    free_rocking_map,
-    free_tail_end,
-)
-from ._logs import (
-    _push,
-    new_tallies,
-)
-from ._phase import (
-    PhaseState,
-    Stepping,
-    _phase,
-    _phase_trig,
-    _variant_named,
-    _work_arrays,
-)
+from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ._free_map import free_rocking_map, free_tail_end
+from ._logs import _push, new_tallies
+from ._phase import PhaseState, Stepping, _phase, _phase_trig, _variant_named, _work_arrays
 from ._tables import _free_map_table
-from ._uplift import (
-    next_uplift,
-)
+from ._uplift import next_uplift
 from .constants import (
     FIRST,
     FIRST_STEP,

@@ -8,9 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..motions._kernels import (
-    vertical_acceleration,
-)
+from ..motions._kernels import vertical_acceleration
 from ._dop853 import dop853_error, hermite5
 from ._events import (
     EV_IMPACT,
@@ -24,12 +22,7 @@ from ._events import (
     _true_state,
 )
 from ._rhs import _record_acceleration, _rhs, _step
-from ._taylor import (
-    FMA,
-    NO_REFCOUNT,
-    taylor_coefficients,
-    taylor_coefficients_trig,
-)
+from ._taylor import FMA, NO_REFCOUNT, taylor_coefficients, taylor_coefficients_trig
 from .constants import (
     ATOL_FRACTION,
     IMPACT_RETRY_SHRINK,

@@ -12,12 +12,8 @@ import math
 from numba import njit
 
 from ..constants import G
-from ._free_map import (
-    _impacts_until_rest,
-)
-from ._taylor import (
-    NO_REFCOUNT,
-)
+from ._free_map import _impacts_until_rest
+from ._taylor import NO_REFCOUNT
 from .constants import (
     TAB_B,
     TAB_DB,

@@ -22,16 +22,8 @@ from ..motions._kernels import (
     vertical_acceleration,
 )
 from ._rhs import _lift
-from ._taylor import (
-    NO_REFCOUNT,
-)
-from .constants import (
-    FIRST,
-    MODEL_LINEAR,
-    MODEL_TABLE,
-    NO_TABLE,
-    TRIG,
-)
+from ._taylor import NO_REFCOUNT
+from .constants import FIRST, MODEL_LINEAR, MODEL_TABLE, NO_TABLE, TRIG
 
 
 @njit(cache=True)
