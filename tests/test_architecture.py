@@ -3,7 +3,8 @@
 cli -> study -> verification -> (dynamics, closedform, similarity, risk) -> structures -> motions
 -> constants. The test reads every module's imports (top level and inside functions) with
 ``ast`` and checks that no package imports a package of a higher layer, and that the
-package-level graph has no cycle.
+package-level graph has no cycle. It also keeps the kernels' package ``dynamics/`` in files and
+functions of one job: no module over 700 lines, no function over 80 lines of code.
 """
 
 import ast
@@ -177,3 +178,69 @@ def test_physics_never_imports_the_study_backends():
                     names = [node.module or ""]
                 bad += [f"{path.name}: {n}" for n in names if n.split(".")[0] in heavy]
     assert not bad, bad
+
+
+# Size limits of the dynamics package (issue 25 §4): short kernels, files of one job.
+MAX_FUNCTION_LINES = 80
+MAX_MODULE_LINES = 700
+
+
+def _docstring_lines(node) -> set[int]:
+    """Line numbers of the docstrings of ``node`` and of the functions and classes inside it."""
+    lines = set()
+    for n in ast.walk(node):
+        body = getattr(n, "body", None)
+        if (
+            isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))
+            and body
+            and isinstance(body[0], ast.Expr)
+            and isinstance(body[0].value, ast.Constant)
+            and isinstance(body[0].value.value, str)
+        ):
+            lines |= set(range(body[0].lineno, body[0].end_lineno + 1))
+    return lines
+
+
+def code_lines(source: str) -> dict[str, int]:
+    """Lines of code of every function in ``source`` (nested functions count in their
+    enclosing one too): from ``def`` to its end, without docstrings, blank lines or comment
+    lines. Keyed by the name, with its line number."""
+    text = source.split("\n")
+    out = {}
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            doc = _docstring_lines(node)
+            out[f"{node.name}:{node.lineno}"] = sum(
+                1
+                for i in range(node.lineno, node.end_lineno + 1)
+                if i not in doc and text[i - 1].strip() and not text[i - 1].strip().startswith("#")
+            )
+    return out
+
+
+def test_code_lines_counts_code_only():
+    source = (
+        'def f(x):\n    """Doc.\n\n    More.\n    """\n\n    # a comment\n    y = x\n    return y\n'
+    )
+    assert code_lines(source) == {"f:1": 3}
+    nested = "def f():\n    def g():\n        return 1\n\n    return g\n"
+    assert code_lines(nested) == {"f:1": 4, "g:2": 2}
+
+
+def test_dynamics_functions_are_short():
+    long = {
+        f"{path.name}:{name}": n
+        for path in sorted((PACKAGE / "dynamics").glob("*.py"))
+        for name, n in code_lines(path.read_text()).items()
+        if n > MAX_FUNCTION_LINES
+    }
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines of code: {long}"
+
+
+def test_dynamics_modules_are_short():
+    long = {
+        path.name: n
+        for path in sorted((PACKAGE / "dynamics").glob("*.py"))
+        if (n := len(path.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"

@@ -122,6 +122,46 @@ def _record_params(record, scale, amplitude, period, cycles, n):
     return kind, mp, times, samples, vsamples
 
 
+def _blocks(half_diagonal, frequency_parameter, slenderness, restitution, n):
+    """The block columns of :func:`simulate_batch`, checked, of length n: (R or None, p,
+    alpha, eta), p from R by eq. (2.2) of [000] and eta by default Housner's eq. (2.4)."""
+    alpha = _column("slenderness", slenderness, n, MIN_SLENDERNESS, np.pi / 2, False)
+    R = None
+    if half_diagonal is not None:
+        R = _column("half_diagonal", half_diagonal, n, *HALF_DIAGONAL_RANGE, False, False)
+        p = np.sqrt(3.0 * G / (4.0 * R))  # eq. (2.2) of [000], as block.frequency_parameter
+    else:
+        p_range = FREQUENCY_PARAMETER_RANGE
+        p = _column("frequency_parameter", frequency_parameter, n, *p_range, False, False)
+    if restitution is None:
+        eta = 1.0 - 1.5 * np.sin(alpha) ** 2  # eq. (2.4), as block.restitution_housner
+    else:
+        eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
+    return R, p, alpha, eta
+
+
+def _motions(pulse, record, scale, amplitude, period, cycles, n):
+    """The motion rows of :func:`simulate_batch`: (kind, mp, times, samples, vsamples) of the
+    scaled record (free fall refused) or of the pulses."""
+    if record is not None:
+        kind, mp, times, samples, vsamples = _record_params(
+            record, scale, amplitude, period, cycles, n
+        )
+        refuse_free_fall(vsamples, mp[:, 0], batch=True)
+        return kind, mp, times, samples, vsamples
+    kind, mp = _pulse_params(pulse, amplitude, period, cycles, n)
+    return kind, mp, np.zeros(2), np.zeros(2), mk.NO_VERTICAL
+
+
+def _motion_inputs(record, mp, amplitude, period, cycles, n):
+    """The motion inputs of a batch's dataset: the record's scale, or the pulses' amplitude,
+    period and cycles, each of length n."""
+    if record is not None:
+        return {"scale": mp[:, 0]}
+    values = (("amplitude", amplitude), ("period", period), ("cycles", cycles))
+    return {name: np.broadcast_to(np.asarray(value), (n,)) for name, value in values}
+
+
 def simulate_batch(
     *,
     half_diagonal=None,
@@ -234,26 +274,10 @@ def simulate_batch(
         scale=scale,
         cycles=cycles,
     )
-    alpha = _column("slenderness", slenderness, n, MIN_SLENDERNESS, np.pi / 2, False)
-    if half_diagonal is not None:
-        R = _column("half_diagonal", half_diagonal, n, *HALF_DIAGONAL_RANGE, False, False)
-        p = np.sqrt(3.0 * G / (4.0 * R))  # eq. (2.2) of [000], as block.frequency_parameter
-    else:
-        p_range = FREQUENCY_PARAMETER_RANGE
-        p = _column("frequency_parameter", frequency_parameter, n, *p_range, False, False)
-    if restitution is None:
-        eta = 1.0 - 1.5 * np.sin(alpha) ** 2  # eq. (2.4), as block.restitution_housner
-    else:
-        eta = _column("restitution", restitution, n, 0.0, 1.0, high_open=False)
-    if record is not None:
-        kind, mp, times, samples, vsamples = _record_params(
-            record, scale, amplitude, period, cycles, n
-        )
-        refuse_free_fall(vsamples, mp[:, 0], batch=True)
-    else:
-        kind, mp = _pulse_params(pulse, amplitude, period, cycles, n)
-        times = samples = np.zeros(2)
-        vsamples = mk.NO_VERTICAL
+    R, p, alpha, eta = _blocks(half_diagonal, frequency_parameter, slenderness, restitution, n)
+    kind, mp, times, samples, vsamples = _motions(
+        pulse, record, scale, amplitude, period, cycles, n
+    )
     p = np.ascontiguousarray(p, dtype=float)
     eta = np.ascontiguousarray(eta, dtype=float)
     rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
@@ -282,11 +306,7 @@ def simulate_batch(
     inputs = {"frequency_parameter": p, "slenderness": alpha, "restitution": eta}
     if half_diagonal is not None:
         inputs["half_diagonal"] = R
-    if record is not None:
-        inputs["scale"] = mp[:, 0]
-    else:
-        for name, value in (("amplitude", amplitude), ("period", period), ("cycles", cycles)):
-            inputs[name] = np.broadcast_to(np.asarray(value), (n,))
+    inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
     return _as_dataset(
         result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
     )

@@ -153,6 +153,103 @@ def _integrate(
     return nh, steps, 0
 
 
+def _start(p, alpha, l, motion, x0, chi_rest):
+    """The start (chi, chi', psi) of the complex formulation from theta, theta_dot = x0 [rad,
+    rad/s] at t = 0 (from rest: chi_c, leaning the way the ground first pushes), with the
+    warnings of a start from rest and of a large l."""
+    th0, om0 = x0
+    chi0 = max(abs(th0) / alpha, chi_rest)
+    psi0 = 0.0 if th0 >= 0 else math.pi
+    a0 = motion.ground_acceleration(0.0)
+    if th0 == 0.0 and om0 == 0.0 and a0 > 0:  # lean the way the first push of the ground goes
+        psi0 = math.pi
+    if th0 == 0.0 and om0 == 0.0 and motion.peak >= G * math.tan(alpha):
+        warnings.warn(FROM_REST_WARNING, ComplexFromRestWarning, stacklevel=5)
+    if l > LARGE_L:
+        warnings.warn(
+            LARGE_L_WARNING.format(l=l, large=LARGE_L), ComplexAccuracyWarning, stacklevel=5
+        )
+    v0 = om0 / (p * alpha) * (1.0 if th0 >= 0 else -1.0)
+    return np.array([chi0, v0, psi0])
+
+
+def _run(p, alpha, eta, l, spec, y0, t_phys, rtol, max_steps):
+    """:func:`_integrate` from y0 to t_phys [s] into a history that grows until it holds the
+    run, under the motion of ``spec`` (its ``kernel_spec()``). Returns (history, rows,
+    steps, status)."""
+    kind, mp, times, samples, _ = spec
+    cap = 200_000
+    while True:
+        hist = np.empty((cap, 4))
+        nh, steps, status = _integrate(
+            p,
+            alpha,
+            math.log(eta),
+            l,
+            kind,
+            mp,
+            times,
+            samples,
+            y0,
+            p * t_phys,
+            rtol,
+            l / 10.0,
+            hist,
+            max_steps,
+        )
+        if nh < cap or status != 0:
+            break
+        cap *= 4
+    return hist, nh, steps, status
+
+
+def _fields(hist, steps, over, p, alpha, l, y0, chi_rest, t_eval):
+    """The RockingResult fields of a run's history rows (t p, chi, chi', psi): theta and
+    theta_dot, the impacts (psi passing an odd multiple of pi/2), the peaks and the dense
+    output on the cubic Hermite interpolant (see :func:`simulate_complex`)."""
+    t = hist[:, 0] / p
+    chi, dchi, psi = hist[:, 1], hist[:, 2], hist[:, 3]
+    theta = alpha * chi * np.cos(psi)
+    dpsi = l / chi**2
+    theta_dot = p * alpha * (dchi * np.cos(psi) - chi * np.sin(psi) * dpsi)
+    # impacts: psi passes an odd multiple of pi/2 (the real part changes sign)
+    turns = np.floor((psi - math.pi / 2) / math.pi)
+    jumps = np.flatnonzero(np.diff(turns) != 0)
+    impacts = t[jumps]
+    chi0, v0, psi0 = y0
+    th_init = alpha * chi0 * math.cos(psi0)
+    om_init = p * alpha * (v0 * math.cos(psi0) - chi0 * math.sin(psi0) * l / chi0**2)
+    curve = CubicHermiteSpline(
+        np.concatenate([[0.0], t]),
+        np.concatenate([[th_init], theta]),
+        np.concatenate([[om_init], theta_dot]),
+    )
+    turns = curve.derivative().roots(extrapolate=False)
+    th_turn = curve(turns)
+    peak = (th_turn * curve(turns, 2) < 0.0) & (np.abs(th_turn) > 2.0 * alpha * chi_rest)
+    dense = {}
+    if t_eval is not None:
+        after = t_eval > (t[-1] if over else np.inf)
+        dense = {
+            "t_eval": t_eval,
+            "theta_eval": np.where(after, np.nan, curve(t_eval)),
+            "theta_dot_eval": np.where(after, np.nan, curve(t_eval, 1)),
+        }
+    return {
+        "peak_times": turns[peak],
+        "peak_rotations": th_turn[peak],
+        **dense,
+        "t": t,
+        "theta": theta,
+        "theta_dot": theta_dot,
+        "max_rotation": FALL_ROTATION if over else float(np.max(np.abs(theta), initial=0)),
+        "overturned": over,
+        "impact_times": impacts,
+        "overturn_time": float(t[-1]) if over else math.nan,
+        "steps": int(steps),
+    }
+
+
 def simulate_complex(
     p,
     alpha,
@@ -188,95 +285,21 @@ def simulate_complex(
     """
     if not 0 < l < 0.1:
         raise ValueError(f"l must lie in (0, 0.1), got {l!r}")
-    kind, mp, times, samples, vsamples = motion.kernel_spec()
-    if vsamples.size:
+    spec = motion.kernel_spec()
+    if spec[4].size:
         raise ValueError(
             "motion: the complex formulation of [001] takes no vertical component (its "
             "gravity is constant); use the nonlinear kernel or the scipy reference"
         )
-    th0, om0 = x0
     chi_rest = chi_c(alpha, l)
-    chi0 = max(abs(th0) / alpha, chi_rest)
-    psi0 = 0.0 if th0 >= 0 else math.pi
-    a0 = motion.ground_acceleration(0.0)
-    if th0 == 0.0 and om0 == 0.0 and a0 > 0:  # lean the way the first push of the ground goes
-        psi0 = math.pi
-    if th0 == 0.0 and om0 == 0.0 and motion.peak >= G * math.tan(alpha):
-        warnings.warn(FROM_REST_WARNING, ComplexFromRestWarning, stacklevel=4)
-    if l > LARGE_L:
-        warnings.warn(
-            LARGE_L_WARNING.format(l=l, large=LARGE_L), ComplexAccuracyWarning, stacklevel=4
-        )
-    v0 = om0 / (p * alpha) * (1.0 if th0 >= 0 else -1.0)
-    y0 = np.array([chi0, v0, psi0])
+    y0 = _start(p, alpha, l, motion, x0, chi_rest)
     t_phys = (motion.duration + 10.0 / p) if t_end is None else t_end
     if t_eval is not None and t_eval.size and t_eval[-1] > t_phys:
         raise ValueError(
             f"t_eval reaches {t_eval[-1]!r} s, beyond the simulated end {t_phys!r} s of "
             "method='complex' (the motion and 10 / p after it unless t_max is given)"
         )
-    cap = 200_000
-    while True:
-        hist = np.empty((cap, 4))
-        nh, steps, status = _integrate(
-            p,
-            alpha,
-            math.log(eta),
-            l,
-            kind,
-            mp,
-            times,
-            samples,
-            y0,
-            p * t_phys,
-            rtol,
-            l / 10.0,
-            hist,
-            max_steps,
-        )
-        if nh < cap or status != 0:
-            break
-        cap *= 4
+    hist, nh, steps, status = _run(p, alpha, eta, l, spec, y0, t_phys, rtol, max_steps)
     if status == 1:
         raise RuntimeError(f"complex: more than max_steps={max_steps} steps")
-    t = hist[:nh, 0] / p
-    chi, dchi, psi = hist[:nh, 1], hist[:nh, 2], hist[:nh, 3]
-    theta = alpha * chi * np.cos(psi)
-    dpsi = l / chi**2
-    theta_dot = p * alpha * (dchi * np.cos(psi) - chi * np.sin(psi) * dpsi)
-    # impacts: psi passes an odd multiple of pi/2 (the real part changes sign)
-    turns = np.floor((psi - math.pi / 2) / math.pi)
-    jumps = np.flatnonzero(np.diff(turns) != 0)
-    impacts = t[jumps]
-    over = status == 2
-    th_init = alpha * chi0 * math.cos(psi0)
-    om_init = p * alpha * (v0 * math.cos(psi0) - chi0 * math.sin(psi0) * l / chi0**2)
-    curve = CubicHermiteSpline(
-        np.concatenate([[0.0], t]),
-        np.concatenate([[th_init], theta]),
-        np.concatenate([[om_init], theta_dot]),
-    )
-    turns = curve.derivative().roots(extrapolate=False)
-    th_turn = curve(turns)
-    peak = (th_turn * curve(turns, 2) < 0.0) & (np.abs(th_turn) > 2.0 * alpha * chi_rest)
-    dense = {}
-    if t_eval is not None:
-        after = t_eval > (t[-1] if over else np.inf)
-        dense = {
-            "t_eval": t_eval,
-            "theta_eval": np.where(after, np.nan, curve(t_eval)),
-            "theta_dot_eval": np.where(after, np.nan, curve(t_eval, 1)),
-        }
-    return {
-        "peak_times": turns[peak],
-        "peak_rotations": th_turn[peak],
-        **dense,
-        "t": t,
-        "theta": theta,
-        "theta_dot": theta_dot,
-        "max_rotation": FALL_ROTATION if over else float(np.max(np.abs(theta), initial=0)),
-        "overturned": over,
-        "impact_times": impacts,
-        "overturn_time": float(t[-1]) if over else math.nan,
-        "steps": int(steps),
-    }
+    return _fields(hist[:nh], steps, status == 2, p, alpha, l, y0, chi_rest, t_eval)

@@ -68,6 +68,138 @@ def _uplift_time(excess, t0, dur, grid):
     return math.inf
 
 
+def _equations(p, alpha, model, tab, acc, vert):
+    """The uplift test excess(t) (>= 0 where a block at rest lifts: |u_h''| >= (g + u_v'')
+    tan alpha, or eq. 10 of [003] for a mechanism by the kernels' own test) and the
+    right-hand side rhs(t, y, s) of the model on side s, under the ground acceleration
+    functions acc and vert [m/s^2]."""
+    linear = model == MODEL_LINEAR
+    thr = G * alpha if linear else G * math.tan(alpha)
+
+    def excess(t):
+        if tab is not None:
+            return _lift(acc(t), vert(t), p, alpha, MODEL_TABLE, tab)
+        return abs(acc(t)) - thr * (1.0 + vert(t) / G)
+
+    def rhs(t, y, s):
+        if tab is not None:
+            return [y[1], _accel(acc(t), vert(t), y[0], y[1], p, alpha, s, MODEL_TABLE, tab)]
+        a = acc(t) / G
+        gv = 1.0 + vert(t) / G
+        if linear:
+            return [y[1], p * p * (gv * (y[0] - alpha * s) - a)]
+        x = alpha * s - y[0]
+        return [y[1], -p * p * (gv * math.sin(x) + a * math.cos(x))]
+
+    return excess, rhs
+
+
+def _events(s, fall_at):
+    """The ``solve_ivp`` events of a phase on side s: the impact (terminal), the fall at
+    rotation ``fall_at`` (terminal) and the peaks of s theta (each also receives s, the
+    ``args`` of the solve)."""
+
+    def impact(t_, y, s=s):
+        return s * y[0]
+
+    def fall(t_, y, s=s):
+        return s * y[0] - fall_at
+
+    def peak(t_, y, s=s):
+        return s * y[1]
+
+    impact.terminal, impact.direction = True, -1
+    fall.terminal, fall.direction = True, 1
+    peak.direction = -1
+    return impact, fall, peak
+
+
+def _free_map(u, v, s, p, alpha, eta, model, tab):
+    """The kernels' free-rocking map from u = s theta, v = s theta_dot on side s: of a block
+    (:func:`._free_map.free_rocking_map`) or, with tables, of a mechanism
+    (:func:`._tables._free_map_table`). Returns (overturns, peak, impacts until rest)."""
+    omega_rest = REST_FRACTION * p * alpha
+    if tab is not None:
+        side = 0 if s > 0.0 else 1
+        return _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
+    return free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
+
+
+def _ground(motion):
+    """The ground accelerations u_h''(t) and u_v''(t) [m/s^2] of a motion as scalar functions
+    (u_v'' = 0 without a vertical component); free fall (u_v'' <= -g) is refused."""
+    _, mp, _, _, vsamples = motion.kernel_spec()
+    refuse_free_fall(vsamples, mp[0])
+    return _scalar_acceleration(motion), _scalar_vertical(motion) or (lambda t: 0.0)
+
+
+def _log_peaks(sol, s, max_u, peaks):
+    """Append the peaks of a phase's ``solve_ivp`` solution on side s to ``peaks``; returns
+    max_u [rad] raised to the largest of them."""
+    if sol.y_events[2].size:
+        max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
+        peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
+    return max_u
+
+
+def _grids(motion):
+    """The times scanned for uplift and those the phases stop at: a record's samples (where
+    u_g'' has a kink) for both, or 4097 points over a pulse and no stops."""
+    if isinstance(motion, Record):
+        grid = np.asarray(motion.time)
+        return grid, grid
+    return np.linspace(0.0, motion.duration, 4097), None
+
+
+def _stop_time(t, dur, breaks, t_end, p):
+    """Where a phase from t [s] stops: the next record sample (``breaks``) or the motion's end
+    ``dur``; after the motion, 100 / p on, at most ``t_end``."""
+    if t < dur:
+        return dur if breaks is None else breaks[np.searchsorted(breaks, t, side="right")]
+    return min(t_end, t + 100.0 / p)
+
+
+def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, dense_output):
+    """One phase on side s by ``solve_ivp`` over ``span``, with the events of :func:`_events`;
+    a failed solve raises RuntimeError."""
+    sol = solve_ivp(
+        rhs,
+        span,
+        y0,
+        method=integrator,
+        args=(s,),
+        rtol=rtol,
+        atol=atol,
+        events=_events(s, fall_at),
+        dense_output=dense_output,
+    )
+    if sol.status < 0:
+        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+    return sol
+
+
+def _side_after_impact(om_post, s, t, acc, excess, omega_rest):
+    """The side after an impact at t [s] on side s that left the speed om_post: the other
+    side, or below ``omega_rest`` rest unless the ground lifts the block again (the Zeno
+    rule), which then restarts on the side it is pushed to. Returns (at rest, side, speed)."""
+    if not abs(om_post) < omega_rest:
+        return False, -s, om_post
+    a = acc(t)
+    if excess(t) < 0.0:
+        return True, s, 0.0
+    return False, (-1.0 if a > 0 else 1.0), 0.0
+
+
+def _warn_incomplete(max_impacts, t):
+    """Warn that the reference stopped at ``max_impacts`` impacts, at t [s]."""
+    warnings.warn(
+        f"scipy reference: max_impacts={max_impacts} impacts reached at t = {t!r} "
+        "s (a chatter it cannot end); the result covers [0, that time] only",
+        IncompleteReferenceWarning,
+        stacklevel=3,
+    )
+
+
 def simulate_reference(
     p,
     alpha,
@@ -128,37 +260,15 @@ def simulate_reference(
     if free_map and t_eval is not None:
         raise ValueError("t_eval needs the free rocking integrated: free_map=False")
     dense = _Dense(t_eval)
-    acc = _scalar_acceleration(motion)
-    _, mp, _, _, vsamples = motion.kernel_spec()
-    refuse_free_fall(vsamples, mp[0])
-    vert = _scalar_vertical(motion) or (lambda t: 0.0)
+    acc, vert = _ground(motion)
     dur = motion.duration
-    linear = model == MODEL_LINEAR
-    thr = G * alpha if linear else G * math.tan(alpha)
     tab, fall_at = table if model == MODEL_TABLE else (None, FALL_ROTATION)
     omega_rest = REST_FRACTION * p * alpha
     t_end = math.inf if t_max is None else float(t_max)
     atol = [rtol * alpha, rtol * p * alpha]
-    if isinstance(motion, Record):
-        grid = breaks = np.asarray(motion.time)
-    else:
-        grid, breaks = np.linspace(0.0, dur, 4097), None
+    grid, breaks = _grids(motion)
 
-    def excess(t):  # >= 0 where a block at rest lifts: |u_h''| >= (g + u_v'') tan alpha
-        if tab is not None:  # the kernels' own test, eq. (10) of [003] for a mechanism
-            return _lift(acc(t), vert(t), p, alpha, MODEL_TABLE, tab)
-        return abs(acc(t)) - thr * (1.0 + vert(t) / G)
-
-    def rhs(t, y, s):
-        if tab is not None:
-            return [y[1], _accel(acc(t), vert(t), y[0], y[1], p, alpha, s, MODEL_TABLE, tab)]
-        a = acc(t) / G
-        gv = 1.0 + vert(t) / G
-        if linear:
-            return [y[1], p * p * (gv * (y[0] - alpha * s) - a)]
-        x = alpha * s - y[0]
-        return [y[1], -p * p * (gv * math.sin(x) + a * math.cos(x))]
-
+    excess, rhs = _equations(p, alpha, model, tab, acc, vert)
     th, om = (float(x) for x in initial_state)
     ts, ths, oms, impacts, peaks = [0.0], [th], [om], [], []
     max_u = abs(th)
@@ -177,56 +287,18 @@ def simulate_reference(
             ts.append(t), ths.append(0.0), oms.append(0.0)
         if t >= dur and free_map and not mapped:
             mapped = True
-            if tab is not None:
-                side = 0 if s > 0.0 else 1
-                over, peak, n_post = _free_map_table(
-                    s * th, s * om, eta, tab[side], tab[1 - side], omega_rest
-                )
-            else:
-                over, peak, n_post = free_rocking_map(
-                    s * th, s * om, p, alpha, eta, model, omega_rest
-                )
+            over, peak, n_post = _free_map(s * th, s * om, s, p, alpha, eta, model, tab)
             if not over:
                 impacts.extend([math.nan] * n_post)
                 return _pack(ts, ths, oms, max(max_u, peak), False, impacts, math.nan, peaks)
-        if t < dur:  # records: stop at every sample, where u_g'' has a kink
-            stop = dur if breaks is None else breaks[np.searchsorted(breaks, t, side="right")]
-        else:
-            stop = min(t_end, t + 100.0 / p)
+        stop = _stop_time(t, dur, breaks, t_end, p)
         if t >= stop:
             break
-
-        def impact(t_, y, s=s):
-            return s * y[0]
-
-        def fall(t_, y, s=s):
-            return s * y[0] - fall_at
-
-        def peak(t_, y, s=s):
-            return s * y[1]
-
-        impact.terminal, impact.direction = True, -1
-        fall.terminal, fall.direction = True, 1
-        peak.direction = -1
-        sol = solve_ivp(
-            rhs,
-            (t, stop),
-            [th, om],
-            method=integrator,
-            args=(s,),
-            rtol=rtol,
-            atol=atol,
-            events=(impact, fall, peak),
-            dense_output=dense.wanted,
-        )
-        if sol.status < 0:
-            raise RuntimeError(f"solve_ivp failed: {sol.message}")
+        sol = _solve(rhs, (t, stop), [th, om], s, integrator, rtol, atol, fall_at, dense.wanted)
         end = -1 if sol.status == 1 else None  # the event row is added below, exactly
         ts.extend(sol.t[1:end]), ths.extend(sol.y[0, 1:end]), oms.extend(sol.y[1, 1:end])
         dense.fill(sol.sol, t, float(sol.t[-1]))  # (a terminal event's time, if one came)
-        if sol.y_events[2].size:
-            max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
-            peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
+        max_u = _log_peaks(sol, s, max_u, peaks)
         if sol.t_events[1].size:
             t_ot = float(sol.t_events[1][0])
             ts.append(t_ot), ths.append(s * fall_at), oms.append(sol.y_events[1][0, 1])
@@ -238,22 +310,11 @@ def simulate_reference(
             impacts.append(t)
             ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([om_pre, om_post])
             th = 0.0
-            if abs(om_post) < omega_rest:
-                a = acc(t)
-                if excess(t) < 0.0:
-                    at_rest = True
-                    om = 0.0
-                    continue
-                s, om = (-1.0 if a > 0 else 1.0), 0.0
-            else:
-                s, om = -s, om_post
+            at_rest, s, om = _side_after_impact(om_post, s, t, acc, excess, omega_rest)
+            if at_rest:
+                continue
             if len(impacts) >= max_impacts:
-                warnings.warn(
-                    f"scipy reference: max_impacts={max_impacts} impacts reached at t = {t!r} "
-                    "s (a chatter it cannot end); the result covers [0, that time] only",
-                    IncompleteReferenceWarning,
-                    stacklevel=2,
-                )
+                _warn_incomplete(max_impacts, t)
                 break
             continue
         t, th, om = float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1])
