@@ -337,7 +337,8 @@ def test_a_sine_pulse_batch_compiles_no_step_it_cannot_take(tmp_path):
     """From an empty cache, a batch of sine-pulse scenes compiles the Taylor steps it runs and
     none of the others (the DOP853 step of Ricker wavelets and mechanisms, the record step,
     the mechanism's free-rocking map): ``scene_batch_trig_serial`` on one thread, whose
-    pruned branches halve the compile of a pulse study. Its results are the scipy reference's (tests of the kernel)."""
+    pruned branches halve the compile of a pulse study. Its results are the scipy
+    reference's (tests of the kernel)."""
     code = (
         COUNTER
         + """
