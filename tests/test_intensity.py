@@ -242,17 +242,20 @@ def test_pgv_and_arias_against_trapezoidal_integrals():
 
 
 def test_huge_records_do_not_overflow_silently():
-    """Issue 26: a record scaled by 1e300 gave Arias and CAV = inf or NaN. CAV is finite and
-    scales; Arias (1e600) cannot be represented and is refused, naming the acceleration."""
+    """Samples scaled by 1e300 gave Arias and CAV = inf or NaN. A Record refuses them (beyond
+    the 1e7 m/s^2 any motion reaches); the measures on raw samples: CAV is finite and scales,
+    Arias (1e600) cannot be represented and is refused, naming the acceleration."""
     rec = _random_record(n=200)
-    big = rec.scaled(1e300)
-    assert intensity.cumulative_absolute_velocity(big.time, big.acceleration) == pytest.approx(
+    with pytest.raises(ValueError, match="factor"):
+        rec.scaled(1e300)
+    t, big = rec.time, rec.acceleration * 1e300
+    assert intensity.cumulative_absolute_velocity(t, big) == pytest.approx(
         1e300 * rec.intensity_measures()["cav"], rel=1e-12
     )
     with pytest.raises(ValueError, match="acceleration"):
-        intensity.arias_intensity(big.time, big.acceleration)
-    small = rec.scaled(1e-160)  # a^2 underflows, the intensity does not
-    assert intensity.arias_intensity(small.time, small.acceleration) == pytest.approx(
+        intensity.arias_intensity(t, big)
+    small = rec.acceleration * 1e-160  # a^2 underflows, the intensity does not
+    assert intensity.arias_intensity(t, small) == pytest.approx(
         1e-320 * rec.intensity_measures()["arias"], rel=1e-6
     )
 
@@ -275,9 +278,13 @@ def test_mean_period_of_two_tones():
 
 
 def test_mean_period_refuses_a_step_that_resolves_no_frequency_of_its_band():
-    """Issue 26: mean_period at dt 1e100 was NaN without a warning."""
+    """mean_period at dt 1e100 was NaN without a warning: a Record refuses the duration, and
+    the measure on raw samples refuses the step."""
+    samples = np.random.default_rng(0).standard_normal(64)
+    with pytest.raises(ValueError, match="duration"):
+        Record(samples, dt=1e100)
     with pytest.raises(ValueError, match="dt"):
-        Record(np.random.default_rng(0).standard_normal(64), dt=1e100).intensity_measures()
+        intensity.mean_period(1e100 * np.arange(64.0), samples)
 
 
 def test_spectrum_intensity_of_a_step():

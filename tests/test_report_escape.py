@@ -89,10 +89,10 @@ def test_hostile_strings_run_no_script(hostile_cube, tmp_path, versions):
     cube = tmp_path / "cube.zarr"
     shutil.copytree(hostile_cube, cube)
     group = zarr.open_group(str(cube), mode="r+", zarr_format=2)
-    group.attrs["versions"] = versions  # a cube received from someone else
+    group.attrs["versions"] = versions  # a cube received from someone else, edited
     group.attrs["study_sha256"] = HOSTILE[1]
     zarr.consolidate_metadata(str(cube), zarr_format=2)
-    page = make_report(cube, tmp_path / "report")
+    page = make_report(cube, tmp_path / "report", verify=False)
     source = page.read_text()
     for payload in HOSTILE:
         assert payload not in source

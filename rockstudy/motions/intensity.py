@@ -297,16 +297,18 @@ def spectral_displacement(t, acc, periods, damping: float = 0.05):
     out = np.zeros(periods.size)
     if periods.size == 0:
         return out
-    steps = _steps(t)
-    _check_long_periods(periods, steps)
-    acc = np.ascontiguousarray(acc, dtype=float)
+    steps = np.array(_steps(t), dtype=float)  # writable C copies: one kernel signature for
+    _check_long_periods(periods, steps)  # every input (a read-only or strided record too)
+    acc = np.array(acc, dtype=float)
     omegas = 2.0 * math.pi / periods
     phase = omegas * float(np.max(steps))
     substeps = np.ceil(np.maximum(phase, 1e-300) / SPECTRUM_PHASE_STEP)
     direct = substeps * steps.size <= SPECTRUM_MAX_WORK
     for k in np.unique(substeps[direct]):
         sel = direct & (substeps == k)
-        out[sel] = _spectrum.peak_displacements(omegas[sel], zeta, steps, acc, int(k))
+        out[sel] = _spectrum.peak_displacements(
+            np.array(omegas[sel], dtype=float), float(zeta), steps, acc, int(k)
+        )
     for j in np.flatnonzero(~direct):
         out[j] = rigid_limit_displacement(t, acc, periods[j], zeta)
     return out

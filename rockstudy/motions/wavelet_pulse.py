@@ -41,7 +41,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 
 from .intensity import ground_velocity, pseudo_velocity_peak_period, uniform_samples
 from .pulse_extraction import PULSE_LIKE_INDICATOR, baker_indicator
@@ -121,6 +120,8 @@ def _kernel(scale: float, x, psi):
 
 def _correlate(v, kernel):
     """C[l] = sum_k v[l + k] kernel[k] for every l with the kernel inside ``v``."""
+    from scipy import signal  # imported on use: it costs ~0.6 s (see stochastic.py)
+
     return signal.fftconvolve(v, kernel[::-1], mode="valid")
 
 

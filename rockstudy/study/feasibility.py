@@ -20,6 +20,9 @@ from ..motions.suites import read_pair, suite_pairs
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
+#: Default of ``[design] max_scale_factor`` (and the bound of Monte Carlo rows scaled to a
+#: target): larger scale factors are noted by validate.
+DEFAULT_MAX_SCALE_FACTOR = 5.0
 
 #: each), the status and the error message.
 _ROW_BYTES = 8 * 20 + 128
@@ -128,8 +131,6 @@ def _scaling_notes(study, base_dir) -> list[str]:
     is horizontal only and even the highest level leaves every record's PGA below the lowest
     uplift acceleration g tan(theta_cr) of the structures, that nothing can rock (every
     point stays at rest)."""
-    from .spec import DEFAULT_MAX_SCALE_FACTOR
-
     de = study.design
     cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
     if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):

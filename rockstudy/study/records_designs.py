@@ -194,7 +194,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     for k, v in structures.items():
         if k != "names":
             data[k] = ("structure", v)
-    names = structures["names"]
+    names = structures.get("names")  # None: sampled structures, numbered
     ds = xr.Dataset(
         data,
         coords={

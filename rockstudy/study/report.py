@@ -547,12 +547,15 @@ def _version(versions) -> str:
     return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
 
 
-def make_report(result, out=None) -> Path:
-    """Write the report of a result cube into ``out`` (default: RESULT's name + '_report')."""
+def make_report(result, out=None, verify: bool = True) -> Path:
+    """Write the report of a result cube into ``out`` (default: RESULT's name + '_report').
+
+    ``verify=False`` reads the cube without checking it against the checksums of its run
+    (see :func:`~rockstudy.study.store.open_result`): a cube whose metadata was edited."""
     result = Path(result)
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     out.mkdir(parents=True, exist_ok=True)
-    ds = open_result(result).load()
+    ds = open_result(result, verify=verify).load()
     if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
         from .report_records import record_report
 

@@ -67,8 +67,8 @@ from ..constants import STANDARD_GRAVITY, G
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
+from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
-from .feasibility import notes, problems
 from .records_designs import IdaOptionError, IdaOptions
 
 
@@ -593,9 +593,6 @@ class RecordSpec(_Model):
         return self.scale_to
 
 
-#: Default of ``[design] max_scale_factor`` (and the bound of Monte Carlo rows scaled to a
-#: target): larger scale factors are noted by validate.
-DEFAULT_MAX_SCALE_FACTOR = 5.0
 
 
 class DesignSpec(_Model):
