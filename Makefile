@@ -42,7 +42,7 @@ demo: $(BASE)
 	$(BIN)/rockstudy demo --out results/demo
 
 test: $(KERNELS) debian docs
-	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q
+	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q --durations=15
 
 # The documentation site (Sphinx, numpydoc, sphinx-gallery; examples executed), warnings as
 # errors, into docs/_build/html
