@@ -246,7 +246,10 @@ def main() -> int:
     import sys
 
     def note():
-        print("compiling the numba kernels (once per install; about 5 minutes on 2 cores) ...", flush=True)
+        print(
+            "compiling the numba kernels (once per install; about 5 minutes on 2 cores) ...",
+            flush=True,
+        )
 
     r = compile_kernels(note)
     what = f"compiled {r['compiled']} kernels" if r["compiled"] else "all kernels were cached"
