@@ -31,7 +31,7 @@ from scipy import stats
 
 from rockstudy.constants import G
 from rockstudy.study import analysis
-from rockstudy.study import records_fragility as rf
+from rockstudy.study.analysis import record_fragility as rf
 
 OUT = Path(__file__).parent / "results"
 THETA, BETA = 0.5, 0.4

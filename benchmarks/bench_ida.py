@@ -34,8 +34,8 @@ import numpy as np
 from rockstudy import Block, simulate_batch
 from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
-from rockstudy.study import records_fragility as rf
-from rockstudy.study.records_designs import incremental_dynamic_analysis
+from rockstudy.study.analysis import record_fragility as rf
+from rockstudy.study.designs.records import incremental_dynamic_analysis
 
 OUT = Path(__file__).parent / "results"
 RECORDS = Path(os.environ.get("ROCKSTUDY_RECORDS") or Path(__file__).parents[2] / "shared/records")

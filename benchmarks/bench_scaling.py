@@ -43,8 +43,9 @@ import numpy as np
 from rockstudy.constants import G
 from rockstudy.dynamics.batch import simulate_batch
 from rockstudy.motions import stochastic_record
-from rockstudy.study import make_design, run_study, runner, store, validate_text
-from rockstudy.study.evaluate import _run_rows, evaluate_chunk
+from rockstudy.study import make_design, run_study, validate_text
+from rockstudy.study.running import runner, store
+from rockstudy.study.running.evaluate import _run_rows, evaluate_chunk
 
 OUT = Path(__file__).parent / "results"
 RTOL = 1e-8

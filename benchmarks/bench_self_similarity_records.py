@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from rockstudy.motions import load_suite
-from rockstudy.study.records_designs import incremental_dynamic_analysis
-from rockstudy.study.records_similarity import size_class_medians
-from rockstudy.study.report_records import record_report
+from rockstudy.study.analysis.record_similarity import size_class_medians
+from rockstudy.study.designs.records import incremental_dynamic_analysis
+from rockstudy.study.report.records import record_report
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = Path(__file__).parent / "results"

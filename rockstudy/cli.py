@@ -193,7 +193,7 @@ def _saved(out) -> tuple[str, bool]:
     """What a stopped run kept, read from its store, and whether ``--resume`` can continue it."""
     import numpy as np
 
-    from .study.store import read_marker, read_status
+    from .study.running.store import read_marker, read_status
 
     try:
         if not (read_marker(out) or {}).get("template_complete"):
@@ -269,8 +269,8 @@ def _run(args) -> int:
     from concurrent.futures import CancelledError
 
     from .study import load_study, run_study
-    from .study.runner import FailedSamplesError, SchedulerError
-    from .study.store import StoreError
+    from .study.running.runner import FailedSamplesError, SchedulerError
+    from .study.running.store import StoreError
 
     study = load_study(args.study)
     for note in study.notes:
@@ -321,7 +321,7 @@ def _run(args) -> int:
 
 def _compile(args) -> int:
     """Prime numba's on-disk cache with every kernel (once per install; ``make setup``)."""
-    from .study._warmup import main as compile_main
+    from .study.running._warmup import main as compile_main
 
     return compile_main()
 
@@ -335,7 +335,7 @@ def _validate(args) -> int:
             study = load_study(path)
             size = f"{study.samples()} samples"
             if study.design is not None:
-                from .study.feasibility import record_pairs
+                from .study.spec.feasibility import record_pairs
 
                 records = len(record_pairs(study.motion, Path(path).resolve().parent))
                 size = (
@@ -387,7 +387,7 @@ def main(argv=None) -> int:
         return 130
     finally:
         if "zarr.core.sync" in sys.modules:  # else exit may print a zarr RuntimeError
-            from .study.store import stop_zarr_io
+            from .study.running.store import stop_zarr_io
 
             stop_zarr_io()
 
@@ -527,7 +527,7 @@ def _verify(args) -> int:
 
     import zarr  # noqa: F401 - loaded before the clock starts: the time is the check's
 
-    from .study.store import StoreError, verify_cube
+    from .study.running.store import StoreError, verify_cube
 
     t0 = time.perf_counter()
     try:
@@ -543,7 +543,7 @@ def _verify(args) -> int:
 
 def _report(args) -> int:
     from .study.report import make_report
-    from .study.store import StoreError
+    from .study.running.store import StoreError
 
     try:
         print(f"wrote {make_report(args.result, args.out)}")
@@ -554,7 +554,7 @@ def _report(args) -> int:
 
 def _refused(exc) -> int:
     """One line for a cube that is refused: exit 1 if it is damaged, 2 if it is not a cube."""
-    from .study.store import DamagedCube
+    from .study.running.store import DamagedCube
 
     print(f"error: {exc}", file=sys.stderr)
     return 1 if isinstance(exc, DamagedCube) else 2

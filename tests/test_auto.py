@@ -444,7 +444,7 @@ def test_study_asks_the_engine_for_its_outputs():
     """A study's outputs reach the engine: auto may run the linear model for a study that
     keeps only covered outputs, and not for one that keeps overturn_time."""
     from rockstudy.study import validate_text
-    from rockstudy.study.evaluate import engine_outputs
+    from rockstudy.study.running.evaluate import engine_outputs
 
     text = """
 name = "t"

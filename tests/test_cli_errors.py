@@ -104,7 +104,7 @@ def test_a_read_only_out_does_not_advise_resume(tmp_path, monkeypatch, capsys):
     """The folder cannot be made (a read-only file system): nothing was saved, nothing to
     resume. In process, since root writes into a folder whatever its mode."""
     from rockstudy.cli import main
-    from rockstudy.study import store
+    from rockstudy.study.running import store
 
     def read_only(path, *args):
         raise OSError(30, "Read-only file system", str(path))

@@ -12,7 +12,7 @@ import pytest
 from test_store_safety import ROCKSTUDY, rockstudy_run, tree, write_study
 
 from rockstudy.study import open_result
-from rockstudy.study.store import DamagedCube
+from rockstudy.study.running.store import DamagedCube
 
 
 @pytest.fixture(scope="module")

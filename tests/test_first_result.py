@@ -152,7 +152,7 @@ import rockstudy as rs
 from rockstudy.motions import CosinePulse, HalfSinePulse, NoMotion, Record
 from rockstudy.structures import RockingWall
 from rockstudy.study import load_study, make_design, validate_text
-from rockstudy.study.evaluate import evaluate_chunk
+from rockstudy.study.running.evaluate import evaluate_chunk
 
 warnings.simplefilter("ignore")
 tmp = {str(tmp_path)!r}
@@ -248,7 +248,7 @@ def test_a_cold_run_compiles_in_the_client_only(tmp_path):
 import json
 from distributed import Client, LocalCluster
 from rockstudy.study import run_study, validate_text
-from rockstudy.study._warmup import _CompileCounter
+from rockstudy.study.running._warmup import _CompileCounter
 
 study = validate_text({text!r})
 with (
@@ -274,7 +274,7 @@ print(json.dumps({{"client": counter.count, "workers": workers}}))
 
 
 def test_run_says_when_it_compiles(monkeypatch, capsys):
-    from rockstudy.study import runner
+    from rockstudy.study.running import runner
 
     def compiling(study_json, columns, base_dir, on_first_compile):
         on_first_compile()
@@ -291,7 +291,7 @@ def test_run_says_when_it_compiles(monkeypatch, capsys):
 def test_warm_up_clears_the_cache_when_a_kernel_source_changes(tmp_path, monkeypatch):
     """numba checks only each kernel's own file; a change in any kernel source (or in the
     constants) clears the package's cache before the warm-up compiles again."""
-    from rockstudy.study._warmup import purge_stale_cache
+    from rockstudy.study.running._warmup import purge_stale_cache
 
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     (tmp_path / "pkg" / "__pycache__").mkdir(parents=True)
@@ -318,7 +318,7 @@ def test_compile_counter_sees_compilation_and_not_cache_hits():
     """The warm-up and the runner learn that numba compiles from its "numba:compile" event."""
     from numba import njit
 
-    from rockstudy.study._warmup import _CompileCounter
+    from rockstudy.study.running._warmup import _CompileCounter
 
     @njit  # no cache: compiled on its first call
     def twice(x):

@@ -25,9 +25,9 @@ import pytest
 
 from rockstudy.motions.suites import RECORD_SUFFIXES
 from rockstudy.study import StudyError, load_study
-from rockstudy.study.evaluate import STATUS_OK, evaluate_chunk
-from rockstudy.study.sampling import make_design
-from rockstudy.study.spec import Output
+from rockstudy.study.designs.sampling import make_design
+from rockstudy.study.running.evaluate import STATUS_OK, evaluate_chunk
+from rockstudy.study.spec.schema import Output
 
 N_FILES = 240
 SEED = 20261125

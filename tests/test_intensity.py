@@ -438,7 +438,7 @@ def test_a_study_cube_states_both_gravities(tmp_path):
     from test_study import study_text
 
     from rockstudy.study import make_design, validate_text
-    from rockstudy.study.store import claim, create_store
+    from rockstudy.study.running.store import claim, create_store
 
     study = validate_text(study_text(chunk=10, n=20))
     out = tmp_path / "cube.zarr"

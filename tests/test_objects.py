@@ -12,8 +12,8 @@ import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.motions import Record, synthetic_near_fault
 from rockstudy.structures.block import frequency_parameter
-from rockstudy.study import records_designs as rd
-from rockstudy.study import records_fragility as rf
+from rockstudy.study.analysis import record_fragility as rf
+from rockstudy.study.designs import records as rd
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +116,7 @@ import test_record_studies  # noqa: E402
 
 from rockstudy.motions import load_suite  # noqa: E402
 from rockstudy.study import StudyError, load_study, run_study  # noqa: E402
-from rockstudy.study.store import open_result  # noqa: E402
+from rockstudy.study.running.store import open_result  # noqa: E402
 
 client = test_record_studies.client  # the one-worker cluster fixture
 write_at2 = test_record_studies.write_at2
@@ -251,7 +251,7 @@ def test_objects_study_errors_name_the_object_and_the_field(suite, tmp_path):
 
 
 def test_objects_geometry_is_that_of_the_block():
-    from rockstudy.study.spec import ObjectSpec
+    from rockstudy.study.spec.schema import ObjectSpec
 
     o = ObjectSpec(name="S", width=0.45, height=1.9)
     b = rs.Block.from_dimensions(width=0.45, height=1.9)

@@ -19,10 +19,10 @@ from rockstudy import simulate_batch
 from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.study import StudyError, load_study, run_study
-from rockstudy.study import records_designs as rd
-from rockstudy.study.evaluate import STATUS_OK, evaluate_chunk
-from rockstudy.study.sampling import make_design
-from rockstudy.study.store import open_result
+from rockstudy.study.designs import records as rd
+from rockstudy.study.designs.sampling import make_design
+from rockstudy.study.running.evaluate import STATUS_OK, evaluate_chunk
+from rockstudy.study.running.store import open_result
 
 
 def write_at2(path, record):
@@ -190,7 +190,7 @@ def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, c
     """A folder of H/V pairs: each record is read with its vertical file; if the solvers take
     vertical shaking the cube equals the Python design on the same pairs, else the study is
     refused by validation (never run without its vertical)."""
-    from rockstudy.study.feasibility import vertical_refusal
+    from rockstudy.study.spec.feasibility import vertical_refusal
 
     if vertical_refusal() is not None:
         with pytest.raises(StudyError, match="motion.vertical"):
@@ -276,7 +276,7 @@ def test_a_record_that_fails_in_its_task_fails_its_rows_and_is_counted(suite, cl
     """A record spoiled after validation: its task fails, its rows are marked failed with the
     reader's message (naming the file), the other records are kept, and the run raises
     FailedSamplesError (max_failed is 0 by default)."""
-    from rockstudy.study.runner import FailedSamplesError
+    from rockstudy.study.running.runner import FailedSamplesError
 
     folder = tmp_path / "records"
     folder.mkdir()

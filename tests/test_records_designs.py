@@ -13,7 +13,7 @@ from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, synthetic_near_fault
 from rockstudy.similarity import record_groups
 from rockstudy.structures.block import frequency_parameter
-from rockstudy.study import records_designs as rd
+from rockstudy.study.designs import records as rd
 
 # ------------------------------------------------------------------------------ suites
 
@@ -416,7 +416,7 @@ def test_ida_censors_at_free_fall_and_the_fit_takes_it_as_censored():
         assert int(ds["censored_reason"][0, 0]) == 2
         low = float(ds["capacity_scale_lower"][0, 0])
         assert low < ceiling and not rs.simulate(rs.Block(5.0, 0.25), rec.scaled(low)).overturned
-    from rockstudy.study import records_fragility as rf
+    from rockstudy.study.analysis import record_fragility as rf
 
     table = rf.ida_fragility(ds, n_boot=5)
     assert table["n"].iloc[0] == 1
@@ -433,7 +433,7 @@ def test_stripes_levels_at_free_fall_are_censored_and_the_others_run():
     for k in (0, 1):
         one = rs.simulate(rs.Block(0.3, 0.2), rec.scaled(levels[k]), method="scipy", rtol=1e-10)
         assert bool(ds["overturned"][0, 0, k]) == one.overturned
-    from rockstudy.study import records_fragility as rf
+    from rockstudy.study.analysis import record_fragility as rf
 
     assert rf.stripe_fragility(ds, n_boot=0)["n"].iloc[0] == 2  # the censored left out
 

@@ -8,8 +8,9 @@ import xarray as xr
 from scipy import optimize, stats
 
 from rockstudy.constants import G
-from rockstudy.study import analysis, fragility_fit
-from rockstudy.study import records_fragility as rf
+from rockstudy.study import analysis
+from rockstudy.study.analysis import fragility_fit
+from rockstudy.study.analysis import record_fragility as rf
 
 
 def _ida_dataset(capacity_scale, pga, pgv, uplift, p, censored=None, sa=None):
@@ -383,7 +384,7 @@ def test_bad_fragility_arguments_are_named():
 def test_record_designs_carry_units():
     from rockstudy.motions import Record
     from rockstudy.motions.intensity import UNITS
-    from rockstudy.study.records_designs import _record_dataset
+    from rockstudy.study.designs.records import _record_dataset
 
     t = np.arange(0, 2.0, 0.01)
     rec = Record(np.sin(2 * np.pi * t), dt=0.01, name="x")

@@ -10,8 +10,8 @@ import xarray as xr
 from rockstudy.constants import G
 from rockstudy.motions import Record, synthetic_near_fault
 from rockstudy.structures.block import frequency_parameter
-from rockstudy.study.records_designs import incremental_dynamic_analysis
-from rockstudy.study.records_similarity import size_class_medians, size_classes
+from rockstudy.study.analysis.record_similarity import size_class_medians, size_classes
+from rockstudy.study.designs.records import incremental_dynamic_analysis
 
 R = np.array([0.4, 1.2, 3.6])
 ALPHA = 0.2

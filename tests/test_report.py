@@ -113,7 +113,7 @@ def test_fragility_section_marks_medians_outside_the_sampled_range(tmp_path):
     import xarray as xr
     from scipy import stats
 
-    from rockstudy.study import report
+    from rockstudy.study.report import sampled as report
 
     rng = np.random.default_rng(7)
     n = 6000
@@ -192,7 +192,7 @@ def test_failed_samples_counted_by_message(tmp_path):
     import pandas as pd
     import xarray as xr
 
-    from rockstudy.study import report
+    from rockstudy.study.report import sampled as report
 
     status = np.array([1, 2, 2, 1, 2, 0], np.int8)
     error = np.array([b"", b"step limit", b"step limit", b"", b"bad record", b""])
@@ -205,7 +205,7 @@ def test_failed_samples_counted_by_message(tmp_path):
 
 
 def test_cells_have_three_significant_figures_and_counts_are_integers():
-    from rockstudy.study.report import _shown
+    from rockstudy.study.report._page import _shown
 
     assert _shown(20000) == "20000" and _shown(np.int64(20000)) == "20000"
     assert (

@@ -12,9 +12,9 @@ from test_report import chromium_figures
 
 from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite
-from rockstudy.study.records_designs import cloud, incremental_dynamic_analysis, multiple_stripes
+from rockstudy.study.designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
 from rockstudy.study.report import make_report
-from rockstudy.study.report_records import record_report
+from rockstudy.study.report.records import record_report
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "records"
 EVIL = "<script>alert(1)</script> & co"

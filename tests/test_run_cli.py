@@ -66,7 +66,7 @@ def test_failed_samples_exit_nonzero_with_a_summary(tmp_path):
 
 
 def test_error_messages_are_stored_whole(tmp_path):
-    from rockstudy.study.evaluate import evaluate_chunk
+    from rockstudy.study.running.evaluate import evaluate_chunk
 
     record = tmp_path / ("a_long_folder_name_" * 6) / "record.txt"
     record.parent.mkdir()
@@ -281,7 +281,7 @@ def test_a_failing_write_is_one_error_line_and_resume_finishes(tmp_path):
 
 
 def test_local_cluster_opens_no_dashboard():
-    from rockstudy.study.runner import _client
+    from rockstudy.study.running.runner import _client
 
     client, cluster = _client(workers=1)
     try:
@@ -377,7 +377,7 @@ from zarr.core import sync
 group = zarr.open_group(sys.argv[1], mode="r", zarr_format=2, use_consolidated=True)
 group["status"][:]  # zarr's IO loop and thread are running
 sync.loop[0].call_soon_threadsafe(time.sleep, 1.0)  # and busy when the process exits
-from rockstudy.study.store import stop_zarr_io
+from rockstudy.study.running.store import stop_zarr_io
 stop_zarr_io()
 """
 

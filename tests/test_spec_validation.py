@@ -13,9 +13,9 @@ import pytest
 from rockstudy import Block
 from rockstudy.cli import main as cli_main
 from rockstudy.study import StudyError, load_study, validate_text
-from rockstudy.study.evaluate import evaluate_chunk, resolve_file
-from rockstudy.study.sampling import make_design
-from rockstudy.study.spec import Study
+from rockstudy.study.designs.sampling import make_design
+from rockstudy.study.running.evaluate import evaluate_chunk, resolve_file
+from rockstudy.study.spec.schema import Study
 
 ROOT = Path(__file__).resolve().parents[1]
 

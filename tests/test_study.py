@@ -14,7 +14,7 @@ import xarray as xr
 
 from rockstudy.cli import main as cli_main
 from rockstudy.study import StudyError, make_design, run_study, validate_text
-from rockstudy.study.spec import json_schema
+from rockstudy.study.spec.schema import json_schema
 
 ROOT = Path(__file__).resolve().parents[1]
 ROCKSTUDY = str(Path(sys.executable).with_name("rockstudy"))

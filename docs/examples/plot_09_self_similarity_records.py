@@ -16,8 +16,8 @@ import numpy as np
 from rockstudy.constants import G
 from rockstudy.motions import synthetic_near_fault
 from rockstudy.motions.shipped import SHIPPED_DT, SHIPPED_SUITE
-from rockstudy.study.records_designs import incremental_dynamic_analysis
-from rockstudy.study.records_similarity import size_class_medians
+from rockstudy.study.analysis.record_similarity import size_class_medians
+from rockstudy.study.designs.records import incremental_dynamic_analysis
 
 records = [
     synthetic_near_fault(pulse_period=tp, pga=pga * G, seed=seed, dt=SHIPPED_DT)

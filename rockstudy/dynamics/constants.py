@@ -5,7 +5,7 @@ controls.
 Some are numpy scalars, not Python ints: numba types a literal argument as Literal[int] and
 compiles a specialization of the callee for each value. numba compiles these values into
 the kernels of other files: the warm-up fingerprints every file named ``constants.py``
-(:func:`rockstudy.study._warmup._kernel_sources`), so a change here empties a stale cache.
+(:func:`rockstudy.study.running._warmup._kernel_sources`), so a change here empties a stale cache.
 """
 
 from __future__ import annotations

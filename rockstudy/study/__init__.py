@@ -3,12 +3,12 @@
 Imports run one way: ``study`` uses the physics packages, never the reverse.
 """
 
-from .records_designs import cloud, incremental_dynamic_analysis, multiple_stripes
-from .records_fragility import ida_fragility, im_efficiency, stripe_fragility
-from .runner import RunReport, run_study
-from .sampling import make_design, salib_problem
-from .spec import Study, StudyError, json_schema, load_study, validate_text
-from .store import export_netcdf, open_result
+from .analysis.record_fragility import ida_fragility, im_efficiency, stripe_fragility
+from .designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
+from .designs.sampling import make_design, salib_problem
+from .running.runner import RunReport, run_study
+from .running.store import export_netcdf, open_result
+from .spec.schema import Study, StudyError, json_schema, load_study, validate_text
 
 __all__ = [
     "RunReport",

@@ -25,13 +25,13 @@ from typing import ClassVar
 import numpy as np
 import xarray as xr
 
-from .. import similarity
-from ..constants import G
-from ..dynamics import simulate_batch
-from ..dynamics._vertical import uplift_ratio
-from ..motions import Record
-from ..motions import intensity as _im
-from ..structures.block import block_parameters, frequency_parameter, restitution_housner
+from ... import similarity
+from ...constants import G
+from ...dynamics import simulate_batch
+from ...dynamics._vertical import uplift_ratio
+from ...motions import Record
+from ...motions import intensity as _im
+from ...structures.block import block_parameters, frequency_parameter, restitution_housner
 
 #: Dimensionless targets: name -> the record measure it divides by the uplift acceleration
 #: (``pga_ratio`` = PGA / (g tan alpha), ``pgv_ratio`` = PGV p / (g tan alpha)).

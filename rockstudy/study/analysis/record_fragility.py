@@ -23,8 +23,8 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from ..constants import G
-from ..motions.intensity import SCALING_POWER
+from ...constants import G
+from ...motions.intensity import SCALING_POWER
 from .fragility_fit import (
     binomial_covariance,
     capacities_covariance,

@@ -24,10 +24,10 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ..motions.intensity import SCALING_POWER, UNITS
-from ..motions.suites import read_pair
-from . import records_designs as rd
-from .feasibility import record_pairs
+from ...motions.intensity import SCALING_POWER, UNITS
+from ...motions.suites import read_pair
+from ..spec.feasibility import record_pairs
+from . import records as rd
 
 #: Per-record variables of the design Dataset: (long_name, units).
 RECORD_VARIABLES = {
@@ -193,7 +193,7 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
 
 @lru_cache(maxsize=8)
 def _suite(motion_json: str, base_dir) -> tuple:
-    from .spec import RecordSpec
+    from ..spec.schema import RecordSpec
 
     return tuple(record_pairs(RecordSpec.model_validate(json.loads(motion_json)), base_dir))
 
@@ -201,7 +201,7 @@ def _suite(motion_json: str, base_dir) -> tuple:
 @lru_cache(maxsize=32)
 def load_record(motion_json: str, base_dir, index: int):
     """Record ``index`` of a study's suite (read once per process)."""
-    from .spec import RecordSpec
+    from ..spec.schema import RecordSpec
 
     units = RecordSpec.model_validate(json.loads(motion_json)).units
     field, h, v = _suite(motion_json, base_dir)[index]
@@ -376,7 +376,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
 
 def _uplift(ds):
     """g tan(theta_cr) [m/s^2] of each structure, as :mod:`.records_designs` forms it."""
-    from ..constants import G
+    from ...constants import G
 
     return G * np.tan(ds["critical_rotation"].values)
 

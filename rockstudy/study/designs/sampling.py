@@ -14,8 +14,8 @@ import numpy as np
 import xarray as xr
 from scipy.stats import qmc
 
-from ..constants import G
-from .spec import Study
+from ...constants import G
+from ..spec.schema import Study
 
 #: CF-style attributes of every design variable.
 VARIABLES = {
@@ -122,7 +122,7 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     st, mo = study.structure, study.motion
     data = {}
     if st.kind == "objects":
-        from .record_studies import design_rows
+        from .record_rows import design_rows
 
         return _attributes(design_rows(study, _object_columns(st), base_dir))
     if st.kind == "equivalent_block":
@@ -151,7 +151,7 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
             critical_rotation=alpha,
         )
     if study.design is not None:
-        from .record_studies import design_rows
+        from .record_rows import design_rows
 
         return _attributes(design_rows(study, data, base_dir))
     uplift = G * np.tan(alpha)
@@ -225,7 +225,7 @@ def _object_columns(objects) -> dict:
 
 def target_attributes(scale_to) -> dict:
     """long_name and units of a record scale target ``scale_to``."""
-    from ..motions.intensity import UNITS
+    from ...motions.intensity import UNITS
 
     what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
     written = "" if scale_to.units is None else f", written in {scale_to.units}"
@@ -245,6 +245,6 @@ def _suite_size(motion, base_dir) -> int:
     """Records of a record motion: its list of files, or those its folder or glob names."""
     if isinstance(motion.files, list) and not hasattr(motion.vertical, "match"):
         return len(motion.files)
-    from .feasibility import record_pairs
+    from ..spec.feasibility import record_pairs
 
     return len(record_pairs(motion, base_dir))

@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .records_fragility import QUOTED_UNITS, fit_binomial, fit_capacities, intensity
+from .record_fragility import QUOTED_UNITS, fit_binomial, fit_capacities, intensity
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"

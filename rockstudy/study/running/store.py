@@ -36,9 +36,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ..constants import STANDARD_GRAVITY, G
+from ...constants import STANDARD_GRAVITY, G
+from ..spec.schema import Study
 from .evaluate import OUTPUTS, STATUS_FAILED, STATUS_OK, STATUS_PENDING
-from .spec import Study
 
 _INT32 = np.iinfo(np.int32)
 _PACKAGES = (
@@ -97,7 +97,7 @@ def input_hashes(study: Study, base_dir=None) -> dict:
     relative to ``base_dir`` (absolute if outside it)."""
     if study.motion.kind != "record":
         return {}
-    from .feasibility import record_pairs
+    from ..spec.feasibility import record_pairs
 
     base = Path(Path.cwd() if base_dir is None else base_dir)
     out = {}
@@ -498,12 +498,12 @@ def output_table(study: Study) -> dict:
     """The per-sample outputs of a study: name -> (long_name, units, dtype, fill, extra
     dimension or None)."""
     if study.design is not None:
-        from .record_studies import outputs
+        from ..designs.record_rows import outputs
 
         return outputs(study)
     out = {name: (*OUTPUTS[name], None) for name in study.run.outputs}
     if study.motion.kind == "record":
-        from .record_studies import sample_outputs
+        from ..designs.record_rows import sample_outputs
 
         out.update(sample_outputs(study))
     return out
@@ -872,7 +872,7 @@ def open_result(path, verify: bool = True) -> xr.Dataset:
             verify_cube(path)
         ds = xr.open_zarr(path, consolidated=True)
     if "record_design" in ds.attrs and "sample" in ds.dims:
-        from .record_studies import design_dataset
+        from ..designs.record_rows import design_dataset
 
         return design_dataset(ds)
     grid = ds.attrs.get("grid_dims")
@@ -941,7 +941,7 @@ def export_netcdf(path, out_path) -> Path:
     out_path = Path(out_path)
     ds = xr.open_zarr(Path(path), consolidated=True)  # lazy: written chunk by chunk
     if "record_design" in ds.attrs:  # a record design is exported in its own layout
-        from .record_studies import design_dataset
+        from ..designs.record_rows import design_dataset
 
         ds = design_dataset(ds)
         empty = [d for d, size in ds.sizes.items() if size == 0]  # netCDF3 has none

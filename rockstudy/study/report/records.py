@@ -17,13 +17,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ..constants import G
-from ..motions import intensity as _im
-from . import records_fragility as rf
-from . import records_similarity as rsim
+from ...constants import G
+from ...motions import intensity as _im
+from ..analysis import record_fragility as rf
+from ..analysis import record_similarity as rsim
+from ..analysis.fragility_fit import BAND_COLUMNS
+from ..analysis.sampled import fragility_curve
 from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
-from .analysis import fragility_curve
-from .fragility_fit import BAND_COLUMNS
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")

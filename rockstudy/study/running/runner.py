@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..designs.sampling import make_design
+from ..spec.schema import Study
 from . import store
 from ._warmup import prime_study
 from .evaluate import STATUS_FAILED, evaluate_chunk
-from .sampling import make_design
-from .spec import Study
 
 
 @dataclass

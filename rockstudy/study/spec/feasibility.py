@@ -13,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
-from ..constants import G
-from ..motions.intensity import SCALING_POWER
-from ..motions.suites import read_pair, suite_pairs
+from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
+from ...constants import G
+from ...motions.intensity import SCALING_POWER
+from ...motions.suites import read_pair, suite_pairs
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
@@ -103,7 +103,7 @@ def notes(study, base_dir=None) -> list[str]:
     found = _scaling_notes(study, base_dir)
     if study.design is None:
         return found
-    from .records_designs import free_fall_scale
+    from ..designs.records import free_fall_scale
 
     for field, h, v in record_pairs(mo, base_dir):
         if v is None:
@@ -277,8 +277,8 @@ def _largest_scale(study, rec) -> tuple[str, float] | None:
 def vertical_refusal() -> str | None:
     """Why the solvers refuse a record with a vertical component (None if they take it), as
     the batch entry point answers for a record at rest."""
-    from ..dynamics import simulate_batch
-    from ..motions import Record
+    from ...dynamics import simulate_batch
+    from ...motions import Record
 
     rest = Record(np.zeros(3), dt=0.01, vertical=np.zeros(3))
     try:

@@ -16,8 +16,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..constants import G
-from . import analysis
+from ...constants import G
+from ..analysis import sampled as analysis
+from ..analysis.fragility_fit import BAND_COLUMNS
+from ..designs.sampling import VARIABLES, target_attributes
+from ..running.store import open_result
 from ._page import (
     _FRAGILITY_NAMES,
     NOT_REACHED,
@@ -26,9 +29,6 @@ from ._page import (
     _plt,
     _shown,
 )
-from .fragility_fit import BAND_COLUMNS
-from .sampling import VARIABLES, target_attributes
-from .store import open_result
 
 
 def _summary(page, ds):
@@ -263,7 +263,7 @@ def _similarity(page, ds, study):
 
 def _eta_law(page, surv):
     """The restitution law (4.14)-(4.16) of [000] against the cube's linear responses."""
-    from ..closedform import d0_star, limit_residual
+    from ...closedform import d0_star, limit_residual
 
     a, w, eta = (surv[v].values for v in ("a", "omega", "restitution"))
     after = limit_residual(a, w) < 0  # first impact after the pulse
@@ -448,7 +448,7 @@ def _overturning_map(page, ds, study):
     block) where they apply."""
     if not {"omega", "amplitude_ratio", "overturned"} <= set(ds.variables):
         return
-    from ..closedform import overturning_boundary
+    from ...closedform import overturning_boundary
 
     d = _computed(ds)
     w, a, over = d["omega"].values, d["amplitude_ratio"].values, d["overturned"].values == 1
@@ -557,7 +557,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     ds = open_result(result, verify=verify).load()
     if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
-        from .report_records import record_report
+        from .records import record_report
 
         if "study" not in ds.attrs:  # a design run from Python and saved: no study file
             return record_report(ds, out, title=result.stem)

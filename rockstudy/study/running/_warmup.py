@@ -37,9 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import G
+from ...constants import G
 
-PACKAGE = Path(__file__).resolve().parents[1]
+PACKAGE = Path(__file__).resolve().parents[2]
 STAMP = "numba-sources.sha256"
 _USES_NUMBA = re.compile(r"^(from numba import|import numba$)", re.MULTILINE)
 
@@ -100,7 +100,7 @@ class _CompileCounter:
 
 def _with_vertical(record):
     """``record`` with a small vertical component on its samples (a third of it, upwards)."""
-    from ..motions import Record
+    from ...motions import Record
 
     return Record(record.acceleration, dt=record.dt, vertical=record.acceleration / 3.0)
 
@@ -108,9 +108,9 @@ def _with_vertical(record):
 def _simulate_calls():
     """One small call of every method of :func:`rockstudy.simulate` on a pulse and a record
     (also one with a vertical component, on the same kernel signatures)."""
-    from ..dynamics import simulate
-    from ..motions import RickerWavelet, SinePulse, stochastic_record
-    from ..structures import Block, PointMassStrut
+    from ...dynamics import simulate
+    from ...motions import RickerWavelet, SinePulse, stochastic_record
+    from ...structures import Block, PointMassStrut
 
     alpha = 0.2
     block = Block(1.0, alpha)
@@ -143,8 +143,8 @@ def _batch_calls(methods=("nonlinear", "linear", "auto")):
 
 def _batch_calls_of(methods):
     """:func:`_batch_calls` on the current number of threads."""
-    from ..dynamics import simulate_batch
-    from ..motions import stochastic_record
+    from ...dynamics import simulate_batch
+    from ...motions import stochastic_record
 
     alpha = np.array([0.15, 0.2])
     peak = 3.0 * G * np.tan(alpha)
@@ -159,7 +159,7 @@ def _batch_calls_of(methods):
 
 def _record_measure_calls():
     """Intensity measures, spectrum and pulse of a record (studies store them per record)."""
-    from ..motions import synthetic_near_fault
+    from ...motions import synthetic_near_fault
 
     record = synthetic_near_fault(pulse_period=1.0, pga=3.0, seed=0, duration=4.0)
     record.intensity_measures(periods=[0.5, 1.0])
@@ -169,7 +169,7 @@ def _record_measure_calls():
 
 def _closedform_calls():
     """Every ufunc of :mod:`rockstudy.closedform.sine`, and the boundary-curve kernel."""
-    from ..closedform import overturning_boundary, sine
+    from ...closedform import overturning_boundary, sine
 
     names = sine.build_all()
     sine.overturning_mode(np.array([2.0]), np.array([1.0]), np.array([0.9]))

@@ -62,14 +62,14 @@ from pydantic import (
     model_validator,
 )
 
-from .. import _validate
-from ..constants import STANDARD_GRAVITY, G
-from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE
-from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
+from ... import _validate
+from ...constants import STANDARD_GRAVITY, G
+from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
+from ...structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
+from ..designs.records import IdaOptionError, IdaOptions
 from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
-from .records_designs import IdaOptionError, IdaOptions
 
 
 def _param_tag(value):
@@ -1286,7 +1286,7 @@ def _read_objects_file(data, base_dir) -> str | None:
         return "structure.file: give objects or file, not both"
     if not isinstance(name, str) or not name.strip():
         return f"structure.file: must be the path of a CSV file, got {_describe(name)}"
-    from ..motions.records import read_text_file
+    from ...motions.records import read_text_file
     from .feasibility import record_path
 
     path = record_path(name, base_dir)
@@ -1325,7 +1325,7 @@ def _cell(text: str):
 
 def load_study(path) -> Study:
     """Read and validate a study file; its relative record paths are relative to its folder."""
-    from ..motions.records import read_text_file
+    from ...motions.records import read_text_file
 
     path = Path(path)
     try:

@@ -22,6 +22,7 @@ import xarray as xr
 from scipy import special
 from scipy.spatial import cKDTree
 
+from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
     binomial_covariance,
@@ -33,7 +34,6 @@ from .fragility_fit import (
     probability_band,
     wald_intervals,
 )
-from .spec import Study
 
 FailedPolicy = Literal["error", "drop", "impute"]
 

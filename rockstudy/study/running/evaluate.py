@@ -13,13 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import G
-from ..dynamics.batch import OUTPUTS as BATCH_OUTPUTS
-from ..dynamics.batch import simulate_batch
-from ..motions import stochastic_record
-from . import record_studies
-from .feasibility import record_path
-from .spec import Study
+from ...constants import G
+from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
+from ...dynamics.batch import simulate_batch
+from ...motions import stochastic_record
+from ..designs import record_rows as record_studies
+from ..spec.feasibility import record_path
+from ..spec.schema import Study
 
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
 

@@ -1,0 +1,31 @@
+"""Analyses of result cubes.
+
+``sampled`` analyses a sampled study's cube (Sobol' indices, fragility, the collapse onto the
+dimensionless groups); ``record_fragility`` fits the fragility of record designs and ranks
+intensity measures; ``record_similarity`` checks whether block sizes collapse on records;
+``fragility_fit`` holds the lognormal fits and bands they share.
+"""
+
+from .sampled import (
+    UnexplainedShare,
+    collapse_metric,
+    first_order_given_data,
+    fragility,
+    fragility_curve,
+    sobol_convergence,
+    sobol_indices,
+    study_of,
+    unexplained_share,
+)
+
+__all__ = [
+    "UnexplainedShare",
+    "collapse_metric",
+    "first_order_given_data",
+    "fragility",
+    "fragility_curve",
+    "sobol_convergence",
+    "sobol_indices",
+    "study_of",
+    "unexplained_share",
+]

@@ -1,0 +1,7 @@
+"""Designs: the scenes a study runs, as an ``xarray.Dataset`` of inputs.
+
+``sampling`` expands a study file into a Monte Carlo, Sobol', LHS or grid design
+(:func:`~rockstudy.study.designs.sampling.make_design`); ``records`` runs record designs from
+Python (cloud, multiple stripes, incremental dynamic analysis); ``record_rows`` lays a study
+file's record design out as rows of the result cube, and folds the rows back.
+"""

@@ -1,0 +1,6 @@
+"""Running a study: dask tasks over chunks of the design, written into a zarr cube.
+
+``runner`` drives the run (:func:`~rockstudy.study.running.runner.run_study`); ``evaluate``
+is the function each task runs on a chunk of rows; ``store`` writes, resumes, verifies and
+opens the cube; ``_warmup`` compiles the numba kernels before the workers need them.
+"""
