@@ -161,3 +161,36 @@ def test_a_hazard_the_design_cannot_express_is_refused():
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     with pytest.raises(ValueError, match="years"):
         object_risk(_ida(cap), hazard, years=0)
+
+
+def test_share_below_a_level_matches_the_closed_form_of_a_power_law():
+    # int_0^u F |d lambda| = E[lambda(C); C < u] - lambda(u) F(u), both in closed form for
+    # lambda = k0 x^-k and ln C ~ N(mu, beta^2)
+    from scipy.stats import norm
+
+    from rockstudy.study.risk_analysis import share_below
+
+    theta, beta, u = 0.5, 0.6, 0.3
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g", levels=[0.01, 0.1, 1.0, 5.0])
+    mu = np.log(theta)
+    tail = (
+        K0 * np.exp(-K * mu + 0.5 * (K * beta) ** 2) * norm.cdf((np.log(u) - mu) / beta + K * beta)
+    )
+    below = tail - K0 * u**-K * norm.cdf((np.log(u) - mu) / beta)
+    total = K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
+    assert share_below(theta, beta, hazard, u) == pytest.approx(below / total, rel=1e-9)
+
+
+def test_the_uplift_share_is_given_for_a_pga_hazard():
+    cap = np.column_stack([_lognormal(0.4, 0.8, 30, 12)])
+    ds = _ida(cap)
+    ds["pga_ratio"] = (("record", "structure"), np.full((30, 1), 1 / 0.2))  # uplift 0.2 g
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(ds, hazard, n_boot=0)
+    assert out["uplift"].item() == pytest.approx(0.2, rel=1e-12)
+    row = out.isel(structure=0)
+    from rockstudy.study.risk_analysis import share_below
+
+    expected = share_below(row["theta"].item(), row["beta"].item(), hazard, 0.2)
+    assert row["share_below_uplift"].item() == pytest.approx(expected, rel=1e-12)
+    assert 0 < expected < 1

@@ -567,8 +567,15 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             page.heading("Study")
             _study_file(page, study, ds)
 
+        hazard = study.hazard
         return record_report(
-            ds, out, title=study.name, description=study.description, appendix=study_section
+            ds,
+            out,
+            title=study.name,
+            description=study.description,
+            appendix=study_section,
+            hazard=None if hazard is None else hazard.curve(),
+            years=50.0 if hazard is None else hazard.years,
         )
     study = analysis.study_of(ds)
     page = _Page(out)

@@ -38,7 +38,7 @@ from .. import risk
 from . import records_fragility as rf
 from .fragility_fit import check_conf_level, check_n_boot, fit_binomial
 
-__all__ = ["STATUSES", "object_risk"]
+__all__ = ["STATUSES", "object_risk", "share_below"]
 
 #: What ``status`` of :func:`object_risk` says of an object's rate (module docstring).
 STATUSES = ("ok", "few", "none", "all", "no fit")
@@ -107,6 +107,32 @@ def _stripe_fitter(ds, im, period):
 
     lowest = np.nanmin(np.where(ok, x, np.nan).reshape(x.shape[0], x.shape[1], -1), axis=(0, 2))
     return fit, count, lowest
+
+
+def _uplift(ds, hazard):
+    """Each structure's uplift PGA g tan(alpha) in the hazard's units (NaN for another IM, or
+    where the design does not say it): below it a block cannot even leave rest."""
+    n = ds.sizes["structure"]
+    if hazard.im != "pga" or not {"pga", "pga_ratio"} <= set(ds.variables):
+        return np.full(n, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        level = (ds["pga"] / ds["pga_ratio"]).transpose("structure", ...).values.reshape(n, -1)
+        level = np.nanmedian(np.where(np.isfinite(level) & (level > 0), level, np.nan), axis=1)
+    return level / risk.UNIT_FACTORS[hazard.units][0]
+
+
+def share_below(theta, beta, hazard, level, units=None) -> float:
+    """The share of lambda_OT (:func:`rockstudy.risk.annual_rate`) that comes from intensities
+    below ``level`` (in the hazard's units): the deaggregation of the curve with ``level``
+    inserted among its levels (at its interpolated rate, which leaves the curve unchanged).
+    NaN without a rate or a level."""
+    if not (np.isfinite(level) and level > 0 and np.isfinite(theta) and np.isfinite(beta)):
+        return np.nan
+    x = np.union1d(hazard.levels, [level])
+    curve = risk.HazardCurve(hazard.im, x, hazard.rate(x), hazard.units, hazard.period)
+    _, upper, parts = risk.rate_deaggregation(theta, beta, curve, units)
+    total = parts.sum()
+    return float(parts[upper <= level].sum() / total) if total > 0 else np.nan
 
 
 def _rate(theta, beta, hazard, unit):
@@ -191,10 +217,14 @@ def object_risk(
         (:data:`STATUSES`), ``annual_rate`` [1/yr] with ``annual_rate_lo``/``_hi`` (the band),
         ``probability`` in ``years`` with ``probability_lo``/``_hi``, ``return_period`` [yr],
         ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
-        ``boot_valid`` (resamples that gave a rate); and on (``structure``, ``interval``)
-        ``deaggregation`` [1/yr], each interval's share of ``annual_rate`` with the edges
-        ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard, ``years``,
-        ``n_boot``, ``conf_level`` and ``seed``.
+        ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
+        PGA g tan(alpha), in ``hazard.units``) and ``share_below_uplift`` (the share of
+        ``annual_rate`` from PGA below it, where the block cannot leave rest: what the
+        lognormal's lower tail adds, not what a simulation saw), ``annual_rate_above_uplift``
+        (the rate of the fragility set to 0 below the uplift PGA); and on (``structure``,
+        ``interval``) ``deaggregation`` [1/yr], each interval's share of ``annual_rate``,
+        with the edges ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard,
+        ``years``, ``n_boot``, ``conf_level`` and ``seed``.
     """
     years = float(risk._positive("years", years))
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
@@ -240,6 +270,7 @@ def _bounds(status, lowest, hazard, ida):
 
 def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
     """The Dataset of :func:`object_risk` from the objects' rows, ranked."""
+    uplift = _uplift(ds, hazard)
     theta, beta, n_over, status, rate, boot = (list(c) for c in zip(*rows, strict=True))
     theta, beta, rate = (np.array(v, float) for v in (theta, beta, rate))
     boot = np.array(boot, float).reshape(len(rows), -1)
@@ -268,7 +299,15 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
         "rate_upper_bound": upper,
         "rate_lower_bound": lower,
         "boot_valid": valid,
+        "uplift": uplift,
+        "share_below_uplift": np.array(
+            [
+                share_below(t * to_hazard, b, hazard, u) if f else np.nan
+                for t, b, u, f in zip(theta, beta, uplift, fitted, strict=True)
+            ]
+        ),
     }
+    v["annual_rate_above_uplift"] = rate * (1.0 - v["share_below_uplift"])
     out = xr.Dataset(
         {k: ("structure", a) for k, a in v.items()},
         coords={"structure": ds["structure"].values},
