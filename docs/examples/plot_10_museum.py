@@ -72,7 +72,7 @@ print(ida["capacity"].to_pandas().T.div(G).round(3))  # first overturning PGA [g
 hazard = HazardCurve.from_csv(ROOT / "data" / "hazard" / "site_pga.csv", im="pga", units="g")
 print(hazard)
 risk_ida = object_risk(ida, hazard, years=50, n_boot=200, seed=0)
-risk_stripes = object_risk(stripes, hazard, years=50, n_boot=200, seed=0)
+risk_stripes = object_risk(stripes, hazard, years=50, n_boot=100, seed=0)
 
 columns = ["status", "theta", "beta", "n_overturning", "annual_rate", "annual_rate_lo",
            "annual_rate_hi", "probability", "probability_lo", "probability_hi",
