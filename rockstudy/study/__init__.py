@@ -4,6 +4,7 @@ Imports run one way: ``study`` uses the physics packages, never the reverse.
 """
 
 from .analysis.record_fragility import ida_fragility, im_efficiency, stripe_fragility
+from .analysis.risk import object_risk
 from .designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
 from .designs.sampling import make_design, salib_problem
 from .running.runner import RunReport, run_study
@@ -17,6 +18,7 @@ __all__ = [
     "im_efficiency",
     "incremental_dynamic_analysis",
     "multiple_stripes",
+    "object_risk",
     "stripe_fragility",
     "Study",
     "StudyError",

@@ -3,7 +3,8 @@
 ``sampled`` analyses a sampled study's cube (Sobol' indices, fragility, the collapse onto the
 dimensionless groups); ``record_fragility`` fits the fragility of record designs and ranks
 intensity measures; ``record_similarity`` checks whether block sizes collapse on records;
-``fragility_fit`` holds the lognormal fits and bands they share.
+``fragility_fit`` holds the lognormal fits and bands they share; ``risk`` turns each named
+object's fragility and a site's hazard curve into its annual rate of overturning.
 """
 
 from .sampled import (

@@ -1,11 +1,11 @@
 """The report of a record design (cloud, multiple stripes or IDA; issue 13 section 8).
 
-From a dataset of :mod:`rockstudy.study.records_designs` (or a result cube of the same layout):
+From a dataset of :mod:`rockstudy.study.designs.records` (or a result cube of the same layout):
 the record list with each record's intensity measures and pulse period; fragility curves with
 bands against PGA [g], PGV [m/s], Sa(T) [g], PGA / (g tan alpha) and PGV p / (g tan alpha), by
 block size; the efficiency of the intensity measures; IDA curves, stripe points or the cloud;
 a per-record breakdown; and, when the blocks span sizes, the self-similarity of the fragility
-on records (:mod:`rockstudy.study.records_similarity`).
+on records (:mod:`rockstudy.study.analysis.record_similarity`).
 """
 
 from __future__ import annotations
@@ -592,6 +592,110 @@ def _self_similarity(page, ds, edges, n_boot):
     pd.concat(medians).to_csv(page.out / "size_class_medians.csv")
 
 
+#: Resamples of the records for the bands of the annual rates (:func:`_risk`).
+RISK_RESAMPLES = 200
+
+
+def _risk_table(out) -> pd.DataFrame:
+    """The ranked table of :func:`~rockstudy.study.analysis.risk.object_risk`, as shown."""
+    unit, y = out.attrs["units"], f"{out.attrs['years']:g}"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = out["deaggregation"].isel(interval=[0, -1]).sum("interval")
+        beyond = (ends / out["annual_rate"]).values
+    counts = zip(out["n_overturning"].values, out["n_records"].values, strict=True)
+    return pd.DataFrame(
+        {
+            "status": out["status"].values,
+            f"median [{unit}]": out["theta"].values,
+            "beta": out["beta"].values,
+            "records overturning": [f"{int(a)} of {int(b)}" for a, b in counts],
+            "lambda_OT [1/yr]": out["annual_rate"].values,
+            "lambda_OT, 5 %": out["annual_rate_lo"].values,
+            "lambda_OT, 95 %": out["annual_rate_hi"].values,
+            "return period [yr]": out["return_period"].values,
+            f"P({y} yr)": out["probability"].values,
+            f"P({y} yr), 5 %": out["probability_lo"].values,
+            f"P({y} yr), 95 %": out["probability_hi"].values,
+            "share beyond the curve's levels": beyond,
+            f"uplift [{unit}]": out["uplift"].values,
+            "share below uplift": out["share_below_uplift"].values,
+            "lambda_OT above uplift only [1/yr]": out["annual_rate_above_uplift"].values,
+            "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
+            "lambda_OT at least [1/yr]": out["rate_lower_bound"].values,
+        },
+        index=pd.Index([str(v) for v in out["structure"].values], name="object"),
+    )
+
+
+def _risk(page, ds, hazard, years):
+    """Per object: lambda_OT and P(``years``) with their 90 % bands by resampling records,
+    ranked, and the deaggregation figure (:func:`~rockstudy.study.analysis.risk.object_risk`)."""
+    from ..analysis.risk import object_risk
+
+    try:
+        out = object_risk(ds, hazard, years=years, n_boot=RISK_RESAMPLES)
+    except ValueError as err:
+        page.text(f"No annual rates: {err}")
+        return
+    page.text(
+        f"Hazard: {out.attrs['hazard']} from {out.attrs['hazard_source'] or 'the study'}. "
+        f"Each object's lognormal fragility in {im_label(hazard.im, hazard.period)} is "
+        "integrated against it (Cornell et al. 2002); the 90 % bands come from "
+        f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
+        "and integrated again. Status 'few': fewer than 5 records overturned the object; "
+        "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
+        "'all': it overturned at every point (stripes give a lower bound). 'share below "
+        "uplift' is the part of the rate from intensities at which the object cannot leave "
+        "rest: the lognormal's lower tail, not a simulated overturning."
+    )
+    page.table(
+        _risk_table(out),
+        "annual_overturning",
+        f"Annual rate of overturning and probability in {years:g} years per object, ranked "
+        "(highest first)",
+    )
+    _deaggregation_figure(page, out)
+
+
+def _deaggregation_figure(page, out):
+    """One line per object: the share of lambda_OT from each interval of the hazard's levels."""
+    fitted = np.isfinite(out["annual_rate"].values)
+    if not fitted.any():
+        page.text("No object has an annual rate: no deaggregation to show.")
+        return
+    plt = _plt()
+    lo, hi = out["im_lower"].values[1:-1], out["im_upper"].values[1:-1]
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for j in np.flatnonzero(fitted):
+        share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
+        label = _mpl_text(str(out["structure"].values[j]))
+        line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label)[0]
+        if np.isfinite(out["uplift"].values[j]):
+            ax.axvline(out["uplift"].values[j], color=line.get_color(), ls=":", lw=1)
+    ax.set_xscale("log")
+    label = im_label(out.attrs["im"], out.attrs.get("period"))
+    ax.set_xlabel(f"{label}, interval centre", fontsize=10)
+    ax.set_ylabel("share of lambda_OT from the interval", fontsize=10)
+    ax.tick_params(labelsize=9)
+    _log_ticks(ax)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "deaggregation",
+        "Deaggregation: the share of each object's annual rate of overturning that comes from "
+        "each interval between the hazard curve's levels (plotted at its geometric centre); "
+        "dotted: each object's uplift PGA g tan(alpha), below which it cannot leave rest (the "
+        "share of the rate from there is the lognormal's lower tail, not a simulated "
+        "overturning: column 'share below uplift'); the shares beyond the first and last "
+        "level are in the table",
+    )
+    frame = out["deaggregation"].to_pandas().T
+    edges = zip(out["im_lower"].values, out["im_upper"].values, strict=True)
+    frame.index = [f"{a:.4g}-{b:.4g}" for a, b in edges]
+    frame.to_csv(page.out / "deaggregation.csv")
+
+
 # ------------------------------------------------------------------------------ page
 
 
@@ -603,15 +707,17 @@ def record_report(
     n_boot: int = 50,
     appendix=None,
     compare: xr.Dataset | None = None,
+    hazard=None,
+    years: float = 50.0,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`~rockstudy.study.records_designs.cloud`,
-        :func:`~rockstudy.study.records_designs.multiple_stripes` or
-        :func:`~rockstudy.study.records_designs.incremental_dynamic_analysis` (``design`` in its
+        From :func:`~rockstudy.study.designs.records.cloud`,
+        :func:`~rockstudy.study.designs.records.multiple_stripes` or
+        :func:`~rockstudy.study.designs.records.incremental_dynamic_analysis` (``design`` in its
         attributes), or a result cube of the same layout.
     out : path-like
         Folder of the page, its PNG figures and CSV tables (created if missing).
@@ -625,6 +731,10 @@ def record_report(
         The other of an IDA and a stripes design on the same records and structures: the
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
+    hazard : rockstudy.risk.HazardCurve, optional
+        The site's hazard curve: the page then ranks the objects by their annual rate of
+        overturning, with the probability in ``years`` [yr] (default 50) and a deaggregation
+        figure (:func:`~rockstudy.study.analysis.risk.object_risk`).
     """
     design = ds.attrs.get("design")
     if design not in DESIGNS:
@@ -639,6 +749,9 @@ def record_report(
     _record_list(page, ds)
     page.heading("Fragility")
     _fragility(page, ds, edges, n_boot)
+    if hazard is not None:
+        page.heading("Annual probability of overturning")
+        _risk(page, ds, hazard, years)
     page.heading("Intensity-measure efficiency")
     _efficiency(page, ds, n_boot)
     page.heading({"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[design])

@@ -551,7 +551,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     """Write the report of a result cube into ``out`` (default: RESULT's name + '_report').
 
     ``verify=False`` reads the cube without checking it against the checksums of its run
-    (see :func:`~rockstudy.study.store.open_result`): a cube whose metadata was edited."""
+    (see :func:`~rockstudy.study.running.store.open_result`): a cube whose metadata was edited."""
     result = Path(result)
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     out.mkdir(parents=True, exist_ok=True)
@@ -567,8 +567,15 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             page.heading("Study")
             _study_file(page, study, ds)
 
+        hazard = study.hazard
         return record_report(
-            ds, out, title=study.name, description=study.description, appendix=study_section
+            ds,
+            out,
+            title=study.name,
+            description=study.description,
+            appendix=study_section,
+            hazard=None if hazard is None else hazard.curve(),
+            years=50.0 if hazard is None else hazard.years,
         )
     study = analysis.study_of(ds)
     page = _Page(out)

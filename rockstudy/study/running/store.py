@@ -93,22 +93,28 @@ def file_sha256(path) -> str:
 
 
 def input_hashes(study: Study, base_dir=None) -> dict:
-    """The sha256 of every input file of a study (its records, H and V), keyed by their path
-    relative to ``base_dir`` (absolute if outside it)."""
+    """The sha256 of every input file of a study (its records, H and V, and the hazard curve's
+    file of ``[hazard]``), keyed by their path relative to ``base_dir`` (absolute if outside
+    it)."""
     if study.motion.kind != "record":
         return {}
-    from ..spec.feasibility import record_pairs
+    from ..spec.feasibility import record_pairs, record_path
 
     base = Path(Path.cwd() if base_dir is None else base_dir)
-    out = {}
+    paths = []
     for _, h, v in record_pairs(study.motion, base_dir):
-        for path in (h, v) if v is not None else (h,):
-            key = (
-                os.path.relpath(path, base)
-                if not path.is_absolute() or path.is_relative_to(base)
-                else str(path)
-            )
-            out[key] = file_sha256(path)
+        paths.extend((h, v) if v is not None else (h,))
+    hazard = getattr(study, "hazard", None)
+    if hazard is not None and hazard.kind == "file":
+        paths.append(record_path(hazard.file, base_dir))
+    out = {}
+    for path in paths:
+        key = (
+            os.path.relpath(path, base)
+            if not path.is_absolute() or path.is_relative_to(base)
+            else str(path)
+        )
+        out[key] = file_sha256(path)
     return out
 
 

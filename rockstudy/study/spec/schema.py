@@ -593,15 +593,13 @@ class RecordSpec(_Model):
         return self.scale_to
 
 
-
-
 class DesignSpec(_Model):
     """A record design over records x structures (``sampler.n`` structures drawn by the
     sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
     each level of ``motion.scale_to.value``, a grid), or ``ida`` (the first overturning
     intensity of each structure under each record in ``im``, by a ladder of ``step`` refined
     by bisection to ``tolerance``; ``max_pga_ratio`` and ``scan`` as in
-    :class:`rockstudy.study.records_designs.IdaOptions`, which holds their defaults and
+    :class:`rockstudy.study.designs.records.IdaOptions`, which holds their defaults and
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio."""
 
@@ -749,6 +747,78 @@ Structure = Annotated[
 MotionSpec = Annotated[PulseSpec | RecordSpec | StochasticSpec, Field(discriminator="kind")]
 
 
+#: Measures a ``[hazard]`` curve may be of: those a record design stores for every record.
+HAZARD_MEASURES = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd")
+
+
+class HazardSpec(_Model):
+    """The site's hazard curve, for the annual probability of overturning of each structure
+    of a record ``[design]`` (:func:`rockstudy.study.analysis.risk.object_risk`).
+
+    ``kind = "power_law"``: lambda(x) = ``k0`` x^-``k`` (x in ``units``); ``kind = "file"``:
+    ``file``, a path relative to the study file, of two columns (level, annual rate of
+    exceedance) or an OpenQuake hazard-curve CSV (:meth:`rockstudy.risk.HazardCurve.from_csv`).
+    The file is read when the study is validated: its levels and rates are then part of the
+    study (``levels``, ``rates``: not to be given by hand), so a stored result keeps the curve
+    it was reported with. ``im`` is the measure (one of :data:`HAZARD_MEASURES`; ``sa``,
+    ``psv`` and ``sd`` at a ``period`` [s] the design stores), ``units`` the units of its
+    levels (:data:`rockstudy.risk.UNIT_FACTORS`; default the IM's SI unit, or OpenQuake's
+    for its files) and ``years`` the exposure time of the probability reported (default 50).
+    """
+
+    kind: Literal["power_law", "file"]
+    im: Literal[HAZARD_MEASURES]
+    units: str | None = None
+    period: _Period | None = None
+    years: float = Field(default=50.0, gt=0, le=1e6)
+    k0: float | None = Field(default=None, gt=0)
+    k: float | None = Field(default=None, gt=0)
+    file: str | None = None
+    levels: list[float] | None = None
+    rates: list[float] | None = None
+
+    @model_validator(mode="after")
+    def _curve(self):
+        own = ("k0", "k") if self.kind == "power_law" else ("file", "levels", "rates")
+        other = ("file", "levels", "rates") if self.kind == "power_law" else ("k0", "k")
+        for name in other:
+            if getattr(self, name) is not None:
+                raise FieldError(name, f"does not apply to kind = {self.kind!r}")
+        for name in own:
+            if getattr(self, name) is None:
+                raise FieldError(
+                    name,
+                    f"is required for kind = {self.kind!r}"
+                    + (
+                        " (read from file when the study file is validated)"
+                        if name in ("levels", "rates")
+                        else ""
+                    ),
+                )
+        try:
+            self.curve()
+        except ValueError as exc:
+            text = str(exc)
+            field = next(
+                (
+                    f
+                    for f in ("units", "period", "levels", "rates", "k0", "k")
+                    if text.startswith(f)
+                ),
+                "file" if self.kind == "file" else "im",
+            )
+            raise FieldError(field, text) from None
+        return self
+
+    def curve(self):
+        """The :class:`rockstudy.risk.HazardCurve`."""
+        from ...risk import HazardCurve
+
+        if self.kind == "power_law":
+            return HazardCurve.power_law(self.k0, self.k, self.im, self.units, self.period)
+        return HazardCurve(self.im, self.levels, self.rates, self.units, self.period, self.file)
+
+
 class Study(_Model):
     """A whole study file."""
 
@@ -760,6 +830,7 @@ class Study(_Model):
     structure: Structure
     motion: MotionSpec
     design: DesignSpec | None = None
+    hazard: HazardSpec | None = None
     run: RunSpec = RunSpec()
     #: The study file's text as read (None for a study not read from text).
     _text: str | None = PrivateAttr(default=None)
@@ -869,6 +940,32 @@ class Study(_Model):
             )
         if self.sampler.replicates > 1:
             raise FieldError("sampler.replicates", "does not apply to a [design]")
+        return self
+
+    @model_validator(mode="after")
+    def _hazard(self):
+        hz, de = self.hazard, self.design
+        if hz is None:
+            return self
+        if de is None:
+            raise FieldError(
+                "hazard",
+                "applies to a record [design] (cloud, stripes or ida) only: the fragility "
+                "it integrates is fitted per structure over records, which a Monte Carlo "
+                "or Sobol study does not have",
+            )
+        if hz.im in ("sa", "psv", "sd"):
+            stored = set(de.periods) | {de.period}
+            if self.motion.kind == "record" and self.motion.scale_to is not None:
+                stored.add(self.motion.scale_to.period)
+            stored.discard(None)
+            if hz.period not in stored:
+                raise FieldError(
+                    "hazard.period",
+                    f"a {hz.im!r} hazard curve needs its period among the periods the design "
+                    f"stores ({sorted(stored) or 'none'}: design.periods, design.period); "
+                    f"got {hz.period!r}",
+                )
         return self
 
     @model_validator(mode="after")
@@ -1228,15 +1325,18 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
             source, [f"not a study file: its tables or lists nest deeper than {MAX_DEPTH} levels"]
         )
     file_problem = _read_objects_file(data, base_dir)
+    hazard_problem = _read_hazard_file(data, base_dir)
     try:
         study = Study.model_validate(data)
     except ValidationError as exc:  # with the problems of the parts that are valid alone
         found = _format_errors(exc, data)
         if file_problem:
             found = [file_problem] + [x for x in found if not x.startswith("structure.objects")]
+        if hazard_problem:
+            found = [hazard_problem] + [x for x in found if not x.startswith("hazard.")]
         raise StudyError(source, found + _motion_problems(data, base_dir)) from None
-    if file_problem:
-        raise StudyError(source, [file_problem])
+    if file_problem or hazard_problem:
+        raise StudyError(source, [p for p in (file_problem, hazard_problem) if p])
 
     if study.design is not None and "chunk_size" in data:
         raise StudyError(
@@ -1311,6 +1411,38 @@ def _read_objects_file(data, base_dir) -> str | None:
         }
         for row in rows
     ]
+    return None
+
+
+def _read_hazard_file(data, base_dir) -> str | None:
+    """Read ``hazard.file`` (:meth:`rockstudy.risk.HazardCurve.from_csv`, relative to the
+    study file's folder) into ``hazard.levels`` and ``hazard.rates`` of ``data``, in place
+    (and ``units``, ``period`` where the file gives them); the problem as one line, or None."""
+    hz = data.get("hazard")
+    if not (isinstance(hz, dict) and hz.get("kind") == "file" and "file" in hz):
+        return None
+    given = [k for k in ("levels", "rates") if k in hz]
+    if given:
+        return f"hazard.{given[0]}: is read from hazard.file; give the file only"
+    name = hz["file"]
+    if not isinstance(name, str) or not name.strip():
+        return f"hazard.file: must be the path of a hazard-curve file, got {_describe(name)}"
+    from ...risk import HazardCurve
+    from .feasibility import record_path
+
+    args = {k: hz.get(k) for k in ("im", "units", "period")}
+    plain = all(v is None or isinstance(v, str | float | int) for v in args.values())
+    if args["im"] not in HAZARD_MEASURES or not plain:
+        return None  # the schema names the bad field; the file is read once it is right
+    path = record_path(name, base_dir)
+    try:
+        curve = HazardCurve.from_csv(path, **args)
+    except (TypeError, ValueError, KeyError) as exc:
+        return f"hazard.file: {exc}"
+    hz["levels"], hz["rates"] = curve.levels.tolist(), curve.rates.tolist()
+    hz["units"] = curve.units
+    if curve.period is not None:
+        hz["period"] = curve.period
     return None
 
 

@@ -1,0 +1,329 @@
+"""The annual probability of overturning of each object of a record design at a site.
+
+Each object's lognormal fragility is fitted in the hazard curve's intensity measure (the IDA
+capacities, or the binomial fit of stripes and clouds: :mod:`.records_fragility`), then
+integrated against the site's hazard curve (:func:`rockstudy.risk.annual_rate`, Cornell et al.
+2002): the mean annual rate of overturning lambda_OT and the probability of at least one
+overturning in a number of years, 1 - exp(-lambda_OT t). The band of lambda_OT comes from
+resampling the records with replacement (the records are what the fragility is uncertain
+about), refitting the fragility and integrating again; the deaggregation
+(:func:`rockstudy.risk.rate_deaggregation`) says which intensity levels the rate comes from.
+
+What the records cannot say is marked, not invented (``status``):
+
+- ``"ok"``: the fit rests on at least ``min_overturning`` records under which the object
+  overturned;
+- ``"few"``: fewer such records (at least two for an IDA, one for stripes): lambda_OT is
+  given but rests on little;
+- ``"none"``: the object never overturned: lambda_OT is not estimable (NaN). An IDA gives
+  ``rate_upper_bound`` = lambda(x_c), x_c the lowest level at which a record's IDA stopped
+  standing: every capacity of these records lies above x_c, so the rate of the records'
+  empirical capacity distribution is below lambda(x_c);
+- ``"all"``: (stripes, clouds) the object overturned at every point: no fit; the rate of
+  exceeding the lowest intensity simulated, ``rate_lower_bound``, is what it is at least,
+  as far as the points say;
+- ``"no fit"``: the fit did not converge to a finite median and dispersion.
+
+Cornell, C. A., Jalayer, F., Hamburger, R. O. and Foutch, D. A. (2002). Probabilistic basis
+for 2000 SAC Federal Emergency Management Agency steel moment frame guidelines. Journal of
+Structural Engineering 128(4), 526-533.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ... import risk
+from . import record_fragility as rf
+from .fragility_fit import check_conf_level, check_n_boot, fit_binomial
+
+__all__ = ["STATUSES", "object_risk", "share_below"]
+
+#: What ``status`` of :func:`object_risk` says of an object's rate (module docstring).
+STATUSES = ("ok", "few", "none", "all", "no fit")
+
+
+def _check_hazard(ds, hazard):
+    """(im, period) of ``hazard`` if the design can express it, else a ValueError naming it."""
+    if not isinstance(hazard, risk.HazardCurve):
+        raise TypeError(f"hazard must be a rockstudy.risk.HazardCurve, got {type(hazard).__name__}")
+    if hazard.im not in rf.QUOTED_UNITS:
+        raise ValueError(
+            f"hazard: its im {hazard.im!r} is not a measure a record design expresses; use a "
+            f"hazard curve of one of {sorted(set(rf.QUOTED_UNITS) & set(risk.UNITS))}"
+        )
+    try:
+        rf.intensity(ds, hazard.im, hazard.period)
+    except ValueError as err:
+        raise ValueError(f"hazard: the design cannot express its IM: {err}") from None
+    return hazard.im, hazard.period
+
+
+def _ida_fitter(ds, im, period):
+    """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
+    level per object) of an IDA, in quoted units."""
+    dims = ("record", "structure")
+    cap = rf.intensity(ds, im, period, scale="capacity_scale").transpose(*dims).values
+    top = rf.intensity(ds, im, period, scale="capacity_scale_lower").transpose(*dims).values
+    cens = ds["censored"].transpose(*dims).values.astype(bool)
+    ok = ds["status"].transpose(*dims).values == 0
+    ok &= np.where(cens, np.isfinite(top), np.isfinite(cap)) & (np.where(cens, top, cap) > 0)
+
+    def fit(j, rows):
+        c, t, cc, kk = cap[:, j], top[:, j], cens[:, j], ok[:, j]
+        if not (kk[rows] & ~cc[rows]).any():  # none overturned in these records
+            return np.inf, np.nan
+        return rf._fit_records(c, t, cc, kk, rows)
+
+    def count(j, rows):
+        return int((ok[rows, j] & ~cens[rows, j]).sum())
+
+    with np.errstate(invalid="ignore"):
+        lowest = np.nanmin(np.where(ok & cens, top, np.nan), axis=0, initial=np.inf)
+    return fit, count, lowest
+
+
+def _stripe_fitter(ds, im, period):
+    """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points); the third
+    item is the lowest intensity simulated per object."""
+    dims = ds["overturned"].dims
+    x = rf.intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
+    y = ds["overturned"].transpose(*dims).values.astype(bool)
+    ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
+    j_axis = dims.index("structure")
+    x, y, ok = (np.moveaxis(a, j_axis, 1) for a in (x, y, ok))  # (record, structure, ...)
+
+    def fit(j, rows):
+        kk = ok[rows, j]
+        xs, ys = x[rows, j][kk], y[rows, j][kk]
+        if not ys.any():
+            return np.inf, np.nan
+        return fit_binomial(xs, ys.astype(float), np.ones(xs.size))
+
+    def count(j, rows):
+        hit = (ok & y)[rows, j]
+        return int(hit.reshape(hit.shape[0], -1).any(axis=1).sum())
+
+    lowest = np.nanmin(np.where(ok, x, np.nan).reshape(x.shape[0], x.shape[1], -1), axis=(0, 2))
+    return fit, count, lowest
+
+
+def _uplift(ds, hazard):
+    """Each structure's uplift PGA g tan(alpha) in the hazard's units (NaN for another IM, or
+    where the design does not say it): below it a block cannot even leave rest."""
+    n = ds.sizes["structure"]
+    if hazard.im != "pga" or not {"pga", "pga_ratio"} <= set(ds.variables):
+        return np.full(n, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        level = (ds["pga"] / ds["pga_ratio"]).transpose("structure", ...).values.reshape(n, -1)
+        level = np.nanmedian(np.where(np.isfinite(level) & (level > 0), level, np.nan), axis=1)
+    return level / risk.UNIT_FACTORS[hazard.units][0]
+
+
+def share_below(theta, beta, hazard, level, units=None) -> float:
+    """The share of lambda_OT (:func:`rockstudy.risk.annual_rate`) that comes from intensities
+    below ``level`` (in the hazard's units): the deaggregation of the curve with ``level``
+    inserted among its levels (at its interpolated rate, which leaves the curve unchanged).
+    NaN without a rate or a level."""
+    if not (np.isfinite(level) and level > 0 and np.isfinite(theta) and np.isfinite(beta)):
+        return np.nan
+    x = np.union1d(hazard.levels, [level])
+    curve = risk.HazardCurve(hazard.im, x, hazard.rate(x), hazard.units, hazard.period)
+    _, upper, parts = risk.rate_deaggregation(theta, beta, curve, units)
+    total = parts.sum()
+    return float(parts[upper <= level].sum() / total) if total > 0 else np.nan
+
+
+def _rate(theta, beta, hazard, unit):
+    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit."""
+    if theta == np.inf:
+        return 0.0
+    if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
+        return np.nan
+    return risk.annual_rate(theta, beta, hazard, units=unit)
+
+
+def _status(ida, theta, beta, n_over, n_rec, min_overturning):
+    if n_over == 0:
+        return "none"
+    if not ida and theta == 0.0:
+        return "all"
+    if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
+        return "no fit" if n_over >= (2 if ida else 1) else "few"
+    return "ok" if n_over >= min(min_overturning, n_rec) else "few"
+
+
+def _probability(years, rate):
+    """P in ``years`` of each rate, NaN where the rate is NaN."""
+    return np.where(np.isfinite(rate), risk.probability_in(years, np.nan_to_num(rate)), np.nan)
+
+
+def _one_object(j, fit, count, n_rec, boot_rows, hazard, unit, ida, min_overturning):
+    """The point estimate, the bootstrap rates and the status of object ``j``."""
+    every = np.arange(n_rec)
+    theta, beta = fit(j, every)
+    n_over = count(j, every)
+    status = _status(ida, theta, beta, n_over, n_rec, min_overturning)
+    rate = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
+    boot = np.full(len(boot_rows), np.nan)
+    if np.isfinite(rate):
+        boot = np.array([_rate(*fit(j, rows), hazard, unit) for rows in boot_rows])
+    return theta, beta, n_over, status, rate, boot
+
+
+def object_risk(
+    ds: xr.Dataset,
+    hazard: risk.HazardCurve,
+    years: float = 50.0,
+    n_boot: int = 200,
+    conf_level: float = 0.9,
+    seed: int = 0,
+    min_overturning: int = 5,
+) -> xr.Dataset:
+    """Per object: the fragility in the hazard's IM, lambda_OT, P(OT in ``years``) and bands.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A record design (:func:`~rockstudy.study.designs.records.incremental_dynamic_analysis`,
+        :func:`~rockstudy.study.designs.records.multiple_stripes` or
+        :func:`~rockstudy.study.designs.records.cloud`), or a study's cube folded into that
+        layout; named objects keep their names.
+    hazard : rockstudy.risk.HazardCurve
+        The site's hazard curve. Its IM must be one the design stores (``pga``, ``pgv``,
+        ``pgd``, ``arias``, ``cav``, ``spectrum_intensity``, or ``sa``/``psv``/``sd`` at a
+        stored period); its units may be any of :data:`rockstudy.risk.UNIT_FACTORS` of that
+        IM (g, m/s^2, cm/s^2 for accelerations): the fragility is converted to them.
+    years : float
+        The exposure time t [yr] of the probability 1 - exp(-lambda_OT t), > 0.
+    n_boot : int
+        Resamples of the records (with replacement) for the band: each refits the
+        fragility and integrates again. 0: no band.
+    conf_level : float
+        Level of the band, in (0, 1): the percentiles (1 -+ level) / 2 of the resampled rates.
+    seed : int
+        Seed of the resampling (the same seed gives the same band).
+    min_overturning : int
+        Records under which an object must have overturned for ``status`` "ok" (fewer:
+        "few"; capped at the number of records).
+
+    Returns
+    -------
+    xarray.Dataset
+        On ``structure``, ranked by ``annual_rate`` (highest first, objects without a rate
+        last): ``theta`` (median, in ``hazard.units``) and ``beta`` of the fragility,
+        ``n_records``, ``n_overturning`` (records under which it overturned), ``status``
+        (:data:`STATUSES`), ``annual_rate`` [1/yr] with ``annual_rate_lo``/``_hi`` (the band),
+        ``probability`` in ``years`` with ``probability_lo``/``_hi``, ``return_period`` [yr],
+        ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
+        ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
+        PGA g tan(alpha), in ``hazard.units``) and ``share_below_uplift`` (the share of
+        ``annual_rate`` from PGA below it, where the block cannot leave rest: what the
+        lognormal's lower tail adds, not what a simulation saw), ``annual_rate_above_uplift``
+        (the rate of the fragility set to 0 below the uplift PGA); and on (``structure``,
+        ``interval``) ``deaggregation`` [1/yr], each interval's share of ``annual_rate``,
+        with the edges ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard,
+        ``years``, ``n_boot``, ``conf_level`` and ``seed``.
+    """
+    years = float(risk._positive("years", years))
+    n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
+    design = ds.attrs.get("design")
+    if design not in ("ida", "stripes", "cloud"):
+        raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")
+    im, period = _check_hazard(ds, hazard)
+    unit = rf.QUOTED_UNITS[im][0]
+    ida = design == "ida"
+    fit, count, lowest = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
+    n_rec = ds.sizes["record"]
+    rng = np.random.default_rng(seed)
+    boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
+    to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
+    rows = [
+        _one_object(j, fit, count, n_rec, boot_rows, hazard, unit, ida, int(min_overturning))
+        for j in range(ds.sizes["structure"])
+    ]
+    attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
+    return _risk_dataset(ds, rows, lowest * to_hazard, hazard, years, to_hazard, attrs)
+
+
+def _bands(boot, conf_level):
+    """(lower, upper, count) of the finite resampled rates of each object (percentiles at
+    resamples, without interpolation); NaN where none is finite."""
+    valid = np.isfinite(boot).sum(axis=1)
+    q = [50 * (1 - conf_level), 50 * (1 + conf_level)]
+    lo, hi = np.full(len(boot), np.nan), np.full(len(boot), np.nan)
+    for i, b in enumerate(boot):
+        if valid[i]:
+            lo[i], hi[i] = np.percentile(b[np.isfinite(b)], q, method="inverted_cdf")
+    return lo, hi, valid
+
+
+def _bounds(status, lowest, hazard, ida):
+    """``rate_upper_bound`` (an IDA's "none") and ``rate_lower_bound`` (stripes' "all")."""
+    at = hazard.rate(np.where(np.isfinite(lowest) & (lowest > 0), lowest, 1.0))
+    ok = np.isfinite(lowest) & (lowest > 0)
+    upper = np.where(ida & (status == "none") & ok, at, np.nan)
+    lower = np.where(~ida & (status == "all") & ok, at, np.nan)
+    return upper, lower
+
+
+def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
+    """The Dataset of :func:`object_risk` from the objects' rows, ranked."""
+    uplift = _uplift(ds, hazard)
+    theta, beta, n_over, status, rate, boot = (list(c) for c in zip(*rows, strict=True))
+    theta, beta, rate = (np.array(v, float) for v in (theta, beta, rate))
+    boot = np.array(boot, float).reshape(len(rows), -1)
+    lo, hi, valid = _bands(boot, attrs["conf_level"])
+    fitted = np.isfinite(rate)
+    deagg_median = np.where(fitted, theta * to_hazard, 1.0)
+    edge_lo, edge_hi, parts = risk.rate_deaggregation(
+        deagg_median, np.where(fitted, beta, 0.0), hazard
+    )
+    parts = np.where(fitted[:, None], parts, np.nan)
+    status = np.array(status, dtype=object)
+    upper, lower = _bounds(status, lowest, hazard, attrs["design"] == "ida")
+    v = {
+        "theta": np.where(np.isfinite(theta), theta * to_hazard, theta),
+        "beta": beta,
+        "n_records": np.full(len(rows), ds.sizes["record"]),
+        "n_overturning": np.array(n_over),
+        "status": status.astype(str),
+        "annual_rate": rate,
+        "annual_rate_lo": lo,
+        "annual_rate_hi": hi,
+        "probability": _probability(years, rate),
+        "probability_lo": _probability(years, lo),
+        "probability_hi": _probability(years, hi),
+        "return_period": np.where(rate > 0, 1.0 / np.where(rate > 0, rate, 1.0), np.nan),
+        "rate_upper_bound": upper,
+        "rate_lower_bound": lower,
+        "boot_valid": valid,
+        "uplift": uplift,
+        "share_below_uplift": np.array(
+            [
+                share_below(t * to_hazard, b, hazard, u) if f else np.nan
+                for t, b, u, f in zip(theta, beta, uplift, fitted, strict=True)
+            ]
+        ),
+    }
+    v["annual_rate_above_uplift"] = rate * (1.0 - v["share_below_uplift"])
+    out = xr.Dataset(
+        {k: ("structure", a) for k, a in v.items()},
+        coords={"structure": ds["structure"].values},
+    )
+    out["deaggregation"] = (("structure", "interval"), parts)
+    out = out.assign_coords(im_lower=("interval", edge_lo), im_upper=("interval", edge_hi))
+    order = np.argsort(np.where(fitted, -rate, np.inf), kind="stable")
+    out = out.isel(structure=order)
+    out.attrs.update(
+        attrs,
+        im=hazard.im,
+        units=hazard.units,
+        years=years,
+        hazard=repr(hazard),
+        hazard_source=hazard.source,
+    )
+    if hazard.period is not None:
+        out.attrs["period"] = hazard.period
+    return out

@@ -1,0 +1,196 @@
+"""Per-object risk of a record design (rockstudy.study.analysis.risk).
+
+Oracles: Cornell et al. (2002)'s closed form lambda = k0 theta^-k exp(k^2 beta^2 / 2) for a
+lognormal capacity and a power-law hazard, with the sampling error of the fit from the
+delta method on the known lognormal; the hazard's units (g against m/s^2, the same site);
+a tabulated curve against the power law it was tabulated from; objects that never or always
+overturn, marked by what the data can say."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from rockstudy import risk
+from rockstudy.constants import G
+from rockstudy.study.analysis.risk import object_risk
+
+K0, K = 2e-4, 2.3  # lambda(x) = k0 x^-k, x in g
+
+
+def _ida(capacities_g, censored=None, names=None):
+    """An IDA dataset of capacities [g of PGA] on (record, structure): every record has a
+    PGA of 1 g, so the capacity scale is the capacity in g."""
+    cap = np.asarray(capacities_g, float)
+    cens = np.zeros(cap.shape, bool) if censored is None else np.asarray(censored)
+    n_rec, n_st = cap.shape
+    names = names or [f"object {j}" for j in range(n_st)]
+    ds = xr.Dataset(
+        {
+            "pga": ("record", np.full(n_rec, G)),
+            "capacity_scale": (("record", "structure"), np.where(cens, np.nan, cap)),
+            "capacity_scale_lower": (("record", "structure"), cap / 1.001),
+            "censored": (("record", "structure"), cens),
+            "status": (("record", "structure"), np.zeros(cap.shape, int)),
+        },
+        coords={"structure": names},
+        attrs={"design": "ida", "im": "pga"},
+    )
+    return ds
+
+
+def _lognormal(theta, beta, n, seed):
+    return theta * np.exp(beta * np.random.default_rng(seed).standard_normal(n))
+
+
+def test_rate_of_a_known_lognormal_capacity_matches_cornell_within_its_sampling_error():
+    # two objects of known capacity distributions; 400 records
+    n, truth = 400, [(0.3, 0.4), (0.6, 0.25)]
+    cap = np.column_stack([_lognormal(t, b, n, s) for s, (t, b) in enumerate(truth)])
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(_ida(cap, names=["Statue", "Column"]), hazard, n_boot=100, seed=1)
+    for name, (theta, beta) in zip(["Statue", "Column"], truth, strict=True):
+        row = out.sel(structure=name)
+        exact = K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
+        # delta method: var ln lambda = k^2 beta^2 / n + k^4 beta^4 / (2 n)
+        sd = np.sqrt((K * beta) ** 2 / n + (K * beta) ** 4 / (2 * n))
+        assert abs(np.log(float(row["annual_rate"]) / exact)) < 4 * sd
+        # the fit's own numbers give Cornell's closed form exactly
+        t_hat, b_hat = float(row["theta"]), float(row["beta"])
+        closed = K0 * t_hat**-K * np.exp(0.5 * (K * b_hat) ** 2)
+        assert float(row["annual_rate"]) == pytest.approx(closed, rel=1e-3)
+        # the 90 % bootstrap band is about +-1.645 sd wide in log (within a third)
+        half = 0.5 * np.log(float(row["annual_rate_hi"]) / float(row["annual_rate_lo"]))
+        assert half == pytest.approx(1.645 * sd, rel=1 / 3)
+        assert str(row["status"].values) == "ok"
+    assert list(out["structure"].values) == ["Statue", "Column"]  # ranked: weaker first
+
+
+def test_band_contains_the_point_estimate_and_is_seeded():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 12, 3), _lognormal(0.8, 0.3, 12, 4)])
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    a = object_risk(_ida(cap), hazard, n_boot=200, seed=7)
+    b = object_risk(_ida(cap), hazard, n_boot=200, seed=7)
+    lam, lo, hi = (a[k].values for k in ("annual_rate", "annual_rate_lo", "annual_rate_hi"))
+    assert np.all(lo < lam) and np.all(lam < hi)
+    assert np.all(a["probability_lo"] < a["probability"])
+    assert np.all(a["probability"] < a["probability_hi"])
+    np.testing.assert_array_equal(lo, b["annual_rate_lo"].values)
+    # probability in 50 yr is Poisson: 1 - exp(-50 lambda)
+    np.testing.assert_allclose(a["probability"], -np.expm1(-50 * lam), rtol=1e-12)
+    # the deaggregation sums to the rate
+    np.testing.assert_allclose(a["deaggregation"].sum("interval"), lam, rtol=1e-9)
+
+
+def test_units_g_or_si_give_the_same_rate():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 15, 5)])
+    in_g = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    in_si = in_g.to_units("m/s^2")
+    a = object_risk(_ida(cap), in_g, n_boot=20)
+    b = object_risk(_ida(cap), in_si, n_boot=20)
+    assert b["annual_rate"].item() == pytest.approx(a["annual_rate"].item(), rel=1e-10)
+    assert b["theta"].item() == pytest.approx(a["theta"].item() * G, rel=1e-12)
+
+
+def test_a_tabulated_curve_gives_the_rate_of_its_power_law_source():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 15, 6), _lognormal(1.2, 0.3, 15, 8)])
+    source = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    levels = np.geomspace(0.05, 2.0, 12)
+    table = risk.HazardCurve("pga", levels, K0 * levels**-K, units="g")
+    a = object_risk(_ida(cap), source, n_boot=0)
+    b = object_risk(_ida(cap), table, n_boot=0)
+    np.testing.assert_allclose(b["annual_rate"], a["annual_rate"], rtol=1e-9)
+
+
+def test_objects_that_never_overturn_are_marked_with_an_upper_bound_not_a_rate():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 9), np.linspace(1.5, 3.0, 10)])
+    cens = np.zeros(cap.shape, bool)
+    cens[:, 1] = True  # the second object stood at the top of every IDA
+    cens[:2, 0] = True  # the first, under two records
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(_ida(cap, cens, ["A", "B"]), hazard, n_boot=20)
+    b = out.sel(structure="B")
+    assert str(b["status"].values) == "none"
+    assert np.isnan(float(b["annual_rate"])) and np.isnan(float(b["probability"]))
+    # every capacity lies above the lowest standing level 1.5 / 1.001 g
+    assert float(b["rate_upper_bound"]) == pytest.approx(K0 * (1.5 / 1.001) ** -K, rel=1e-9)
+    a = out.sel(structure="A")
+    assert str(a["status"].values) == "ok" and int(a["n_overturning"]) == 8
+    assert list(out["structure"].values) == ["A", "B"]  # objects without a rate last
+
+
+def test_few_overturning_records_are_marked():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 10)])
+    cens = np.ones(cap.shape, bool)
+    cens[:3, 0] = False
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(_ida(cap, cens), hazard, n_boot=10)
+    assert str(out["status"].values[0]) == "few"
+    assert int(out["n_overturning"].values[0]) == 3
+
+
+def test_stripes_overturned_everywhere_give_a_lower_bound():
+    levels = np.array([0.2, 0.4, 0.8])
+    n_rec = 4
+    ds = xr.Dataset(
+        {
+            "pga": ("record", np.full(n_rec, G)),
+            "scale": (("record", "structure", "level"), np.broadcast_to(levels, (n_rec, 1, 3))),
+            "overturned": (("record", "structure", "level"), np.ones((n_rec, 1, 3), bool)),
+            "status": (("record", "structure", "level"), np.zeros((n_rec, 1, 3), int)),
+        },
+        coords={"structure": ["Vase"], "level": levels},
+        attrs={"design": "stripes", "im": "pga"},
+    )
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(ds, hazard, n_boot=10)
+    assert str(out["status"].values[0]) == "all"
+    assert float(out["rate_lower_bound"].values[0]) == pytest.approx(K0 * 0.2**-K, rel=1e-9)
+    assert np.isnan(out["annual_rate"].values[0])
+
+
+def test_a_hazard_the_design_cannot_express_is_refused():
+    cap = np.column_stack([_lognormal(0.4, 0.5, 5, 11)])
+    sa = risk.HazardCurve.power_law(K0, K, im="sa", units="g", period=0.5)
+    with pytest.raises(ValueError, match="hazard: the design cannot express"):
+        object_risk(_ida(cap), sa)
+    dur = risk.HazardCurve.power_law(1.0, 1.0, im="significant_duration")
+    with pytest.raises(ValueError, match="hazard: its im 'significant_duration'"):
+        object_risk(_ida(cap), dur)
+    with pytest.raises(TypeError, match="hazard must be"):
+        object_risk(_ida(cap), "pga")
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    with pytest.raises(ValueError, match="years"):
+        object_risk(_ida(cap), hazard, years=0)
+
+
+def test_share_below_a_level_matches_the_closed_form_of_a_power_law():
+    # int_0^u F |d lambda| = E[lambda(C); C < u] - lambda(u) F(u), both in closed form for
+    # lambda = k0 x^-k and ln C ~ N(mu, beta^2)
+    from scipy.stats import norm
+
+    from rockstudy.study.analysis.risk import share_below
+
+    theta, beta, u = 0.5, 0.6, 0.3
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g", levels=[0.01, 0.1, 1.0, 5.0])
+    mu = np.log(theta)
+    tail = (
+        K0 * np.exp(-K * mu + 0.5 * (K * beta) ** 2) * norm.cdf((np.log(u) - mu) / beta + K * beta)
+    )
+    below = tail - K0 * u**-K * norm.cdf((np.log(u) - mu) / beta)
+    total = K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
+    assert share_below(theta, beta, hazard, u) == pytest.approx(below / total, rel=1e-9)
+
+
+def test_the_uplift_share_is_given_for_a_pga_hazard():
+    cap = np.column_stack([_lognormal(0.4, 0.8, 30, 12)])
+    ds = _ida(cap)
+    ds["pga_ratio"] = (("record", "structure"), np.full((30, 1), 1 / 0.2))  # uplift 0.2 g
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(ds, hazard, n_boot=0)
+    assert out["uplift"].item() == pytest.approx(0.2, rel=1e-12)
+    row = out.isel(structure=0)
+    from rockstudy.study.analysis.risk import share_below
+
+    expected = share_below(row["theta"].item(), row["beta"].item(), hazard, 0.2)
+    assert row["share_below_uplift"].item() == pytest.approx(expected, rel=1e-12)
+    assert 0 < expected < 1
