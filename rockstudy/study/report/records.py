@@ -1,11 +1,11 @@
 """The report of a record design (cloud, multiple stripes or IDA; issue 13 section 8).
 
-From a dataset of :mod:`rockstudy.study.records_designs` (or a result cube of the same layout):
+From a dataset of :mod:`rockstudy.study.designs.records` (or a result cube of the same layout):
 the record list with each record's intensity measures and pulse period; fragility curves with
 bands against PGA [g], PGV [m/s], Sa(T) [g], PGA / (g tan alpha) and PGV p / (g tan alpha), by
 block size; the efficiency of the intensity measures; IDA curves, stripe points or the cloud;
 a per-record breakdown; and, when the blocks span sizes, the self-similarity of the fragility
-on records (:mod:`rockstudy.study.records_similarity`).
+on records (:mod:`rockstudy.study.analysis.record_similarity`).
 """
 
 from __future__ import annotations
@@ -609,9 +609,9 @@ def record_report(
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`~rockstudy.study.records_designs.cloud`,
-        :func:`~rockstudy.study.records_designs.multiple_stripes` or
-        :func:`~rockstudy.study.records_designs.incremental_dynamic_analysis` (``design`` in its
+        From :func:`~rockstudy.study.designs.records.cloud`,
+        :func:`~rockstudy.study.designs.records.multiple_stripes` or
+        :func:`~rockstudy.study.designs.records.incremental_dynamic_analysis` (``design`` in its
         attributes), or a result cube of the same layout.
     out : path-like
         Folder of the page, its PNG figures and CSV tables (created if missing).
