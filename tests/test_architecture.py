@@ -3,8 +3,9 @@
 cli -> study -> verification -> (dynamics, closedform, similarity, risk) -> structures -> motions
 -> constants. The test reads every module's imports (top level and inside functions) with
 ``ast`` and checks that no package imports a package of a higher layer, and that the
-package-level graph has no cycle. It also keeps the kernels' package ``dynamics/`` in files and
-functions of one job: no module over 700 lines, no function over 80 lines of code.
+package-level graph has no cycle. Inside ``study/`` the subpackages follow the flow of a study
+the same way: spec -> designs -> running -> analysis -> report. No function of the package has
+over 80 lines of code, and the kernels' package ``dynamics/`` keeps its files under 700 lines.
 """
 
 import ast
@@ -165,6 +166,59 @@ def test_the_cycle_finder_finds_cycles():
         _find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}})
 
 
+# The subpackages of study/ in the order of a study's flow (issue 25 section 1): the study file,
+# its designs, running them, analysing the cube, reporting it. Lower number = earlier; a module
+# of study/ may import only from its own subpackage or from earlier ones.
+STUDY_LAYER = {
+    "spec": 0,  # the study file: schema, distributions, feasibility, IDA options
+    "designs": 1,  # sampled designs, record designs (Python API), a study's record rows
+    "running": 2,  # runner (dask), evaluate (one chunk), store (zarr cube), kernel warm-up
+    "analysis": 3,  # Sobol', fragility, collapse, record fragility and similarity
+    "report": 4,  # the HTML pages
+    "__init__": 5,  # rockstudy.study itself: the public names
+}
+
+
+def _study_part(module: str) -> str:
+    """The subpackage of study/ that holds ``module`` (``__init__`` for rockstudy.study)."""
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 else "__init__"
+
+
+def _study_graph():
+    """Each subpackage of study/ to the subpackages of study/ its modules import."""
+    graph: dict[str, set[str]] = {}
+    for mod, deps in _module_graph().items():
+        if mod == "rockstudy.study" or mod.startswith("rockstudy.study."):
+            inside = {_study_part(d) for d in deps if d.startswith("rockstudy.study.")}
+            graph.setdefault(_study_part(mod), set()).update(inside - {_study_part(mod)})
+    return graph
+
+
+def _against_the_flow(graph, layer) -> list[str]:
+    return sorted(
+        f"{a} imports {b}" for a, deps in graph.items() for b in deps if layer[b] > layer[a]
+    )
+
+
+def test_every_study_subpackage_has_a_layer():
+    graph = _study_graph()
+    assert {"spec", "designs", "running", "analysis", "report"} <= set(graph)
+    assert set(graph) <= set(STUDY_LAYER), set(graph) - set(STUDY_LAYER)
+
+
+def test_study_imports_follow_the_flow():
+    graph = _study_graph()
+    assert "designs" in graph["running"] and "running" in graph["report"]  # the graph is read
+    assert not _against_the_flow(graph, STUDY_LAYER), _against_the_flow(graph, STUDY_LAYER)
+    _find_cycle(graph)
+
+
+def test_the_flow_check_finds_an_import_against_it():
+    graph = {"spec": {"designs"}, "designs": {"spec"}, "report": {"spec"}}
+    assert _against_the_flow(graph, STUDY_LAYER) == ["spec imports designs"]
+
+
 def test_physics_never_imports_the_study_backends():
     heavy = ("dask", "distributed", "SALib", "zarr", "netCDF4", "h5netcdf")
     bad = []
@@ -180,7 +234,7 @@ def test_physics_never_imports_the_study_backends():
     assert not bad, bad
 
 
-# Size limits of the dynamics package (issue 25 §4): short kernels, files of one job.
+# Size limits (issue 25 §4): short functions everywhere, and the kernels' files of one job.
 MAX_FUNCTION_LINES = 80
 MAX_MODULE_LINES = 700
 
@@ -227,10 +281,13 @@ def test_code_lines_counts_code_only():
     assert code_lines(nested) == {"f:1": 4, "g:2": 2}
 
 
-def test_dynamics_functions_are_short():
+def test_functions_are_short():
+    """Every function of the package, not only the kernels."""
+    paths = sorted(PACKAGE.rglob("*.py"))
+    assert PACKAGE / "study" / "designs" / "sampling.py" in paths
     long = {
-        f"{path.name}:{name}": n
-        for path in sorted((PACKAGE / "dynamics").glob("*.py"))
+        f"{path.relative_to(PACKAGE)}:{name}": n
+        for path in paths
         for name, n in code_lines(path.read_text()).items()
         if n > MAX_FUNCTION_LINES
     }

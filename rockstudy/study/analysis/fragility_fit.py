@@ -1,6 +1,6 @@
 """Lognormal fragility fits, shared by the Monte Carlo analyses
 (:func:`rockstudy.study.analysis.fragility`) and the record designs
-(:mod:`rockstudy.study.records_fragility`), and pointwise bands of the fitted curve.
+(:mod:`rockstudy.study.analysis.record_fragility`), and pointwise bands of the fitted curve.
 
 A lognormal fragility is P(x) = Phi(ln(x / theta) / beta): theta the median capacity, beta the
 dispersion. **beta is the maximum-likelihood estimate everywhere**: for capacities (IDA), the

@@ -1,4 +1,4 @@
-"""Fragility from record designs (:mod:`rockstudy.study.records_designs`): the binomial
+"""Fragility from record designs (:mod:`rockstudy.study.designs.records`): the binomial
 maximum-likelihood fit of stripes (Baker 2015), the lognormal fit of IDA capacities, and the
 efficiency of intensity measures.
 
@@ -195,13 +195,13 @@ def stripe_fragility(
     (:func:`~rockstudy.study.analysis.fragility_curve`) comes from the covariance of
     (ln theta, ln beta): the expected information where each record gives one point (a cloud
     of one block), else the sandwich clustered by record (a record's points are not
-    independent); see :mod:`rockstudy.study.fragility_fit`.
+    independent); see :mod:`rockstudy.study.analysis.fragility_fit`.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`~rockstudy.study.records_designs.multiple_stripes` or
-        :func:`~rockstudy.study.records_designs.cloud`.
+        From :func:`~rockstudy.study.designs.records.multiple_stripes` or
+        :func:`~rockstudy.study.designs.records.cloud`.
     im, period : str, float
         The intensity measure (default the stripes' own); any other stored measure makes the
         points single Bernoulli trials at their own intensities.
@@ -217,8 +217,8 @@ def stripe_fragility(
     pandas.DataFrame
         One row per group: ``theta`` [quoted unit], ``beta``, their intervals, ``n``
         (points), ``im_min``, ``im_max``, ``theta_in_range``, ``band_in_range``, the band
-        columns of :func:`~rockstudy.study.fragility_fit.fragility_row` and ``unit``. Points
-        that failed (``status`` != 0) or have no finite intensity are left out.
+        columns of :func:`~rockstudy.study.analysis.fragility_fit.fragility_row` and ``unit``.
+        Points that failed (``status`` != 0) or have no finite intensity are left out.
     """
     conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
     im, period = _measure(ds, im, period)

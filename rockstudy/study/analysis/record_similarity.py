@@ -2,9 +2,9 @@
 the intensity is expressed in the record groups?
 
 For each size class of blocks (bins of the half-diagonal R) the median overturning intensity
-theta is fitted from a record design (:mod:`rockstudy.study.records_designs`: the lognormal
+theta is fitted from a record design (:mod:`rockstudy.study.designs.records`: the lognormal
 fit of IDA capacities, or the binomial fit of stripes and clouds, as in
-:mod:`rockstudy.study.records_fragility`). The spread of those medians across size classes
+:mod:`rockstudy.study.analysis.record_fragility`). The spread of those medians across size classes
 measures how far the measure is from collapsing the sizes:
 
 - ``ratio``: the largest median over the smallest (1 for a complete collapse);
@@ -165,11 +165,11 @@ def size_class_medians(
     Parameters
     ----------
     ds : xarray.Dataset
-        A record design (:func:`~rockstudy.study.records_designs.incremental_dynamic_analysis`,
-        :func:`~rockstudy.study.records_designs.multiple_stripes` or ``cloud``).
+        A record design (:func:`~rockstudy.study.designs.records.incremental_dynamic_analysis`,
+        :func:`~rockstudy.study.designs.records.multiple_stripes` or ``cloud``).
     im, period : str, float
         The intensity measure (a key of
-        :data:`~rockstudy.study.records_fragility.QUOTED_UNITS`) and the period [s] of a
+        :data:`~rockstudy.study.analysis.record_fragility.QUOTED_UNITS`) and the period [s] of a
         spectral one.
     size_bins : int or array_like
         Size classes (:func:`size_classes`).

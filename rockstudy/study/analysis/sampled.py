@@ -173,7 +173,7 @@ def fragility(
 ) -> pd.DataFrame:
     """Lognormal fragility curves P(outcome | intensity) fitted by maximum likelihood.
 
-    The Bernoulli case of :func:`~rockstudy.study.fragility_fit.fit_binomial` (Baker 2015,
+    The Bernoulli case of :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial` (Baker 2015,
     eq. 11): ``beta`` is the maximum-likelihood estimate.
 
     Parameters
@@ -262,7 +262,7 @@ def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:
     """Evaluate fitted fragility curves at intensities ``im``, with pointwise bands of P.
 
     The bands vary both theta and beta: the method and level are the table's (``p_band``,
-    ``conf_level``; see :func:`~rockstudy.study.fragility_fit.probability_band`). A group
+    ``conf_level``; see :func:`~rockstudy.study.analysis.fragility_fit.probability_band`). A group
     without a fit (beta NaN) gives NaN.
 
     Returns

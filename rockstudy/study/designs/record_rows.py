@@ -5,10 +5,10 @@ sampler draws (``sampler.n`` of them) [at every level of ``motion.scale_to.value
 on the store's ``sample`` dimension are (record, structure[, level]) in C order, and each
 record is one chunk: one dask task, stored and hashed as any chunk, so an interrupted run
 resumes at the records not yet done. A task calls the Python design functions of
-:mod:`.records_designs` on its record and structures (no second pipeline), and
+:mod:`.records` on its record and structures (no second pipeline), and
 :func:`design_dataset` folds the rows back into their layout: dims ``record``,
 ``structure`` [, ``level``] [, ``step``, ``period``], with each record's intensity measures,
-pulse and groups, as :mod:`.records_designs` returns them.
+pulse and groups, as :mod:`.records` returns them.
 
 The store's per-row ``status`` (1 ok, 2 failed: the task raised) is ``run_status`` there, and
 ``status`` is the design's own (0 ok; else a simulation hit the step limit), as in the API.
@@ -210,7 +210,7 @@ def load_record(motion_json: str, base_dir, index: int):
 
 def stored_periods(study) -> np.ndarray:
     """Periods [s] of the stored ``sa``: ``design.periods`` and the period of a spectral target
-    (as :mod:`.records_designs` stores them), sorted."""
+    (as :mod:`.records` stores them), sorted."""
     de, periods = study.design, set(study.design.periods)
     if de.kind == "stripes" and study.motion.scale_to.period is not None:
         periods.add(study.motion.scale_to.period)
@@ -235,7 +235,7 @@ def empty_rows(study, n: int) -> dict:
 
 
 def _run_design(study, record, structures, levels):
-    """The design function of :mod:`.records_designs` on one record."""
+    """The design function of :mod:`.records` on one record."""
     de, run = study.design, study.run
     common = dict(
         periods=de.periods,
@@ -301,7 +301,7 @@ def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
 
 
 def design_dataset(cube: xr.Dataset) -> xr.Dataset:
-    """Fold a design study's rows (the store's cube) into the layout of :mod:`.records_designs`:
+    """Fold a design study's rows (the store's cube) into the layout of :mod:`.records`:
     ``record`` x ``structure`` [x ``level``], per-record and per-structure tables, attributes.
     """
     kind = cube.attrs["record_design"]
@@ -375,7 +375,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
 
 
 def _uplift(ds):
-    """g tan(theta_cr) [m/s^2] of each structure, as :mod:`.records_designs` forms it."""
+    """g tan(theta_cr) [m/s^2] of each structure, as :mod:`.records` forms it."""
     from ...constants import G
 
     return G * np.tan(ds["critical_rotation"].values)

@@ -9,7 +9,7 @@ record's intensity measures (:meth:`rockstudy.motions.Record.intensity_measures`
 (:meth:`rockstudy.motions.Record.pulse`) and its dimensionless groups for each structure
 (:func:`rockstudy.similarity.record_groups`) as variables, all of the unscaled record. The
 intensity of a scaled record is its unscaled value times ``scale`` (``scale`` squared for Arias
-intensity); :func:`rockstudy.study.records_fragility.intensity` forms it in quoted units.
+intensity); :func:`rockstudy.study.analysis.record_fragility.intensity` forms it in quoted units.
 
 Rocking is not monotonic in intensity: a block that overturns at one scale can survive a
 higher one. The IDA reports the first overturning rung of a ladder of 1 % steps (refined by
@@ -19,8 +19,6 @@ bisection) and the switch band above it, where the block is seen to survive agai
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
-from typing import ClassVar
 
 import numpy as np
 import xarray as xr
@@ -32,6 +30,8 @@ from ...dynamics._vertical import uplift_ratio
 from ...motions import Record
 from ...motions import intensity as _im
 from ...structures.block import block_parameters, frequency_parameter, restitution_housner
+from ..spec.feasibility import free_fall_scale
+from ..spec.ida_options import IdaOptions
 
 #: Dimensionless targets: name -> the record measure it divides by the uplift acceleration
 #: (``pga_ratio`` = PGA / (g tan alpha), ``pgv_ratio`` = PGV p / (g tan alpha)).
@@ -395,89 +395,6 @@ def multiple_stripes(
 # ------------------------------------------------------------------------------ IDA
 
 
-@dataclass(frozen=True)
-class IdaOptions:
-    """The options of an incremental dynamic analysis, one place for the API, the study file
-    (``[design]`` of kind ``ida``) and the dataset read back from a store.
-
-    Attributes
-    ----------
-    im : str
-        The measure the capacity is reported in (one of :data:`SCALABLE`).
-    period : float or None
-        T [s] of ``sa``, ``psv`` and ``sd``.
-    step : float
-        Ladder step: successive rungs differ by the factor ``1 + step`` in scale (about
-        ``step`` in log scale), in [1e-3, 0.5]. Default 0.01.
-    tolerance : float
-        Relative width of the final bisection bracket of the capacity scale, in
-        [1e-6, 0.5]. Default 0.001; at or above ``step`` there is no bisection (the bracket
-        is the last surviving and the first overturning rung).
-    max_pga_ratio : float
-        Top of the ladder, PGA / (g tan alpha), in (1, 1e4]. Default 30.
-    scan : int
-        Levels simulated above the first overturning rung, spaced geometrically up to the top
-        of the ladder, in [0, 1000] (0: none). Default 24.
-    """
-
-    im: str = "pga"
-    period: float | None = None
-    step: float = 0.01
-    tolerance: float = 0.001
-    max_pga_ratio: float = 30.0
-    scan: int = 24
-
-    #: name -> (lowest, highest, lowest allowed itself) of the numeric options
-    RANGES: ClassVar[dict] = {
-        "step": (1e-3, 0.5, True),
-        "tolerance": (1e-6, 0.5, True),
-        "max_pga_ratio": (1.0, 1e4, False),
-        "scan": (0, 1000, True),
-    }
-
-    def __post_init__(self):
-        for name, (low, high, closed) in self.RANGES.items():
-            value = getattr(self, name)
-            whole = name == "scan"
-            kind = "a whole number" if whole else "a number"
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, (int, float, np.integer, np.floating))
-                or (whole and int(value) != value)
-                or not math.isfinite(value)
-                or not (value >= low if closed else value > low)
-                or value > high
-            ):
-                bracket = "[" if closed else "("
-                raise IdaOptionError(
-                    name,
-                    f"{name} must be {kind} in {bracket}{low:g}, {high:g}], got {value!r}",
-                )
-        object.__setattr__(self, "scan", int(self.scan))
-
-    @classmethod
-    def given(cls, mapping) -> IdaOptions:
-        """From a mapping whose missing or None entries take the defaults (a study's
-        ``[design]`` table; other keys are ignored)."""
-        names = [f.name for f in fields(cls)]
-        return cls(**{k: mapping[k] for k in names if mapping.get(k) is not None})
-
-    def attrs(self) -> dict:
-        """The options as dataset attributes (``im_period`` NaN when there is none)."""
-        out = asdict(self)
-        period = out.pop("period")
-        out["im_period"] = np.nan if period is None else float(period)
-        return out
-
-
-class IdaOptionError(ValueError):
-    """An IDA option outside its range; ``option`` names it."""
-
-    def __init__(self, option, message):
-        super().__init__(message)
-        self.option = option
-
-
 #: ``censored_reason`` of a capacity (CF flag values and meanings).
 CENSORED_REASONS = {0: "not censored", 1: "standing at max_pga_ratio", 2: "free fall above"}
 #: ``step_kind`` of a simulated point of an IDA curve.
@@ -522,7 +439,7 @@ def incremental_dynamic_analysis(
     At scales where u_v'' reaches -g (free fall) Housner's model does not apply: the ladder
     stops below that scale, and a block that has not overturned there is censored (reason
     2) at its highest surviving rung; the censored fit of
-    :func:`~rockstudy.study.records_fragility.ida_fragility` takes it as such.
+    :func:`~rockstudy.study.analysis.record_fragility.ida_fragility` takes it as such.
 
     **The guarantee.** Every rung below the capacity was simulated and survived, so the
     capacity is within ``tolerance`` of the lowest overturning scale of the ladder's grid,
@@ -619,13 +536,6 @@ def _ida_tables(ds, results):
     for c, k in enumerate(STEP_VARIABLES):
         ds[k] = (dims + ("step",), steps[..., c])
     return ds
-
-
-def free_fall_scale(record) -> float:
-    """The lowest |scale| at which the record's vertical u_v'' reaches -g (inf if never)."""
-    v = record.vertical
-    low = float(np.min(v)) if v is not None and v.size else 0.0
-    return G / -low if low < 0 else math.inf
 
 
 def _rest_scale(record, alpha, ceiling):

@@ -50,27 +50,42 @@ def salib_problem(study: Study) -> dict:
     return {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
 
 
+def _monte_carlo(study: Study, d: int) -> np.ndarray:
+    """Plain Monte Carlo: independent uniform points from the study's root seed."""
+    return np.random.default_rng(np.random.SeedSequence(study.seed)).random((study.sampler.n, d))
+
+
+def _latin_hypercube(study: Study, d: int) -> np.ndarray:
+    """A scrambled Latin hypercube (``scipy.stats.qmc``) from the study's root seed."""
+    rng = np.random.default_rng(np.random.SeedSequence(study.seed))
+    return qmc.LatinHypercube(d=d, seed=rng).random(study.sampler.n)
+
+
+def _saltelli(study: Study, d: int) -> np.ndarray:
+    """Scrambled Sobol' points in SALib's Saltelli layout (N (D + 2) rows, or N (2 D + 2)
+    with second-order indices)."""
+    from SALib.sample import sobol
+
+    s = study.sampler
+    x = sobol.sample(
+        salib_problem(study), s.n, calc_second_order=s.second_order, scramble=True, seed=study.seed
+    )
+    return np.clip(x, 0.0, np.nextafter(1.0, 0.0))
+
+
+#: Sampler kind -> its points in [0, 1)^D: (study, D) -> array (rows = samples). The grid
+#: sampler takes each distribution's own points instead (:func:`_inputs`).
+UNIT_SAMPLERS = {"monte_carlo": _monte_carlo, "lhs": _latin_hypercube, "sobol": _saltelli}
+
+
 def unit_samples(study: Study) -> np.ndarray:
     """Points in [0, 1)^D of the study's sampler (rows = samples)."""
-    d = len(study.parameters())
-    s = study.sampler
-    root = np.random.SeedSequence(study.seed)
-    if s.kind == "monte_carlo":
-        return np.random.default_rng(root).random((s.n, d))
-    if s.kind == "lhs":
-        return qmc.LatinHypercube(d=d, seed=np.random.default_rng(root)).random(s.n)
-    if s.kind == "sobol":
-        from SALib.sample import sobol
-
-        x = sobol.sample(
-            salib_problem(study),
-            s.n,
-            calc_second_order=s.second_order,
-            scramble=True,
-            seed=study.seed,
+    kind = study.sampler.kind
+    if kind not in UNIT_SAMPLERS:
+        raise ValueError(
+            f"unit samples do not apply to sampler {kind!r}; they do to {', '.join(UNIT_SAMPLERS)}"
         )
-        return np.clip(x, 0.0, np.nextafter(1.0, 0.0))
-    raise ValueError(f"unit samples do not apply to sampler {s.kind!r}")
+    return UNIT_SAMPLERS[kind](study, len(study.parameters()))
 
 
 def _inputs(study: Study) -> tuple[dict, dict]:
@@ -108,9 +123,9 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     (p, alpha, eta), the motion in SI units and the dimensionless groups of [000].
 
     For grid studies the grid axes are kept as coordinates ``<name>_grid`` and the attribute
-    ``grid_dims`` lists them, so :func:`rockstudy.study.store.open_result` can unstack. A study
-    with a ``[design]`` gets the rows (record, structure[, level]) of
-    :func:`.record_studies.design_rows`; ``base_dir`` is where its relative record paths are
+    ``grid_dims`` lists them, so :func:`rockstudy.study.running.store.open_result` can unstack.
+    A study with a ``[design]`` gets the rows (record, structure[, level]) of
+    :func:`.record_rows.design_rows`; ``base_dir`` is where its relative record paths are
     (the study file's folder), and a suite given as a folder or glob is listed there.
     """
     cols, axes = _inputs(study)
@@ -120,81 +135,17 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
         reps = study.sampler.replicates
         cols["group_point"] = np.repeat(np.arange(n // reps), reps)
     st, mo = study.structure, study.motion
-    data = {}
     if st.kind == "objects":
         from .record_rows import design_rows
 
         return _attributes(design_rows(study, _object_columns(st), base_dir))
-    if st.kind == "equivalent_block":
-        p = _value(cols, st, "frequency_parameter", n)
-        alpha = _value(cols, st, "critical_rotation", n)
-        eta = _value(cols, st, "restitution", n)
-        data.update(frequency_parameter=p, critical_rotation=alpha, restitution=eta)
-    else:
-        R = _value(cols, st, "half_diagonal", n)
-        alpha0 = _value(cols, st, "slenderness", n)
-        p = np.sqrt(3.0 * G / (4.0 * R))
-        alpha = alpha0
-        if st.kind == "rocking_wall":  # eq. (23) of [003]: p_wall = sqrt(2) p, theta_cr = 2 alpha
-            p = math.sqrt(2.0) * p
-            alpha = 2.0 * alpha0
-        eta = (
-            1.0 - 1.5 * np.sin(alpha0) ** 2
-            if st.restitution == "housner"
-            else _value(cols, st, "restitution", n)
-        )
-        data.update(
-            half_diagonal=R,
-            slenderness=alpha0,
-            restitution=eta,
-            frequency_parameter=p,
-            critical_rotation=alpha,
-        )
+    data = _structure_columns(st, cols, n)
     if study.design is not None:
         from .record_rows import design_rows
 
         return _attributes(design_rows(study, data, base_dir))
-    uplift = G * np.tan(alpha)
-    if mo.kind == "pulse":
-        if mo.amplitude is not None:
-            ratio = _value(cols, mo, "amplitude", n) / uplift
-        elif mo.amplitude_a is not None:
-            data["amplitude_a"] = _value(cols, mo, "amplitude_a", n)
-            ratio = data["amplitude_a"] * G * alpha / uplift
-        else:
-            ratio = _value(cols, mo, "amplitude_ratio", n)
-        amp = mo.direction * ratio * uplift
-        period = (
-            _value(cols, mo, "period", n)
-            if mo.frequency_ratio is None
-            else 2.0 * np.pi / (_value(cols, mo, "frequency_ratio", n) * p)
-        )
-        data.update(
-            amplitude=amp,
-            amplitude_ratio=ratio,
-            period=period,
-            frequency_ratio=2.0 * np.pi / (period * p),
-        )
-        a_g = np.abs(amp)
-        data.update(
-            omega=2.0 * np.pi / (period * p),
-            a=a_g / (G * alpha),
-            inverse_a=G * alpha / a_g,
-            uplift_ratio=uplift / a_g,
-        )
-    elif mo.kind == "record":
-        rng = np.random.default_rng(np.random.SeedSequence([study.seed, 1]))
-        data["record"] = rng.integers(0, _suite_size(mo, base_dir), n).astype(np.int64)
-        if mo.scale is not None:
-            data["scale"] = _value(cols, mo, "scale", n)
-        elif mo.pga_ratio is not None:
-            data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
-        else:
-            value, si = mo.scale_to.value, mo.scale_to.si_factor()  # written in units: to SI
-            data["target"] = si * (cols["target"] if "target" in cols else np.full(n, float(value)))
-    else:
-        data["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
-    data["cos_alpha"] = np.cos(alpha)
+    data.update(_MOTION_COLUMNS[mo.kind](study, cols, n, data, base_dir))
+    data["cos_alpha"] = np.cos(data["critical_rotation"])
     if "group_point" in cols:
         data["group_point"] = cols["group_point"]
     ds = xr.Dataset(
@@ -207,6 +158,98 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
     if "target" in ds:  # in the units of the measure it targets
         ds["target"].attrs.update(target_attributes(mo.scale_to))
     return ds
+
+
+def _structure_columns(st, cols, n) -> dict:
+    """The rocking parameters (p, theta_cr, eta) of each row, and the half-diagonal and
+    slenderness of a block or a wall."""
+    if st.kind == "equivalent_block":
+        p = _value(cols, st, "frequency_parameter", n)
+        alpha = _value(cols, st, "critical_rotation", n)
+        eta = _value(cols, st, "restitution", n)
+        return dict(frequency_parameter=p, critical_rotation=alpha, restitution=eta)
+    R = _value(cols, st, "half_diagonal", n)
+    alpha0 = _value(cols, st, "slenderness", n)
+    p = np.sqrt(3.0 * G / (4.0 * R))
+    alpha = alpha0
+    if st.kind == "rocking_wall":  # eq. (23) of [003]: p_wall = sqrt(2) p, theta_cr = 2 alpha
+        p = math.sqrt(2.0) * p
+        alpha = 2.0 * alpha0
+    eta = (
+        1.0 - 1.5 * np.sin(alpha0) ** 2
+        if st.restitution == "housner"
+        else _value(cols, st, "restitution", n)
+    )
+    return dict(
+        half_diagonal=R,
+        slenderness=alpha0,
+        restitution=eta,
+        frequency_parameter=p,
+        critical_rotation=alpha,
+    )
+
+
+def _pulse_columns(study, cols, n, data, base_dir) -> dict:
+    """A pulse's amplitude and period in SI units, and the groups of eq. (3.6) of [000]."""
+    mo, p, alpha = study.motion, data["frequency_parameter"], data["critical_rotation"]
+    out = {}
+    uplift = G * np.tan(alpha)
+    if mo.amplitude is not None:
+        ratio = _value(cols, mo, "amplitude", n) / uplift
+    elif mo.amplitude_a is not None:
+        out["amplitude_a"] = _value(cols, mo, "amplitude_a", n)
+        ratio = out["amplitude_a"] * G * alpha / uplift
+    else:
+        ratio = _value(cols, mo, "amplitude_ratio", n)
+    amp = mo.direction * ratio * uplift
+    period = (
+        _value(cols, mo, "period", n)
+        if mo.frequency_ratio is None
+        else 2.0 * np.pi / (_value(cols, mo, "frequency_ratio", n) * p)
+    )
+    out.update(
+        amplitude=amp,
+        amplitude_ratio=ratio,
+        period=period,
+        frequency_ratio=2.0 * np.pi / (period * p),
+    )
+    a_g = np.abs(amp)
+    out.update(
+        omega=2.0 * np.pi / (period * p),
+        a=a_g / (G * alpha),
+        inverse_a=G * alpha / a_g,
+        uplift_ratio=uplift / a_g,
+    )
+    return out
+
+
+def _record_columns(study, cols, n, data, base_dir) -> dict:
+    """The record of each row (drawn from the suite) and its scale, PGA ratio or target."""
+    mo = study.motion
+    rng = np.random.default_rng(np.random.SeedSequence([study.seed, 1]))
+    out = {"record": rng.integers(0, _suite_size(mo, base_dir), n).astype(np.int64)}
+    if mo.scale is not None:
+        out["scale"] = _value(cols, mo, "scale", n)
+    elif mo.pga_ratio is not None:
+        out["pga_ratio"] = _value(cols, mo, "pga_ratio", n)
+    else:
+        value, si = mo.scale_to.value, mo.scale_to.si_factor()  # written in units: to SI
+        out["target"] = si * (cols["target"] if "target" in cols else np.full(n, float(value)))
+    return out
+
+
+def _stochastic_columns(study, cols, n, data, base_dir) -> dict:
+    """A synthetic record's PGA ratio."""
+    return {"pga_ratio": _value(cols, study.motion, "pga_ratio", n)}
+
+
+#: Motion kind -> the design columns of its motion: (study, cols, n, structure columns,
+#: base_dir) -> dict of columns.
+_MOTION_COLUMNS = {
+    "pulse": _pulse_columns,
+    "record": _record_columns,
+    "stochastic": _stochastic_columns,
+}
 
 
 def _object_columns(objects) -> dict:

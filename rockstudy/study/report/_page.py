@@ -1,4 +1,4 @@
-"""The HTML page shared by the reports (:mod:`.report`, :mod:`.report_records`): sections,
+"""The HTML page shared by the reports (:mod:`.sampled`, :mod:`.records`): sections,
 escaped text, tables as the page shows them (CSV beside), and figures embedded as PNG."""
 
 from __future__ import annotations

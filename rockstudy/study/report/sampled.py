@@ -21,6 +21,7 @@ from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
+from ..spec.schema import SAMPLER_LAYOUTS
 from ._page import (
     _FRAGILITY_NAMES,
     NOT_REACHED,
@@ -89,7 +90,23 @@ _BANDS = {
 }
 
 
-def _fragility(page, ds):
+#: The two views of the fragility: (intensity, pulse variable held to its middle third, axis
+#: label). Dimensional first, then the groups of (6.1).
+_FRAGILITY_VIEWS = (
+    (
+        "abs_amplitude",
+        "period",
+        "pulse amplitude a_g [m/s^2], pulse period T_p in its middle third",
+    ),
+    (
+        "amplitude_ratio",
+        "omega",
+        "amplitude ratio a_g / (g tan alpha) [-], omega_g / p in its middle third",
+    ),
+)
+
+
+def _fragility(page, ds, study=None):
     """Fragility by block size: against a_g for pulses of similar period T_p (dimensional),
     and against a_g / (g tan alpha) for pulses of similar omega_g / p (the groups of 6.1)."""
     if "overturned" not in ds or "amplitude" not in ds or "half_diagonal" not in ds:
@@ -99,46 +116,11 @@ def _fragility(page, ds):
     bins[-1] += 1e-12
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.8))
-    tables = []
-    for ax, im, band, label in (
-        (
-            axes[0],
-            "abs_amplitude",
-            "period",
-            "pulse amplitude a_g [m/s^2], pulse period T_p in its middle third",
-        ),
-        (
-            axes[1],
-            "amplitude_ratio",
-            "omega",
-            "amplitude ratio a_g / (g tan alpha) [-], omega_g / p in its middle third",
-        ),
-    ):
-        sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
-        try:
-            t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
-        except ValueError as err:  # no block size saw both outcomes
-            page.text(f"Fragility against {im}: {err}")
-            continue
-        # the groups by readable names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
-        t.index = [
-            f"R {lo:.3g} to {hi:.3g} m"
-            for lo, hi in (map(float, g.split("-")) for g in t.index.astype(str))
-        ]
-        t.index.name = "block size"
-        t.insert(0, "intensity", im)
-        t.insert(1, "band", band)
-        tables.append(t)
-        grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
-        curve = analysis.fragility_curve(t, grid)
-        for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
-            c = curve.sel(group=g)
-            note = "" if inside else " (median outside the data)"
-            ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
-            ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
-        ax.set(xscale="log", xlabel=label, ylabel="probability of overturning")
-        _plain_log_ticks(ax)
-        ax.legend(fontsize=8)
+    tables = [
+        t
+        for ax, view in zip(axes, _FRAGILITY_VIEWS, strict=True)
+        if (t := _fragility_view(page, ax, d, bins, *view)) is not None
+    ]
     if not tables:
         plt.close(fig)
         return
@@ -154,7 +136,44 @@ def _fragility(page, ds):
         "collapse (to the extent the groups make the response self-similar); dashed: the "
         "median lies outside the sampled intensities",
     )
-    fit = pd.concat(tables)
+    _fragility_table(page, pd.concat(tables))
+    _fragility_spread(page, tables)
+
+
+def _fragility_view(page, ax, d, bins, im, band, label):
+    """The fits by block size against ``im`` over the middle third of ``band``, drawn on
+    ``ax`` with their bands; the table of the fits, or None (said on the page) when no block
+    size saw both outcomes."""
+    sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
+    try:
+        t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
+    except ValueError as err:  # no block size saw both outcomes
+        page.text(f"Fragility against {im}: {err}")
+        return None
+    # the groups by readable names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
+    t.index = [
+        f"R {lo:.3g} to {hi:.3g} m"
+        for lo, hi in (map(float, g.split("-")) for g in t.index.astype(str))
+    ]
+    t.index.name = "block size"
+    t.insert(0, "intensity", im)
+    t.insert(1, "band", band)
+    grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
+    curve = analysis.fragility_curve(t, grid)
+    for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
+        c = curve.sel(group=g)
+        note = "" if inside else " (median outside the data)"
+        ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
+        ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
+    ax.set(xscale="log", xlabel=label, ylabel="probability of overturning")
+    _plain_log_ticks(ax)
+    ax.legend(fontsize=8)
+    return t
+
+
+def _fragility_table(page, fit):
+    """The fitted parameters: all of them in fragility_fit.csv, and on the page the medians
+    as measured (g beside m/s^2), limits outside the sampled range read as not reached."""
     fit.to_csv(page.out / "fragility_fit.csv")
     shown = _capacities_as_measured(fit).drop(columns=list(BAND_COLUMNS))
     dimensional = (fit["intensity"] == "abs_amplitude").to_numpy()
@@ -172,6 +191,10 @@ def _fragility(page, ds):
         f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
         f"'{NOT_REACHED}' (the fitted numbers and flags are in fragility_fit.csv)",
     )
+
+
+def _fragility_spread(page, tables):
+    """How far apart the block sizes' medians lie, for each intensity."""
     spread = []
     for t in tables:
         inside = t["theta"][t["theta_in_range"]]
@@ -187,7 +210,7 @@ def _fragility(page, ds):
     )
 
 
-def _grid(page, ds):
+def _grid(page, ds, study=None):
     dims = list(ds.dims)
     if len(dims) != 2:
         return
@@ -398,7 +421,7 @@ def _computed(ds):
     return ds.isel(sample=np.flatnonzero(ds["status"].values == 1))
 
 
-def _response(page, ds):
+def _response(page, ds, study=None):
     """Distributions of the response: theta_max / theta_cr of the survivors, and the
     overturned share against the amplitude ratio."""
     if "max_rotation_ratio" not in ds or "overturned" not in ds:
@@ -547,6 +570,36 @@ def _version(versions) -> str:
     return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
 
 
+def _laid_out(layout):
+    """Whether a study's sampler has ``layout`` (a value of
+    :data:`~rockstudy.study.spec.schema.SAMPLER_LAYOUTS`)."""
+    return lambda study, ds: SAMPLER_LAYOUTS[study.sampler.kind] == layout
+
+
+#: The sections of a sampled study's page between its summary and its study file, in order:
+#: (heading, whether the study and its cube have the section, the function that writes it:
+#: (page, ds, study)). A new section is one entry.
+_SECTIONS = (
+    ("Response", _laid_out("random"), _response),
+    ("Overturning map", _laid_out("random"), _overturning_map),
+    ("First-order sensitivity", _laid_out("random"), _first_order),
+    ("Sensitivity", _laid_out("saltelli"), _sobol),
+    ("Spectrum and overturning map", _laid_out("grid"), _grid),
+    (
+        "Fragility",
+        lambda study, ds: (
+            SAMPLER_LAYOUTS[study.sampler.kind] != "grid" and study.motion.kind == "pulse"
+        ),
+        _fragility,
+    ),
+    (
+        "Self-similarity",
+        lambda study, ds: study.sampler.replicates > 1 and "overturned" in ds,
+        _similarity,
+    ),
+)
+
+
 def make_report(result, out=None, verify: bool = True) -> Path:
     """Write the report of a result cube into ``out`` (default: RESULT's name + '_report').
 
@@ -582,25 +635,10 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     page.heading("Summary")
     _summary(page, ds)
     _failures(page, ds)
-    if study.sampler.kind in ("monte_carlo", "lhs"):
-        page.heading("Response")
-        _response(page, ds)
-        page.heading("Overturning map")
-        _overturning_map(page, ds, study)
-        page.heading("First-order sensitivity")
-        _first_order(page, ds, study)
-    if study.sampler.kind == "sobol":
-        page.heading("Sensitivity")
-        _sobol(page, ds, study)
-    if study.sampler.kind == "grid":
-        page.heading("Spectrum and overturning map")
-        _grid(page, ds)
-    elif study.motion.kind == "pulse":
-        page.heading("Fragility")
-        _fragility(page, ds)
-    if study.sampler.replicates > 1 and "overturned" in ds:
-        page.heading("Self-similarity")
-        _similarity(page, ds, study)
+    for heading, applies, section in _SECTIONS:
+        if applies(study, ds):
+            page.heading(heading)
+            section(page, ds, study)
     page.heading("Study")
     _study_file(page, study, ds)
     meta = (

@@ -20,7 +20,7 @@ the other) were tried: numba saves a function's cache index without a lock, so t
 compiling different signatures of one shared helper can lose an entry or map one signature to
 the other's machine code, and the gain was not measurable on the shared 2-core machine.
 
-``python -m rockstudy.study._warmup`` does the same as ``rockstudy compile``.
+``python -m rockstudy.study.running._warmup`` does the same as ``rockstudy compile``.
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ from ...constants import G
 from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ...dynamics.batch import simulate_batch
 from ...motions import stochastic_record
-from ..designs import record_rows as record_studies
+from ..designs import record_rows
 from ..spec.feasibility import record_path
 from ..spec.schema import Study
 
@@ -42,7 +42,8 @@ OUTPUTS = {
 
 
 def resolve_file(name: str, base_dir) -> Path:
-    """A record path as written in a study: see :func:`rockstudy.study.feasibility.record_path`."""
+    """A record path as written in a study: see
+    :func:`rockstudy.study.spec.feasibility.record_path`."""
     return record_path(name, base_dir)
 
 
@@ -80,15 +81,15 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
         motion_json = mo.model_dump_json()
         for r in np.unique(rec_idx):
             sel = rec_idx == r
-            rec = record_studies.load_record(motion_json, base_dir, int(r))
-            scale = record_studies.scale_factors(study, rec, cols, idx[sel])
+            rec = record_rows.load_record(motion_json, base_dir, int(r))
+            scale = record_rows.scale_factors(study, rec, cols, idx[sel])
             part = simulate_batch(
                 record=rec,
                 scale=scale,
                 **{k: (v[sel] if isinstance(v, np.ndarray) else v) for k, v in common.items()},
             )
             part.update(
-                record_studies.sample_measures(
+                record_rows.sample_measures(
                     rec, scale, common["frequency_parameter"][sel], uplift[sel]
                 )
             )
@@ -154,7 +155,7 @@ def evaluate_chunk(study_json: str, cols: dict, base_dir=None) -> dict:
             values = raw[name]
         result[name][ok] = values[ok].astype(OUTPUTS[name][2])
     if study.motion.kind == "record":  # the record's measures and groups, per sample
-        for name in record_studies.sample_outputs(study):  # (not the design's columns)
+        for name in record_rows.sample_outputs(study):  # (not the design's columns)
             result[name] = np.where(ok, raw[name], np.nan)
     result["status"] = status
     result["error"] = error
@@ -167,11 +168,11 @@ def _design_chunk(study, cols, base_dir) -> dict:
     the step limit (the design's own status) fails too, its outputs kept."""
     n = cols["sample"].size
     try:
-        result = record_studies.evaluate_rows(study, cols, base_dir)
+        result = record_rows.evaluate_rows(study, cols, base_dir)
         failed = result["kernel_status"] == 1  # 2: a free-fall point, censored, not failed
         message = f"kernel stopped: more than max_steps={study.run.max_steps} steps"
     except Exception as exc:  # recorded per row, never aborts the run
-        result = record_studies.empty_rows(study, n)
+        result = record_rows.empty_rows(study, n)
         failed = np.ones(n, bool)
         message = f"{type(exc).__name__}: {exc}"
     result["status"] = np.where(failed, STATUS_FAILED, STATUS_OK).astype(np.int8)
@@ -183,7 +184,7 @@ def _rows_one_by_one(study, cols, base_dir, error):
     n = cols["sample"].size
     names = engine_outputs(study)
     if study.motion.kind == "record":
-        names += tuple(record_studies.sample_outputs(study))
+        names += tuple(record_rows.sample_outputs(study))
     raw = {k: np.zeros(n) for k in names}
     failed = np.zeros(n, bool)
     for i in range(n):

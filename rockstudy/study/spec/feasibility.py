@@ -1,6 +1,6 @@
 """Checks of a valid study against the machine and the files it reads, before it runs.
 
-The schema (:mod:`.spec`) checks what a study says; this module checks that it can work here:
+The schema (:mod:`.schema`) checks what a study says; this module checks that it can work here:
 every record file is a readable record, and the design and each sample fit in memory. Each
 problem is one sentence naming the field, the quantity and what is allowed.
 """
@@ -103,8 +103,6 @@ def notes(study, base_dir=None) -> list[str]:
     found = _scaling_notes(study, base_dir)
     if study.design is None:
         return found
-    from ..designs.records import free_fall_scale
-
     for field, h, v in record_pairs(mo, base_dir):
         if v is None:
             continue
@@ -122,6 +120,13 @@ def notes(study, base_dir=None) -> list[str]:
                 "above free fall are stored as censored (reason: free fall); the others run"
             )
     return found
+
+
+def free_fall_scale(record) -> float:
+    """The lowest |scale| at which the record's vertical u_v'' reaches -g (inf if never)."""
+    v = record.vertical
+    low = float(np.min(v)) if v is not None and v.size else 0.0
+    return G / -low if low < 0 else math.inf
 
 
 def _scaling_notes(study, base_dir) -> list[str]:

@@ -66,10 +66,10 @@ from ... import _validate
 from ...constants import STANDARD_GRAVITY, G
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
-from ..designs.records import IdaOptionError, IdaOptions
 from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
+from .ida_options import IdaOptionError, IdaOptions
 
 
 def _param_tag(value):
@@ -189,7 +189,8 @@ class EquivalentBlockSpec(_Model):
 
 
 #: Kinds an object of ``[structure] kind = "objects"`` may be (frames and arches have no study
-#: spec: give them through the Python API, :func:`.records_designs.cloud` and the others).
+#: spec: give them through the Python API,
+#: :func:`~rockstudy.study.designs.records.cloud` and the others).
 OBJECT_KINDS = ("block", "rocking_wall")
 
 
@@ -599,7 +600,7 @@ class DesignSpec(_Model):
     each level of ``motion.scale_to.value``, a grid), or ``ida`` (the first overturning
     intensity of each structure under each record in ``im``, by a ladder of ``step`` refined
     by bisection to ``tolerance``; ``max_pga_ratio`` and ``scan`` as in
-    :class:`rockstudy.study.designs.records.IdaOptions`, which holds their defaults and
+    :class:`rockstudy.study.spec.ida_options.IdaOptions`, which holds their defaults and
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio."""
 
@@ -676,10 +677,23 @@ class StochasticSpec(_Model):
         return int(round(self.duration / self.dt)) + 1
 
 
+#: Sampler kind -> its layout: ``"random"`` (n independent draws: replicated group points
+#: allowed, and a ``[design]`` may draw its structures with it), ``"saltelli"`` (Sobol' points
+#: in SALib's Saltelli layout, n = 2^k) or ``"grid"`` (each parameter's own points). A new
+#: sampler is one entry here and its points in
+#: :data:`rockstudy.study.designs.sampling.UNIT_SAMPLERS`.
+SAMPLER_LAYOUTS = {"monte_carlo": "random", "lhs": "random", "sobol": "saltelli", "grid": "grid"}
+
+
+def samplers_laid_out(*layouts) -> list[str]:
+    """The sampler kinds of the given layouts, in the order of :data:`SAMPLER_LAYOUTS`."""
+    return [kind for kind, layout in SAMPLER_LAYOUTS.items() if layout in layouts]
+
+
 class SamplerSpec(_Model):
     """Monte Carlo, Latin hypercube, Sobol' (Saltelli layout, n = 2^k) or a full grid."""
 
-    kind: Literal["monte_carlo", "lhs", "sobol", "grid"]
+    kind: Literal[tuple(SAMPLER_LAYOUTS)]
     n: int | None = Field(default=None, ge=1, le=2**53)
     second_order: bool = False
     replicates: int = Field(default=1, ge=1, le=10**6)
@@ -695,8 +709,9 @@ class SamplerSpec(_Model):
             raise FieldError("n", f"sobol needs n = 2^k, got {self.n}")
         if self.second_order and self.kind != "sobol":
             raise FieldError("second_order", "applies to the sobol sampler only")
-        if self.replicates > 1 and self.kind not in ("monte_carlo", "lhs"):
-            raise FieldError("replicates", "applies to the monte_carlo and lhs samplers")
+        if self.replicates > 1 and SAMPLER_LAYOUTS[self.kind] != "random":
+            random = " and ".join(samplers_laid_out("random"))
+            raise FieldError("replicates", f"applies to the {random} samplers")
         return self
 
 
@@ -901,10 +916,11 @@ class Study(_Model):
             return self
         if mo.kind != "record":
             raise FieldError("design", f"needs [motion] kind = 'record', not {mo.kind!r}")
-        if self.sampler.kind not in ("monte_carlo", "lhs", "grid"):
+        if SAMPLER_LAYOUTS[self.sampler.kind] not in ("random", "grid"):
+            *some, last = samplers_laid_out("random", "grid")
             raise FieldError(
                 "sampler.kind",
-                "a [design] draws its structures with monte_carlo, lhs or grid, not "
+                f"a [design] draws its structures with {', '.join(some)} or {last}, not "
                 f"{self.sampler.kind!r}",
             )
         if mo.scale is not None or mo.pga_ratio is not None:
