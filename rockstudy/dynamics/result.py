@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -92,8 +93,9 @@ class RockingResult:
     theta_eval: np.ndarray | None = None
     theta_dot_eval: np.ndarray | None = None
     _contact: Callable[[], Any] | None = field(default=None, repr=False, compare=False)
-    #: the motion that produced the result (for ``plot(ground=True)``), or None
+    #: the motion and the structure that produced the result (for ``plot``), or None
     _motion: Any = field(default=None, repr=False, compare=False)
+    _structure: Any = field(default=None, repr=False, compare=False)
 
     @property
     def friction_demand(self) -> float | None:
@@ -348,7 +350,7 @@ class RockingResult:
 
     def _title(self, structure=None, motion=None) -> str:
         """The structure and the motion: their names if given, else their descriptions."""
-        structure = structure or self.info.get("structure", "structure")
+        structure = structure or (describe(self._structure) if self._structure else "structure")
         motion = motion or getattr(self._motion, "name", "") or self.info.get("motion", "motion")
         title = f"{structure} under {motion}"
         return title if len(title) <= 70 else f"{structure}\nunder {motion}"
@@ -408,3 +410,20 @@ class RockingResult:
             **self._contact_summary(),
             **self.info,
         }
+
+
+def describe(thing) -> str:
+    """A one-line description of a motion or a structure: its class and scalar parameters
+    (floats to 12 significant digits: a width of 0.45, not 0.44999999999999996)."""
+    if dataclasses.is_dataclass(thing):
+        scalars = {
+            f.name: getattr(thing, f.name)
+            for f in dataclasses.fields(thing)
+            if not f.name.startswith("_") and isinstance(getattr(thing, f.name), (int, float, str))
+        }
+        text = ", ".join(
+            f"{k}={float(f'{v:.12g}')!r}" if isinstance(v, float) else f"{k}={v!r}"
+            for k, v in scalars.items()
+        )
+        return f"{type(thing).__name__}({text})"
+    return type(thing).__name__

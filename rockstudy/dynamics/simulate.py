@@ -21,7 +21,7 @@ from . import _auto, _linear, _linear_record, _rocking, contact
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
-from .result import RockingResult
+from .result import RockingResult, describe
 
 #: simulate(method="linear") warns above this linearization error bound.
 LINEAR_WARN = 0.1
@@ -475,32 +475,15 @@ def simulate(
             warnings.simplefilter("ignore")
             t_eval = _validate.uniform_times(float(dt_out), float(run(*run_args).t[-1]))
     r = run(*run_args, t_eval=t_eval)
-    r = dataclasses.replace(r, _motion=motion)
+    object.__setattr__(r, "_motion", motion)  # a fresh result: for plot(), at no cost
+    object.__setattr__(r, "_structure", structure)
     r.info.update(
-        structure=_describe(structure),
-        motion=_describe(motion),
+        motion=describe(motion),
         rtol_requested=rtol,
         initial_rotation=th0,
         initial_velocity=om0,
     )
     return contact.with_contact(r, motion, method, friction) if block else r
-
-
-def _describe(thing) -> str:
-    """A one-line description of a motion or a structure: its class and scalar parameters
-    (floats to 12 significant digits: a width of 0.45, not 0.44999999999999996)."""
-    if dataclasses.is_dataclass(thing):
-        scalars = {
-            f.name: getattr(thing, f.name)
-            for f in dataclasses.fields(thing)
-            if not f.name.startswith("_") and isinstance(getattr(thing, f.name), (int, float, str))
-        }
-        text = ", ".join(
-            f"{k}={float(f'{v:.12g}')!r}" if isinstance(v, float) else f"{k}={v!r}"
-            for k, v in scalars.items()
-        )
-        return f"{type(thing).__name__}({text})"
-    return type(thing).__name__
 
 
 def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l, t_eval=None):
