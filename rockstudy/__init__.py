@@ -28,7 +28,7 @@ from ._warnings import (
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
     from . import closedform, motions, risk, similarity, structures
-    from .dynamics import RockingResult, simulate, simulate_batch
+    from .dynamics import RockingResult, StepLimitError, simulate, simulate_batch
     from .structures import Block
 
 __version__ = "0.1.0"
@@ -39,6 +39,7 @@ _LAZY = {
     "RockingResult": (".dynamics", "RockingResult"),
     "simulate": (".dynamics", "simulate"),
     "simulate_batch": (".dynamics", "simulate_batch"),
+    "StepLimitError": (".dynamics", "StepLimitError"),
     "closedform": (".closedform", None),
     "motions": (".motions", None),
     "risk": (".risk", None),
@@ -58,6 +59,7 @@ __all__ = [
     "LooseToleranceWarning",
     "IncompleteReferenceWarning",
     "RockingResult",
+    "StepLimitError",
     "closedform",
     "motions",
     "risk",

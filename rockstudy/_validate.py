@@ -27,6 +27,12 @@ MIN_STEP = 1e-6
 MAX_DURATION = 1e6
 
 
+class NotANumberError(TypeError, ValueError):
+    """A string, a boolean, None or another object where a number was expected: a wrong type
+    (a ``TypeError``, as for every wrong type), and also a ``ValueError`` so that the callers
+    that catch bad values keep catching it."""
+
+
 def machine_memory() -> float:
     """Physical memory of this machine [bytes]."""
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
@@ -52,12 +58,13 @@ def check_memory(name: str, nbytes: float, what: str, advice: str, share=SAMPLE_
 
 
 def number(name: str, value) -> float:
-    """``value`` as a float, or a ValueError naming ``name`` if it is not a real number: a
-    string (``"0.1"``), a boolean (``True``) or anything else is not taken for one."""
+    """``value`` as a float, or a :class:`NotANumberError` naming ``name`` if it is not a real
+    number: a string (``"0.1"``), a boolean (``True``) or anything else is not taken for
+    one."""
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
         value = value.item()
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a number, got {_what(value)}")
+        raise NotANumberError(f"{name} must be a number, got {_what(value)}")
     return float(value)
 
 
@@ -116,8 +123,12 @@ def real_array(name: str, values, low=-math.inf, high=math.inf, label="") -> np.
     (strings, None, booleans), NaN, infinite, or outside [low, high] (``label`` says the
     allowed range in the message)."""
     raw = _as_array(name, values)
-    if raw.dtype.kind not in "iuf" or raw.size == 0:
+    if raw.size == 0:
         raise ValueError(f"{name} must be a number or an array of numbers, got {_what(values)}")
+    if raw.dtype.kind not in "iuf":
+        raise NotANumberError(
+            f"{name} must be a number or an array of numbers, got {_what(values)}"
+        )
     arr = raw.astype(float)
     bad = ~np.isfinite(arr) | (arr < low) | (arr > high)
     if bad.any():

@@ -14,8 +14,7 @@ from . import __version__
 
 
 def _simulate(args) -> int:
-    from . import Block, simulate
-    from .motions import PULSES
+    from . import Block, StepLimitError, simulate
 
     if (args.half_diagonal is None) != (args.slenderness is None) or (args.width is None) != (
         args.height is None
@@ -39,34 +38,23 @@ def _simulate(args) -> int:
         block = Block.from_dimensions(args.width, args.height, args.restitution)
     else:
         block = Block(args.half_diagonal, args.slenderness, args.restitution)
-    if args.units is not None and not args.record:
-        return _usage("--units applies to a --record only")
-    if args.record:
-        path = args.record
-        if path.lower().endswith(".at2") and args.units not in (None, "g"):
-            return _usage(f"--units {args.units}: a PEER .AT2 file is in g; leave --units out")
-        motion = _read_record(path, args.units or "g")
-        if args.scale is not None:
-            motion = motion.scaled(args.scale)
-        described = {"record": path, "units": args.units or "g"}
-        described["scale"] = 1.0 if args.scale is None else args.scale
-    else:
-        if args.amplitude is None or args.period is None:
-            return _usage("a pulse needs --amplitude and --period (or give --record)")
-        shape = args.pulse or "sine"
-        cycles = 1 if args.cycles is None else args.cycles
-        kw = {"cycles": cycles} if shape in ("sine", "cosine") else {}
-        motion = PULSES[shape](args.amplitude, args.period, **kw)
-        described = {"pulse": shape, "amplitude": args.amplitude, "period": args.period, **kw}
-    res = simulate(
-        block,
-        motion,
-        method=args.method,
-        rtol=args.rtol,
-        initial_rotation=args.initial_rotation,
-        initial_velocity=args.initial_velocity,
-        dt_out=args.dt_out,
-    )
+    motion, described = _motion(args)
+    if motion is None:
+        return _usage(described)
+    try:
+        res = simulate(
+            block,
+            motion,
+            method=args.method,
+            rtol=args.rtol,
+            initial_rotation=args.initial_rotation,
+            initial_velocity=args.initial_velocity,
+            dt_out=args.dt_out,
+            **({} if args.max_steps is None else {"max_steps": args.max_steps}),
+        )
+    except StepLimitError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     if args.out:
         _write_history(res, Path(args.out))
     summary = res.summary()
@@ -87,6 +75,33 @@ def _simulate(args) -> int:
         if args.out:
             print(f"wrote {args.out}")
     return 0
+
+
+def _motion(args):
+    """(motion, what describes it) of ``rockstudy simulate``'s options: the record or the
+    pulse; or (None, the usage message) for options that contradict each other."""
+    from .motions import PULSES
+
+    if args.units is not None and not args.record:
+        return None, "--units applies to a --record only"
+    if args.record:
+        path = args.record
+        if path.lower().endswith(".at2") and args.units not in (None, "g"):
+            return None, f"--units {args.units}: a PEER .AT2 file is in g; leave --units out"
+        motion = _read_record(path, args.units or "g")
+        if args.scale is not None:
+            motion = motion.scaled(args.scale)
+        described = {"record": path, "units": args.units or "g"}
+        described["scale"] = 1.0 if args.scale is None else args.scale
+    else:
+        if args.amplitude is None or args.period is None:
+            return None, "a pulse needs --amplitude and --period (or give --record)"
+        shape = args.pulse or "sine"
+        cycles = 1 if args.cycles is None else args.cycles
+        kw = {"cycles": cycles} if shape in ("sine", "cosine") else {}
+        motion = PULSES[shape](args.amplitude, args.period, **kw)
+        described = {"pulse": shape, "amplitude": args.amplitude, "period": args.period, **kw}
+    return motion, described
 
 
 def _inputs(args, block, described) -> dict:
@@ -402,6 +417,49 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"rockstudy {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _add_simulate(sub)
+    demo = sub.add_parser(
+        "demo", help="the demo job: a plot and a JSON summary", formatter_class=_Help
+    )
+    demo.add_argument("--out", default="results/demo", help="directory to write")
+    figs = sub.add_parser(
+        "figures", help="recompute the figures of paper 000 as PNGs", formatter_class=_Help
+    )
+    figs.add_argument("--out", default="results/figures", help="directory to write")
+    _add_run(sub)
+    val = sub.add_parser(
+        "validate", help="check study files, naming every problem", formatter_class=_Help
+    )
+    val.add_argument("study", nargs="+", help="study files (TOML)")
+    sub.add_parser("schema", help="print the JSON schema of study files")
+    sub.add_parser("compile", help="compile the numba kernels into their cache (once per install)")
+    rep = sub.add_parser(
+        "report",
+        help="an HTML report (figures, CSV tables) of a result cube",
+        formatter_class=_Help,
+    )
+    rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
+    rep.add_argument("--out", help="directory (default: RESULT_report)")
+    ver = sub.add_parser(
+        "verify",
+        help="check a result cube against the checksums written with it",
+        formatter_class=_Help,
+        description="Check a zarr cube written by 'rockstudy run': its metadata, design and "
+        "every finished chunk against the sha256 recorded when they were written. Exit 0 and "
+        "one line if it is intact; else one line naming the damaged variable and chunk, exit 1.",
+    )
+    ver.add_argument("cube", help="a zarr store written by 'rockstudy run'")
+    return parser
+
+
+#: The ``--method`` choices of ``rockstudy simulate``: the methods of
+#: :data:`rockstudy.dynamics.methods.METHODS` that run a Block (written out here so that the
+#: parser does not load numba; a test holds the two equal).
+SIMULATE_METHODS = ["nonlinear", "linear", "scipy", "scipy-linear", "complex", "auto"]
+
+
+def _add_simulate(sub) -> None:
+    """The ``simulate`` subcommand and its options."""
     sim = sub.add_parser(
         "simulate",
         help="rock one block through one motion",
@@ -444,10 +502,16 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--method",
         default="nonlinear",
-        choices=["nonlinear", "linear", "scipy", "scipy-linear", "complex", "auto"],
+        choices=SIMULATE_METHODS,
         help="the model and solver",
     )
     sim.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance")
+    sim.add_argument(
+        "--max-steps",
+        type=_positive_int,
+        help="cap on the integrator steps in one rocking phase (default 1,000,000; exceeded: "
+        "exit 1)",
+    )
     sim.add_argument(
         "--out",
         help="write the history to this .csv or .nc file (netCDF: with the peaks, and the "
@@ -462,14 +526,10 @@ def _parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--json", action="store_true", help="print the inputs and the outcomes as JSON"
     )
-    demo = sub.add_parser(
-        "demo", help="the demo job: a plot and a JSON summary", formatter_class=_Help
-    )
-    demo.add_argument("--out", default="results/demo", help="directory to write")
-    figs = sub.add_parser(
-        "figures", help="recompute the figures of paper 000 as PNGs", formatter_class=_Help
-    )
-    figs.add_argument("--out", default="results/figures", help="directory to write")
+
+
+def _add_run(sub) -> None:
+    """The ``run`` subcommand and its options."""
     run = sub.add_parser("run", help="run a study file into a zarr cube", formatter_class=_Help)
     run.add_argument("study", help="the study file (TOML)")
     run.add_argument("--out", required=True, help="the zarr store to write (PATH.nc too)")
@@ -497,29 +557,6 @@ def _parser() -> argparse.ArgumentParser:
     for flag, what in (("ca-file", "CA certificate"), ("cert", "client certificate")):
         run.add_argument(f"--tls-{flag}", help=f"{what} (PEM) for a tls:// scheduler")
     run.add_argument("--tls-key", help="client private key (PEM) for a tls:// scheduler")
-    val = sub.add_parser(
-        "validate", help="check study files, naming every problem", formatter_class=_Help
-    )
-    val.add_argument("study", nargs="+", help="study files (TOML)")
-    sub.add_parser("schema", help="print the JSON schema of study files")
-    sub.add_parser("compile", help="compile the numba kernels into their cache (once per install)")
-    rep = sub.add_parser(
-        "report",
-        help="an HTML report (figures, CSV tables) of a result cube",
-        formatter_class=_Help,
-    )
-    rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
-    rep.add_argument("--out", help="directory (default: RESULT_report)")
-    ver = sub.add_parser(
-        "verify",
-        help="check a result cube against the checksums written with it",
-        formatter_class=_Help,
-        description="Check a zarr cube written by 'rockstudy run': its metadata, design and "
-        "every finished chunk against the sha256 recorded when they were written. Exit 0 and "
-        "one line if it is intact; else one line naming the damaged variable and chunk, exit 1.",
-    )
-    ver.add_argument("cube", help="a zarr store written by 'rockstudy run'")
-    return parser
 
 
 def _verify(args) -> int:

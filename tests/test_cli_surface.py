@@ -144,3 +144,23 @@ def test_units_of_a_text_record_hints_in_cli_terms_and_inputs_without_noise(tmp_
     assert lines["width"] == "0.45" and lines["height"] == "1.9"
     assert lines["half_diagonal"] == f"{math.hypot(0.45, 1.9) / 2:.12g}"
     assert float(lines["slenderness"]) == pytest.approx(math.atan2(0.45, 1.9), rel=1e-11)
+
+
+def test_method_choices_are_the_registry_methods_that_run_a_block():
+    from rockstudy.cli import SIMULATE_METHODS
+    from rockstudy.dynamics.methods import METHODS
+
+    assert sorted(SIMULATE_METHODS) == sorted(
+        m for m, i in METHODS.items() if "block" in i.structures
+    )
+
+
+def test_step_limit_is_one_line_and_exit_1():
+    block = ["simulate", "--half-diagonal", "1", "--slenderness", "0.2", *PULSE]
+    out = cli(*block, "--max-steps", "3")
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert out.stderr.strip() == (
+        "error: nonlinear: more than max_steps=3 steps in one rocking phase (raise max_steps, "
+        "or loosen rtol)"
+    )
+    assert cli(*block, "--max-steps", "100000").returncode == 0

@@ -83,9 +83,10 @@ def test_plot_draws_theta_over_alpha_with_impacts_and_overturning(rocking, falli
     assert set(zip(rocking.t.tolist(), (rocking.theta / 0.2).tolist(), strict=True)) <= drawn
     peaks = (rocking.peak_rotations / 0.2).tolist()
     assert set(zip(rocking.peak_times.tolist(), peaks, strict=True)) <= drawn
-    impacts = [ln for ln in ax.get_lines()[1:] if ln.get_linestyle() == ":"]
-    assert len(impacts) == rocking.n_impacts
-    assert ax.get_lines()[1].get_xdata()[0] == rocking.impact_times[0]
+    ticks = [ln for ln in ax.get_lines() if ln.get_marker() == "|"]
+    assert len(ticks) == 1  # one artist: a tick per impact, at theta = 0 where it happens
+    np.testing.assert_array_equal(ticks[0].get_xdata(), rocking.impact_times)
+    np.testing.assert_array_equal(ticks[0].get_ydata(), np.zeros(rocking.n_impacts))
     plt.close(ax.figure)
     fig, given = plt.subplots()
     ax = falling.plot(ax=given)
@@ -114,3 +115,79 @@ def test_batch_as_dataset_equals_the_dict():
     np.testing.assert_array_equal(ds["slenderness"].values, [0.2] * 3)
     assert ds["amplitude"].attrs["units"] == "m s-2" and ds["period"].attrs["units"] == "s"
     assert "half_diagonal" in ds.coords and ds.attrs["method"] == "nonlinear"
+
+
+def test_plot_stays_readable_with_many_impacts():
+    """Over 150 impacts: short ticks (one marker per impact, no full-height line), a title
+    with the names, the labels inside the figure after drawing (constrained layout), and a
+    ground panel on the same time axis that is the record itself (linear between samples)."""
+    from rockstudy.motions import stochastic_record
+
+    record = stochastic_record(0.2 * 9.81, duration=20.0, seed=3)
+    r = rs.simulate(rs.Block(1.0, 0.15, 0.9), record)
+    assert r.n_impacts >= 150
+    ax = r.plot(ground=True, structure="Statue A")
+    fig = ax.figure
+    assert len(fig.axes) == 2
+    ground = fig.axes[1]
+    assert ground.get_shared_x_axes().joined(ax, ground)
+    ticks = [ln for ln in ax.get_lines() if ln.get_marker() == "|"]
+    assert len(ticks) == 1 and ticks[0].get_xdata().size == r.n_impacts
+    # no full-height line (an axvline spans the axes in the x-axis transform)
+    assert not [ln for ln in ax.get_lines() if ln.get_transform() is ax.get_xaxis_transform()]
+    assert ax.get_title() == f"Statue A under {record.name}"
+    assert ground.get_ylabel() == "a_g [m/s^2]" and ground.get_xlabel() == "time t [s]"
+    t, a = ground.get_lines()[0].get_data()
+    assert t[-1] >= record.duration
+    inside = t <= record.time[-1]
+    np.testing.assert_allclose(
+        a[inside], np.interp(t[inside], record.time, record.acceleration), rtol=0, atol=1e-12
+    )
+    fig.canvas.draw()
+    box = fig.bbox
+    for axes in fig.axes:
+        for label in (axes.yaxis.label, axes.xaxis.label, axes.title):
+            if label.get_text():
+                ext = label.get_window_extent()
+                assert box.x0 <= ext.x0 and ext.x1 <= box.x1, label.get_text()
+                assert box.y0 <= ext.y0 and ext.y1 <= box.y1, label.get_text()
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_plot_names_and_ground_refusals(rocking):
+    import matplotlib.pyplot as plt
+
+    ax = rocking.plot(structure="Column 2", motion="design pulse")
+    assert ax.get_title() == "Column 2 under design pulse"
+    assert len(ax.figure.axes) == 1
+    plt.close(ax.figure)
+    ax = rocking.plot()
+    assert ax.get_title().startswith("Block(half_diagonal=1.0, slenderness=0.2")
+    assert "SinePulse(amplitude=3.0, period=0.5" in ax.get_title()
+    plt.close(ax.figure)
+    ax = rocking.plot(ground=SinePulse(3.0, 0.5))
+    t, a = ax.figure.axes[1].get_lines()[0].get_data()
+    np.testing.assert_allclose(
+        a, np.where(t <= 0.5, 3.0 * np.sin(2 * np.pi * t / 0.5), 0.0), atol=1e-12
+    )
+    plt.close(ax.figure)
+    fig, given = plt.subplots()
+    with pytest.raises(ValueError, match="ground"):
+        rocking.plot(ax=given, ground=True)
+    with pytest.raises(TypeError, match="ground must be"):
+        rocking.plot(ground="yes")
+    orphan = rs.RockingResult(
+        rocking.t,
+        rocking.theta,
+        rocking.theta_dot,
+        0.1,
+        False,
+        rocking.impact_times,
+        math.nan,
+        "nonlinear",
+    )
+    with pytest.raises(ValueError, match="does not hold its motion"):
+        orphan.plot(ground=True)
+    plt.close(fig)

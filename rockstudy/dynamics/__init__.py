@@ -3,7 +3,16 @@ reference, and the batch entry point used by studies."""
 
 from .._warnings import ComplexFromRestWarning
 from .batch import simulate_batch
+from .methods import MAX_STEPS, METHODS, StepLimitError
 from .result import RockingResult
 from .simulate import simulate
 
-__all__ = ["ComplexFromRestWarning", "RockingResult", "simulate", "simulate_batch"]
+__all__ = [
+    "MAX_STEPS",
+    "METHODS",
+    "ComplexFromRestWarning",
+    "RockingResult",
+    "StepLimitError",
+    "simulate",
+    "simulate_batch",
+]

@@ -17,6 +17,7 @@ from ..motions import Motion
 from ..motions import _kernels as mk
 from . import _auto, _rocking, contact
 from ._vertical import uplift_ratio
+from .methods import StepLimitError
 from .simulate import _kernel, _linear_exact
 
 
@@ -39,7 +40,9 @@ def contact_rows(rows, codes, method, rtol, max_steps):
     """(friction_demand, lift_off) of every row: ``rows`` = (p, alpha, eta, kind, mp, times,
     samples, vsamples) as :func:`rockstudy.simulate_batch` encodes them, ``codes`` the model
     each row ran (:data:`rockstudy.dynamics._auto.MODEL_NAMES`), ``method`` and ``rtol`` the
-    batch's (``"auto"`` reruns its nonlinear rows at the kernel's rtol, as it ran them)."""
+    batch's (``"auto"`` reruns its nonlinear rows at the kernel's rtol, as it ran them).
+    A row whose history run reaches ``max_steps`` has a NaN demand, ``lift_off`` False and
+    True in the third array (the batch gives it status 1)."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
     if kind == mk.KIND_RECORD:
         psi = uplift_ratio(mp[:, 0], alpha, samples, vsamples)
@@ -47,6 +50,7 @@ def contact_rows(rows, codes, method, rtol, max_steps):
         psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
     demand = psi * np.tan(alpha)  # at rest throughout: max |u_h''| / (g + u_v'')
     lift_off = np.zeros(p.size, bool)
+    limited = np.zeros(p.size, bool)
     linear_rows = codes == _auto.MODEL_LINEAR  # lift at g alpha, below g tan(alpha)
     lifts = psi >= np.where(linear_rows, alpha / np.tan(alpha), 1.0)
     for i in np.flatnonzero(lifts):
@@ -56,9 +60,13 @@ def contact_rows(rows, codes, method, rtol, max_steps):
         model = _rocking.MODEL_LINEAR if linear else _rocking.MODEL_NONLINEAR
         k_rtol = _auto.kernel_rtol(rtol) if method == "auto" and not linear else rtol
         args = (p[i], alpha[i], eta[i], motion, model, k_rtol, None, max_steps, method)
-        r = run(*args, (0.0, 0.0))
+        try:
+            r = run(*args, (0.0, 0.0))
+        except StepLimitError:
+            demand[i], limited[i] = np.nan, True
+            continue
         check = contact.check_contact(
             r.t, r.theta, r.theta_dot, motion, p[i], alpha[i], eta[i], linear, r.overturned
         )
         demand[i], lift_off[i] = check.friction_demand, check.lift_off
-    return demand, lift_off
+    return demand, lift_off, limited

@@ -102,6 +102,34 @@ def _after_impact(stepping, mot, log, ta, t, th, om, s, k, t_ev, om_ev):
     return resting, t, 0.0, om, s, k, f0
 
 
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _peak_inside(peaks, ta, u_pk, t_pk, s):
+    """Log the peak of u = s theta that a step found inside it (``u_pk`` >= 0 at ``t_pk``
+    [s]; -1 for none) and raise the largest rotation to it."""
+    if u_pk >= 0.0:
+        ta.max_rotation = max(ta.max_rotation, u_pk)
+        _log_peak(peaks, ta, t_pk, s * u_pk)
+
+
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _reached(hist, ta, t, th, om, u):
+    """A step's end (t [s], theta [rad], theta_dot [rad/s]) with u = s theta: the largest
+    rotation raised to u, and the history row appended when a history is kept."""
+    ta.max_rotation = max(ta.max_rotation, u)
+    if hist.shape[0] > 0:
+        _push(hist, ta, t, th, om)
+
+
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _fell(hist, ta, t, th, om, fall):
+    """The fall at t [s], theta = +-``fall`` [rad]: the largest rotation is ``fall``, the
+    history row appended when a history is kept; returns (t, theta, theta_dot)."""
+    ta.max_rotation = fall
+    if hist.shape[0] > 0:
+        _push(hist, ta, t, th, om)
+    return t, th, om
+
+
 def _make_phase(general):
     """The phase kernel (:func:`_phase`): for every motion and model (``general``), or only for
     the block models under a trigonometric pulse without a vertical component, which step by
@@ -161,9 +189,7 @@ def _make_phase(general):
             ta.steps += work
             if ev == EV_REJECT:
                 continue
-            if u_pk >= 0.0:  # the peak site: a peak of u = s theta inside the step
-                ta.max_rotation = max(ta.max_rotation, u_pk)
-                _log_peak(peaks, ta, t_pk, s * u_pk)
+            _peak_inside(peaks, ta, u_pk, t_pk, s)
             t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
             if trig_only or taylor:
                 _log_poly_step(log, ta, w, order, t, hs, t_end)
@@ -171,16 +197,11 @@ def _make_phase(general):
                 args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
                 _log_dop853_step(log, ta, args, t, t_end, th, om, f0, kx, kv)
             if ev == EV_OVER:
-                t, th, om = t_ev, s * fall, om_ev
-                ta.max_rotation = fall
-                if hist.shape[0] > 0:
-                    _push(hist, ta, t, th, om)
+                t, th, om = _fell(hist, ta, t_ev, s * fall, om_ev, fall)
                 code = PH_OVER
                 break
             if ev == EV_NONE:
-                ta.max_rotation = max(ta.max_rotation, s * th1)
-                if hist.shape[0] > 0:
-                    _push(hist, ta, t1, th1, om1)
+                _reached(hist, ta, t1, th1, om1, s * th1)
                 t, th, om, f0 = t1, th1, om1, f1
                 continue
             # impact at t_ev, with speed om_ev just before it

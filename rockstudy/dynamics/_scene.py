@@ -139,6 +139,24 @@ def _table_map_from(state, eta, tab, omega_rest):
     return _free_map_table(u, v, eta, tab[side], tab[1 - side], omega_rest)
 
 
+@njit(cache=True, inline="always")
+def _scene_start(body, controls, start):
+    """The start of a :func:`scene`: its :class:`Stepping` (the rest speed REST_FRACTION p
+    alpha [rad/s] and the local error target TOL_SAFETY rtol), the first
+    :class:`PhaseState` (on the side the start rocks on; the first step FIRST_STEP / p [s])
+    and whether it starts at rest."""
+    p, alpha = body.p, body.alpha
+    th0, om0 = start.theta, start.theta_dot
+    omega_rest = REST_FRACTION * p * alpha
+    tol = TOL_SAFETY * controls.rtol
+    stepping = Stepping(
+        p, alpha, body.eta, body.model, omega_rest, tol, controls.max_steps, body.fall, body.table
+    )
+    s0 = math.copysign(1.0, th0 if th0 != 0.0 else om0)  # the side the start rocks on
+    state = PhaseState(0.0, th0, om0, s0, FIRST_STEP / p)
+    return stepping, state, th0 == 0.0 and om0 == 0.0
+
+
 def _make_scene(general):
     """:func:`scene` on :func:`_phase` (``general``), or :func:`scene_trig` on
     :func:`_phase_trig` (block models under a trigonometric pulse, no vertical component)."""
@@ -157,20 +175,11 @@ def _make_scene(general):
         their values: fill them with 0, the state at rest); each of length 0 for none.
         Returns a :class:`SceneOutcome`.
         """
-        p, alpha, eta, model, tab = body.p, body.alpha, body.eta, body.model, body.table
+        stepping, state, at_rest = _scene_start(body, controls, start)
         th0, om0 = start.theta, start.theta_dot
-        kind, mp, times, samples, vsamples = mot
-        omega_rest = REST_FRACTION * p * alpha
-        tol = TOL_SAFETY * controls.rtol
-        stepping = Stepping(
-            p, alpha, eta, model, omega_rest, tol, controls.max_steps, body.fall, tab
-        )
         hist = log[0]
         rec = hist.shape[0] > 0
-        dur = mp[3]
-        at_rest = th0 == 0.0 and om0 == 0.0
-        s0 = math.copysign(1.0, th0 if th0 != 0.0 else om0)  # the side the start rocks on
-        state = PhaseState(0.0, th0, om0, s0, FIRST_STEP / p)
+        dur = mot[1][3]
         tallies = new_tallies(abs(th0))
         ta = tallies[0]  # updated in place; the outcome reads tallies, last (new_tallies)
         wk = _work_arrays()
@@ -210,10 +219,13 @@ def _make_scene(general):
             if rec:
                 _push(hist, ta, dur, 0.0, 0.0)
         elif code == PH_END or code == PH_IMPACT:
-            if general and model == MODEL_TABLE:
-                over, peak, n_post = _table_map_from(state, eta, tab, omega_rest)
+            eta, omega_rest = body.eta, stepping.omega_rest
+            if general and body.model == MODEL_TABLE:
+                over, peak, n_post = _table_map_from(state, eta, body.table, omega_rest)
             else:
-                over, peak, n_post = _block_map_from(state, p, alpha, eta, model, omega_rest)
+                over, peak, n_post = _block_map_from(
+                    state, body.p, body.alpha, eta, body.model, omega_rest
+                )
             if controls.free_map and not over and eta < 1.0:
                 ta.max_rotation = max(ta.max_rotation, peak)
                 ta.n_impacts += n_post

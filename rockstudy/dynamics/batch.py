@@ -19,8 +19,11 @@ from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from . import _auto, _linear, _linear_record, _rocking
 from ._vertical import refuse_free_fall, uplift_ratio
+from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
+#: batch method -> kernel model (None: chosen row by row); what each method can run is in
+#: :data:`rockstudy.dynamics.methods.METHODS`
 _MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR, "auto": None}
 _CODES = {
     _rocking.MODEL_NONLINEAR: _auto.MODEL_NONLINEAR,
@@ -79,11 +82,14 @@ def _common_length(**columns) -> int:
 
 
 def _numbers(name, values):
-    """``values`` as an array of numbers, or a ValueError naming ``name`` (strings, booleans
-    and objects are not numbers)."""
+    """``values`` as an array of numbers, or a :class:`rockstudy._validate.NotANumberError`
+    (a TypeError and a ValueError) naming ``name`` (strings, booleans and objects are not
+    numbers)."""
     arr = np.asarray(values)
     if arr.dtype.kind not in "iuf":
-        raise ValueError(f"{name} must be a number or an array of numbers, got {values!r:.60}")
+        raise _validate.NotANumberError(
+            f"{name} must be a number or an array of numbers, got {values!r:.60}"
+        )
     return arr
 
 
@@ -122,10 +128,24 @@ def _record_params(record, scale, amplitude, period, cycles, n):
     return kind, mp, times, samples, vsamples
 
 
-def _blocks(half_diagonal, frequency_parameter, slenderness, restitution, n):
+def _critical_rotation(critical_rotation, slenderness):
+    """(name, values) of the critical rotation given to :func:`simulate_batch` under its
+    name or its block alias ``slenderness``; a ValueError for both or neither."""
+    if (critical_rotation is None) == (slenderness is None):
+        raise ValueError(
+            "give critical_rotation [rad] (or its alias for a block, slenderness), exactly once"
+        )
+    if critical_rotation is None:
+        return "slenderness", slenderness
+    return "critical_rotation", critical_rotation
+
+
+def _blocks(half_diagonal, frequency_parameter, critical_rotation, restitution, n):
     """The block columns of :func:`simulate_batch`, checked, of length n: (R or None, p,
-    alpha, eta), p from R by eq. (2.2) of [000] and eta by default Housner's eq. (2.4)."""
-    alpha = _column("slenderness", slenderness, n, MIN_SLENDERNESS, np.pi / 2, False)
+    alpha, eta), p from R by eq. (2.2) of [000] and eta by default Housner's eq. (2.4).
+    ``critical_rotation`` is (the name it was given under, the values)."""
+    name, values = critical_rotation
+    alpha = _column(name, values, n, MIN_SLENDERNESS, np.pi / 2, False)
     R = None
     if half_diagonal is not None:
         R = _column("half_diagonal", half_diagonal, n, *HALF_DIAGONAL_RANGE, False, False)
@@ -166,7 +186,8 @@ def simulate_batch(
     *,
     half_diagonal=None,
     frequency_parameter=None,
-    slenderness,
+    critical_rotation=None,
+    slenderness=None,
     restitution=None,
     pulse: PulseName = "sine",
     amplitude=None,
@@ -176,7 +197,7 @@ def simulate_batch(
     scale=1.0,
     method: Literal["nonlinear", "linear", "auto"] = "nonlinear",
     rtol: float = 1e-8,
-    max_steps: int = 1_000_000,
+    max_steps: int = MAX_STEPS,
     outputs=None,
     as_dataset: bool = False,
 ):
@@ -189,8 +210,12 @@ def simulate_batch(
     ----------
     half_diagonal : array_like, optional
         R [m] > 0; or give ``frequency_parameter`` p [rad/s] directly (equivalent blocks).
+    critical_rotation : array_like
+        theta_cr [rad] in (0, pi/2): a block's slenderness alpha, or the critical rotation of
+        an equivalent block (with ``frequency_parameter``).
     slenderness : array_like
-        alpha [rad] in (0, pi/2).
+        The block's name of ``critical_rotation`` (an alias, kept for blocks): give one of
+        the two, not both.
     restitution : array_like, optional
         eta in (0, 1]; default Housner's (2.4) of [000].
     pulse : {"sine", "cosine", "half-sine", "ricker"}
@@ -202,10 +227,12 @@ def simulate_batch(
         component, if any, by ``|scale|``; it acts as gravity g + u_v'', and a row where
         that reaches 0, free fall, is refused with a ValueError before any integration).
     method : {"nonlinear", "linear", "auto"}
-        Housner's eq. (2.2) or the linearized eq. (3.1) of [000]. The linear model under
-        trigonometric pulses and under records uses the exact piecewise solution (under a
-        record with a vertical component, whose time-varying gravity it cannot take, the
-        DOP853 kernel of the linear model: ``steps`` > 0 says so). ``"auto"``
+        The methods of :data:`rockstudy.dynamics.methods.METHODS` that run in a batch (the
+        others are refused with the message :func:`rockstudy.simulate` gives for what they
+        cannot run). Housner's eq. (2.2) or the linearized eq. (3.1) of [000]. The linear
+        model under trigonometric pulses and under records uses the exact piecewise solution
+        (under a record with a vertical component, whose time-varying gravity it cannot
+        take, the DOP853 kernel of the linear model: ``steps`` > 0 says so). ``"auto"``
         chooses row by row the cheapest model whose error bound meets ``rtol``: rest where the
         ground never reaches g tan(alpha) (exact), the exact linear solver where its tabulated
         linearization error (one-cycle trigonometric pulses) is below ``rtol`` and only
@@ -232,14 +259,18 @@ def simulate_batch(
         1-40 ms a row), while a row that never lifts has ``max |u_h''| / (g + u_v'')``,
         exactly, without a run.
     max_steps : int
-        Cap on the integrator steps in one rocking phase of a row (status 1 when reached), a
-        whole number in [1, 1e12].
+        Cap on the integrator steps in one rocking phase of a row, a whole number in
+        [1, 1e12]; default :data:`rockstudy.dynamics.methods.MAX_STEPS`, as
+        :func:`rockstudy.simulate`. A row that reaches it has ``status`` 1 (the other rows
+        run on), where :func:`rockstudy.simulate` raises a
+        :class:`~rockstudy.dynamics.methods.StepLimitError` on the same scene.
 
     as_dataset : bool
         Return an :class:`xarray.Dataset` on a ``scene`` dimension instead: the inputs
-        (``frequency_parameter`` p [rad/s], ``slenderness``, ``restitution``, and
-        ``amplitude``, ``period``, ``cycles`` of the pulse or the record's ``scale``; with
-        ``half_diagonal`` if given) as coordinates with units, the outputs as variables.
+        (``frequency_parameter`` p [rad/s], ``critical_rotation`` or ``slenderness`` under
+        the name it was given, ``restitution``, and ``amplitude``, ``period``, ``cycles`` of
+        the pulse or the record's ``scale``; with ``half_diagonal`` if given) as coordinates
+        with units, the outputs as variables.
 
     Returns
     -------
@@ -254,10 +285,15 @@ def simulate_batch(
         ``status``) if given.
     """
     wanted = _requested_outputs(outputs)
-    try:
-        model = _MODELS[method]
-    except KeyError:
-        raise ValueError(f"method must be one of {sorted(_MODELS)}, got {method!r}") from None
+    method_for(
+        method,
+        batch=True,
+        record=record is not None,
+        vertical=getattr(record, "vertical", None) is not None,
+        friction_demand=bool(set(CONTACT_OUTPUTS) & set(wanted)),
+    )
+    model = _MODELS[method]
+    theta_cr = _critical_rotation(critical_rotation, slenderness)
     rtol = _validate.rtol(rtol)
     max_steps = _validate.max_steps(max_steps)
     if method == "nonlinear":
@@ -267,14 +303,14 @@ def simulate_batch(
     n = _common_length(
         half_diagonal=half_diagonal,
         frequency_parameter=frequency_parameter,
-        slenderness=slenderness,
+        **{theta_cr[0]: theta_cr[1]},
         restitution=restitution,
         amplitude=amplitude,
         period=period,
         scale=scale,
         cycles=cycles,
     )
-    R, p, alpha, eta = _blocks(half_diagonal, frequency_parameter, slenderness, restitution, n)
+    R, p, alpha, eta = _blocks(half_diagonal, frequency_parameter, theta_cr, restitution, n)
     kind, mp, times, samples, vsamples = _motions(
         pulse, record, scale, amplitude, period, cycles, n
     )
@@ -297,13 +333,14 @@ def simulate_batch(
     if set(CONTACT_OUTPUTS) & set(wanted):
         from ._batch_contact import contact_rows
 
-        demand, lift_off = contact_rows(rows, codes, method, rtol, max_steps)
+        demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
+        result["status"] = np.where(limited, STATUS_STEP_LIMIT, result["status"])
         result.update(
             {k: v for k, v in zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True) if k in wanted}
         )
     if not as_dataset:
         return result
-    inputs = {"frequency_parameter": p, "slenderness": alpha, "restitution": eta}
+    inputs = {"frequency_parameter": p, theta_cr[0]: alpha, "restitution": eta}
     if half_diagonal is not None:
         inputs["half_diagonal"] = R
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
@@ -317,6 +354,7 @@ _BATCH_UNITS = {
     "half_diagonal": ("half-diagonal R", "m"),
     "frequency_parameter": ("frequency parameter p", "rad s-1"),
     "slenderness": ("slenderness alpha", "rad"),
+    "critical_rotation": ("critical rotation theta_cr", "rad"),
     "restitution": ("coefficient of restitution eta", "1"),
     "amplitude": ("pulse amplitude a_g", "m s-2"),
     "period": ("pulse period T_p", "s"),

@@ -301,10 +301,6 @@ def check_contact(t, theta, theta_dot, motion, p, alpha, eta, linear=False, over
     return ContactCheck(best, False, when)
 
 
-#: The methods whose history is a rocking block's under Housner's impact rule.
-METHODS = ("nonlinear", "linear", "scipy", "scipy-linear", "auto")
-
-
 def with_contact(result, motion, method, friction=None):
     """``result`` whose ``friction_demand`` and ``lift_off`` come from :func:`check_contact`
     on its history and the rocking parameters in its ``info`` (computed on first use); a

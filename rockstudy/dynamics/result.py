@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -92,6 +93,9 @@ class RockingResult:
     theta_eval: np.ndarray | None = None
     theta_dot_eval: np.ndarray | None = None
     _contact: Callable[[], Any] | None = field(default=None, repr=False, compare=False)
+    #: the motion and the structure that produced the result (for ``plot``), or None
+    _motion: Any = field(default=None, repr=False, compare=False)
+    _structure: Any = field(default=None, repr=False, compare=False)
 
     @property
     def friction_demand(self) -> float | None:
@@ -256,22 +260,57 @@ class RockingResult:
             )
         raise ValueError(f"part must be 'history', 'dense' or 'peaks', got {part!r}")
 
-    def plot(self, ax=None):
-        """Draw theta / theta_cr against t, the impacts as dotted verticals and the
-        overturning as a cross; return the matplotlib axes. The curve passes through the
-        exact peaks and the dense output, smooth between the history's points (their cubic
-        Hermite interpolant in theta and theta_dot). Without ``info
-        ["critical_rotation"]`` theta is drawn in rad."""
-        if ax is None:
-            import matplotlib.pyplot as plt
+    def plot(self, ax=None, *, ground=False, structure=None, motion=None):
+        """Draw theta / theta_cr against t, with the impacts and the overturning marked.
 
-            ax = plt.figure().add_subplot()
+        The curve passes through the exact peaks and the dense output, smooth between the
+        history's points (their cubic Hermite interpolant in theta and theta_dot). Each
+        impact is a short tick on the time axis (theta = 0, where it happens), so that a
+        long record with a hundred impacts stays readable; an overturning is a cross.
+        Without ``info["critical_rotation"]`` theta is drawn in rad.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Where to draw (not with ``ground``); default a new figure with constrained
+            layout, so that no label is clipped.
+        ground : bool or Motion
+            Add a panel below with the ground acceleration a_g(t) [m/s^2] on the same time
+            axis: True for the motion the result was computed with (a result of
+            :func:`rockstudy.simulate`), or the :class:`~rockstudy.motions.Motion` to draw.
+        structure, motion : str, optional
+            Names for the title, e.g. ``"Statue A"`` and ``"Northridge 1994"``; default the
+            descriptions in ``info["structure"]`` and ``info["motion"]``.
+
+        Returns
+        -------
+        matplotlib Axes
+            The rotation's axes (with ``ground``, ``ax.figure.axes[1]`` is the ground's).
+        """
+        import matplotlib.pyplot as plt
+
+        drawn = self._ground_motion(ground)
+        if ax is None:
+            fig = plt.figure(layout="constrained", figsize=(7.0, 4.8 if drawn else 3.6))
+            axes = fig.subplots(2 if drawn else 1, 1, sharex=True, squeeze=False)[:, 0]
+            ax = axes[0]
+        elif drawn is not None:
+            raise ValueError("ground: the ground panel needs a new figure; leave ax out")
         crit = self.info.get("critical_rotation")
         scale = crit if crit else 1.0
         t, theta = self._curve()
         ax.plot(t, theta / scale, lw=1, label="rotation")
-        for k, ti in enumerate(self.impact_times):
-            ax.axvline(ti, color="0.6", ls=":", lw=0.8, label="impacts" if k == 0 else None)
+        ax.axhline(0.0, color="0.8", lw=0.6, zorder=0)
+        if self.n_impacts:
+            ax.plot(
+                self.impact_times,
+                np.zeros(self.n_impacts),
+                "|",
+                color="0.35",
+                ms=7,
+                mew=0.8,
+                label=f"impacts ({self.n_impacts})",
+            )
         if self.overturned and np.isfinite(self.overturn_time):
             ax.plot(
                 [self.overturn_time],
@@ -281,11 +320,40 @@ class RockingResult:
                 label="overturned",
             )
         ax.set(
-            xlabel="time t [s]",
             ylabel="theta / theta_cr [-]" if crit else "theta [rad]",
+            title=self._title(structure, motion),
         )
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="best")
+        if drawn is None:
+            ax.set_xlabel("time t [s]")
+            return ax
+        g_ax = axes[1]
+        g_t = np.linspace(0.0, max(float(t[-1]), drawn.duration), 4000)
+        g_ax.plot(g_t, drawn.ground_acceleration(g_t), lw=0.8, color="0.3")
+        g_ax.set(xlabel="time t [s]", ylabel="a_g [m/s^2]")
         return ax
+
+    def _ground_motion(self, ground):
+        """The motion to draw under the response: None, the result's own, or ``ground``."""
+        if ground is False or ground is None:
+            return None
+        if ground is True:
+            if self._motion is None:
+                raise ValueError(
+                    "ground=True: this result does not hold its motion (it was not made by "
+                    "rockstudy.simulate); pass the Motion itself, ground=motion"
+                )
+            return self._motion
+        if not hasattr(ground, "ground_acceleration"):
+            raise TypeError(f"ground must be True, False or a Motion, got {type(ground).__name__}")
+        return ground
+
+    def _title(self, structure=None, motion=None) -> str:
+        """The structure and the motion: their names if given, else their descriptions."""
+        structure = structure or (describe(self._structure) if self._structure else "structure")
+        motion = motion or getattr(self._motion, "name", "") or self.info.get("motion", "motion")
+        title = f"{structure} under {motion}"
+        return title if len(title) <= 70 else f"{structure}\nunder {motion}"
 
     def _curve(self, per_interval=8):
         """(t, theta) to draw: the history with the exact peaks and the dense output merged
@@ -306,11 +374,14 @@ class RockingResult:
         t, y, d = t[order], y[order], d[order]
         h = np.diff(t)[:, None]
         s = np.linspace(0.0, 1.0, per_interval + 2)[1:-1][None, :]
+        # theta = 0 at both ends and no peak between (the peaks are merged in): the block
+        # rests there, flat, whatever speed the row of the impact that stopped it holds
+        moving = ~((y[:-1] == 0.0) & (y[1:] == 0.0)) if self.peak_times is not None else True
         between = (
             (2 * s**3 - 3 * s**2 + 1) * y[:-1, None]
-            + (s**3 - 2 * s**2 + s) * h * d[:-1, None]
+            + (s**3 - 2 * s**2 + s) * h * (moving * d[:-1])[:, None]
             + (3 * s**2 - 2 * s**3) * y[1:, None]
-            + (s**3 - s**2) * h * d[1:, None]
+            + (s**3 - s**2) * h * (moving * d[1:])[:, None]
         )
         t_all = np.concatenate([t[:-1, None], t[:-1, None] + s * h], axis=1)
         y_all = np.concatenate([y[:-1, None], between], axis=1)
@@ -339,3 +410,20 @@ class RockingResult:
             **self._contact_summary(),
             **self.info,
         }
+
+
+def describe(thing) -> str:
+    """A one-line description of a motion or a structure: its class and scalar parameters
+    (floats to 12 significant digits: a width of 0.45, not 0.44999999999999996)."""
+    if dataclasses.is_dataclass(thing):
+        scalars = {
+            f.name: getattr(thing, f.name)
+            for f in dataclasses.fields(thing)
+            if not f.name.startswith("_") and isinstance(getattr(thing, f.name), (int, float, str))
+        }
+        text = ", ".join(
+            f"{k}={float(f'{v:.12g}')!r}" if isinstance(v, float) else f"{k}={v!r}"
+            for k, v in scalars.items()
+        )
+        return f"{type(thing).__name__}({text})"
+    return type(thing).__name__

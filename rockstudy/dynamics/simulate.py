@@ -19,8 +19,9 @@ from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
 from . import _auto, _linear, _linear_record, _rocking, contact
 from ._vertical import refuse_free_fall, uplift_ratio
+from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
-from .result import RockingResult
+from .result import RockingResult, describe
 
 #: simulate(method="linear") warns above this linearization error bound.
 LINEAR_WARN = 0.1
@@ -71,7 +72,7 @@ def _kernel(
             break
         cap *= 4
     if r.status == _rocking.STATUS_MAX_STEPS:
-        raise RuntimeError(f"{method}: more than max_steps={max_steps} steps in one phase")
+        raise StepLimitError(method, max_steps)
     nh, over, t_ot = r.n_history, bool(r.overturned), float(r.overturn_time)
     return RockingResult(
         hist[:nh, 0].copy(),
@@ -307,7 +308,9 @@ def _scipy(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0, t_e
     return RockingResult.from_dict(r, method)
 
 
-_METHODS = {
+#: method -> (runner, kernel model) of a block; what each method can run is in
+#: :data:`rockstudy.dynamics.methods.METHODS`
+_RUNNERS = {
     "nonlinear": (_kernel, _rocking.MODEL_NONLINEAR),
     "linear": (_linear_exact, _rocking.MODEL_LINEAR),
     "scipy": (_scipy, _rocking.MODEL_NONLINEAR),
@@ -326,7 +329,7 @@ def simulate(
     t_max: float | None = None,
     initial_rotation: float = 0.0,
     initial_velocity: float = 0.0,
-    max_steps: int = 10_000_000,
+    max_steps: int = MAX_STEPS,
     l: float = 1e-4,
     t_eval=None,
     dt_out: float | None = None,
@@ -345,6 +348,10 @@ def simulate(
         every method but ``"complex"``, which refuses it; u_v'' <= -g anywhere (free fall)
         is refused with a ValueError before any integration.
     method : {"nonlinear", "linear", "scipy", "scipy-linear", "mechanism", "complex", "auto"}
+        One of :data:`rockstudy.dynamics.methods.METHODS`, which says what each can run; a
+        combination it cannot (a vertical component under ``"complex"``, a Block under
+        ``"mechanism"``, ``friction`` where no demand is computed) is refused with a
+        ValueError, the message :func:`rockstudy.simulate_batch` gives too.
         ``"nonlinear"``: Housner's eq. (2.2) of [000] by an event-driven kernel: Taylor-series
         steps under trigonometric pulses, inside records and in free rocking, DOP853 steps
         under a Ricker wavelet and for mechanisms (``info["steps"]`` counts both;
@@ -386,7 +393,13 @@ def simulate(
         theta [rad] and theta_dot [rad/s] at t = 0; |theta| < pi/2. Both zero (default): the
         block starts at rest. Use with :class:`rockstudy.motions.NoMotion` for free rocking.
     max_steps : int
-        Safety cap on the integrator steps in one rocking phase, a whole number in [1, 1e12].
+        Safety cap on the integrator steps in one rocking phase, a whole number in [1, 1e12];
+        default :data:`rockstudy.dynamics.methods.MAX_STEPS`, as
+        :func:`rockstudy.simulate_batch`. Reached: a
+        :class:`~rockstudy.dynamics.methods.StepLimitError` (a ``RuntimeError``), where the
+        batch marks the same scene with ``status`` 1. For the kernel methods (``"nonlinear"``,
+        ``"linear"`` where it runs the kernel, ``"mechanism"``, ``"auto"``); ``"scipy"`` has
+        no cap, and ``"complex"`` its own (50,000,000 steps over the whole motion).
     l : float
         The complex formulation's l (method ``"complex"`` only), in (0, 0.1).
     t_eval : array_like, optional
@@ -419,27 +432,19 @@ def simulate(
         methods but ``"complex"``), ``friction_demand`` and ``lift_off``
         (:func:`rockstudy.dynamics.contact.check_contact`).
     """
-    try:
-        runner, model = _METHODS[method]
-    except KeyError:
-        raise ValueError(f"method must be one of {sorted(_METHODS)}, got {method!r}") from None
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
-    _, mp, _, _, vsamples = motion.kernel_spec()
+    kind, mp, _, _, vsamples = motion.kernel_spec()
     refuse_free_fall(vsamples, mp[0])
-    if vsamples.size and method == "complex":
-        raise ValueError(
-            "method='complex' takes no vertical component (the single-ODE formulation of "
-            "[001] has gravity constant); use method='nonlinear', 'linear', 'scipy' or 'auto', "
-            "or simulate Record(motion.acceleration, time=motion.time) for the horizontal alone"
-        )
+    method_for(
+        method,
+        structure="mechanism" if hasattr(structure, "mechanism") else "block",
+        record=kind == mk.KIND_RECORD,
+        vertical=bool(vsamples.size),
+        friction_demand=friction is not None,
+    )
     rtol = _validate.rtol(rtol)
     max_steps = _validate.max_steps(max_steps)
-    if method == "mechanism" and not hasattr(structure, "mechanism"):
-        raise ValueError(
-            f"method='mechanism' needs a structure with a mechanism() (a wall, an arch, a "
-            f"frame); a {type(structure).__name__} has none: use method='nonlinear'"
-        )
     if t_max is not None:
         t_max = _validate.positive("t_max", t_max)
     th0 = _validate.in_open_interval(
@@ -452,13 +457,13 @@ def simulate(
         _auto.warn_loose_tolerance(rtol)
     x0 = (th0, om0)
     t_eval = _validate.output_times(t_eval, dt_out, t_max)
-    block = not hasattr(structure, "mechanism") and method in contact.METHODS
+    block = not hasattr(structure, "mechanism") and method_for(method).friction_demand
     if friction is not None:
         friction = _validate.positive("friction", friction)
         if not block:
             raise ValueError(
-                f"friction: the friction demand is computed for a Block under the methods "
-                f"{contact.METHODS}, not for a {type(structure).__name__} under {method!r}"
+                "friction: the friction demand is computed for a Block, not for a "
+                f"{type(structure).__name__}"
             )
     run_args = (motion, method, rtol, t_max, int(max_steps), x0, l)
     if hasattr(structure, "mechanism"):
@@ -470,8 +475,10 @@ def simulate(
             warnings.simplefilter("ignore")
             t_eval = _validate.uniform_times(float(dt_out), float(run(*run_args).t[-1]))
     r = run(*run_args, t_eval=t_eval)
+    object.__setattr__(r, "_motion", motion)  # a fresh result: for plot(), at no cost
+    object.__setattr__(r, "_structure", structure)
     r.info.update(
-        motion=_describe(motion),
+        motion=describe(motion),
         rtol_requested=rtol,
         initial_rotation=th0,
         initial_velocity=om0,
@@ -479,21 +486,9 @@ def simulate(
     return contact.with_contact(r, motion, method, friction) if block else r
 
 
-def _describe(motion) -> str:
-    """A one-line description of a motion: its class and scalar parameters."""
-    if dataclasses.is_dataclass(motion):
-        scalars = {
-            f.name: getattr(motion, f.name)
-            for f in dataclasses.fields(motion)
-            if not f.name.startswith("_") and isinstance(getattr(motion, f.name), (int, float, str))
-        }
-        return f"{type(motion).__name__}({', '.join(f'{k}={v!r}' for k, v in scalars.items())})"
-    return type(motion).__name__
-
-
 def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l, t_eval=None):
     """A block (p, alpha, eta) through ``method``."""
-    runner, model = _METHODS[method]
+    runner, model = _RUNNERS[method]
     if method in ("linear", "scipy-linear"):
         _warn_linearization(p, alpha, eta, motion, x0)
     args = (p, alpha, eta, motion, model, rtol, t_max, max_steps, method, x0)

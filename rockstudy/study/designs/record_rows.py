@@ -267,7 +267,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
         first = rows[np.unique(st_pos, return_index=True)[1]]
         structures = {
             "frequency_parameter": cols["frequency_parameter"][first],
-            "slenderness": cols["critical_rotation"][first],
+            "critical_rotation": cols["critical_rotation"][first],
             "restitution": cols["restitution"][first],
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
@@ -438,7 +438,7 @@ def scale_factors(study, record, cols, idx) -> np.ndarray:
         return cols["pga_ratio"][idx] * uplift / record.peak
     t = study.motion.scale_to
     structures = {
-        "slenderness": alpha,
+        "critical_rotation": alpha,
         "frequency_parameter": cols["frequency_parameter"][idx],
         "uplift_acceleration": uplift,
     }

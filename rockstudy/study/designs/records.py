@@ -27,6 +27,7 @@ from ... import similarity
 from ...constants import G
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
+from ...dynamics.methods import MAX_STEPS
 from ...motions import Record
 from ...motions import intensity as _im
 from ...structures.block import block_parameters, frequency_parameter, restitution_housner
@@ -41,7 +42,13 @@ SCALABLE = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "ps
     DIMENSIONLESS
 )
 _SCALARS = tuple(k for k in _im.UNITS if k not in _im.SPECTRAL)
-_STRUCTURE_KEYS = ("half_diagonal", "frequency_parameter", "slenderness", "restitution")
+_STRUCTURE_KEYS = (
+    "half_diagonal",
+    "frequency_parameter",
+    "critical_rotation",
+    "slenderness",  # the block's name of critical_rotation (an alias)
+    "restitution",
+)
 
 
 # ------------------------------------------------------------------------------ inputs
@@ -53,7 +60,7 @@ def _records(records) -> list[Record]:
         raise ValueError("records: give at least one Record")
     for i, r in enumerate(records):
         if not isinstance(r, Record):
-            raise ValueError(f"records[{i}] must be a rockstudy Record, got {type(r).__name__}")
+            raise TypeError(f"records[{i}] must be a rockstudy Record, got {type(r).__name__}")
     return records
 
 
@@ -91,13 +98,17 @@ def _structures(structures) -> dict:
             )
         if ("half_diagonal" in structures) == ("frequency_parameter" in structures):
             raise ValueError("structures: give exactly one of half_diagonal or frequency_parameter")
-        if "slenderness" not in structures:
-            raise ValueError("structures: slenderness is required")
+        if ("critical_rotation" in structures) == ("slenderness" in structures):
+            raise ValueError(
+                "structures: give critical_rotation [rad] (or its alias for a block, "
+                "slenderness), exactly once"
+            )
+        theta_cr = "slenderness" if "slenderness" in structures else "critical_rotation"
         arrays = {k: np.atleast_1d(np.asarray(v, float)) for k, v in structures.items()}
         n = int(np.prod(np.broadcast_shapes(*(a.shape for a in arrays.values()))))
         arrays = {k: np.broadcast_to(a, (n,)).ravel() for k, a in arrays.items()}
-        alpha = arrays["slenderness"]
-        _check("structures.slenderness", alpha, 0.0, math.pi / 2)
+        alpha = arrays[theta_cr]
+        _check(f"structures.{theta_cr}", alpha, 0.0, math.pi / 2)
         if "half_diagonal" in arrays:
             R = arrays["half_diagonal"]
             _check("structures.half_diagonal", R, 0.0, math.inf)
@@ -122,7 +133,7 @@ def _structures(structures) -> dict:
         uplift = np.array([similarity.uplift_acceleration(s) for s in items])
     return {
         "frequency_parameter": p,
-        "slenderness": alpha,
+        "critical_rotation": alpha,
         "restitution": eta,
         "half_diagonal": R,
         "uplift_acceleration": uplift,
@@ -157,7 +168,7 @@ def _record_measure(record, im, period, damping, structures):
     """The unscaled record's measure ``im`` [SI, or dimensionless], per structure (array)."""
     base = DIMENSIONLESS.get(im, im)
     value = record.intensity_measure(base, period=period, damping=damping)
-    value = np.full(structures["slenderness"].size, value)
+    value = np.full(structures["critical_rotation"].size, value)
     if im == "pgv_ratio":
         value = value * structures["frequency_parameter"]
     if im in DIMENSIONLESS:
@@ -194,12 +205,13 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     for k, v in structures.items():
         if k != "names":
             data[k] = ("structure", v)
+    data["slenderness"] = data["critical_rotation"]  # the block's name, kept
     names = structures.get("names")  # None: sampled structures, numbered
     ds = xr.Dataset(
         data,
         coords={
             "record": np.arange(len(records)),
-            "structure": np.arange(structures["slenderness"].size)
+            "structure": np.arange(structures["critical_rotation"].size)
             if names is None
             else np.array(names, dtype=object),
             "period": periods,
@@ -230,7 +242,7 @@ def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None)
     """simulate_batch on the structures ``idx`` (array) at ``scales`` (same length)."""
     return simulate_batch(
         frequency_parameter=structures["frequency_parameter"][idx],
-        slenderness=structures["slenderness"][idx],
+        critical_rotation=structures["critical_rotation"][idx],
         restitution=structures["restitution"][idx],
         record=record,
         scale=scales,
@@ -276,7 +288,7 @@ def cloud(
     damping: float = 0.05,
     method: str = "nonlinear",
     rtol: float = 1e-8,
-    max_steps: int = 1_000_000,
+    max_steps: int = MAX_STEPS,
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -287,9 +299,11 @@ def cloud(
     structures : sequence or dict
         Blocks or structures with ``equivalent_block()``; or a dict ``{name: structure}`` of
         them (named objects: the ``structure`` coordinate then carries the names, str, and
-        every output keeps them); or a dict of arrays (broadcast) with ``slenderness``
-        [rad], one of ``half_diagonal`` [m] or ``frequency_parameter`` [rad/s], and
-        optionally ``restitution`` (default Housner's).
+        every output keeps them); or a dict of arrays (broadcast) with
+        ``critical_rotation`` [rad] (or its alias for a block, ``slenderness``), one of
+        ``half_diagonal`` [m] or ``frequency_parameter`` [rad/s], and optionally
+        ``restitution`` (default Housner's). The dataset carries it as
+        ``critical_rotation`` and as ``slenderness``.
     periods : array_like
         Periods T [s] of the stored spectral accelerations ``sa``.
     damping : float
@@ -309,7 +323,7 @@ def cloud(
     st = _structures(structures)
     _, periods = _target("pga", None, periods)
     ds = _record_dataset(records, st, periods, damping)
-    idx = np.arange(st["slenderness"].size)
+    idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
     outs = [_run_below_free_fall(r, st, idx, ones, method, rtol, max_steps) for r in records]
     for k in _OUT:
@@ -333,7 +347,7 @@ def multiple_stripes(
     damping: float = 0.05,
     method: str = "nonlinear",
     rtol: float = 1e-8,
-    max_steps: int = 1_000_000,
+    max_steps: int = MAX_STEPS,
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -368,7 +382,7 @@ def multiple_stripes(
     if levels.ndim != 1 or not levels.size or not np.all(np.isfinite(levels) & (levels > 0)):
         raise ValueError(f"levels must be one or more finite numbers > 0, got {levels!r}")
     ds = _record_dataset(records, st, periods, damping)
-    n = st["slenderness"].size
+    n = st["critical_rotation"].size
     idx = np.repeat(np.arange(n), levels.size)
     scales, outs = [], []
     for r in records:
@@ -416,7 +430,7 @@ def incremental_dynamic_analysis(
     damping: float = 0.05,
     method: str = "nonlinear",
     rtol: float = 1e-8,
-    max_steps: int = 1_000_000,
+    max_steps: int = MAX_STEPS,
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -583,7 +597,7 @@ class _Points:
     """Runs batches of (structure, scale) points of one record and keeps every outcome."""
 
     def __init__(self, record, st, method, rtol, max_steps):
-        n = st["slenderness"].size
+        n = st["critical_rotation"].size
         self.args = (record, st, method, rtol, max_steps)
         self.history = [[] for _ in range(n)]
         self.sims = np.zeros(n, np.int64)
@@ -627,13 +641,13 @@ def _climb(points, ladders):
 def _ida_record(record, st, options, method, rtol, max_steps):
     """Ladder, bisection and scan of all structures under one record (see the public
     function)."""
-    n = st["slenderness"].size
+    n = st["critical_rotation"].size
     pga = record.peak
     if not pga > 0:
         raise ValueError(f"records: the record {record.name!r} has PGA 0; it cannot be scaled")
     ceiling = free_fall_scale(record)
-    top = options.max_pga_ratio * G * np.tan(st["slenderness"]) / pga
-    low = np.broadcast_to(_rest_scale(record, st["slenderness"], ceiling), (n,))
+    top = options.max_pga_ratio * G * np.tan(st["critical_rotation"]) / pga
+    low = np.broadcast_to(_rest_scale(record, st["critical_rotation"], ceiling), (n,))
     ladders = [_ladder(low[j], top[j], ceiling, 1.0 + options.step) for j in range(n)]
     points = _Points(record, st, method, rtol, max_steps)
     first, done = _climb(points, ladders)

@@ -59,7 +59,7 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
     mo = study.motion
     common = dict(
         frequency_parameter=cols["frequency_parameter"][idx],
-        slenderness=cols["critical_rotation"][idx],
+        critical_rotation=cols["critical_rotation"][idx],
         restitution=cols["restitution"][idx],
         method=study.run.method,
         rtol=study.run.rtol,

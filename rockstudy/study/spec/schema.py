@@ -64,6 +64,7 @@ from pydantic import (
 
 from ... import _validate
 from ...constants import STANDARD_GRAVITY, G
+from ...dynamics.methods import MAX_STEPS
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
@@ -740,7 +741,7 @@ class RunSpec(_Model):
 
     method: Literal["nonlinear", "linear", "auto"] = "nonlinear"
     rtol: float = Field(default=1e-8, gt=0, lt=1)  # for "auto": accuracy of the max rotation
-    max_steps: int = Field(default=1_000_000, ge=1, le=_validate.MAX_STEPS_MAX)
+    max_steps: int = Field(default=MAX_STEPS, ge=1, le=_validate.MAX_STEPS_MAX)
     outputs: list[Output] = Field(default=["max_rotation", "overturned"], min_length=1)
 
     @model_validator(mode="after")
