@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rockstudy.study import spec
 from rockstudy.study.running.store import input_hashes
+from rockstudy.study.spec import schema as spec
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 STUDY = """

@@ -28,7 +28,7 @@ from rockstudy.dynamics.methods import (
 )
 from rockstudy.motions import Record, SinePulse
 from rockstudy.structures import RockingWall
-from rockstudy.study import records_designs as rd
+from rockstudy.study.designs import records as rd
 
 ALPHA = 0.2
 BLOCK = rs.Block(half_diagonal=1.2, slenderness=ALPHA)
@@ -190,7 +190,7 @@ def test_simulate_and_batch_stop_at_the_same_step_limit():
 def test_one_default_step_limit():
     for fn in (rs.simulate, rs.simulate_batch, rd.cloud, rd.multiple_stripes):
         assert inspect.signature(fn).parameters["max_steps"].default == MAX_STEPS, fn
-    from rockstudy.study.spec import RunSpec
+    from rockstudy.study.spec.schema import RunSpec
 
     assert RunSpec.model_fields["max_steps"].default == MAX_STEPS
 
@@ -258,7 +258,7 @@ def test_ida_options_defined_once():
     defaults = {f.name: f.default for f in fields(rd.IdaOptions)}
     params = inspect.signature(rd.incremental_dynamic_analysis).parameters
     assert {k: params[k].default for k in defaults} == defaults
-    from rockstudy.study.spec import DesignSpec
+    from rockstudy.study.spec.schema import DesignSpec
 
     spec = DesignSpec(kind="ida")
     assert spec.ida_options() == defaults

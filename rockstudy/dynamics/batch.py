@@ -331,13 +331,7 @@ def simulate_batch(
     cols["model"] = codes
     result = {name: cols[name] for name in wanted if name in cols}
     if set(CONTACT_OUTPUTS) & set(wanted):
-        from ._batch_contact import contact_rows
-
-        demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
-        result["status"] = np.where(limited, STATUS_STEP_LIMIT, result["status"])
-        result.update(
-            {k: v for k, v in zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True) if k in wanted}
-        )
+        _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps)
     if not as_dataset:
         return result
     inputs = {"frequency_parameter": p, theta_cr[0]: alpha, "restitution": eta}
@@ -348,6 +342,18 @@ def simulate_batch(
         result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
     )
 
+
+
+def _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps):
+    """Add the friction demand and lift-off of each scene to ``result`` (a scene whose contact
+    pass reached the step limit gets that status)."""
+    from ._batch_contact import contact_rows
+
+    demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
+    result["status"] = np.where(limited, STATUS_STEP_LIMIT, result["status"])
+    for name, values in zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True):
+        if name in wanted:
+            result[name] = values
 
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
 _BATCH_UNITS = {
