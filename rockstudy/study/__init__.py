@@ -5,6 +5,7 @@ Imports run one way: ``study`` uses the physics packages, never the reverse.
 
 from .records_designs import cloud, incremental_dynamic_analysis, multiple_stripes
 from .records_fragility import ida_fragility, im_efficiency, stripe_fragility
+from .risk_analysis import object_risk
 from .runner import RunReport, run_study
 from .sampling import make_design, salib_problem
 from .spec import Study, StudyError, json_schema, load_study, validate_text
@@ -17,6 +18,7 @@ __all__ = [
     "im_efficiency",
     "incremental_dynamic_analysis",
     "multiple_stripes",
+    "object_risk",
     "stripe_fragility",
     "Study",
     "StudyError",
