@@ -13,8 +13,8 @@ What the records cannot say is marked, not invented (``status``):
 
 - ``"ok"``: the fit rests on at least ``min_overturning`` records under which the object
   overturned;
-- ``"few"``: fewer such records (at least two for an IDA, one for stripes): lambda_OT is
-  given but rests on little;
+- ``"few"``: fewer such records: lambda_OT is given where a fit exists (an IDA needs two
+  capacities; with one, NaN) but rests on little;
 - ``"none"``: the object never overturned: lambda_OT is not estimable (NaN). An IDA gives
   ``rate_upper_bound`` = lambda(x_c), x_c the lowest level at which a record's IDA stopped
   standing: every capacity of these records lies above x_c, so the rate of the records'
@@ -199,7 +199,9 @@ def object_risk(
         The exposure time t [yr] of the probability 1 - exp(-lambda_OT t), > 0.
     n_boot : int
         Resamples of the records (with replacement) for the band: each refits the
-        fragility and integrates again. 0: no band.
+        fragility and integrates again; a resample in which the object never overturns
+        counts as a rate of 0 (its fitted median is not reached), one without a fit (fewer
+        than two capacities) is left out (``boot_valid`` counts the rest). 0: no band.
     conf_level : float
         Level of the band, in (0, 1): the percentiles (1 -+ level) / 2 of the resampled rates.
     seed : int

@@ -594,6 +594,8 @@ def _self_similarity(page, ds, edges, n_boot):
 
 #: Resamples of the records for the bands of the annual rates (:func:`_risk`).
 RISK_RESAMPLES = 200
+#: Most objects drawn in the deaggregation figure (the highest rates; all are in its CSV).
+MAX_DEAGGREGATION_LINES = 10
 
 
 def _risk_table(out) -> pd.DataFrame:
@@ -666,7 +668,8 @@ def _deaggregation_figure(page, out):
     plt = _plt()
     lo, hi = out["im_lower"].values[1:-1], out["im_upper"].values[1:-1]
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    for j in np.flatnonzero(fitted):
+    shown = np.flatnonzero(fitted)[:MAX_DEAGGREGATION_LINES]  # ranked: the highest rates
+    for j in shown:
         share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
         label = _mpl_text(str(out["structure"].values[j]))
         line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label)[0]
@@ -688,7 +691,12 @@ def _deaggregation_figure(page, out):
         "dotted: each object's uplift PGA g tan(alpha), below which it cannot leave rest (the "
         "share of the rate from there is the lognormal's lower tail, not a simulated "
         "overturning: column 'share below uplift'); the shares beyond the first and last "
-        "level are in the table",
+        "level are in the table"
+        + (
+            f"; the {shown.size} highest rates of {int(fitted.sum())} are drawn"
+            if fitted.sum() > shown.size
+            else ""
+        ),
     )
     frame = out["deaggregation"].to_pandas().T
     edges = zip(out["im_lower"].values, out["im_upper"].values, strict=True)
