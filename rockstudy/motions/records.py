@@ -194,15 +194,19 @@ class Record(Motion):
         return self._cache[key]
 
     def _spectral_displacement(self, periods, damping: float) -> np.ndarray:
+        """SD [m] at ``periods``, cached per period: the periods not yet computed go to the
+        spectrum kernel in one call (each period's value is independent of the others)."""
         periods = intensity.check_periods(periods)
         damping = intensity.check_damping(damping)
-        key = ("sd", periods.tobytes(), damping)
-        return self._cached(
-            key,
-            lambda: intensity.spectral_displacement(
-                self._times, self.acceleration, periods, damping
-            ),
-        )
+        missing = [t for t in np.unique(periods) if ("sd", float(t), damping) not in self._cache]
+        if missing:
+            sd = intensity.spectral_displacement(
+                self._times, self.acceleration, np.array(missing), damping
+            )
+            self._cache.update(
+                {("sd", float(t), damping): v for t, v in zip(missing, sd, strict=True)}
+            )
+        return np.array([self._cache[("sd", float(t), damping)] for t in periods])
 
     def intensity_measures(self, periods=(), damping: float = 0.05) -> dict:
         """The intensity measures of the (horizontal) record: every listed measure of the
@@ -237,6 +241,8 @@ class Record(Motion):
         periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
         damping = intensity.check_damping(damping)
         out = {k: self.intensity_measure(k, damping=damping) for k in measures.listed(False)}
+        if periods.size:  # the spectrum in one pass: the spectral measures read it per period
+            self._spectral_displacement(periods, damping)
         for k in measures.listed(True):
             out[k] = np.array([self.intensity_measure(k, t, damping) for t in periods], float)
         return out
