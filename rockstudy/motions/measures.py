@@ -118,9 +118,23 @@ RESERVED = (
     "scale",
     "level",
     "record",
+    "record_name",
     "structure",
     "period",
     "target",
+    "half_diagonal",
+    "slenderness",
+    "restitution",
+    "frequency_parameter",
+    "critical_rotation",
+    "uplift_acceleration",
+    "max_rotation",
+    "overturned",
+    "n_impacts",
+    "overturn_time",
+    "status",
+    "censored",
+    "capacity",
 )
 
 #: Units a target may be written in, per SI unit: name -> factor to SI (``g`` is the standard
