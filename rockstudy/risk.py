@@ -22,11 +22,11 @@ import numpy as np
 from scipy.special import log_ndtr, ndtr
 
 from .constants import G
-from .motions.intensity import SPECTRAL, UNITS
+from .motions import measures
 
 #: Units a hazard curve's levels may be given in: name -> (factor to SI, SI unit). An IM's SI
-#: unit is ``rockstudy.motions.intensity.UNITS[im]``; its levels may be in any unit here of
-#: that dimension ("g" is rockstudy's g, 9.81 m/s^2).
+#: unit is that of the registry (:mod:`rockstudy.motions.measures`); its levels may be in any
+#: unit here of that dimension ("g" is rockstudy's g, 9.81 m/s^2).
 UNIT_FACTORS = {
     "g": (G, "m/s^2"),
     "m/s^2": (1.0, "m/s^2"),
@@ -52,15 +52,15 @@ OPENQUAKE_IMTS = {
 
 def _units_for(im: str, units: str | None, name: str = "units") -> str:
     """``units`` checked against the dimension of ``im`` (its SI unit when None)."""
-    if units is None:
-        return UNITS[im]
+    si = measures.measure(im).unit
+    if units is None or units == si:
+        return si
     if units not in UNIT_FACTORS:
         raise ValueError(f"{name} must be one of {sorted(UNIT_FACTORS)}, got {units!r}")
-    if UNIT_FACTORS[units][1] != UNITS[im]:
-        allowed = sorted(u for u, (_, si) in UNIT_FACTORS.items() if si == UNITS[im])
+    if UNIT_FACTORS[units][1] != si:
+        allowed = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
         raise ValueError(
-            f"{name}={units!r} is not a unit of {im!r}, which is in {UNITS[im]}: use one of "
-            f"{allowed}"
+            f"{name}={units!r} is not a unit of {im!r}, which is in {si}: use one of {allowed}"
         )
     return units
 
@@ -88,7 +88,7 @@ class HazardCurve:
     Parameters
     ----------
     im : str
-        The intensity measure, a name of :data:`rockstudy.motions.intensity.UNITS` (``"pga"``,
+        The intensity measure, a name of :data:`rockstudy.motions.measures.MEASURES` (``"pga"``,
         ``"pgv"``, ``"sa"``, ...).
     levels : array_like
         IM levels x, in ``units``: at least two, finite, > 0 and strictly increasing.
@@ -114,8 +114,7 @@ class HazardCurve:
     source: str = ""
 
     def __post_init__(self):
-        if self.im not in UNITS:
-            raise ValueError(f"im must be one of {sorted(UNITS)}, got {self.im!r}")
+        measures.measure(self.im)
         units = _units_for(self.im, self.units)
         levels = _positive_increasing("levels", self.levels)
         step = np.flatnonzero(np.diff(levels) <= 0.0)
@@ -150,14 +149,14 @@ class HazardCurve:
         object.__setattr__(self, "rates", rates)
 
     def _check_period(self):
-        if self.im in SPECTRAL:
+        if measures.measure(self.im).needs_period:
             p = self.period
             if p is None or not (math.isfinite(float(p)) and float(p) > 0.0):
                 raise ValueError(f"period: a {self.im!r} hazard curve needs its period T > 0 [s]")
             object.__setattr__(self, "period", float(p))
         elif self.period is not None:
             raise ValueError(
-                f"period is only for the spectral measures {SPECTRAL}, not {self.im!r}"
+                f"period is only for the spectral measures (those that need one), not {self.im!r}"
             )
 
     def __repr__(self) -> str:
@@ -170,11 +169,13 @@ class HazardCurve:
 
     def to_si(self) -> HazardCurve:
         """The same curve with its levels in the IM's SI unit (e.g. g -> m/s^2)."""
-        return self.to_units(UNITS[self.im])
+        return self.to_units(measures.measure(self.im).unit)
 
     def to_units(self, units: str) -> HazardCurve:
         """The same curve with its levels in ``units`` (of the IM's dimension)."""
         units = _units_for(self.im, units)
+        if units == self.units:
+            return self
         factor = UNIT_FACTORS[self.units][0] / UNIT_FACTORS[units][0]
         return HazardCurve(
             self.im, self.levels * factor, self.rates, units, self.period, self.source
@@ -257,7 +258,7 @@ class HazardCurve:
         if im is None:
             raise ValueError(
                 f"im: {path.name} is a two-column file, which does not name its intensity "
-                f"measure: give im= (one of {sorted(UNITS)}) and units="
+                f"measure: give im= (one of {list(measures.MEASURES)}) and units="
             )
         levels, rates = _two_columns(path, lines)
         return cls(im, levels, rates, units, period, str(path))

@@ -221,18 +221,18 @@ def record_groups(structure, record: Record) -> dict:
       omega_p A (that of a harmonic of velocity amplitude A) over a_up, the a_g / (g tan alpha)
       of (5.3). NaN when the record has no pulse (A = 0).
 
-    PGA and PGV are those of :meth:`rockstudy.motions.Record.intensity_measures`.
+    PGA and PGV are those of :meth:`rockstudy.motions.Record.intensity_measure`.
     """
     if not isinstance(record, Record):
         raise TypeError(f"record must be a rockstudy Record, got {type(record).__name__}")
     p = _block(structure)[0]
     a_up = uplift_acceleration(structure)
-    im = record.intensity_measures()
+    pga, pgv = record.intensity_measure("pga"), record.intensity_measure("pgv")
     pulse = record.pulse()
     w_p = 2.0 * math.pi / pulse.period if pulse.amplitude > 0 else math.nan
     return {
-        "pga_ratio": im["pga"] / a_up,
-        "pgv_ratio": im["pgv"] * p / a_up,
+        "pga_ratio": pga / a_up,
+        "pgv_ratio": pgv * p / a_up,
         "pulse_frequency_ratio": w_p / p,
         "pulse_amplitude_ratio": w_p * pulse.amplitude / a_up,
     }

@@ -349,13 +349,13 @@ def test_imefficiency_ranks_equal_measures_of_different_powers_equal():
 def test_the_scaling_power_is_the_measures_own():
     # the table against the measures of a record and of the record scaled by 3
     from rockstudy.motions import Record
-    from rockstudy.motions.intensity import SCALING_POWER, SPECTRAL, UNITS
+    from rockstudy.motions.measures import MEASURES
 
-    assert set(SCALING_POWER) == set(UNITS)
     t = np.arange(0, 4.0, 0.01)
     rec = Record(np.sin(2 * np.pi * t) * np.exp(-0.3 * t), dt=0.01, name="x")
-    for k, p in SCALING_POWER.items():
-        period = 0.5 if k in SPECTRAL else None
+    for k, m in MEASURES.items():
+        p = m.power
+        period = 0.5 if m.needs_period else None
         a = rec.intensity_measure(k, period=period)
         b = rec.scaled(3.0).intensity_measure(k, period=period)
         assert b == pytest.approx(3.0**p * a, rel=1e-9), k
@@ -383,7 +383,7 @@ def test_bad_fragility_arguments_are_named():
 
 def test_record_designs_carry_units():
     from rockstudy.motions import Record
-    from rockstudy.motions.intensity import UNITS
+    from rockstudy.motions.measures import MEASURES
     from rockstudy.study.designs.records import _record_dataset
 
     t = np.arange(0, 2.0, 0.01)
@@ -392,7 +392,7 @@ def test_record_designs_carry_units():
     st["frequency_parameter"] = np.array([2.0])
     ds = _record_dataset([rec], st, np.array([0.5]), 0.05)
     for k in ("pga", "pgv", "arias", "sa", "cav"):
-        assert ds[k].attrs["units"] == UNITS[k]
+        assert ds[k].attrs["units"] == MEASURES[k].unit
     assert ds["pga_ratio"].attrs["units"] == "1"
 
 

@@ -2,6 +2,7 @@
 
 from .base import Motion
 from .mavroeidis import mp_pulse_acceleration, mp_pulse_velocity
+from .measures import register_measure
 from .pulse_extraction import VelocityPulse
 from .pulses import PULSES, CosinePulse, HalfSinePulse, NoMotion, RickerWavelet, SinePulse
 from .records import Record
@@ -19,6 +20,7 @@ __all__ = [
     "RickerWavelet",
     "NoMotion",
     "Record",
+    "register_measure",
     "RECORD_SUFFIXES",
     "load_suite",
     "stochastic_record",

@@ -1,7 +1,9 @@
 """Intensity measures of a sampled record.
 
 Every function takes the sample times ``t`` [s] and accelerations ``acc`` [m/s^2] of a record.
-:class:`rockstudy.motions.Record` calls them through ``intensity_measures``, which caches.
+The registry of measures (:mod:`rockstudy.motions.measures`: units, scaling powers, labels)
+names them; :class:`rockstudy.motions.Record` calls them through ``intensity_measures``, which
+caches.
 
 Conventions (those of eqsig and of the usual processing; see docs/records.rst):
 
@@ -43,39 +45,6 @@ MEAN_PERIOD_DF = 0.05
 #: Periods of Housner's spectrum intensity [s] (Housner 1952) and the quadrature step [s].
 SPECTRUM_INTENSITY_PERIODS = (0.1, 2.5)
 SPECTRUM_INTENSITY_STEP = 0.02
-
-#: name -> unit of each scalar measure; ``sa``, ``psv`` and ``sd`` also take a period.
-UNITS = {
-    "pga": "m/s^2",
-    "pgv": "m/s",
-    "pgd": "m",
-    "arias": "m/s",
-    "cav": "m/s",
-    "significant_duration": "s",
-    "mean_period": "s",
-    "spectrum_intensity": "m",
-    "sa": "m/s^2",
-    "psv": "m/s",
-    "sd": "m",
-}
-SPECTRAL = ("sa", "psv", "sd")
-#: name -> power k with which each measure of :data:`UNITS` follows a scale factor s of the
-#: record: IM(s a_g) = |s|^k IM(a_g). Amplitudes, spectral values, CAV and spectrum intensity
-#: are linear in the record (k = 1); Arias intensity, an integral of a_g^2, goes as s^2;
-#: durations and periods do not change (k = 0). The one place every reader takes it from.
-SCALING_POWER = {
-    "pga": 1,
-    "pgv": 1,
-    "pgd": 1,
-    "arias": 2,
-    "cav": 1,
-    "significant_duration": 0,
-    "mean_period": 0,
-    "spectrum_intensity": 1,
-    "sa": 1,
-    "psv": 1,
-    "sd": 1,
-}
 
 
 def _steps(t):
@@ -397,10 +366,10 @@ def response_spectrum_dataset(periods, sd, damping: float):
             "sa": (
                 "period",
                 w * w * sd,
-                {"units": UNITS["sa"], "long_name": "pseudo-acceleration"},
+                {"units": "m/s^2", "long_name": "pseudo-acceleration"},
             ),
-            "psv": ("period", w * sd, {"units": UNITS["psv"], "long_name": "pseudo-velocity"}),
-            "sd": ("period", sd, {"units": UNITS["sd"], "long_name": "spectral displacement"}),
+            "psv": ("period", w * sd, {"units": "m/s", "long_name": "pseudo-velocity"}),
+            "sd": ("period", sd, {"units": "m", "long_name": "spectral displacement"}),
         },
         coords=coords,
         attrs={"damping": damping},

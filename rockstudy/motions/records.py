@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import _validate
 from ..constants import STANDARD_GRAVITY
-from . import _kernels, intensity
+from . import _kernels, intensity, measures
 from .base import Motion
 from .pulse_extraction import extract_pulse
 from .wavelet_pulse import extract_wavelet_pulse
@@ -166,15 +166,17 @@ class Record(Motion):
         Parameters
         ----------
         value : float
-            Target, > 0, in the units of ``im`` (see :data:`rockstudy.motions.intensity.UNITS`).
+            Target, > 0, in the SI unit of ``im`` (:data:`rockstudy.motions.measures.MEASURES`).
         im : str
-            A measure that scales with the record: ``pga``, ``pgv``, ``pgd``, ``cav``,
-            ``spectrum_intensity``, ``sa``, ``psv``, ``sd`` (linearly) or ``arias``
-            (quadratically).
+            A measure of the registry that changes with a scale factor (power k > 0: ``pga``,
+            ``pgv``, ``pgd``, ``cav``, ``spectrum_intensity``, ``sa``, ``psv``, ``sd`` linearly,
+            ``arias`` quadratically, and any measure registered with a power > 0); the factor
+            is (value / current)^(1/k).
         period, damping
-            For the spectral measures: T [s] and zeta.
+            For the measures that need them (``sa``, ``psv``, ``sd``): T [s] and zeta.
         """
-        if intensity.SCALING_POWER.get(im) == 0:
+        m = measures.measure(im)
+        if not m.scalable:
             raise ValueError(f"im={im!r} does not change with a scale factor; cannot scale to it")
         value = _validate.positive("value", value)
         current = self.intensity_measure(im, period=period, damping=damping)
@@ -184,50 +186,36 @@ class Record(Motion):
                 f"so no scale factor reaches {value!r}"
             )
         ratio = value / current
-        return self.scaled(ratio ** (1.0 / intensity.SCALING_POWER[im]))
+        return self.scaled(ratio ** (1.0 / m.power))
 
     def _cached(self, key, compute):
         if key not in self._cache:
             self._cache[key] = compute()
         return self._cache[key]
 
-    def _scalar_measures(self, damping: float) -> dict:
-        t, a = self._times, self.acceleration
-
-        def compute():
-            v = self._cached("velocity", lambda: intensity.ground_velocity(t, a))
-            d = self._cached("displacement", lambda: intensity.ground_displacement(t, a))
-            return {
-                "pga": self.peak,
-                "pgv": float(np.max(np.abs(v))),
-                "pgd": float(np.max(np.abs(d))),
-                "arias": intensity.arias_intensity(t, a),
-                "cav": intensity.cumulative_absolute_velocity(t, a),
-                "significant_duration": intensity.significant_duration(t, a),
-                "mean_period": intensity.mean_period(t, a),
-                "spectrum_intensity": intensity.spectrum_intensity(t, a, damping),
-            }
-
-        return self._cached(("scalars", damping), compute)
-
     def _spectral_displacement(self, periods, damping: float) -> np.ndarray:
+        """SD [m] at ``periods``, cached per period: the periods not yet computed go to the
+        spectrum kernel in one call (each period's value is independent of the others)."""
         periods = intensity.check_periods(periods)
         damping = intensity.check_damping(damping)
-        key = ("sd", periods.tobytes(), damping)
-        return self._cached(
-            key,
-            lambda: intensity.spectral_displacement(
-                self._times, self.acceleration, periods, damping
-            ),
-        )
+        missing = [t for t in np.unique(periods) if ("sd", float(t), damping) not in self._cache]
+        if missing:
+            sd = intensity.spectral_displacement(
+                self._times, self.acceleration, np.array(missing), damping
+            )
+            self._cache.update(
+                {("sd", float(t), damping): v for t, v in zip(missing, sd, strict=True)}
+            )
+        return np.array([self._cache[("sd", float(t), damping)] for t in periods])
 
     def intensity_measures(self, periods=(), damping: float = 0.05) -> dict:
-        """The intensity measures of the (horizontal) record, with units.
+        """The intensity measures of the (horizontal) record: every listed measure of the
+        registry (:mod:`rockstudy.motions.measures`), in SI units.
 
         Parameters
         ----------
         periods : array_like
-            Periods T [s] of the pseudo-spectral accelerations ``sa`` (may be empty).
+            Periods T [s] of the measures that need one (``sa``; may be empty).
         damping : float
             Damping ratio zeta in [0, 1) of ``sa`` and ``spectrum_intensity``.
 
@@ -236,7 +224,8 @@ class Record(Motion):
         dict
             ``pga`` [m/s^2], ``pgv`` [m/s], ``pgd`` [m], ``arias`` [m/s], ``cav`` [m/s],
             ``significant_duration`` [s] (5-95 %), ``mean_period`` [s] (Rathje et al. 2004),
-            ``spectrum_intensity`` [m] (Housner 1952) and ``sa`` [m/s^2], an array over
+            ``spectrum_intensity`` [m] (Housner 1952), every measure registered since, and
+            ``sa`` [m/s^2] (and each registered measure that needs a period), an array over
             ``periods``. Arias, CAV and the Husid curve are trapezoids over the samples (as
             eqsig); see :mod:`rockstudy.motions.intensity` for definitions and the baseline
             corrections (a constant offset for the velocity, a least-squares c2 t^2 + c3 t^3
@@ -251,27 +240,31 @@ class Record(Motion):
         """
         periods = intensity.check_periods(periods) if np.size(periods) else np.zeros(0)
         damping = intensity.check_damping(damping)
-        out = dict(self._scalar_measures(damping))
-        w = 2.0 * np.pi / periods
-        out["sa"] = w * w * self._spectral_displacement(periods, damping) if periods.size else w
+        out = {k: self.intensity_measure(k, damping=damping) for k in measures.listed(False)}
+        if periods.size:  # the spectrum in one pass: the spectral measures read it per period
+            self._spectral_displacement(periods, damping)
+        for k in measures.listed(True):
+            out[k] = np.array([self.intensity_measure(k, t, damping) for t in periods], float)
         return out
 
     def intensity_measure(self, im: str, period=None, damping: float = 0.05) -> float:
-        """One intensity measure by name (see :meth:`intensity_measures`; also ``psv``, ``sd``).
+        """One intensity measure of the registry by name [SI] (see :meth:`intensity_measures`;
+        also ``psv``, ``sd``), cached.
 
-        ``period`` [s] is required by ``sa``, ``psv`` and ``sd`` and refused by the others.
+        ``period`` [s] is required by the measures that need one (``sa``, ``psv``, ``sd``) and
+        refused by the others.
         """
-        if im not in intensity.UNITS:
-            raise ValueError(f"im must be one of {sorted(intensity.UNITS)}, got {im!r}")
-        if im not in intensity.SPECTRAL:
+        m = measures.measure(im)
+        damping = intensity.check_damping(damping)
+        if not m.needs_period:
             if period is not None:
-                raise ValueError(f"period is only for {intensity.SPECTRAL}, not im={im!r}")
-            return self._scalar_measures(intensity.check_damping(damping))[im]
-        if period is None:
+                raise ValueError(f"period is only for the measures that need one, not im={im!r}")
+        elif period is None:
             raise ValueError(f"im={im!r} needs a period [s]")
-        period = float(intensity.check_periods(period)[0])
-        sd = float(self._spectral_displacement([period], damping)[0])
-        return sd * (2.0 * np.pi / period) ** {"sd": 0, "psv": 1, "sa": 2}[im]
+        else:
+            period = float(intensity.check_periods(period)[0])
+        zeta = damping if m.needs_period or m.needs_damping else None
+        return self._cached(("im", m, period, zeta), lambda: m.of(self, period, damping))
 
     def response_spectrum(self, periods, damping: float = 0.05):
         """Elastic response spectrum (Nigam & Jennings 1969) as an :class:`xarray.Dataset`.

@@ -3,8 +3,9 @@ maximum-likelihood fit of stripes (Baker 2015), the lognormal fit of IDA capacit
 efficiency of intensity measures.
 
 A lognormal fragility is P(overturning | IM = x) = Phi(ln(x / theta) / beta): theta the median
-capacity, beta the dispersion. Intensities are in the units users quote (:data:`QUOTED_UNITS`:
-PGA and Sa in g, PGV in m/s, the dimensionless groups of [000] as they are).
+capacity, beta the dispersion. Intensities are in the units users quote (:func:`quoted`, from
+the registry of measures :mod:`rockstudy.motions.measures`: PGA and Sa in g, PGV in m/s, the
+dimensionless groups of [000] as they are).
 
 Every table carries the observed intensity range (``im_min``, ``im_max``) and the flags
 ``theta_in_range`` and ``band_in_range``: a median outside the data is an extrapolation of the
@@ -23,8 +24,8 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from ...constants import G
-from ...motions.intensity import SCALING_POWER
+from ...motions import measures
+from ...motions.measures import MEASURES, RATIOS
 from .fragility_fit import (
     binomial_covariance,
     capacities_covariance,
@@ -38,91 +39,100 @@ from .fragility_fit import (
 )
 
 __all__ = [
-    "DEFAULT_CANDIDATES",
-    "POWER",
-    "QUOTED_UNITS",
+    "GROUPS",
+    "default_candidates",
     "fit_binomial",
     "fit_capacities",
     "ida_fragility",
     "im_efficiency",
     "intensity",
+    "names",
+    "power",
+    "quoted",
     "stripe_fragility",
 ]
 
-#: measure -> (quoted unit, factor from SI to it).
-QUOTED_UNITS = {
-    "pga": ("g", 1.0 / G),
-    "sa": ("g", 1.0 / G),
-    "pgv": ("m/s", 1.0),
-    "psv": ("m/s", 1.0),
-    "pgd": ("m", 1.0),
-    "sd": ("m", 1.0),
-    "arias": ("m/s", 1.0),
-    "cav": ("m/s", 1.0),
-    "spectrum_intensity": ("m", 1.0),
-    "pga_ratio": ("-", 1.0),
-    "pgv_ratio": ("-", 1.0),
-    "pulse_amplitude_ratio": ("-", 1.0),
-}
-#: measure -> power with which it follows a scale factor of the record: the measures'
-#: own (:data:`rockstudy.motions.intensity.SCALING_POWER`); a ratio follows its measure.
-POWER = {
-    **{k: v for k, v in SCALING_POWER.items() if k in QUOTED_UNITS},
-    "pga_ratio": SCALING_POWER["pga"],
-    "pgv_ratio": SCALING_POWER["pgv"],
-    "pulse_amplitude_ratio": 1,  # omega_p A_p / (g tan alpha), A_p linear in the record
-}
-_SPECTRAL = ("sa", "psv", "sd")
-#: candidates of :func:`im_efficiency` (with ``sa`` at every stored period).
-DEFAULT_CANDIDATES = (
-    "pga",
-    "pgv",
-    "cav",
-    "spectrum_intensity",
-    "sa",
-    "pga_ratio",
-    "pgv_ratio",
-    "pulse_amplitude_ratio",
-)
+#: Dimensionless groups of the pulse fitted besides the measures and :data:`RATIOS`: name ->
+#: power under a scale factor (omega_p A_p / (g tan alpha): A_p is linear in the record).
+GROUPS = {"pulse_amplitude_ratio": 1}
+#: Spectral measures not stored that follow from the stored ``sa``: name -> k in sa / omega^k.
+_FROM_SA = {"psv": 1, "sd": 2}
+
+
+def names() -> list[str]:
+    """Every name :func:`intensity` takes: the registry's measures
+    (:data:`rockstudy.motions.measures.MEASURES`), its ratios and :data:`GROUPS`."""
+    return [*MEASURES, *RATIOS, *GROUPS]
+
+
+def quoted(im: str) -> tuple[str, float]:
+    """(quoted unit, factor from SI to it) of ``im``: the registry's (PGA and Sa in g);
+    "-" for the dimensionless ratios and groups. ValueError naming ``im`` if unknown."""
+    if im not in names():
+        raise ValueError(f"im must be one of {names()}, got {im!r}")
+    return ("-", 1.0) if im in GROUPS else measures.quoted(im)
+
+
+def power(im: str) -> float:
+    """The power with which ``im`` follows a scale factor of the record: the registry's; a
+    ratio follows its measure (:func:`rockstudy.motions.measures.power`)."""
+    return GROUPS[im] if im in GROUPS else measures.power(im)
+
+
+def default_candidates(ds: xr.Dataset) -> tuple[str, ...]:
+    """The candidates of :func:`im_efficiency` by default: every measure of the registry that a
+    scale factor changes and ``ds`` stores (``sa`` at every stored period), the ratios and
+    :data:`GROUPS`."""
+    stored = tuple(k for k in measures.listed(False) + measures.listed(True) if k in ds)
+    return tuple(k for k in stored if MEASURES[k].scalable) + (*RATIOS, *GROUPS)
+
+
+def _needs_period(im: str) -> bool:
+    return im in MEASURES and MEASURES[im].needs_period
+
+
+def _stored(ds, im, period):
+    """The unscaled value of ``im`` [SI] from ``ds``: a stored variable, at ``period`` for a
+    measure that needs one (``psv`` and ``sd`` from the stored ``sa``)."""
+    source = "sa" if im in _FROM_SA and im not in ds else im
+    if source not in ds:
+        raise ValueError(f"im={im!r} is not stored in the dataset")
+    if not _needs_period(im):
+        if period is not None:
+            raise ValueError(f"period is only for the measures that need one, not im={im!r}")
+        return ds[im]
+    if period is None:
+        raise ValueError(f"im={im!r} needs a period [s]")
+    stored = np.asarray(ds["period"].values, float)
+    hit = np.flatnonzero(np.isclose(stored, float(period), rtol=1e-12, atol=0.0))
+    if not hit.size:
+        raise ValueError(f"period: {period!r} s is not stored; the dataset has {list(stored)}")
+    w = 2.0 * np.pi / stored[hit[0]]
+    k = _FROM_SA[im] if source != im else 0
+    return ds[source].isel(period=hit[0], drop=True) / w**k
 
 
 def intensity(ds: xr.Dataset, im: str, period=None, scale: str = "scale") -> xr.DataArray:
     """The intensity measure ``im`` of each simulated point of a record design, in quoted units.
 
     The unscaled record's value (``ds[im]``, per record or per record and structure) times the
-    scale factor ``ds[scale]`` to the measure's power (:data:`POWER`: squared for Arias
+    scale factor ``ds[scale]`` to the measure's power (:func:`power`: squared for Arias
     intensity); for a cloud (no scale variable),
     the unscaled value. ``scale="capacity_scale"`` gives the IDA capacities in ``im``.
 
     Parameters
     ----------
     im : str
-        A key of :data:`QUOTED_UNITS`.
+        One of :func:`names`: a measure of the registry stored in ``ds``, a ratio or a group.
     period : float, optional
-        T [s] of ``sa``, ``psv`` or ``sd``: one of the dataset's ``period`` values. ``psv`` and
-        ``sd`` follow from the stored ``sa``.
+        T [s] of ``sa``, ``psv``, ``sd`` (or any measure that needs one): one of the dataset's
+        ``period`` values. ``psv`` and ``sd`` follow from the stored ``sa``.
     """
-    if im not in QUOTED_UNITS:
-        raise ValueError(f"im must be one of {sorted(QUOTED_UNITS)}, got {im!r}")
-    unit, factor = QUOTED_UNITS[im]
-    if (im if im not in _SPECTRAL else "sa") not in ds:
-        raise ValueError(f"im={im!r} is not stored in the dataset")
-    if im in _SPECTRAL:
-        if period is None:
-            raise ValueError(f"im={im!r} needs a period [s]")
-        stored = np.asarray(ds["period"].values, float)
-        hit = np.flatnonzero(np.isclose(stored, float(period), rtol=1e-12, atol=0.0))
-        if not hit.size:
-            raise ValueError(f"period: {period!r} s is not stored; the dataset has {list(stored)}")
-        w = 2.0 * np.pi / stored[hit[0]]
-        base = ds["sa"].isel(period=hit[0], drop=True) / w ** {"sa": 0, "psv": 1, "sd": 2}[im]
-    else:
-        if period is not None:
-            raise ValueError(f"period is only for {_SPECTRAL}, not im={im!r}")
-        base = ds[im]
+    unit, factor = quoted(im)
+    base = _stored(ds, im, period)
     value = base * factor
     if scale in ds:
-        value = value * ds[scale] ** POWER[im]
+        value = value * ds[scale] ** power(im)
     return value.rename(im).assign_attrs(unit=unit, units=unit)
 
 
@@ -174,7 +184,7 @@ def _check(ds, design, conf_level, n_boot):
 
 def _measure(ds, im, period):
     im = ds.attrs.get("im", "pga") if im is None else im
-    if period is None and im in _SPECTRAL and np.isfinite(ds.attrs.get("im_period", np.nan)):
+    if period is None and _needs_period(im) and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
     return im, period
 
@@ -230,7 +240,7 @@ def stripe_fragility(
     record = np.broadcast_to(
         np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (len(dims) - 1)), x_all.shape
     )
-    unit = QUOTED_UNITS[im][0]
+    unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
@@ -309,7 +319,7 @@ def ida_fragility(
     ok &= np.where(cens_all, np.isfinite(top), np.isfinite(cap)) & (
         np.where(cens_all, top, cap) > 0
     )
-    unit = QUOTED_UNITS[im][0]
+    unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
@@ -360,28 +370,33 @@ def _specs(ds, candidates):
     """(name, period) of each candidate measure; a ValueError for none or an unknown one."""
     if isinstance(candidates, str) or len(candidates) == 0:
         raise ValueError(
-            f"candidates must be a non-empty sequence of measures of {sorted(QUOTED_UNITS)} "
+            f"candidates must be a non-empty sequence of measures of {names()} "
             f"or (name, period) pairs, got {candidates!r}"
         )
     specs = []
     for c in candidates:
         if isinstance(c, tuple):
             specs.append(c)
-        elif c in _SPECTRAL:
+        elif c not in names():
+            raise ValueError(f"candidates: {c!r} is not one of {names()}")
+        elif power(c) == 0:
+            raise ValueError(
+                f"candidates: {c!r} does not change with a scale factor (power 0), so its "
+                "dispersion per power is undefined"
+            )
+        elif _needs_period(c):
             specs.extend((c, float(t)) for t in np.asarray(ds["period"].values, float))
-        elif c in QUOTED_UNITS:
-            specs.append((c, None))
         else:
-            raise ValueError(f"candidates: {c!r} is not one of {sorted(QUOTED_UNITS)}")
+            specs.append((c, None))
     return specs
 
 
 def im_efficiency(
-    ds: xr.Dataset, candidates=DEFAULT_CANDIDATES, by=None, bins=None, n_boot: int = 100, **kw
+    ds: xr.Dataset, candidates=None, by=None, bins=None, n_boot: int = 100, **kw
 ) -> pd.DataFrame:
     """Which intensity measure predicts overturning best: the dispersion of each, per power.
 
-    A measure that goes as the k-th power of a scale factor of the record (:data:`POWER`:
+    A measure that goes as the k-th power of a scale factor of the record (:func:`power`:
     Arias intensity k = 2) has, for the same information, k times the dispersion of one that
     goes linearly: IM^(1/k) is an equally informative, linear measure, and the fragility
     against it has exactly beta / k. So measures are compared by ``beta_linear`` = beta / k,
@@ -395,9 +410,10 @@ def im_efficiency(
 
     Parameters
     ----------
-    candidates : sequence
+    candidates : sequence, optional
         Measure names (``"sa"`` expands to every stored period) or ``(name, period)`` pairs;
-        at least one.
+        at least one. Default :func:`default_candidates` (every stored measure that scales,
+        a registered one too, the ratios and the pulse group).
     by, bins, n_boot, kw
         Passed to the fit (``n_boot`` resamples for the bands, where they are bootstrapped).
 
@@ -409,16 +425,17 @@ def im_efficiency(
         ``dimensionless``.
     """
     fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
+    candidates = default_candidates(ds) if candidates is None else candidates
     frames = []
     for name, period in _specs(ds, candidates):
         if name == "pulse_amplitude_ratio" and not np.isfinite(ds[name].values).any():
             continue  # no record has a pulse
         t = fit(ds, im=name, period=period, by=by, bins=bins, n_boot=n_boot, **kw)
         t.insert(0, "im", _label(name, period))
-        t["power"] = POWER[name]
+        t["power"] = power(name)
         for col in ("", "_lo", "_hi"):
-            t[f"beta_linear{col}"] = t[f"beta{col}"] / POWER[name]
-        t["dimensionless"] = QUOTED_UNITS[name][0] == "-"
+            t[f"beta_linear{col}"] = t[f"beta{col}"] / power(name)
+        t["dimensionless"] = quoted(name)[0] == "-"
         frames.append(t.reset_index())
     if not frames:
         raise ValueError(f"candidates: none of {list(candidates)!r} is stored with a value")

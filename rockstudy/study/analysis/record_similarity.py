@@ -24,7 +24,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .record_fragility import QUOTED_UNITS, fit_binomial, fit_capacities, intensity
+from ...motions import measures
+from .record_fragility import fit_binomial, fit_capacities, intensity, quoted
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"
@@ -113,11 +114,8 @@ def _frequency_bands(ds, frequency_bins) -> dict:
 def _median_fitter(ds, im, period):
     """A function (record rows, mask on (record, structure)) -> (theta, points, im range)
     of the design's fit, and the quoted unit of ``im``."""
-    if (
-        im in ("sa", "psv", "sd")
-        and period is None
-        and np.isfinite(ds.attrs.get("im_period", np.nan))
-    ):
+    needs_period = im in measures.MEASURES and measures.MEASURES[im].needs_period
+    if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
     if ds.attrs.get("design") == "ida":
         rs = ("record", "structure")
@@ -147,7 +145,7 @@ def _median_fitter(ds, im, period):
             xs = x[rows][keep]
             return fit_binomial(xs, y[rows][keep], np.ones(xs.size))[0], xs
 
-    return fit, QUOTED_UNITS[im][0]
+    return fit, quoted(im)[0]
 
 
 def size_class_medians(
@@ -168,9 +166,8 @@ def size_class_medians(
         A record design (:func:`~rockstudy.study.designs.records.incremental_dynamic_analysis`,
         :func:`~rockstudy.study.designs.records.multiple_stripes` or ``cloud``).
     im, period : str, float
-        The intensity measure (a key of
-        :data:`~rockstudy.study.analysis.record_fragility.QUOTED_UNITS`) and the period [s] of a
-        spectral one.
+        The intensity measure (one of :func:`~rockstudy.study.analysis.record_fragility.names`) and
+        the period [s] of one that needs it.
     size_bins : int or array_like
         Size classes (:func:`size_classes`).
     frequency_bins : None, int or array_like

@@ -48,10 +48,10 @@ def _check_hazard(ds, hazard):
     """(im, period) of ``hazard`` if the design can express it, else a ValueError naming it."""
     if not isinstance(hazard, risk.HazardCurve):
         raise TypeError(f"hazard must be a rockstudy.risk.HazardCurve, got {type(hazard).__name__}")
-    if hazard.im not in rf.QUOTED_UNITS:
+    if hazard.im not in rf.names():
         raise ValueError(
             f"hazard: its im {hazard.im!r} is not a measure a record design expresses; use a "
-            f"hazard curve of one of {sorted(set(rf.QUOTED_UNITS) & set(risk.UNITS))}"
+            f"hazard curve of one of {sorted(rf.MEASURES)}"
         )
     try:
         rf.intensity(ds, hazard.im, hazard.period)
@@ -234,7 +234,7 @@ def object_risk(
     if design not in ("ida", "stripes", "cloud"):
         raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")
     im, period = _check_hazard(ds, hazard)
-    unit = rf.QUOTED_UNITS[im][0]
+    unit = rf.quoted(im)[0]
     ida = design == "ida"
     fit, count, lowest = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
     n_rec = ds.sizes["record"]

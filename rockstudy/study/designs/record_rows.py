@@ -24,18 +24,26 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ...motions.intensity import SCALING_POWER, UNITS
+from ...motions import measures
 from ...motions.suites import read_pair
 from ..spec.feasibility import record_pairs
 from . import records as rd
 
-#: Per-record variables of the design Dataset: (long_name, units).
-RECORD_VARIABLES = {
-    **{k: (k.replace("_", " "), UNITS[k]) for k in UNITS if k not in ("sa", "psv", "sd")},
+#: Per-record variables of the pulse in the design Dataset: (long_name, units).
+PULSE_VARIABLES = {
     "pulse_period": ("period T_p of the extracted velocity pulse", "s"),
     "pulse_amplitude": ("amplitude of the extracted velocity pulse", "m s-1"),
     "pulse_indicator": ("pulse indicator (Baker 2007)", "1"),
 }
+
+
+def record_variables() -> dict:
+    """Per-record variables of the design Dataset: (long_name, units) of every listed measure
+    without a period (:mod:`rockstudy.motions.measures`) and of the pulse."""
+    ms = measures.MEASURES
+    return {**{k: (ms[k].label, ms[k].unit) for k in measures.listed(False)}, **PULSE_VARIABLES}
+
+
 #: (record, structure) groups of the unscaled record (:func:`rockstudy.similarity.record_groups`).
 GROUP_VARIABLES = {
     "pga_ratio": ("PGA / (g tan alpha)", "1"),
@@ -111,18 +119,15 @@ def outputs(study) -> dict:
     """The per-row outputs of a design study: name -> (long_name, units, dtype, fill, extra
     dimension or None). ``kernel_status`` is the design's ``status`` (0 ok)."""
     de = study.design
-    out = {k: (*_float(*v), None) for k, v in RECORD_VARIABLES.items()}
-    out["sa"] = (
-        "pseudo-spectral acceleration Sa(T) of the unscaled record",
-        "m s-2",
-        "f8",
-        np.nan,
-        "period",
-    )
+    out = {k: (*_float(*v), None) for k, v in record_variables().items()}
+    for k in measures.listed(True):
+        m = measures.MEASURES[k]
+        out[k] = (f"{m.label}(T) of the unscaled record", m.unit, "f8", np.nan, "period")
     out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
     if de.kind == "ida":
         out.update({k: (*v, None) for k, v in _IDA.items()})
-        unit = UNITS.get(de.ida().im, "1")
+        im = de.ida().im
+        unit = "1" if im in measures.RATIOS else measures.measure(im).unit
         out["capacity"] = (_IDA["capacity"][0], unit, "f8", np.nan, None)
         for k in _STEPS:
             out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
@@ -319,7 +324,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         extra = var.dims[1:]
         if name in STRUCTURE_VARIABLES:
             out[new] = (("structure",), values[0, :, 0], var.attrs)
-        elif name in RECORD_VARIABLES or name == "sa":
+        elif name in record_variables() or name in measures.listed(True):
             out[new] = (("record",) + extra, values[:, 0, 0], var.attrs)
         elif name in GROUP_VARIABLES or kind != "stripes":
             out[new] = (("record", "structure") + extra, values[:, :, 0], var.attrs)
@@ -384,16 +389,16 @@ def _uplift(ds):
 # ------------------------------------------------------------------ Monte Carlo rows
 
 
-#: power of |scale| with which each stored measure follows the scale factor: the measures' own
-#: (:data:`~rockstudy.motions.intensity.SCALING_POWER`), and those of the velocity pulse.
-_POWER = {**SCALING_POWER, "pulse_amplitude": 1, "pulse_period": 0, "pulse_indicator": 0}
+#: power of |scale| with which each value of the velocity pulse follows the scale factor (the
+#: measures follow their own, :func:`rockstudy.motions.measures.power`).
+_PULSE_POWER = {"pulse_amplitude": 1, "pulse_period": 0, "pulse_indicator": 0}
 
 
 def sample_outputs(study) -> dict:
     """Per-sample record outputs of a Monte Carlo record study: the factor applied, the
     measures of the scaled record and its groups (see :func:`sample_measures`)."""
     out = {"scale": ("factor applied to the record", "1", "f8", np.nan, None)}
-    for k, (long_name, units) in {**RECORD_VARIABLES, **GROUP_VARIABLES}.items():
+    for k, (long_name, units) in {**record_variables(), **GROUP_VARIABLES}.items():
         out[k] = (f"{long_name} of the scaled record", units, "f8", np.nan, None)
     if study.motion.pga_ratio is not None:
         del out["pga_ratio"]  # a design column already
@@ -404,12 +409,12 @@ def sample_outputs(study) -> dict:
 
 def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     """Measures and groups of ``record`` scaled by ``scale`` (arrays over samples), from the
-    unscaled record's (cached) measures: linear ones times |scale|, Arias intensity times
-    scale^2, durations, periods and the pulse indicator unchanged; groups as in
+    unscaled record's (cached) measures times |scale|^k, their power in the registry (linear
+    ones k = 1, Arias intensity 2, durations and periods 0; the pulse's amplitude 1, its period
+    and indicator 0); groups as in
     :func:`rockstudy.similarity.record_groups` (PGA / (g tan alpha), PGV p / (g tan alpha),
     omega_p / p and omega_p v_p / (g tan alpha), eqs. of issue 13 section 3)."""
-    ims = dict(record.intensity_measures())
-    ims.pop("sa")
+    ims = {k: v for k, v in record.intensity_measures().items() if k in measures.listed(False)}
     pulse = record.pulse()
     ims.update(
         pulse_period=pulse.period, pulse_amplitude=pulse.amplitude, pulse_indicator=pulse.indicator
@@ -417,7 +422,7 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     s = np.abs(np.asarray(scale, float))
     out = {}
     for k, v in ims.items():
-        out[k] = float(v) * s ** _POWER[k]
+        out[k] = float(v) * s ** (_PULSE_POWER[k] if k in _PULSE_POWER else measures.power(k))
     w_p = 2.0 * np.pi / pulse.period if pulse.amplitude > 0 else np.nan
     out["pga_ratio"] = out["pga"] / uplift
     out["pgv_ratio"] = out["pgv"] * frequency_parameter / uplift

@@ -30,18 +30,11 @@ from ...dynamics._vertical import uplift_ratio
 from ...dynamics.methods import MAX_STEPS
 from ...motions import Record
 from ...motions import intensity as _im
+from ...motions import measures as _ms
 from ...structures.block import block_parameters, frequency_parameter, restitution_housner
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
 
-#: Dimensionless targets: name -> the record measure it divides by the uplift acceleration
-#: (``pga_ratio`` = PGA / (g tan alpha), ``pgv_ratio`` = PGV p / (g tan alpha)).
-DIMENSIONLESS = {"pga_ratio": "pga", "pgv_ratio": "pgv"}
-#: Measures a record can be scaled to (Arias intensity goes as the scale squared).
-SCALABLE = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd") + tuple(
-    DIMENSIONLESS
-)
-_SCALARS = tuple(k for k in _im.UNITS if k not in _im.SPECTRAL)
 _STRUCTURE_KEYS = (
     "half_diagonal",
     "frequency_parameter",
@@ -149,30 +142,30 @@ def _check(name, arr, low, high):
 
 
 def _target(im, period, periods):
-    """Check the scaling measure; return the periods to store (with ``period`` for sa)."""
-    if im not in SCALABLE:
-        raise ValueError(f"im must be one of {list(SCALABLE)}, got {im!r}")
+    """Check the scaling measure (:func:`rockstudy.motions.measures.scale_targets`); return the
+    periods to store (with ``period`` for a measure that needs one)."""
+    m = _ms.target(im)
     periods = [] if periods is None else [float(t) for t in np.atleast_1d(periods)]
-    if im in _im.SPECTRAL:
+    if m.needs_period:
         if period is None:
             raise ValueError(f"im={im!r} needs a period [s]")
         period = float(_im.check_periods(period)[0])
         if period not in periods:
             periods.append(period)
     elif period is not None:
-        raise ValueError(f"period is only for {_im.SPECTRAL}, not im={im!r}")
+        raise ValueError(f"period is only for the measures that need one, not im={im!r}")
     return period, np.array(sorted(periods), float)
 
 
 def _record_measure(record, im, period, damping, structures):
     """The unscaled record's measure ``im`` [SI, or dimensionless], per structure (array)."""
-    base = DIMENSIONLESS.get(im, im)
+    ratio = _ms.RATIOS.get(im)
+    base = im if ratio is None else ratio.base
     value = record.intensity_measure(base, period=period, damping=damping)
     value = np.full(structures["critical_rotation"].size, value)
-    if im == "pgv_ratio":
-        value = value * structures["frequency_parameter"]
-    if im in DIMENSIONLESS:
-        value = value / structures["uplift_acceleration"]
+    if ratio is not None:
+        p = structures["frequency_parameter"]
+        value = value * p**ratio.p_power / structures["uplift_acceleration"]
     if not np.all(np.isfinite(value) & (value > 0)):
         raise ValueError(
             f"im={im!r}: the record {record.name!r} has {base} = {float(value[0])!r}, so no "
@@ -182,23 +175,26 @@ def _record_measure(record, im, period, damping, structures):
 
 
 def _scale_for(level, measure, im):
-    """Scale factor(s) that bring ``measure`` to ``level`` (Arias goes as the square)."""
+    """Scale factor(s) that bring ``measure`` to ``level``: the ratio to the power 1 / k of
+    the measure (:func:`rockstudy.motions.measures.power`; Arias k = 2)."""
     ratio = level / measure
-    return ratio ** (1.0 / _im.SCALING_POWER[DIMENSIONLESS.get(im, im)])
+    return ratio ** (1.0 / _ms.power(im))
 
 
 # ------------------------------------------------------------------------------ tables
 
 
 def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
-    """Measures of the unscaled records (on ``record``) and their groups for each structure."""
+    """Measures of the unscaled records (on ``record``; on ``period`` too for those that need
+    one) and their groups for each structure."""
     ims = [r.intensity_measures(periods=periods, damping=damping) for r in records]
     pulses = [r.pulse() for r in records]
-    data = {k: ("record", np.array([m[k] for m in ims], float)) for k in _SCALARS}
-    data["sa"] = (
-        ("record", "period"),
-        np.array([m["sa"] for m in ims], float).reshape(len(ims), len(periods)),
-    )
+    data = {k: ("record", np.array([m[k] for m in ims], float)) for k in _ms.listed(False)}
+    for k in _ms.listed(True):
+        data[k] = (
+            ("record", "period"),
+            np.array([m[k] for m in ims], float).reshape(len(ims), len(periods)),
+        )
     data["pulse_period"] = ("record", np.array([q.period for q in pulses], float))
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
@@ -227,7 +223,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     ds["pulse_amplitude_ratio"] = w_p * ds["pulse_amplitude"] / up
     ratios = ("pga_ratio", "pgv_ratio", "pulse_frequency_ratio", "pulse_amplitude_ratio")
     units = {
-        **_im.UNITS,
+        **{k: m.unit for k, m in _ms.MEASURES.items()},
         "pulse_period": "s",
         "pulse_amplitude": "m/s",
         **dict.fromkeys(ratios, "1"),
@@ -355,13 +351,15 @@ def multiple_stripes(
     ----------
     levels : array_like
         Target values (> 0) of ``im``, in its SI units (``pga``, ``sa`` [m/s^2], ``pgv``
-        [m/s], ...; see :data:`rockstudy.motions.intensity.UNITS`) or dimensionless for
+        [m/s], ...; see :data:`rockstudy.motions.measures.MEASURES`) or dimensionless for
         ``pga_ratio`` = PGA / (g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha), whose
         scale factor differs from structure to structure.
     im : str
-        One of :data:`SCALABLE`.
+        One of :func:`rockstudy.motions.measures.scale_targets`: a measure of the registry
+        with a power > 0 (one registered by :func:`rockstudy.motions.register_measure` too),
+        ``pga_ratio`` or ``pgv_ratio``.
     period : float, optional
-        T [s] of ``sa``, ``psv`` and ``sd``.
+        T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
     records, structures, periods, damping, method, rtol, max_steps
         As in :func:`cloud`.
 
@@ -500,12 +498,11 @@ def incremental_dynamic_analysis(
     measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
     results = [_ida_record(r, st, options, method, rtol, max_steps) for r in records]
     ds = _ida_tables(ds, results)
-    power = _im.SCALING_POWER[DIMENSIONLESS.get(im, im)]
     ds["capacity"] = (
         ("record", "structure"),
-        np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** power),
+        np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** _ms.power(im)),
         {
-            "units": "1" if im in DIMENSIONLESS else _im.UNITS[im],
+            "units": "1" if im in _ms.RATIOS else _ms.MEASURES[im].unit,
             "long_name": f"overturning {im} (first overturning level)",
         },
     )

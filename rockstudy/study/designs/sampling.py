@@ -268,11 +268,12 @@ def _object_columns(objects) -> dict:
 
 def target_attributes(scale_to) -> dict:
     """long_name and units of a record scale target ``scale_to``."""
-    from ...motions.intensity import UNITS
+    from ...motions import measures
 
     what = scale_to.im + ("" if scale_to.period is None else f"({scale_to.period:g} s)")
     written = "" if scale_to.units is None else f", written in {scale_to.units}"
-    return {"long_name": f"scale target {what}{written}", "units": UNITS.get(scale_to.im, "1")}
+    unit = "1" if scale_to.im in measures.RATIOS else measures.measure(scale_to.im).unit
+    return {"long_name": f"scale target {what}{written}", "units": unit}
 
 
 def _attributes(ds):

@@ -18,7 +18,7 @@ import pandas as pd
 import xarray as xr
 
 from ...constants import G
-from ...motions import intensity as _im
+from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS
@@ -28,23 +28,9 @@ from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
 
-#: Intensity measures in words, with the units of the tables and figures.
-IM_NAMES = {
-    "pga": "PGA [g]",
-    "pgv": "PGV [m/s]",
-    "pgd": "PGD [m]",
-    "arias": "Arias intensity [m/s]",
-    "cav": "CAV [m/s]",
-    "significant_duration": "significant duration 5-95 % [s]",
-    "mean_period": "mean period T_m [s]",
-    "spectrum_intensity": "spectrum intensity [m]",
-    "sa": "Sa [g]",
-    "psv": "PSV [m/s]",
-    "sd": "Sd [m]",
-    "pga_ratio": "PGA / (g tan alpha) [-]",
-    "pgv_ratio": "PGV p / (g tan alpha) [-]",
-    "pulse_amplitude_ratio": "pulse amplitude omega_p A_p / (g tan alpha) [-]",
-}
+#: The dimensionless group of the pulse in words (the measures' and ratios' labels are those of
+#: the registry, :func:`rockstudy.motions.measures.label`).
+GROUP_NAMES = {"pulse_amplitude_ratio": "pulse amplitude omega_p A_p / (g tan alpha) [-]"}
 _DESIGN_NAMES = {
     "cloud": "cloud (records unscaled)",
     "stripes": "multiple-stripe analysis",
@@ -55,12 +41,13 @@ FREQUENCY_BINS = 3
 
 
 def im_label(im: str, period=None) -> str:
-    """An intensity measure's name in words with its units, e.g. 'Sa(T = 0.5 s) [g]'."""
-    name = IM_NAMES.get(im, im)
-    if period is None:
-        return name
-    head, unit = name.split(" [")
-    return f"{head}(T = {float(period):.3g} s) [{unit}"
+    """An intensity measure's name in words with its quoted unit, e.g. 'Sa(T = 0.5 s) [g]'
+    (the registry's label; the name itself if it is no measure)."""
+    if im in GROUP_NAMES:
+        return GROUP_NAMES[im]
+    if im in _ms.MEASURES or im in _ms.RATIOS:
+        return _ms.label(im, period)
+    return im if period is None else f"{im}(T = {float(period):.3g} s)"
 
 
 def _names(ds) -> list[str]:
@@ -94,13 +81,18 @@ def _mpl_text(text: str) -> str:
 
 def _measures(ds) -> list[tuple[str, float | None]]:
     """The measures of the fragility section: PGA, PGV, Sa at the design's (or the first
-    stored) period, and the two dimensionless groups."""
+    stored) period, the two dimensionless groups, and the design's own measure (one
+    registered by :func:`rockstudy.motions.register_measure` too)."""
     out = [("pga", None), ("pgv", None)]
     periods = np.asarray(ds["period"].values, float) if "period" in ds.coords else np.zeros(0)
+    t = ds.attrs.get("im_period", np.nan)
     if periods.size:
-        t = ds.attrs.get("im_period", np.nan)
         out.append(("sa", float(t) if np.isfinite(t) else float(periods[0])))
-    return out + [("pga_ratio", None), ("pgv_ratio", None)]
+    out += [("pga_ratio", None), ("pgv_ratio", None)]
+    own = ds.attrs.get("im")
+    if own in _ms.MEASURES and own not in ("pga", "pgv", "sa") and own in ds:
+        out.append((own, float(t) if _ms.MEASURES[own].needs_period else None))
+    return out
 
 
 def _sizes(ds):
@@ -161,13 +153,15 @@ def _summary(page, ds):
 
 
 def _record_list(page, ds):
-    scalars = [k for k in _im.UNITS if k not in _im.SPECTRAL and k in ds]
-    cols = {k: ds[k].values * (1.0 / G if k == "pga" else 1.0) for k in scalars}
-    table = pd.DataFrame({IM_NAMES[k]: v for k, v in cols.items()}, index=_names(ds))
-    if "pga" in cols:  # g next to m/s^2
-        table.insert(table.columns.get_loc(IM_NAMES["pga"]) + 1, "PGA [m/s^2]", ds["pga"].values)
-    for k, t in enumerate(np.asarray(ds["period"].values, float) if "period" in ds.coords else []):
-        table[im_label("sa", t)] = ds["sa"].values[:, k] / G
+    scalars = [k for k in _ms.listed(False) if k in ds]
+    cols = {im_label(k): ds[k].values * _ms.quoted(k)[1] for k in scalars}
+    table = pd.DataFrame(cols, index=_names(ds))
+    if "pga" in scalars:  # g next to m/s^2
+        table.insert(table.columns.get_loc(im_label("pga")) + 1, "PGA [m/s^2]", ds["pga"].values)
+    periods = np.asarray(ds["period"].values, float) if "period" in ds.coords else []
+    for name in (k for k in _ms.listed(True) if k in ds):
+        for j, t in enumerate(periods):
+            table[im_label(name, t)] = ds[name].values[:, j] * _ms.quoted(name)[1]
     table["pulse period T_p [s]"] = ds["pulse_period"].values
     table["pulse amplitude A_p [m/s]"] = ds["pulse_amplitude"].values
     table["pulse indicator (Baker 2007) [-]"] = ds["pulse_indicator"].values

@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ...constants import G
+from ...motions import measures
 from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS
 from ..designs.sampling import VARIABLES, target_attributes
@@ -339,8 +340,12 @@ _SHORT = {
 
 
 def _units(name):
-    """'long name [units]' of a cube variable, in words."""
-    long_name, units = VARIABLES.get(name, (name, "1"))
+    """'long name [units]' of a cube variable, in words (a measure's: the registry's label and
+    its SI unit, as the cube stores it)."""
+    if name in measures.MEASURES:
+        long_name, units = measures.MEASURES[name].label, measures.MEASURES[name].unit
+    else:
+        long_name, units = VARIABLES.get(name, (name, "1"))
     return f"{long_name} [{'-' if units == '1' else units}]"
 
 

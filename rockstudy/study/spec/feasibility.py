@@ -15,7 +15,7 @@ import numpy as np
 
 from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
 from ...constants import G
-from ...motions.intensity import SCALING_POWER
+from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
@@ -211,7 +211,7 @@ def _record_problems(study, pairs) -> list[str]:
                 f"{MAX_ACCELERATION:.0e} m/s^2 the solvers take (about a million g)"
             )
         for im, period, damping in _scaled_measures(study):
-            base = {"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(im, im)
+            base = measures.target(im).name  # a ratio's measure
             value = rec.intensity_measure(base, period=period, damping=damping)
             if not value > 0:
                 found.append(
@@ -265,17 +265,16 @@ def _largest_scale(study, rec) -> tuple[str, float] | None:
         return None
     value = draw_span(target.value)[1] * target.si_factor()
     field = "motion.pga_ratio" if mo.pga_ratio is not None else "motion.scale_to.value"
-    if target.im == "pga_ratio":
-        value, base = value * uplift, rec.peak
-    elif target.im == "pgv_ratio":
-        value = value * uplift / study.frequency_parameter_span()[0]
-        base = rec.intensity_measure("pgv")
-    else:
-        base = rec.intensity_measure(target.im, period=target.period, damping=target.damping)
+    m = measures.target(target.im)
+    ratio = measures.RATIOS.get(target.im)
+    if ratio is not None:  # the largest base value: the stiffest block's uplift, the lowest p
+        value = value * uplift
+        if ratio.p_power:
+            value = value / study.frequency_parameter_span()[0] ** ratio.p_power
+    base = rec.intensity_measure(m.name, period=target.period, damping=target.damping)
     if not base > 0:
         return None
-    power = SCALING_POWER[{"pga_ratio": "pga", "pgv_ratio": "pgv"}.get(target.im, target.im)]
-    return field, (value / base) ** (1.0 / power)
+    return field, (value / base) ** (1.0 / m.power)
 
 
 @lru_cache(maxsize=1)

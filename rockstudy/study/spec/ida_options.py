@@ -19,8 +19,8 @@ class IdaOptions:
     Attributes
     ----------
     im : str
-        The measure the capacity is reported in (one of
-        :data:`rockstudy.study.designs.records.SCALABLE`).
+        The measure the capacity is reported in (as ``im`` of
+        :func:`~rockstudy.study.designs.records.multiple_stripes`).
     period : float or None
         T [s] of ``sa``, ``psv`` and ``sd``.
     step : float

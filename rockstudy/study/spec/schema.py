@@ -51,6 +51,7 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Discriminator,
@@ -63,8 +64,9 @@ from pydantic import (
 )
 
 from ... import _validate
-from ...constants import STANDARD_GRAVITY, G
+from ...constants import G
 from ...dynamics.methods import MAX_STEPS
+from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from .distributions import Distribution
@@ -416,14 +418,18 @@ class PulseSpec(_Model):
         return self
 
 
-#: Intensity measures a record can be scaled to (see :meth:`rockstudy.motions.Record.scaled_to`)
-#: and the dimensionless targets ``pga_ratio`` = PGA / (g tan alpha) and ``pgv_ratio`` =
-#: PGV p / (g tan alpha); ``sa``, ``psv`` and ``sd`` need a ``period``.
-ScaleIM = Literal[
-    "pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd",
-    "pga_ratio", "pgv_ratio",
-]  # fmt: skip
-_SPECTRAL_IMS = ("sa", "psv", "sd")
+def _scale_im(name: str) -> str:
+    """A name of :func:`rockstudy.motions.measures.scale_targets`, or a ValueError listing them."""
+    if name not in measures.scale_targets():
+        raise ValueError(f"must be one of {list(measures.scale_targets())}, got {name!r}")
+    return name
+
+
+#: Intensity measures a record can be scaled to: the registry's measures of power > 0 (see
+#: :func:`rockstudy.motions.register_measure`) and the dimensionless targets ``pga_ratio`` =
+#: PGA / (g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha); ``sa``, ``psv`` and ``sd``
+#: (any measure that needs one) need a ``period``.
+ScaleIM = Annotated[str, AfterValidator(_scale_im)]
 #: The damping ratio of ``sa``, ``psv``, ``sd`` and the spectrum intensity in record studies.
 _Damping = Annotated[float, Field(ge=0.0, lt=1.0)]
 #: Periods of spectral measures [s]: 1 ms to 100 s, the span of response spectra.
@@ -431,34 +437,29 @@ _Period = Annotated[float, Field(ge=1e-3, le=100.0)]
 
 
 def _check_period(im, period, field):
-    """``period`` [s] is required by the spectral measures and refused by the others."""
-    if im in _SPECTRAL_IMS and period is None:
+    """``period`` [s] is required by the measures that need one and refused by the others."""
+    needs = measures.target(im).needs_period
+    if needs and period is None:
         raise FieldError(field, f"im = {im!r} needs a period [s]")
-    if im not in _SPECTRAL_IMS and period is not None:
-        raise FieldError(field, f"applies to im = 'sa', 'psv' or 'sd' only, not {im!r}")
+    if not needs and period is not None:
+        raise FieldError(field, f"applies to measures with a period (sa, psv, sd), not {im!r}")
 
 
-_ACCELERATION = {"m/s^2": 1.0, "m/s2": 1.0, "g": STANDARD_GRAVITY, "cm/s^2": 0.01, "cm/s2": 0.01}
-#: Units ``value`` may be written in, per scaling measure: name -> factor to SI (the first is
-#: the SI unit, the default). ``g`` is the standard gravity 9.80665 m/s^2, as for records.
-SCALE_UNITS = {
-    "pga": _ACCELERATION,
-    "sa": _ACCELERATION,
-    "pgv": {"m/s": 1.0, "cm/s": 0.01},
-    "psv": {"m/s": 1.0, "cm/s": 0.01},
-    "pgd": {"m": 1.0, "cm": 0.01},
-    "sd": {"m": 1.0, "cm": 0.01},
-    "spectrum_intensity": {"m": 1.0, "cm": 0.01},
-    "arias": {"m/s": 1.0},
-    "cav": {"m/s": 1.0, "g s": STANDARD_GRAVITY},
-    "pga_ratio": {"1": 1.0},
-    "pgv_ratio": {"1": 1.0},
-}
+def scale_units(im: str) -> dict:
+    """Units a target of ``im`` may be written in: name -> factor to SI, the SI unit first
+    (:data:`rockstudy.motions.measures.UNIT_ALIASES` of its SI unit, and its quoted unit;
+    ``g`` is the standard gravity 9.80665 m/s^2, as for records); ``1`` for a ratio."""
+    if im in measures.RATIOS:
+        return {"1": 1.0}
+    m = measures.measure(im)
+    out = {m.unit: 1.0, **measures.UNIT_ALIASES.get(m.unit, {})}
+    out.setdefault(m.quoted_unit, 1.0 / m.factor)
+    return out
 
 
 class ScaleTo(_Model):
     """Scale each record so that its measure ``im`` equals ``value``, in ``units`` (one of
-    :data:`SCALE_UNITS` of ``im``; by default the SI units of ``im``: ``pga``, ``sa``
+    :func:`scale_units` of ``im``; by default the SI units of ``im``: ``pga``, ``sa``
     [m/s^2], ``pgv`` [m/s], ...; dimensionless for ``pga_ratio`` and ``pgv_ratio``). ``value``
     is a number or a distribution (Monte Carlo rows), or a grid (the levels of a stripes
     design); it is converted to SI before the run (:meth:`si_factor`)."""
@@ -472,24 +473,24 @@ class ScaleTo(_Model):
     @model_validator(mode="after")
     def _ranges(self):
         _check_period(self.im, self.period, "period")
-        allowed = SCALE_UNITS[self.im]
+        allowed = scale_units(self.im)
         if self.units is not None and self.units not in allowed:
             raise FieldError(
                 "units", f"for im = {self.im!r} must be one of {list(allowed)}, got {self.units!r}"
             )
         _check_positive("value", self.value)
-        if self.value is not None and self.im in ("pga_ratio", "pgv_ratio"):
+        if self.value is not None and self.im in measures.RATIOS:
             _span("value", self.value, MIN_RATIO, MAX_RATIO, _RATIO_LABEL)
         return self
 
     @property
     def unit_label(self) -> str:
         """The units ``value`` is written in (the SI unit of ``im`` when none is given)."""
-        return self.units or next(iter(SCALE_UNITS[self.im]))
+        return self.units or next(iter(scale_units(self.im)))
 
     def si_factor(self) -> float:
         """The factor that turns ``value`` (in :attr:`unit_label`) into SI."""
-        return SCALE_UNITS[self.im][self.unit_label]
+        return scale_units(self.im)[self.unit_label]
 
     def levels(self) -> np.ndarray:
         """The levels of a stripes design (the grid of ``value``) in SI."""

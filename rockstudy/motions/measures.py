@@ -1,0 +1,381 @@
+"""The registry of intensity measures: every measure defined once, and read by everything.
+
+A measure (:class:`Measure`) is its function of a :class:`~rockstudy.motions.Record`, its SI
+unit, the unit users quote it in and the factor from SI to that unit, the power with which it
+follows a scale factor of the record, whether it needs a period and a damping ratio, and a
+label for reports. :meth:`Record.intensity_measures <rockstudy.motions.Record.intensity_measures>`,
+:meth:`Record.scaled_to <rockstudy.motions.Record.scaled_to>`, the record designs
+(``multiple_stripes(..., im=name)``, cloud, IDA), a study's ``scale_to`` and its feasibility
+checks, the fragility and IM-efficiency tables and both reports read this registry, so a new
+measure joins them all in one call of :func:`register_measure`::
+
+    import numpy as np
+    from rockstudy.motions import register_measure
+
+    register_measure(
+        "pga_first_half",
+        lambda record: float(np.max(np.abs(record.acceleration[: record.acceleration.size // 2]))),
+        unit="m/s^2", power=1, quoted_unit="g", factor=1 / 9.80665, label="PGA of the first half",
+    )
+
+Scaling power k: IM(s a_g) = abs(s)^k IM(a_g) for a record scaled by s. Amplitudes, spectral
+values, CAV and spectrum intensity are linear in the record (k = 1); Arias intensity, an
+integral of a_g^2, goes as s^2; durations and periods do not change (k = 0) and cannot be
+scaled to.
+
+The dimensionless scale targets of the record designs (:data:`RATIOS`, ``pga_ratio`` = PGA /
+(g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha)) are a measure of this registry divided
+by the block's uplift acceleration; they follow their measure's power.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _validate
+from ..constants import STANDARD_GRAVITY, G
+from . import intensity
+
+
+@dataclass(frozen=True)
+class Measure:
+    """One intensity measure of the registry (see :func:`register_measure` for the fields).
+
+    ``function(record)``; ``function(record, damping)`` if ``needs_damping``;
+    ``function(record, period, damping)`` if ``needs_period`` (period [s], damping ratio).
+    """
+
+    name: str
+    function: Callable
+    unit: str
+    power: float
+    quoted_unit: str
+    factor: float
+    label: str
+    needs_period: bool = False
+    needs_damping: bool = False
+    listed: bool = True
+
+    @property
+    def scalable(self) -> bool:
+        """True if a scale factor changes the measure (power != 0)."""
+        return self.power != 0
+
+    def of(self, record, period=None, damping: float = 0.05) -> float:
+        """The measure of ``record`` [SI] (``period`` [s] and ``damping`` where it needs them).
+
+        Raises ValueError naming the measure if its function returns no real number.
+        """
+        if self.needs_period:
+            value = self.function(record, period, damping)
+        elif self.needs_damping:
+            value = self.function(record, damping)
+        else:
+            value = self.function(record)
+        try:
+            return _validate.number(f"the measure {self.name!r}", value)
+        except ValueError as exc:
+            raise ValueError(f"{exc} (its function must return a real number)") from None
+
+    def quoted_label(self, period=None) -> str:
+        """The label with the quoted unit, e.g. 'PGA [g]' or 'Sa(T = 0.5 s) [g]'."""
+        head = self.label if period is None else f"{self.label}(T = {float(period):.3g} s)"
+        return f"{head} [{self.quoted_unit}]"
+
+
+@dataclass(frozen=True)
+class Ratio:
+    """A dimensionless scale target: the measure ``base`` times p^``p_power`` divided by the
+    uplift acceleration g tan(alpha) of each block; it follows the power of ``base``."""
+
+    base: str
+    p_power: int
+    label: str
+
+
+#: name -> :class:`Measure`, in registration order (the order of the tables and reports).
+MEASURES: dict[str, Measure] = {}
+
+#: The dimensionless scale targets of the record designs (eqs. of issue 13 section 3).
+RATIOS = {
+    "pga_ratio": Ratio("pga", 0, "PGA / (g tan alpha)"),
+    "pgv_ratio": Ratio("pgv", 1, "PGV p / (g tan alpha)"),
+}
+
+#: Names the designs store beside the measures (a measure may not take them).
+RESERVED = (
+    *RATIOS,
+    "pulse_period",
+    "pulse_amplitude",
+    "pulse_indicator",
+    "pulse_frequency_ratio",
+    "pulse_amplitude_ratio",
+    "scale",
+    "level",
+    "record",
+    "record_name",
+    "structure",
+    "period",
+    "target",
+    "half_diagonal",
+    "slenderness",
+    "restitution",
+    "frequency_parameter",
+    "critical_rotation",
+    "uplift_acceleration",
+    "max_rotation",
+    "overturned",
+    "n_impacts",
+    "overturn_time",
+    "status",
+    "censored",
+    "capacity",
+)
+
+#: Units a target may be written in, per SI unit: name -> factor to SI (``g`` is the standard
+#: gravity, as for records; ``g s`` a velocity, as CAV is often quoted).
+UNIT_ALIASES = {
+    "m/s^2": {"m/s^2": 1.0, "m/s2": 1.0, "g": STANDARD_GRAVITY, "cm/s^2": 0.01, "cm/s2": 0.01},
+    "m/s": {"m/s": 1.0, "cm/s": 0.01, "g s": STANDARD_GRAVITY},
+    "m": {"m": 1.0, "cm": 0.01},
+    "s": {"s": 1.0},
+}
+
+_NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
+
+
+def _flag(name: str, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _text(name: str, value) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError(f"{name} must be a non-empty string, got {value!r}")
+    return value
+
+
+def _check_name(name, replace: bool) -> str:
+    if not isinstance(name, str) or not _NAME.match(name) or len(name) > 64:
+        raise ValueError(
+            f"name must be a lower-case identifier (letters, digits, '_', starting with a "
+            f"letter, at most 64 characters), got {name!r}"
+        )
+    if name in RESERVED:
+        raise ValueError(f"name {name!r} is reserved (the designs store it); choose another")
+    if name in MEASURES and not replace:
+        raise ValueError(f"name {name!r} is already a measure; give replace=True to redefine it")
+    return name
+
+
+def _check_power(power) -> float:
+    power = _validate.number("power", power)
+    if not (math.isfinite(power) and power >= 0.0):
+        raise ValueError(
+            f"power must be a finite number >= 0 (IM(s a) = |s|^power IM(a); 0: a scale factor "
+            f"does not change it), got {power!r}"
+        )
+    return power
+
+
+def register_measure(
+    name: str,
+    function: Callable,
+    *,
+    unit: str,
+    power: float,
+    quoted_unit: str | None = None,
+    factor: float = 1.0,
+    label: str | None = None,
+    needs_period: bool = False,
+    needs_damping: bool = False,
+    listed: bool = True,
+    replace: bool = False,
+) -> Measure:
+    """Add an intensity measure to the registry: one call, and every reader has it.
+
+    Parameters
+    ----------
+    name : str
+        A lower-case identifier, not yet a measure (unless ``replace``) nor a name of
+        :data:`RESERVED`.
+    function : callable
+        ``function(record) -> float`` [SI]; ``function(record, damping)`` if
+        ``needs_damping``; ``function(record, period, damping)`` if ``needs_period``.
+        ``record`` is a :class:`~rockstudy.motions.Record` (``.time`` [s],
+        ``.acceleration`` [m/s^2]). Values are cached per record.
+    unit : str
+        SI unit of the value, e.g. ``"m/s^2"`` (a target in a study may then be written in
+        any unit of :data:`UNIT_ALIASES` of it).
+    power : float
+        k >= 0 with IM(s a_g) = abs(s)^k IM(a_g) for the record scaled by s (1 for
+        amplitudes, 2 for Arias intensity, 0 for durations: those cannot be scaled to).
+    quoted_unit, factor : str, float
+        The unit of tables and reports and the factor from SI to it (``"g"`` and
+        ``1 / 9.80665``); default ``unit`` and 1.
+    label : str, optional
+        Words for reports, without the unit (default the name with spaces).
+    needs_period, needs_damping : bool
+        Whether the function takes a period [s] and a damping ratio.
+    listed : bool
+        Whether :meth:`~rockstudy.motions.Record.intensity_measures` and the designs list it
+        (``psv`` and ``sd`` are not: they follow from ``sa``).
+    replace : bool
+        Redefine an existing measure.
+
+    Returns
+    -------
+    Measure
+        The registered measure.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument that is not allowed, and what is.
+    """
+    replace = _flag("replace", replace)
+    name = _check_name(name, replace)
+    if not callable(function):
+        raise ValueError(f"function must be callable (record -> float), got {function!r}")
+    unit = _text("unit", unit)
+    power = _check_power(power)
+    factor = _validate.positive("factor", factor)
+    if quoted_unit is None and factor != 1.0:
+        raise ValueError(f"factor = {factor!r} needs quoted_unit (the unit it converts SI to)")
+    quoted = unit if quoted_unit is None else _text("quoted_unit", quoted_unit)
+    label = name.replace("_", " ") if label is None else _text("label", label)
+    measure = Measure(
+        name,
+        function,
+        unit,
+        power,
+        quoted,
+        factor,
+        label,
+        _flag("needs_period", needs_period),
+        _flag("needs_damping", needs_damping),
+        _flag("listed", listed),
+    )
+    MEASURES[name] = measure
+    return measure
+
+
+def unregister_measure(name: str) -> None:
+    """Remove a measure from the registry (ValueError naming ``name`` if it is none)."""
+    if name not in MEASURES:
+        raise ValueError(f"name must be one of {list(MEASURES)}, got {name!r}")
+    del MEASURES[name]
+
+
+def measure(name: str, argument: str = "im") -> Measure:
+    """The measure ``name``, or a ValueError naming ``argument`` and listing the measures."""
+    try:
+        return MEASURES[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"{argument} must be one of {list(MEASURES)}, got {name!r}") from None
+
+
+def listed(period: bool) -> tuple[str, ...]:
+    """Names of the listed measures with (``period=True``) or without a period."""
+    return tuple(k for k, m in MEASURES.items() if m.listed and m.needs_period == period)
+
+
+def scale_targets() -> tuple[str, ...]:
+    """Names a record can be scaled to: every measure of power > 0, and :data:`RATIOS`."""
+    return tuple(k for k, m in MEASURES.items() if m.scalable) + tuple(RATIOS)
+
+
+def target(name: str, argument: str = "im") -> Measure:
+    """The measure behind a scale target (a ratio's base), or a ValueError naming
+    ``argument`` and listing :func:`scale_targets`."""
+    if name not in scale_targets():
+        raise ValueError(f"{argument} must be one of {list(scale_targets())}, got {name!r}")
+    return MEASURES[RATIOS[name].base] if name in RATIOS else MEASURES[name]
+
+
+def power(name: str) -> float:
+    """The scaling power of a measure or a ratio (its base measure's)."""
+    return MEASURES[RATIOS[name].base if name in RATIOS else name].power
+
+
+def quoted(name: str) -> tuple[str, float]:
+    """(quoted unit, factor from SI) of a measure; ("-", 1) for a ratio."""
+    if name in RATIOS:
+        return "-", 1.0
+    m = measure(name)
+    return m.quoted_unit, m.factor
+
+
+def label(name: str, period=None) -> str:
+    """Label with quoted unit of a measure or a ratio, e.g. 'Sa(T = 0.5 s) [g]'."""
+    if name in RATIOS:
+        return f"{RATIOS[name].label} [-]"
+    return measure(name).quoted_label(period)
+
+
+# ------------------------------------------------------------------------------ built-ins
+
+
+def _peak_ground_velocity(record) -> float:
+    return float(np.max(np.abs(intensity.ground_velocity(record.time, record.acceleration))))
+
+
+def _peak_ground_displacement(record) -> float:
+    d = intensity.ground_displacement(record.time, record.acceleration)
+    return float(np.max(np.abs(d)))
+
+
+def _spectral(omega_power: int) -> Callable:
+    """SD(T, zeta) omega^omega_power of a record (0: SD [m], 1: PSV [m/s], 2: Sa [m/s^2])."""
+
+    def function(record, period, damping):
+        sd = record._spectral_displacement([period], damping)[0]
+        return float(sd * (2.0 * math.pi / period) ** omega_power)
+
+    return function
+
+
+#: Measures of the samples (t, a) by :mod:`rockstudy.motions.intensity`: name, function, SI
+#: unit, power, label (spectrum intensity takes the damping ratio too).
+_SERIES = (
+    ("arias", intensity.arias_intensity, "m/s", 2, "Arias intensity"),
+    ("cav", intensity.cumulative_absolute_velocity, "m/s", 1, "CAV"),
+    ("significant_duration", intensity.significant_duration, "s", 0, "significant duration 5-95 %"),
+    ("mean_period", intensity.mean_period, "s", 0, "mean period T_m"),
+    ("spectrum_intensity", intensity.spectrum_intensity, "m", 1, "spectrum intensity"),
+)
+
+
+def _of_samples(f: Callable) -> Callable:
+    return lambda record, *args: f(record.time, record.acceleration, *args)
+
+
+def _builtins():
+    """The measures of :mod:`rockstudy.motions.intensity` (see its conventions), in the order
+    of the tables."""
+    to_g = {"quoted_unit": "g", "factor": 1.0 / G}  # as the fragility tables always quoted
+    register_measure("pga", lambda r: r.peak, unit="m/s^2", power=1, label="PGA", **to_g)
+    register_measure("pgv", _peak_ground_velocity, unit="m/s", power=1, label="PGV")
+    register_measure("pgd", _peak_ground_displacement, unit="m", power=1, label="PGD")
+    for name, f, unit, k, label in _SERIES:
+        register_measure(
+            name,
+            _of_samples(f),
+            unit=unit,
+            power=k,
+            label=label,
+            needs_damping=name == "spectrum_intensity",
+        )
+    spectral = {"power": 1, "needs_period": True}
+    register_measure("sa", _spectral(2), unit="m/s^2", label="Sa", **spectral, **to_g)
+    register_measure("psv", _spectral(1), unit="m/s", label="PSV", listed=False, **spectral)
+    register_measure("sd", _spectral(0), unit="m", label="Sd", listed=False, **spectral)
+
+
+_builtins()
