@@ -9,13 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rockstudy.study.designs.records import cloud, multiple_stripes
-from rockstudy.study.report.records import record_report
 from test_record_studies import rows_study, run_rows, suite  # noqa: F401  (a fixture)
 
 from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import Record, load_suite, measures, register_measure
 from rockstudy.study.analysis import record_fragility as rf
+from rockstudy.study.designs.records import cloud, multiple_stripes
+from rockstudy.study.report.records import record_report
 from rockstudy.study.spec.schema import ScaleTo
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "records"
