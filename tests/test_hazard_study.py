@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rockstudy.study.running.store import input_hashes
-from rockstudy.study.spec.schema import schema as spec
+from rockstudy.study.spec import schema as spec
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 STUDY = """

@@ -388,7 +388,7 @@ def test_record_designs_carry_units():
 
     t = np.arange(0, 2.0, 0.01)
     rec = Record(np.sin(2 * np.pi * t), dt=0.01, name="x")
-    st = {"slenderness": np.array([0.2]), "uplift_acceleration": np.array([G * np.tan(0.2)])}
+    st = {"critical_rotation": np.array([0.2]), "uplift_acceleration": np.array([G * np.tan(0.2)])}
     st["frequency_parameter"] = np.array([2.0])
     ds = _record_dataset([rec], st, np.array([0.5]), 0.05)
     for k in ("pga", "pgv", "arias", "sa", "cav"):

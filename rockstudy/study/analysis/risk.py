@@ -48,10 +48,11 @@ def _check_hazard(ds, hazard):
     """(im, period) of ``hazard`` if the design can express it, else a ValueError naming it."""
     if not isinstance(hazard, risk.HazardCurve):
         raise TypeError(f"hazard must be a rockstudy.risk.HazardCurve, got {type(hazard).__name__}")
-    if hazard.im not in rf.names():
+    scalable = sorted(k for k, m in rf.MEASURES.items() if m.scalable)
+    if hazard.im not in scalable:
         raise ValueError(
-            f"hazard: its im {hazard.im!r} is not a measure a record design expresses; use a "
-            f"hazard curve of one of {sorted(rf.MEASURES)}"
+            f"hazard: its im {hazard.im!r} is not a measure a scale factor changes, so no "
+            f"fragility is expressed in it; use a hazard curve of one of {scalable}"
         )
     try:
         rf.intensity(ds, hazard.im, hazard.period)
