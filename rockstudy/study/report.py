@@ -547,6 +547,15 @@ def _version(versions) -> str:
     return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
 
 
+def _acceleration_units(study) -> str:
+    """The units of a record study's report accelerations: those of ``scale_to.units`` for
+    an acceleration target (g, else m/s^2), g otherwise."""
+    target = getattr(study.motion, "scale_to", None)
+    if target is None or target.im not in ("pga", "sa"):
+        return "g"
+    return "g" if target.unit_label == "g" else "m/s^2"
+
+
 def make_report(result, out=None, verify: bool = True) -> Path:
     """Write the report of a result cube into ``out`` (default: RESULT's name + '_report').
 
@@ -568,7 +577,13 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             _study_file(page, study, ds)
 
         return record_report(
-            ds, out, title=study.name, description=study.description, appendix=study_section
+            ds,
+            out,
+            title=study.name,
+            description=study.description,
+            appendix=study_section,
+            units=_acceleration_units(study),
+            max_scale_factor=study.design.max_scale_factor,
         )
     study = analysis.study_of(ds)
     page = _Page(out)

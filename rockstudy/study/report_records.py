@@ -21,9 +21,20 @@ from ..constants import G
 from ..motions import intensity as _im
 from . import records_fragility as rf
 from . import records_similarity as rsim
-from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
+from . import report_objects as ro
+from ._page import (
+    _FRAGILITY_NAMES,
+    _capacities_as_measured,
+    _log_ticks,
+    _mpl_text,
+    _names,
+    _Page,
+    _plt,
+)
 from .analysis import fragility_curve
+from .feasibility import DEFAULT_MAX_SCALE_FACTOR
 from .fragility_fit import BAND_COLUMNS
+from .report_objects import ReportContext, _structure_title
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
@@ -50,6 +61,8 @@ _DESIGN_NAMES = {
     "stripes": "multiple-stripe analysis",
     "ida": "incremental dynamic analysis (a ladder of rungs, refined by bisection)",
 }
+#: Units of the report's accelerations: as given (a study's scale_to.units) -> as shown.
+REPORT_UNITS = {"g": "g", "m/s^2": "m/s^2", "m/s2": "m/s^2"}
 #: Frequency bins of omega_p / p (of equal count) within which PGA / (g tan alpha) is compared.
 FREQUENCY_BINS = 3
 
@@ -63,35 +76,6 @@ def im_label(im: str, period=None) -> str:
     return f"{head}(T = {float(period):.3g} s) [{unit}"
 
 
-def _names(ds) -> list[str]:
-    """Record names as text (a cube may store them as bytes)."""
-    values = ds["record_name"].values if "record_name" in ds.coords else ds["record"].values
-    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in values]
-
-
-def _log_ticks(ax, axis="x"):
-    """Plain-number labels (0.2, 1, 5) on a logarithmic axis; minor ones (2 and 5 of each
-    decade) only where the axis spans under 1.5 decades. Call it after plotting."""
-    from matplotlib.ticker import FuncFormatter
-
-    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
-    few = hi > lo > 0 and np.log10(hi / lo) < 1.5
-
-    def minor(v, _):
-        mantissa = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
-        return f"{v:g}" if few and np.isclose(mantissa, [2.0, 5.0]).any() else ""
-
-    target = ax.xaxis if axis == "x" else ax.yaxis
-    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    target.set_minor_formatter(FuncFormatter(minor))
-    ax.tick_params(axis=axis, which="minor", labelsize=7)
-
-
-def _mpl_text(text: str) -> str:
-    """Text for a matplotlib label: a '$' from a file must not start mathtext."""
-    return text.replace("$", r"\$")
-
-
 def _measures(ds) -> list[tuple[str, float | None]]:
     """The measures of the fragility section: PGA, PGV, Sa at the design's (or the first
     stored) period, and the two dimensionless groups."""
@@ -103,32 +87,25 @@ def _measures(ds) -> list[tuple[str, float | None]]:
     return out + [("pga_ratio", None), ("pgv_ratio", None)]
 
 
-def _sizes(ds):
-    """Size-class edges [m] of the blocks, or None when they do not span three sizes."""
-    R = ds["half_diagonal"].values if "half_diagonal" in ds else np.zeros(0)
-    if not (R.size and np.all(np.isfinite(R)) and np.unique(R).size >= 3):
-        return None
-    return rsim.size_edges(ds, 3)
-
-
-def _fit(ds, im, period, edges, n_boot):
-    """The design's fragility table against ``im``, by size class when there are sizes."""
+def _fit(ds, im, period, edges, n_boot, by=None):
+    """The design's fragility table against ``im``, by size class when there are sizes (or
+    ``by`` a coordinate, e.g. ``"structure"`` for named objects)."""
     fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
-    by = None if edges is None else "half_diagonal"
+    by = by if edges is None else "half_diagonal"
     table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
     if edges is not None:  # analysis labels bins "lo-hi" in %g: name them in words
         table.index = [
             rsim.size_label(lo, hi)
             for lo, hi in (map(float, g.split("-")) for g in table.index.astype(str))
         ]
-    table.index.name = "block size" if edges is not None else "blocks"
+    table.index.name = "block size" if edges is not None else "object" if by else "blocks"
     return table
 
 
 # ------------------------------------------------------------------------------ sections
 
 
-def _summary(page, ds):
+def _summary(page, ds, relabel=str):
     design = ds.attrs.get("design")
     rows = {
         "design": _DESIGN_NAMES.get(design, str(design)),
@@ -138,9 +115,11 @@ def _summary(page, ds):
         "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
     if design in ("stripes", "ida"):
-        rows["scaling measure"] = im_label(
-            ds.attrs.get("im", "pga"),
-            ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
+        rows["scaling measure"] = relabel(
+            im_label(
+                ds.attrs.get("im", "pga"),
+                ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
+            )
         )
     if design == "stripes":
         rows["levels"] = int(ds.sizes["level"])
@@ -208,7 +187,7 @@ def _fragility(page, ds, edges, n_boot):
             ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
         ax.set(xscale="log", xlabel=im_label(im, period), ylabel="probability of overturning")
         _log_ticks(ax)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=8)
         t.insert(0, "intensity", im_label(im, period))
         tables.append(t)
     for ax in axes[len(measures) :]:
@@ -244,15 +223,15 @@ def _fragility(page, ds, edges, n_boot):
     )
 
 
-def _efficiency(page, ds, n_boot):
-    table = rf.im_efficiency(ds, n_boot=n_boot)
+def _efficiency(page, ctx):
+    table = ctx.efficiency()
     rows = []
     for (label, _), r in table.iterrows():
         name, _, rest = label.partition("(T=")
         period = float(rest.rstrip(" s)")) if rest else None
         rows.append(
             {
-                "intensity measure": im_label(name, period),
+                "intensity measure": ctx.relabel(im_label(name, period)),
                 "dispersion per power beta / k [-]": r["beta_linear"],
                 "beta / k, lower": r["beta_linear_lo"],
                 "beta / k, upper": r["beta_linear_hi"],
@@ -281,15 +260,6 @@ def _representatives(ds, k=3) -> list[int]:
     order = np.argsort(key, kind="stable")
     picks = np.unique(np.round(np.linspace(0, order.size - 1, min(k, order.size))).astype(int))
     return [int(order[i]) for i in picks]
-
-
-def _structure_title(ds, j) -> str:
-    alpha = float(ds["slenderness"].values[j])
-    R = float(ds["half_diagonal"].values[j]) if "half_diagonal" in ds else np.nan
-    size = f"R = {R:.3g} m, " if np.isfinite(R) else ""
-    name = ds["structure"].values[j]
-    label = name if isinstance(name, str) else f"block {j}"
-    return f"{label}: {size}alpha = {alpha:.3g} rad"
 
 
 def _responses(page, ds):
@@ -345,7 +315,7 @@ def _responses(page, ds):
         )
         _log_ticks(ax, "y")
         if len(names) <= 15:
-            ax.legend(fontsize=6)
+            ax.legend(fontsize=8)
     fig.tight_layout()
     what = {
         "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
@@ -437,15 +407,15 @@ def _switch_band(page, ds):
     )
 
 
-def _side_by_side(page, ida, stripes, edges, n_boot):
+def _side_by_side(page, ida, stripes, edges, n_boot, by=None):
     """The fragility of the IDA and of the stripes on the same records and blocks, measure by
     measure and size class; a warning where their median bands do not overlap."""
     rows, plt = [], _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
     for im, period in _measures(ida):
         try:
-            t_ida = _fit(ida, im, period, edges, n_boot)
-            t_str = _fit(stripes, im, period, edges, n_boot)
+            t_ida = _fit(ida, im, period, edges, n_boot, by)
+            t_str = _fit(stripes, im, period, edges, n_boot, by)
         except ValueError as err:
             page.text(f"Stripes and IDA against {im_label(im, period)}: {err}")
             continue
@@ -506,7 +476,7 @@ def _plot_pair(ax, t_ida, t_str, im):
             ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
     ax.set(xscale="log", xlabel=im_label(im), ylabel="probability of overturning")
     _log_ticks(ax)
-    ax.legend(fontsize=6)
+    ax.legend(fontsize=8)
 
 
 def _median(values) -> float:
@@ -561,7 +531,7 @@ def _self_similarity(page, ds, edges, n_boot):
         _log_ticks(ax)
         _log_ticks(ax, "y")
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7)
+            ax.legend(fontsize=8)
     fig.tight_layout()
     page.figure(
         fig,
@@ -595,6 +565,74 @@ def _self_similarity(page, ds, edges, n_boot):
 # ------------------------------------------------------------------------------ page
 
 
+def _section(heading, function, when=None):
+    """A section of :data:`SECTIONS`: ``heading`` (text, or a callable of the context),
+    then ``function(page, ctx)``; skipped where ``when(ctx)`` is False."""
+
+    def run(page, ctx):
+        if when is not None and not when(ctx):
+            return
+        page.heading(heading(ctx) if callable(heading) else heading)
+        function(page, ctx)
+
+    run.__name__ = getattr(function, "__name__", "section")
+    return run
+
+
+def _fits(ctx) -> bool:
+    return ctx.overturned
+
+
+#: The sections of the record report, in order: each a function (page, ctx) that writes its
+#: own heading (or nothing). Adding a section is adding one entry.
+SECTIONS = [
+    _section("Summary", lambda page, ctx: _summary(page, ctx.ds, ctx.relabel)),
+    ro.outcome,
+    ro.scale_factors,
+    _section("Records", lambda page, ctx: _record_list(page, ctx.ds)),
+    _section(
+        "Fragility",
+        lambda page, ctx: _fragility(page, ctx.ds, ctx.edges, ctx.n_boot),
+        when=lambda ctx: _fits(ctx) and not ctx.objects,
+    ),
+    ro.object_fragility,
+    _section(
+        "Intensity-measure efficiency",
+        lambda page, ctx: _efficiency(page, ctx),
+        when=_fits,
+    ),
+    ro.object_capacity,
+    ro.object_curves,
+    _section(
+        lambda ctx: {"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[ctx.design],
+        lambda page, ctx: _responses(page, ctx.ds),
+        when=lambda ctx: not ctx.objects or ctx.design == "cloud",
+    ),
+    _section(
+        "Switch band",
+        lambda page, ctx: _switch_band(page, ctx.ds),
+        when=lambda ctx: ctx.design == "ida",
+    ),
+    _section(
+        "Stripes and IDA side by side",
+        lambda page, ctx: _compare(page, ctx),
+        when=lambda ctx: ctx.compare is not None and _fits(ctx),
+    ),
+    _section("Per-record breakdown", lambda page, ctx: _per_record(page, ctx.ds)),
+    _section(
+        "Self-similarity on records",
+        lambda page, ctx: _self_similarity(page, ctx.ds, ctx.edges, ctx.n_boot),
+        when=lambda ctx: ctx.edges is not None and _fits(ctx),
+    ),
+]
+
+
+def _compare(page, ctx):
+    ida, stripes = (ctx.ds, ctx.compare) if ctx.design == "ida" else (ctx.compare, ctx.ds)
+    by = "structure" if ctx.objects else None
+    _side_by_side(page, ida, stripes, ctx.edges, ctx.n_boot, by)
+
+
 def record_report(
     ds: xr.Dataset,
     out,
@@ -603,8 +641,15 @@ def record_report(
     n_boot: int = 50,
     appendix=None,
     compare: xr.Dataset | None = None,
+    units: str = "g",
+    max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
+
+    The page runs the sections of :data:`SECTIONS` in order. For named objects (the
+    ``structure`` coordinate holds names) it answers per object: fragility, capacity under
+    each record with the governing record, and the IDA curves or stripes of each object.
+    When nothing overturned (or nothing rocked) it says so in words and fits nothing.
 
     Parameters
     ----------
@@ -625,41 +670,31 @@ def record_report(
         The other of an IDA and a stripes design on the same records and structures: the
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
+    units : {"g", "m/s^2"}
+        Units of the accelerations of the per-object sections and warnings (a study's
+        ``scale_to.units``).
+    max_scale_factor : float
+        A warning box lists the stripe points or IDA capacities whose record is scaled by
+        more than this (> 1; a study's ``design.max_scale_factor``).
     """
     design = ds.attrs.get("design")
     if design not in DESIGNS:
         raise ValueError(f"ds: attrs['design'] must be one of {DESIGNS}, got {design!r}")
+    if units not in REPORT_UNITS:
+        raise ValueError(f"units: must be one of {list(REPORT_UNITS)}, got {units!r}")
+    if not (isinstance(max_scale_factor, (int, float)) and max_scale_factor > 1):
+        raise ValueError(f"max_scale_factor: must be a number > 1, got {max_scale_factor!r}")
+    if compare is not None and {design, compare.attrs.get("design")} != {"ida", "stripes"}:
+        kinds = {design, compare.attrs.get("design")}
+        raise ValueError(
+            f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
+        )
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     page = _Page(out)
-    edges = _sizes(ds)
-    page.heading("Summary")
-    _summary(page, ds)
-    page.heading("Records")
-    _record_list(page, ds)
-    page.heading("Fragility")
-    _fragility(page, ds, edges, n_boot)
-    page.heading("Intensity-measure efficiency")
-    _efficiency(page, ds, n_boot)
-    page.heading({"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[design])
-    _responses(page, ds)
-    if design == "ida":
-        page.heading("Switch band")
-        _switch_band(page, ds)
-    if compare is not None:
-        kinds = {design, compare.attrs.get("design")}
-        if kinds != {"ida", "stripes"}:
-            raise ValueError(
-                f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
-            )
-        page.heading("Stripes and IDA side by side")
-        ida, stripes = (ds, compare) if design == "ida" else (compare, ds)
-        _side_by_side(page, ida, stripes, edges, n_boot)
-    page.heading("Per-record breakdown")
-    _per_record(page, ds)
-    if edges is not None:
-        page.heading("Self-similarity on records")
-        _self_similarity(page, ds, edges, n_boot)
+    ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
+    for section in SECTIONS:
+        section(page, ctx)
     if appendix is not None:
         appendix(page)
     meta = f"<p>{html.escape(description)}</p>" if description else ""
