@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 import rockstudy as rs
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY, G
 from rockstudy.motions import load_suite
 from rockstudy.study.records_designs import multiple_stripes
 from rockstudy.study.report_records import record_report
@@ -113,3 +113,122 @@ def test_scale_factor_warning_and_units(tmp_path, records):
         record_report(ds, tmp_path / "bad", units="gee")
     with pytest.raises(ValueError, match="max_scale_factor"):
         record_report(ds, tmp_path / "bad", max_scale_factor=0.5)
+
+
+# ------------------------------------------------------------------------------ friction
+
+
+def test_friction_below_uplift_is_the_peak_ground_acceleration_and_flags(tmp_path, records):
+    """Below uplift the block moves with the ground: its friction demand is max |a_g| / g,
+    here the stripe level / g; a level whose demand exceeds mu is flagged, the others not."""
+    lowest_uplift = min(G * math.tan(b.slenderness) for b in OBJECTS.values())
+    levels = np.array([0.3, 0.6, 0.9]) * lowest_uplift
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6, contact=True)
+    expect = np.broadcast_to(levels / G, ds["friction_demand"].shape)
+    np.testing.assert_allclose(ds["friction_demand"].values, expect, rtol=1e-9)
+    assert not ds["lift_off"].values.any()
+    mu = 0.5 * (levels[1] + levels[2]) / G  # between the second and the third level
+    page = record_report(ds, tmp_path / "r", n_boot=5, friction=mu)
+    text = _text(page)
+    n_flag = len(records) * len(OBJECTS)  # the third level, every record and object
+    assert f"{n_flag} of {ds['friction_demand'].size} scenes lie outside" in text
+    table = pd.read_csv(tmp_path / "r" / "friction_check.csv", index_col=0)
+    assert (table["scenes outside the model (demand > mu or lift-off)"] == 1).all()
+    assert set(table.index) == {f"{o} / {r.name}" for o in OBJECTS for r in records}
+    # per object: the Vase alone given a friction above every demand
+    per_object = [mu, 1.0]
+    text = _text(record_report(ds, tmp_path / "p", n_boot=5, friction=per_object))
+    assert f"{len(records)} of {ds['friction_demand'].size} scenes lie outside" in text
+    text = _text(record_report(ds, tmp_path / "q", n_boot=5, friction=1.0))
+    assert "the block model holds" in text and "lie outside" not in text
+    for bad in (-0.2, [0.3, 0.4, 0.5], np.nan):
+        with pytest.raises(ValueError, match="friction"):
+            record_report(ds, tmp_path / "bad", n_boot=5, friction=bad)
+
+
+import test_record_studies  # noqa: E402
+
+from rockstudy.study import load_study, run_study  # noqa: E402
+from rockstudy.study.report import make_report  # noqa: E402
+from rockstudy.study.store import open_result  # noqa: E402
+
+client = test_record_studies.client  # the one-worker cluster fixture
+
+FRICTION_STUDY = """
+name = "museum friction"
+seed = 1
+friction = 0.6
+[structure]
+kind = "objects"
+objects = [
+  {{ name = "Statue A", width = 0.45, height = 1.9, friction = 0.07 }},
+  {{ name = "Vase", half_diagonal = 0.4, slenderness = 0.3, restitution = 0.85 }},
+]
+[motion]
+kind = "record"
+files = ["{a}", "{b}"]
+scale_to = {{ im = "pga", units = "g", value = {{ dist = "grid", values = [0.05, 0.1] }} }}
+[design]
+kind = "stripes"
+"""
+
+
+def test_friction_in_an_objects_study_cube_report_and_run_warning(client, tmp_path, capsys):
+    """Levels below the uplift of both objects: each scene's demand is its level in g (the
+    oracle); Statue A's mu 0.07 lies between the levels, the Vase's (the study's 0.6) above."""
+    a, b = DATA / "NF03_Tp0.80s_H.AT2", DATA / "NF06_Tp1.70s_H.AT2"
+    path = tmp_path / "museum.toml"
+    path.write_text(FRICTION_STUDY.format(a=a, b=b))
+    study = load_study(path)
+    np.testing.assert_array_equal(study.friction_coefficients(), [0.07, 0.6])
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    levels_g = np.array([0.05, 0.1]) * STANDARD_GRAVITY / G  # "g" of units: 9.80665 m/s^2
+    demand = cube["friction_demand"].transpose("record", "structure", "level").values
+    np.testing.assert_allclose(demand, np.broadcast_to(levels_g, demand.shape), rtol=1e-9)
+    text = _text(make_report(out, tmp_path / "report"))
+    assert "2 of 8 scenes lie outside" in text  # Statue A at 0.1 g under both records
+    table = pd.read_csv(tmp_path / "report" / "friction_check.csv", index_col=0)
+    flagged = table["scenes outside the model (demand > mu or lift-off)"]
+    assert flagged.filter(like="Statue A").tolist() == [1, 1]
+    assert flagged.filter(like="Vase").tolist() == [0, 0]
+    from rockstudy.cli import _contact_warning
+
+    _contact_warning(study, out)
+    assert "warning: 2 of 8 scenes lie outside" in capsys.readouterr().err
+
+
+def test_friction_in_a_monte_carlo_study(client, tmp_path):
+    """A Monte Carlo pulse study with friction stores the contact check: below uplift (the
+    pulse amplitude a fraction of g tan alpha) the demand is a_g / g."""
+    text = """
+name = "mc friction"
+seed = 3
+friction = 0.15
+[sampler]
+kind = "monte_carlo"
+n = 16
+[structure]
+kind = "block"
+half_diagonal = { dist = "uniform", low = 0.5, high = 2.0 }
+slenderness = { dist = "uniform", low = 0.2, high = 0.3 }
+[motion]
+kind = "pulse"
+shape = "sine"
+amplitude_ratio = { dist = "uniform", low = 0.2, high = 0.9 }
+period = { dist = "uniform", low = 0.3, high = 1.0 }
+"""
+    path = tmp_path / "mc.toml"
+    path.write_text(text)
+    study = load_study(path)
+    assert {"friction_demand", "lift_off"} <= set(study.run.outputs)
+    out = tmp_path / "mc.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    a_g = cube["amplitude"].values
+    np.testing.assert_allclose(cube["friction_demand"].values, a_g / G, rtol=1e-9)
+    page = make_report(out, tmp_path / "report")
+    n = int((a_g / G > 0.15).sum())
+    assert 0 < n < a_g.size
+    assert f"{n} of {a_g.size} scenes lie outside" in _text(page)

@@ -547,6 +547,38 @@ def _version(versions) -> str:
     return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
 
 
+def _contact(page, ds, study):
+    """The scenes outside the block model (friction demand above mu, or lift-off)."""
+    mu = study.friction_coefficients()
+    if mu is None or "friction_demand" not in ds:
+        return
+    from .contact_checks import outside_model, summary_line
+
+    page.heading("Friction and lift-off: where the block model stops")
+    line = summary_line(ds, mu)
+    if line:
+        page.warning(line)
+    else:
+        page.text("No scene needs more friction than mu or lifts off: the block model holds.")
+    flags = outside_model(ds, mu)
+    page.table(
+        pd.DataFrame(
+            {
+                "scenes": [int(ds["friction_demand"].notnull().sum())],
+                "friction coefficient mu [-]": [float(mu[0])],
+                "largest friction demand |F_h / F_v| [-]": [
+                    float(ds["friction_demand"].where(np.isfinite(ds["friction_demand"])).max())
+                ],
+                "lift-offs": [int((ds["lift_off"] == 1).sum())],
+                "scenes outside the model": [int(flags.sum())],
+            },
+            index=pd.Index(["all"], name="scenes"),
+        ),
+        "friction_check",
+        "The contact check: the friction demand max |F_h / F_v| of each scene against mu",
+    )
+
+
 def _acceleration_units(study) -> str:
     """The units of a record study's report accelerations: those of ``scale_to.units`` for
     an acceleration target (g, else m/s^2), g otherwise."""
@@ -584,6 +616,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             appendix=study_section,
             units=_acceleration_units(study),
             max_scale_factor=study.design.max_scale_factor,
+            friction=study.friction_coefficients(),
         )
     study = analysis.study_of(ds)
     page = _Page(out)
@@ -606,6 +639,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     elif study.motion.kind == "pulse":
         page.heading("Fragility")
         _fragility(page, ds)
+    _contact(page, ds, study)
     if study.sampler.replicates > 1 and "overturned" in ds:
         page.heading("Self-similarity")
         _similarity(page, ds, study)

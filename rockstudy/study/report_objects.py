@@ -11,6 +11,7 @@ curves or stripe points with the switch band. Each section is a function ``(page
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -55,7 +56,9 @@ class ReportContext:
     compare: xr.Dataset | None = None
     units: str = "g"
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR
-    study: object = None
+    friction: object = None
+    #: The one lookup of a measure's name and units (:func:`.report_records.im_label`).
+    im_label: Callable[..., str] | None = None
     _cache: dict = field(default_factory=dict)
 
     @property
@@ -100,10 +103,8 @@ class ReportContext:
 
     def stripe_label(self) -> str:
         period = self.ds.attrs.get("im_period", np.nan)
-        from .report_records import im_label
-
         return self.relabel(
-            im_label(self.ds.attrs.get("im", "pga"), period if np.isfinite(period) else None)
+            self.im_label(self.ds.attrs.get("im", "pga"), period if np.isfinite(period) else None)
         )
 
     def recommended(self):
@@ -123,6 +124,24 @@ class ReportContext:
         if "efficiency" not in self._cache:
             self._cache["efficiency"] = rf.im_efficiency(self.ds, n_boot=self.n_boot)
         return self._cache["efficiency"]
+
+
+def _section(heading, function, when=None):
+    """A section of :data:`SECTIONS`: ``heading`` (text, or a callable of the context),
+    then ``function(page, ctx)``; skipped where ``when(ctx)`` is False."""
+
+    def run(page, ctx):
+        if when is not None and not when(ctx):
+            return
+        page.heading(heading(ctx) if callable(heading) else heading)
+        function(page, ctx)
+
+    run.__name__ = getattr(function, "__name__", "section")
+    return run
+
+
+def _fits(ctx) -> bool:
+    return ctx.overturned
 
 
 def outcome(page, ctx):
@@ -166,9 +185,7 @@ def scale_factors(page, ctx):
 
 
 def _label(ctx, im, period=None):
-    from .report_records import im_label
-
-    return ctx.relabel(im_label(im, period))
+    return ctx.relabel(ctx.im_label(im, period))
 
 
 def _accel_factor(ctx, im) -> float:
@@ -390,15 +407,17 @@ def object_curves(page, ctx):
     names = list(map(str, ctx.ds["structure"].values))
     records = ctx.record_names()
     fig, axes = _panels(len(names))
-    spread = 0.012 * (np.arange(len(records)) - (len(records) - 1) / 2)
+    spread = 0.015 * (np.arange(len(records)) - (len(records) - 1) / 2)
+    uplift = _uplift(ctx, "pga")
     for j, ax in enumerate(axes):
         for i in range(len(records)):
             if ctx.design == "ida":
                 _ida_curve(ax, ctx, i, j, spread[i])
             else:
                 _stripe_points(ax, ctx, i, j, spread[i])
+        ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
-        ax.set_xlim(0, 1.08)
+        ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
         ax.set_xlabel("peak rotation / slenderness, theta_max / alpha [-]", fontsize=FONT + 1)
         ax.set_ylabel(f"PGA of the scaled record [{ctx.units}]", fontsize=FONT + 1)
@@ -418,7 +437,8 @@ def object_curves(page, ctx):
             else "the stripe points (open circles: stood; crosses: overturned, drawn at "
             "theta_max / alpha = 1)"
         )
-        + "; markers of the records are offset slightly in x so that none hides another",
+        + "; dotted: the object's uplift level g tan alpha; markers of the records are offset "
+        "slightly in x so that none hides another",
     )
 
 
@@ -441,3 +461,55 @@ def _stripe_points(ax, ctx, i, j, offset):
     (line,) = ax.plot(x[order], y[order], "-", lw=0.8, alpha=0.6, label=name)
     ax.plot(x[~over], y[~over], "o", mfc="none", color=line.get_color(), ms=5)
     ax.plot(x[over], y[over], "x", color=line.get_color(), ms=6, mew=1.2)
+
+
+# ------------------------------------------------------------------------------ friction
+
+
+def friction_check(page, ctx):
+    """Per object (or per record for sampled structures): the scenes whose friction demand
+    exceeds the friction coefficient or that lift off, with a warning box."""
+    ds = ctx.ds
+    if "friction_demand" not in ds:
+        return
+    page.heading("Friction and lift-off: where the block model stops")
+    demand = ds["friction_demand"]
+    finite = demand.where(np.isfinite(demand))
+    lift = ds["lift_off"] == 1
+    by = ("structure", "record") if ctx.objects else ("record",)
+    rest = [d for d in demand.dims if d not in by]
+    table = {
+        "scenes": demand.notnull().sum(rest),
+        "largest finite friction demand |F_h / F_v| [-]": finite.max(rest),
+        "lift-offs": lift.sum(rest),
+    }
+    flags = None
+    if ctx.friction is not None:
+        from .contact_checks import friction_array, outside_model
+
+        flags = outside_model(ds, ctx.friction)
+        table["friction coefficient mu [-]"] = (
+            friction_array(ds, ctx.friction).broadcast_like(demand).max(rest)
+        )
+        table["scenes outside the model (demand > mu or lift-off)"] = flags.sum(rest)
+    frame = xr.Dataset(table).to_dataframe(dim_order=list(by))[list(table)]
+    names = ctx.record_names()
+    if ctx.objects:
+        frame.index = [f"{o} / {names[int(r)]}" for o, r in frame.index]
+    else:
+        frame.index = [names[int(r)] for r in frame.index]
+    frame.index.name = "object / record" if ctx.objects else "record"
+    if flags is not None and bool(flags.any()):
+        from .contact_checks import summary_line
+
+        page.warning(summary_line(ds, ctx.friction))
+    elif flags is not None:
+        page.text("No scene needs more friction than mu or lifts off: the block model holds.")
+    design = {"ida": " (IDA: at the highest scale below the first overturning)"}
+    page.table(
+        frame,
+        "friction_check",
+        "The contact check of each scene: the friction demand max |F_h / F_v| (below uplift "
+        "it is max |a_g| / g), the lift-offs and the scenes outside the rocking-block model"
+        + design.get(ctx.design, ""),
+    )

@@ -34,7 +34,7 @@ from ._page import (
 from .analysis import fragility_curve
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR
 from .fragility_fit import BAND_COLUMNS
-from .report_objects import ReportContext, _structure_title
+from .report_objects import ReportContext, _fits, _section, _structure_title
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
@@ -565,24 +565,6 @@ def _self_similarity(page, ds, edges, n_boot):
 # ------------------------------------------------------------------------------ page
 
 
-def _section(heading, function, when=None):
-    """A section of :data:`SECTIONS`: ``heading`` (text, or a callable of the context),
-    then ``function(page, ctx)``; skipped where ``when(ctx)`` is False."""
-
-    def run(page, ctx):
-        if when is not None and not when(ctx):
-            return
-        page.heading(heading(ctx) if callable(heading) else heading)
-        function(page, ctx)
-
-    run.__name__ = getattr(function, "__name__", "section")
-    return run
-
-
-def _fits(ctx) -> bool:
-    return ctx.overturned
-
-
 #: The sections of the record report, in order: each a function (page, ctx) that writes its
 #: own heading (or nothing). Adding a section is adding one entry.
 SECTIONS = [
@@ -618,6 +600,7 @@ SECTIONS = [
         lambda page, ctx: _compare(page, ctx),
         when=lambda ctx: ctx.compare is not None and _fits(ctx),
     ),
+    ro.friction_check,
     _section("Per-record breakdown", lambda page, ctx: _per_record(page, ctx.ds)),
     _section(
         "Self-similarity on records",
@@ -643,6 +626,7 @@ def record_report(
     compare: xr.Dataset | None = None,
     units: str = "g",
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
+    friction=None,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
 
@@ -676,6 +660,10 @@ def record_report(
     max_scale_factor : float
         A warning box lists the stripe points or IDA capacities whose record is scaled by
         more than this (> 1; a study's ``design.max_scale_factor``).
+    friction : float or array_like, optional
+        The friction coefficient mu (one, or one per structure): with ``friction_demand`` in
+        ``ds`` (``contact=True`` of the design functions, or a study's ``friction``) the page
+        counts the scenes whose demand exceeds it or that lift off, with a warning box.
     """
     design = ds.attrs.get("design")
     if design not in DESIGNS:
@@ -693,6 +681,7 @@ def record_report(
     out.mkdir(parents=True, exist_ok=True)
     page = _Page(out)
     ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
+    ctx.friction, ctx.im_label = friction, im_label
     for section in SECTIONS:
         section(page, ctx)
     if appendix is not None:
