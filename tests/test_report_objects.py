@@ -232,3 +232,28 @@ period = { dist = "uniform", low = 0.3, high = 1.0 }
     n = int((a_g / G > 0.15).sum())
     assert 0 < n < a_g.size
     assert f"{n} of {a_g.size} scenes lie outside" in _text(page)
+
+
+@pytest.mark.parametrize("span", [(0.3, 0.8), (0.2, 4.0), (0.015, 40.0), (1.2, 1.9)])
+def test_every_log_axis_is_numbered(span):
+    """A logarithmic axis of the reports carries at least three numbered ticks, however
+    short its span (the right-hand panel of the size-collapse figure had none)."""
+    from rockstudy.study._page import _log_ticks, _plt
+
+    plt = _plt()
+    fig, ax = plt.subplots()
+    ax.plot(span, span)
+    ax.set(xscale="log", yscale="log", xlim=span, ylim=span)
+    _log_ticks(ax)
+    _log_ticks(ax, "y")
+    fig.canvas.draw()
+    for axis in (ax.xaxis, ax.yaxis):
+        labels = [t.get_text() for t in axis.get_ticklabels(minor=False)]
+        labels += [t.get_text() for t in axis.get_ticklabels(minor=True)]
+        ticks = list(axis.get_majorticklocs()) + list(axis.get_minorticklocs())
+        shown = {float(t) for t, s in zip(ticks, labels, strict=True) if s}
+        inside = [t for t in shown if span[0] <= t <= span[1]]
+        assert len(inside) >= 3, (span, labels)
+        for t in axis.get_ticklabels(minor=True) + axis.get_ticklabels():
+            assert t.get_fontsize() >= 8
+    plt.close(fig)

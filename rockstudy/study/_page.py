@@ -104,27 +104,33 @@ def _names(ds) -> list[str]:
 def _log_ticks(ax, axis="x"):
     """Plain-number labels (0.2, 1, 5) on a logarithmic axis, with as many minor labels
     (mantissas 2 and 5, then 2, 3, 5 and 7, then every one) as needed for at least three
-    numbered ticks: every axis is read without counting decades. Call it after plotting."""
-    from matplotlib.ticker import FuncFormatter
+    numbered ticks; an axis too short even for that (under about a third of a decade) gets
+    three to five evenly spaced numbered ticks instead. Every axis is read without counting
+    decades. Call it after plotting."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
 
     lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
-    labelled = []
-    if hi > lo > 0:
-        for mantissas in ((1.0,), (1.0, 2.0, 5.0), (1.0, 2.0, 3.0, 5.0, 7.0), tuple(range(1, 10))):
-            labelled = [float(m) for m in mantissas]
-            decades = 10.0 ** np.arange(np.floor(np.log10(lo)), np.ceil(np.log10(hi)) + 1)
-            ticks = np.outer(decades, labelled).ravel()
-            if ((ticks >= lo) & (ticks <= hi)).sum() >= 3:
-                break
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    labelled, enough = [], not hi > lo > 0
+    for mantissas in ((1.0,), (1.0, 2.0, 5.0), (1.0, 2.0, 3.0, 5.0, 7.0), tuple(range(1, 10))):
+        if enough:
+            break
+        labelled = [float(m) for m in mantissas]
+        decades = 10.0 ** np.arange(np.floor(np.log10(lo)), np.ceil(np.log10(hi)) + 1)
+        ticks = np.outer(decades, labelled).ravel()
+        enough = ((ticks >= lo) & (ticks <= hi)).sum() >= 3
 
     def minor(v, _):
         mantissa = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
         return f"{v:g}" if np.isclose(mantissa, labelled).any() else ""
 
-    target = ax.xaxis if axis == "x" else ax.yaxis
     target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     target.set_minor_formatter(FuncFormatter(minor))
-    ax.tick_params(axis=axis, which="minor", labelsize=8)
+    if not enough:  # a short span: evenly spaced round numbers
+        ticks = MaxNLocator(4).tick_values(lo, hi)
+        target.set_major_locator(FixedLocator(ticks[(ticks >= lo) & (ticks <= hi)]))
+        target.set_minor_formatter(NullFormatter())
+    ax.tick_params(axis=axis, which="both", labelsize=8)
 
 
 def _mpl_text(text: str) -> str:

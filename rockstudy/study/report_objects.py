@@ -298,8 +298,10 @@ def _ida_capacity(ctx):
     cap = ds["capacity_scale"].values * pga
     value = np.where(ds["censored"].values == 1, np.nan, cap).T
     lower = (ds["capacity_scale_lower"].values * pga).T
-    cells = np.where(np.isfinite(value), value, [[f"above {v:.3g}" for v in r] for r in lower])
-    return cells.astype(object), value
+    cells = np.empty(value.shape, object)  # numbers, or text where censored
+    for k, v in np.ndenumerate(value):
+        cells[k] = float(v) if np.isfinite(v) else f"above {lower[k]:.3g}"
+    return cells, value
 
 
 def _stripe_capacity(ctx):
@@ -479,9 +481,9 @@ def friction_check(page, ctx):
     by = ("structure", "record") if ctx.objects else ("record",)
     rest = [d for d in demand.dims if d not in by]
     table = {
-        "scenes": demand.notnull().sum(rest),
+        "scenes": demand.notnull().sum(rest).astype(int),
         "largest finite friction demand |F_h / F_v| [-]": finite.max(rest),
-        "lift-offs": lift.sum(rest),
+        "lift-offs": lift.sum(rest).astype(int),
     }
     flags = None
     if ctx.friction is not None:
@@ -491,7 +493,7 @@ def friction_check(page, ctx):
         table["friction coefficient mu [-]"] = (
             friction_array(ds, ctx.friction).broadcast_like(demand).max(rest)
         )
-        table["scenes outside the model (demand > mu or lift-off)"] = flags.sum(rest)
+        table["scenes outside the model (demand > mu or lift-off)"] = flags.sum(rest).astype(int)
     frame = xr.Dataset(table).to_dataframe(dim_order=list(by))[list(table)]
     names = ctx.record_names()
     if ctx.objects:
