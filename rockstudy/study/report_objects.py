@@ -342,13 +342,13 @@ def object_capacity(page, ctx):
     records = ctx.record_names()
     table = pd.DataFrame(cells, index=list(map(str, ctx.ds["structure"].values)), columns=records)
     table.index.name = "object"
-    govern = [
-        (records[int(np.nanargmin(v))], float(np.nanmin(v)))
+    govern = [  # every record at the lowest capacity (stripes often tie)
+        (", ".join(records[k] for k in np.flatnonzero(v == np.nanmin(v))), float(np.nanmin(v)))
         if np.isfinite(v).any()
         else ("", np.nan)
         for v in values
     ]
-    table["governing record (lowest capacity)"] = [g for g, _ in govern]
+    table["governing record(s) (lowest capacity)"] = [g for g, _ in govern]
     table["governing capacity"] = [v for _, v in govern]
     what = {
         "ida": f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
