@@ -617,6 +617,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             units=_acceleration_units(study),
             max_scale_factor=study.design.max_scale_factor,
             friction=study.friction_coefficients(),
+            study=study,
         )
     study = analysis.study_of(ds)
     page = _Page(out)

@@ -59,6 +59,9 @@ class ReportContext:
     friction: object = None
     #: The one lookup of a measure's name and units (:func:`.report_records.im_label`).
     im_label: Callable[..., str] | None = None
+    #: The study the dataset was run from (None for a design made in Python): sections that
+    #: read a study's settings (e.g. a ``[hazard]`` section) find them here.
+    study: object = None
     _cache: dict = field(default_factory=dict)
 
     @property

@@ -262,61 +262,36 @@ def _representatives(ds, k=3) -> list[int]:
     return [int(order[i]) for i in picks]
 
 
-def _responses(page, ds):
-    """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes."""
+def _responses(page, ctx):
+    """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes (the
+    per-object panels' drawing; markers of the records offset in x, survivors hollow)."""
+    ds = ctx.ds
     design = ds.attrs.get("design")
     names = _names(ds)
     picks = _representatives(ds)
     plt = _plt()
     fig, axes = plt.subplots(1, len(picks), figsize=(4.4 * len(picks), 4), squeeze=False)
-    pga_g = ds["pga"].values / G
+    spread = 0.015 * (np.arange(len(names)) - (len(names) - 1) / 2)
     for ax, j in zip(axes[0], picks, strict=True):
-        alpha = float(ds["slenderness"].values[j])
-        for i, name in enumerate(names):
+        for i in range(len(names)):
             if design == "ida":
-                s = ds["step_scale"].values[i, j]
-                cap = ds["capacity_scale"].values[i, j]
-                ok = np.isfinite(s)
-                order = np.argsort(s[ok])
-                s = s[ok][order]
-                x = (ds["step_max_rotation"].values[i, j][ok] / alpha)[order]
-                over = ds["step_overturned"].values[i, j][ok][order] == 1
-                x = np.where(over, 1.0, np.minimum(x, 1.0))
-                upto = ~(s > cap)  # the curve up to the first overturning (all if censored)
-                (line,) = ax.plot(x[upto], s[upto] * pga_g[i], "-", lw=1, label=_mpl_text(name))
-                ax.plot(x[over], s[over] * pga_g[i], "x", color=line.get_color(), ms=5)
-                above = (s > cap) & ~over  # survived above the first overturning
-                ax.plot(x[above], s[above] * pga_g[i], "o", mfc="none", color=line.get_color())
+                ro._ida_curve(ax, ctx, i, j, spread[i])
+            elif design == "stripes":
+                ro._stripe_points(ax, ctx, i, j, spread[i])
             else:
-                y = pga_g[i] * (ds["scale"].values[i, j] if design == "stripes" else 1.0)
-                x = ds["max_rotation"].values[i, j] / alpha
-                over = ds["overturned"].values[i, j] == 1
-                x = np.where(over, 1.0, np.minimum(x, 1.0))
-                (line,) = ax.plot(
-                    np.atleast_1d(x)[~np.atleast_1d(over)],
-                    np.atleast_1d(y)[~np.atleast_1d(over)],
-                    "o",
-                    ms=4,
-                    label=_mpl_text(name),
-                )
-                ax.plot(
-                    np.atleast_1d(x)[np.atleast_1d(over)],
-                    np.atleast_1d(y)[np.atleast_1d(over)],
-                    "x",
-                    color=line.get_color(),
-                    ms=6,
-                )
+                _cloud_point(ax, ctx, i, j, spread[i])
         ax.set(
             xlabel="peak rotation / slenderness, theta_max / alpha [-]",
-            ylabel="PGA of the scaled record [g]",
+            ylabel=f"PGA of the scaled record [{ctx.units}]",
             yscale="log",
-            xlim=(0, 1.05),
+            xlim=(-0.04, 1.08),
             title=_structure_title(ds, j),
         )
         _log_ticks(ax, "y")
-        if len(names) <= 15:
-            ax.legend(fontsize=8)
-    fig.tight_layout()
+    if len(names) <= 15:
+        ro._shared_legend(fig, axes[0][0], len(names))
+    else:
+        fig.tight_layout()
     what = {
         "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
         "stripes": "Stripe points: each record scaled to each level",
@@ -329,11 +304,22 @@ def _responses(page, ds):
         "theta_max / alpha = 1)"
         + (
             "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive"
+            "at which the block was seen to survive, shaded: the switch band"
             if design == "ida"
-            else ""
-        ),
+            else "; open circles: stood"
+        )
+        + "; markers of the records offset slightly in x so that none hides another",
     )
+
+
+def _cloud_point(ax, ctx, i, j, offset):
+    """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
+    ds = ctx.ds
+    y = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    over = bool(ds["overturned"].values[i, j] == 1)
+    x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
+    style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
+    ax.plot([x + offset], [y], ls="none", label=_mpl_text(ctx.record_names()[i]), **style)
 
 
 def _per_record(page, ds):
@@ -587,7 +573,7 @@ SECTIONS = [
     ro.object_curves,
     _section(
         lambda ctx: {"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[ctx.design],
-        lambda page, ctx: _responses(page, ctx.ds),
+        lambda page, ctx: _responses(page, ctx),
         when=lambda ctx: not ctx.objects or ctx.design == "cloud",
     ),
     _section(
@@ -627,6 +613,7 @@ def record_report(
     units: str = "g",
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
     friction=None,
+    study=None,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
 
@@ -664,6 +651,9 @@ def record_report(
         The friction coefficient mu (one, or one per structure): with ``friction_demand`` in
         ``ds`` (``contact=True`` of the design functions, or a study's ``friction``) the page
         counts the scenes whose demand exceeds it or that lift off, with a warning box.
+    study : rockstudy.study.spec.Study, optional
+        The study the dataset was run from, for the sections that read its settings
+        (``ReportContext.study``).
     """
     design = ds.attrs.get("design")
     if design not in DESIGNS:
@@ -681,7 +671,7 @@ def record_report(
     out.mkdir(parents=True, exist_ok=True)
     page = _Page(out)
     ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
-    ctx.friction, ctx.im_label = friction, im_label
+    ctx.friction, ctx.im_label, ctx.study = friction, im_label, study
     for section in SECTIONS:
         section(page, ctx)
     if appendix is not None:
