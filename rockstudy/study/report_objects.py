@@ -236,7 +236,14 @@ def object_fragility(page, ctx):
             page.text(f"Fragility of the objects against {_label(ctx, im, period)}: {err}")
             ax.set_visible(False)
             continue
-        _plot_objects(ax, ctx, t, im, period)
+        if not _plot_objects(ax, ctx, t, im, period):
+            page.text(
+                f"Fragility of the objects against {_label(ctx, im, period)}: no object's fit "
+                f"is defined (records per object: {int(t['n'].max())}; a lognormal fit needs "
+                "at least two distinct capacities or outcomes)"
+            )
+            ax.set_visible(False)
+            continue
         t.insert(0, "intensity", _label(ctx, im, period))
         tables.append(t)
     if not tables:
@@ -269,25 +276,36 @@ def object_fragility(page, ctx):
     page.table(shown, "object_fragility", "Fragility of each object, by name (90 % bands)")
 
 
-def _plot_objects(ax, ctx, t, im, period):
+def _plot_objects(ax, ctx, t, im, period) -> bool:
+    """Each object's fitted curve and band on ``ax``; False (nothing drawn) when no fit is
+    defined."""
     low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
     up = _uplift(ctx, im)
     names = list(map(str, ctx.ds["structure"].values))
     if up is not None:
         low = min(low, np.nanmin(up))
+    if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
+        return False
     grid = np.geomspace(low / 1.2, high * 1.2, 200)
     curve = fragility_curve(t, grid)
+    drawn = 0
     for g in curve.group.values:
         c = curve.sel(group=g)
+        if not np.isfinite(c.probability.values).any():
+            continue
+        drawn += 1
         (line,) = ax.plot(grid, c.probability, "-", label=ctx.text(str(g)))
         ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
         if up is not None:
             ax.axvline(up[names.index(str(g))], ls=":", lw=1.5, color=line.get_color())
+    if not drawn:
+        return False
     ax.set(xscale="log", ylim=(-0.02, 1.02), ylabel="probability of overturning [-]")
     ax.set_xlabel(_label(ctx, im, period), fontsize=FONT + 1)
     ctx.log_ticks(ax)
     ax.tick_params(labelsize=FONT)
     ax.legend(fontsize=FONT, loc="upper left")
+    return True
 
 
 # ------------------------------------------------------------------------------ capacity
