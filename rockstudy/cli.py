@@ -331,7 +331,21 @@ def _run(args) -> int:
     print(
         f"cube: {report.path} (xarray.open_zarr)" + (f", {report.netcdf}" if report.netcdf else "")
     )
+    _contact_warning(study, report.path)
     return 0
+
+
+def _contact_warning(study, path) -> None:
+    """A warning on stderr when scenes lie outside the block model (a study's friction)."""
+    mu = study.friction_coefficients()
+    if mu is None:
+        return
+    from .study.analysis.contact import summary_line
+    from .study.store import open_result
+
+    line = summary_line(open_result(path).load(), mu)
+    if line:
+        print(f"warning: {line}; `rockstudy report` lists them", file=sys.stderr)
 
 
 def _compile(args) -> int:

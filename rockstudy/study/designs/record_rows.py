@@ -111,6 +111,18 @@ _STEPS = rd.STEP_VARIABLES
 _BOOLS = ("censored", "survives_above_capacity")
 
 
+#: The contact check of a scene (a study's ``friction``): (long_name, units, dtype, fill).
+CONTACT_VARIABLES = {
+    "friction_demand": (
+        "friction demand max |F_h / F_v| at the contact (inf with a lift-off)",
+        "1",
+        "f8",
+        np.nan,
+    ),
+    "lift_off": ("1 if the vertical contact force was not compressive somewhere", "1", "i1", -1),
+}
+
+
 def _float(long_name, units):
     return (long_name, units, "f8", np.nan)
 
@@ -142,6 +154,9 @@ def outputs(study) -> dict:
             -1,
             None,
         )
+    if study.friction_coefficients() is not None:  # the contact check (spec.Study.friction)
+        for name in ("friction_demand", "lift_off"):
+            out[name] = (*CONTACT_VARIABLES[name], None)
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
         "1",
@@ -249,6 +264,7 @@ def _run_design(study, record, structures, levels):
         rtol=run.rtol,
         max_steps=run.max_steps,
     )
+    common["contact"] = study.friction_coefficients() is not None
     if de.kind == "cloud":
         return rd.cloud([record], structures, **common)
     if de.kind == "stripes":

@@ -27,6 +27,7 @@ from ... import similarity
 from ...constants import G
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
+from ...dynamics.batch import CONTACT_OUTPUTS
 from ...dynamics.methods import MAX_STEPS
 from ...motions import Record
 from ...motions import intensity as _im
@@ -255,10 +256,11 @@ _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
 STATUS_FREE_FALL = 2
 
 
-def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps):
+def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps, contact=False):
     """:func:`_run` on the points whose |scale| stays below the record's free-fall scale;
     the others get ``status`` :data:`STATUS_FREE_FALL`, NaN rotation and time, no overturning
-    and -1 impacts."""
+    and -1 impacts. With ``contact``, also ``friction_demand`` (NaN where not run) and
+    ``lift_off`` (see :func:`rockstudy.simulate_batch`)."""
     ok = np.abs(scales) < free_fall_scale(record)
     out = {
         "max_rotation": np.full(scales.size, np.nan),
@@ -267,9 +269,15 @@ def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps):
         "overturn_time": np.full(scales.size, np.nan),
         "status": np.full(scales.size, STATUS_FREE_FALL, np.int64),
     }
+    keys = _OUT + (CONTACT_OUTPUTS if contact else ())
+    if contact:
+        out.update(
+            friction_demand=np.full(scales.size, np.nan), lift_off=np.zeros(scales.size, bool)
+        )
     if ok.any():
-        run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps)
-        for k in _OUT:
+        wanted = keys if contact else None
+        run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps, wanted)
+        for k in keys:
             out[k][ok] = run[k]
     return out
 
@@ -285,6 +293,7 @@ def cloud(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
+    contact: bool = False,
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -306,6 +315,11 @@ def cloud(
         Damping ratio of ``sa`` and the spectrum intensity.
     method, rtol, max_steps
         As in :func:`rockstudy.simulate_batch`.
+    contact : bool
+        Also ``friction_demand`` (max abs(F_h / F_v) at the contact; below uplift
+        max abs(u_h'') / g) and ``lift_off`` of every point, as
+        :attr:`rockstudy.RockingResult.friction_demand` (each point that lifts is run again
+        with a history: 1-40 ms a point).
 
     Returns
     -------
@@ -321,8 +335,10 @@ def cloud(
     ds = _record_dataset(records, st, periods, damping)
     idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
-    outs = [_run_below_free_fall(r, st, idx, ones, method, rtol, max_steps) for r in records]
-    for k in _OUT:
+    outs = [
+        _run_below_free_fall(r, st, idx, ones, method, rtol, max_steps, contact) for r in records
+    ]
+    for k in _OUT + (CONTACT_OUTPUTS if contact else ()):
         ds[k] = (("record", "structure"), np.array([o[k] for o in outs]))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     n_run = int((~ds["censored"]).sum())
@@ -344,6 +360,7 @@ def multiple_stripes(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
+    contact: bool = False,
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -360,7 +377,7 @@ def multiple_stripes(
         ``pga_ratio`` or ``pgv_ratio``.
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
-    records, structures, periods, damping, method, rtol, max_steps
+    records, structures, periods, damping, method, rtol, max_steps, contact
         As in :func:`cloud`.
 
     Returns
@@ -386,11 +403,11 @@ def multiple_stripes(
     for r in records:
         s = _scale_for(levels[None, :], _record_measure(r, im, period, damping, st)[:, None], im)
         scales.append(s)
-        outs.append(_run_below_free_fall(r, st, idx, s.ravel(), method, rtol, max_steps))
+        outs.append(_run_below_free_fall(r, st, idx, s.ravel(), method, rtol, max_steps, contact))
     dims = ("record", "structure", "level")
     ds = ds.assign_coords(level=levels)
     ds["scale"] = (dims, np.array(scales))
-    for k in _OUT:
+    for k in _OUT + (CONTACT_OUTPUTS if contact else ()):
         ds[k] = (dims, np.array([o[k] for o in outs]).reshape(len(records), n, levels.size))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     ds.attrs.update(
@@ -429,6 +446,7 @@ def incremental_dynamic_analysis(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
+    contact: bool = False,
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -472,8 +490,11 @@ def incremental_dynamic_analysis(
     step, tolerance, max_pga_ratio, scan
         See :class:`IdaOptions` (ranges checked; a ValueError names the option).
     records, structures, period, periods, damping, method, rtol, max_steps
-        As in :func:`multiple_stripes`. ``method="linear"`` runs the exact piecewise
-        solution of the linearized model for records without a vertical component.
+        As in :func:`multiple_stripes`. ``contact``: also ``friction_demand`` and ``lift_off``
+        (see :func:`cloud`) at ``capacity_scale_lower``, the highest scale simulated below
+        the first overturning (of a censored block: the highest it stood at).
+        ``method="linear"`` runs the exact piecewise solution of the linearized model for
+        records without a vertical component.
 
     Returns
     -------
@@ -498,6 +519,10 @@ def incremental_dynamic_analysis(
     measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
     results = [_ida_record(r, st, options, method, rtol, max_steps) for r in records]
     ds = _ida_tables(ds, results)
+    if contact:
+        ds["friction_demand"], ds["lift_off"] = _ida_contact(
+            records, st, ds, method, rtol, max_steps
+        )
     ds["capacity"] = (
         ("record", "structure"),
         np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** _ms.power(im)),
@@ -527,6 +552,22 @@ _IDA_FLOATS = (
 )
 _IDA_INTS = ("censored_reason", "rungs", "simulations", "status")
 STEP_VARIABLES = ("step_scale", "step_max_rotation", "step_overturned", "step_kind")
+
+
+def _ida_contact(records, st, ds, method, rtol, max_steps):
+    """(friction_demand, lift_off) on (record, structure) at the highest scale below each
+    first overturning (``capacity_scale_lower``)."""
+    idx = np.arange(ds.sizes["structure"])
+    demand = np.full((len(records), idx.size), np.nan)
+    lift = np.zeros(demand.shape, bool)
+    for i, r in enumerate(records):
+        s = ds["capacity_scale_lower"].values[i]
+        ok = np.isfinite(s) & (s > 0)
+        if ok.any():
+            run = _run(r, st, idx[ok], s[ok], method, rtol, max_steps, CONTACT_OUTPUTS)
+            demand[i, ok], lift[i, ok] = run["friction_demand"], run["lift_off"]
+    dims = ("record", "structure")
+    return (dims, demand), (dims, lift)
 
 
 def _ida_tables(ds, results):

@@ -45,6 +45,10 @@ class _Page:
     def text(self, text):
         self.parts.append(f"<p>{html.escape(text)}</p>")
 
+    def warning(self, text):
+        """A boxed warning (escaped): what makes the results below less trustworthy."""
+        self.parts.append(f"<div class='warn'><b>Warning:</b> {html.escape(text)}</div>")
+
     def preformatted(self, text):
         self.parts.append(f"<pre>{html.escape(text)}</pre>")
 
@@ -75,7 +79,8 @@ class _Page:
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
             "img{max-width:100%}table.t{border-collapse:collapse;font-size:12px}"
             "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
-            ".cap{color:#555}</style></head><body>"
+            ".cap{color:#555}.warn{border:2px solid #c60;background:#fff4e5;padding:6px 10px;"
+            "margin:8px 0}</style></head><body>"
         )
         # a check for headless browsers, invisible to the reader: the count of decoded figures
         # goes into the body's data-figures attribute ("shown/total")
@@ -88,6 +93,49 @@ class _Page:
         path = self.out / "index.html"
         path.write_text(head + body + "</body></html>")
         return path
+
+
+def _names(ds) -> list[str]:
+    """Record names as text (a cube may store them as bytes)."""
+    values = ds["record_name"].values if "record_name" in ds.coords else ds["record"].values
+    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in values]
+
+
+def _log_ticks(ax, axis="x"):
+    """Plain-number labels (0.2, 1, 5) on a logarithmic axis, with as many minor labels
+    (mantissas 2 and 5, then 2, 3, 5 and 7, then every one) as needed for at least three
+    numbered ticks; an axis too short even for that (under about a third of a decade) gets
+    three to five evenly spaced numbered ticks instead. Every axis is read without counting
+    decades. Call it after plotting."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
+
+    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    labelled, enough = [], not hi > lo > 0
+    for mantissas in ((1.0,), (1.0, 2.0, 5.0), (1.0, 2.0, 3.0, 5.0, 7.0), tuple(range(1, 10))):
+        if enough:
+            break
+        labelled = [float(m) for m in mantissas]
+        decades = 10.0 ** np.arange(np.floor(np.log10(lo)), np.ceil(np.log10(hi)) + 1)
+        ticks = np.outer(decades, labelled).ravel()
+        enough = ((ticks >= lo) & (ticks <= hi)).sum() >= 3
+
+    def minor(v, _):
+        mantissa = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
+        return f"{v:g}" if np.isclose(mantissa, labelled).any() else ""
+
+    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    target.set_minor_formatter(FuncFormatter(minor))
+    if not enough:  # a short span: evenly spaced round numbers
+        ticks = MaxNLocator(4).tick_values(lo, hi)
+        target.set_major_locator(FixedLocator(ticks[(ticks >= lo) & (ticks <= hi)]))
+        target.set_minor_formatter(NullFormatter())
+    ax.tick_params(axis=axis, which="both", labelsize=8)
+
+
+def _mpl_text(text: str) -> str:
+    """Text for a matplotlib label: a '$' from a file must not start mathtext."""
+    return text.replace("$", r"\$")
 
 
 NOT_REACHED = "not reached within the sampled range"

@@ -23,7 +23,19 @@ from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS
 from ..analysis.sampled import fragility_curve
-from ._page import _FRAGILITY_NAMES, _capacities_as_measured, _Page, _plt
+from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
+from . import objects as ro
+from ._page import (
+    _FRAGILITY_NAMES,
+    _capacities_as_measured,
+    _log_ticks,
+    _mpl_text,
+    _names,
+    _Page,
+    _plt,
+)
+from .objects import ReportContext, _fits, _section, _structure_title
+from .risk import section as risk_section
 
 #: Designs this report reads (``ds.attrs["design"]``).
 DESIGNS = ("cloud", "stripes", "ida")
@@ -36,6 +48,8 @@ _DESIGN_NAMES = {
     "stripes": "multiple-stripe analysis",
     "ida": "incremental dynamic analysis (a ladder of rungs, refined by bisection)",
 }
+#: Units of the report's accelerations: as given (a study's scale_to.units) -> as shown.
+REPORT_UNITS = {"g": "g", "m/s^2": "m/s^2", "m/s2": "m/s^2"}
 #: Frequency bins of omega_p / p (of equal count) within which PGA / (g tan alpha) is compared.
 FREQUENCY_BINS = 3
 
@@ -48,35 +62,6 @@ def im_label(im: str, period=None) -> str:
     if im in _ms.MEASURES or im in _ms.RATIOS:
         return _ms.label(im, period)
     return im if period is None else f"{im}(T = {float(period):.3g} s)"
-
-
-def _names(ds) -> list[str]:
-    """Record names as text (a cube may store them as bytes)."""
-    values = ds["record_name"].values if "record_name" in ds.coords else ds["record"].values
-    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in values]
-
-
-def _log_ticks(ax, axis="x"):
-    """Plain-number labels (0.2, 1, 5) on a logarithmic axis; minor ones (2 and 5 of each
-    decade) only where the axis spans under 1.5 decades. Call it after plotting."""
-    from matplotlib.ticker import FuncFormatter
-
-    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
-    few = hi > lo > 0 and np.log10(hi / lo) < 1.5
-
-    def minor(v, _):
-        mantissa = v / 10.0 ** np.floor(np.log10(v)) if v > 0 else 0.0
-        return f"{v:g}" if few and np.isclose(mantissa, [2.0, 5.0]).any() else ""
-
-    target = ax.xaxis if axis == "x" else ax.yaxis
-    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    target.set_minor_formatter(FuncFormatter(minor))
-    ax.tick_params(axis=axis, which="minor", labelsize=7)
-
-
-def _mpl_text(text: str) -> str:
-    """Text for a matplotlib label: a '$' from a file must not start mathtext."""
-    return text.replace("$", r"\$")
 
 
 def _measures(ds) -> list[tuple[str, float | None]]:
@@ -95,32 +80,25 @@ def _measures(ds) -> list[tuple[str, float | None]]:
     return out
 
 
-def _sizes(ds):
-    """Size-class edges [m] of the blocks, or None when they do not span three sizes."""
-    R = ds["half_diagonal"].values if "half_diagonal" in ds else np.zeros(0)
-    if not (R.size and np.all(np.isfinite(R)) and np.unique(R).size >= 3):
-        return None
-    return rsim.size_edges(ds, 3)
-
-
-def _fit(ds, im, period, edges, n_boot):
-    """The design's fragility table against ``im``, by size class when there are sizes."""
+def _fit(ds, im, period, edges, n_boot, by=None):
+    """The design's fragility table against ``im``, by size class when there are sizes (or
+    ``by`` a coordinate, e.g. ``"structure"`` for named objects)."""
     fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
-    by = None if edges is None else "half_diagonal"
+    by = by if edges is None else "half_diagonal"
     table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
     if edges is not None:  # analysis labels bins "lo-hi" in %g: name them in words
         table.index = [
             rsim.size_label(lo, hi)
             for lo, hi in (map(float, g.split("-")) for g in table.index.astype(str))
         ]
-    table.index.name = "block size" if edges is not None else "blocks"
+    table.index.name = "block size" if edges is not None else "object" if by else "blocks"
     return table
 
 
 # ------------------------------------------------------------------------------ sections
 
 
-def _summary(page, ds):
+def _summary(page, ds, relabel=str):
     design = ds.attrs.get("design")
     rows = {
         "design": _DESIGN_NAMES.get(design, str(design)),
@@ -130,9 +108,11 @@ def _summary(page, ds):
         "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
     if design in ("stripes", "ida"):
-        rows["scaling measure"] = im_label(
-            ds.attrs.get("im", "pga"),
-            ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
+        rows["scaling measure"] = relabel(
+            im_label(
+                ds.attrs.get("im", "pga"),
+                ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
+            )
         )
     if design == "stripes":
         rows["levels"] = int(ds.sizes["level"])
@@ -202,7 +182,7 @@ def _fragility(page, ds, edges, n_boot):
             ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
         ax.set(xscale="log", xlabel=im_label(im, period), ylabel="probability of overturning")
         _log_ticks(ax)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=8)
         t.insert(0, "intensity", im_label(im, period))
         tables.append(t)
     for ax in axes[len(measures) :]:
@@ -238,15 +218,15 @@ def _fragility(page, ds, edges, n_boot):
     )
 
 
-def _efficiency(page, ds, n_boot):
-    table = rf.im_efficiency(ds, n_boot=n_boot)
+def _efficiency(page, ctx):
+    table = ctx.efficiency()
     rows = []
     for (label, _), r in table.iterrows():
         name, _, rest = label.partition("(T=")
         period = float(rest.rstrip(" s)")) if rest else None
         rows.append(
             {
-                "intensity measure": im_label(name, period),
+                "intensity measure": ctx.relabel(im_label(name, period)),
                 "dispersion per power beta / k [-]": r["beta_linear"],
                 "beta / k, lower": r["beta_linear_lo"],
                 "beta / k, upper": r["beta_linear_hi"],
@@ -277,70 +257,36 @@ def _representatives(ds, k=3) -> list[int]:
     return [int(order[i]) for i in picks]
 
 
-def _structure_title(ds, j) -> str:
-    alpha = float(ds["slenderness"].values[j])
-    R = float(ds["half_diagonal"].values[j]) if "half_diagonal" in ds else np.nan
-    size = f"R = {R:.3g} m, " if np.isfinite(R) else ""
-    name = ds["structure"].values[j]
-    label = name if isinstance(name, str) else f"block {j}"
-    return f"{label}: {size}alpha = {alpha:.3g} rad"
-
-
-def _responses(page, ds):
-    """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes."""
+def _responses(page, ctx):
+    """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes (the
+    per-object panels' drawing; markers of the records offset in x, survivors hollow)."""
+    ds = ctx.ds
     design = ds.attrs.get("design")
     names = _names(ds)
     picks = _representatives(ds)
     plt = _plt()
     fig, axes = plt.subplots(1, len(picks), figsize=(4.4 * len(picks), 4), squeeze=False)
-    pga_g = ds["pga"].values / G
+    spread = 0.015 * (np.arange(len(names)) - (len(names) - 1) / 2)
     for ax, j in zip(axes[0], picks, strict=True):
-        alpha = float(ds["slenderness"].values[j])
-        for i, name in enumerate(names):
+        for i in range(len(names)):
             if design == "ida":
-                s = ds["step_scale"].values[i, j]
-                cap = ds["capacity_scale"].values[i, j]
-                ok = np.isfinite(s)
-                order = np.argsort(s[ok])
-                s = s[ok][order]
-                x = (ds["step_max_rotation"].values[i, j][ok] / alpha)[order]
-                over = ds["step_overturned"].values[i, j][ok][order] == 1
-                x = np.where(over, 1.0, np.minimum(x, 1.0))
-                upto = ~(s > cap)  # the curve up to the first overturning (all if censored)
-                (line,) = ax.plot(x[upto], s[upto] * pga_g[i], "-", lw=1, label=_mpl_text(name))
-                ax.plot(x[over], s[over] * pga_g[i], "x", color=line.get_color(), ms=5)
-                above = (s > cap) & ~over  # survived above the first overturning
-                ax.plot(x[above], s[above] * pga_g[i], "o", mfc="none", color=line.get_color())
+                ro._ida_curve(ax, ctx, i, j, spread[i])
+            elif design == "stripes":
+                ro._stripe_points(ax, ctx, i, j, spread[i])
             else:
-                y = pga_g[i] * (ds["scale"].values[i, j] if design == "stripes" else 1.0)
-                x = ds["max_rotation"].values[i, j] / alpha
-                over = ds["overturned"].values[i, j] == 1
-                x = np.where(over, 1.0, np.minimum(x, 1.0))
-                (line,) = ax.plot(
-                    np.atleast_1d(x)[~np.atleast_1d(over)],
-                    np.atleast_1d(y)[~np.atleast_1d(over)],
-                    "o",
-                    ms=4,
-                    label=_mpl_text(name),
-                )
-                ax.plot(
-                    np.atleast_1d(x)[np.atleast_1d(over)],
-                    np.atleast_1d(y)[np.atleast_1d(over)],
-                    "x",
-                    color=line.get_color(),
-                    ms=6,
-                )
+                _cloud_point(ax, ctx, i, j, spread[i])
         ax.set(
             xlabel="peak rotation / slenderness, theta_max / alpha [-]",
-            ylabel="PGA of the scaled record [g]",
+            ylabel=f"PGA of the scaled record [{ctx.units}]",
             yscale="log",
-            xlim=(0, 1.05),
+            xlim=(-0.04, 1.08),
             title=_structure_title(ds, j),
         )
         _log_ticks(ax, "y")
-        if len(names) <= 15:
-            ax.legend(fontsize=6)
-    fig.tight_layout()
+    if len(names) <= 15:
+        ro._shared_legend(fig, axes[0][0], len(names))
+    else:
+        fig.tight_layout()
     what = {
         "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
         "stripes": "Stripe points: each record scaled to each level",
@@ -353,11 +299,22 @@ def _responses(page, ds):
         "theta_max / alpha = 1)"
         + (
             "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive"
+            "at which the block was seen to survive, shaded: the switch band"
             if design == "ida"
-            else ""
-        ),
+            else "; open circles: stood"
+        )
+        + "; markers of the records offset slightly in x so that none hides another",
     )
+
+
+def _cloud_point(ax, ctx, i, j, offset):
+    """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
+    ds = ctx.ds
+    y = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    over = bool(ds["overturned"].values[i, j] == 1)
+    x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
+    style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
+    ax.plot([x + offset], [y], ls="none", label=_mpl_text(ctx.record_names()[i]), **style)
 
 
 def _per_record(page, ds):
@@ -431,15 +388,15 @@ def _switch_band(page, ds):
     )
 
 
-def _side_by_side(page, ida, stripes, edges, n_boot):
+def _side_by_side(page, ida, stripes, edges, n_boot, by=None):
     """The fragility of the IDA and of the stripes on the same records and blocks, measure by
     measure and size class; a warning where their median bands do not overlap."""
     rows, plt = [], _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
     for im, period in _measures(ida):
         try:
-            t_ida = _fit(ida, im, period, edges, n_boot)
-            t_str = _fit(stripes, im, period, edges, n_boot)
+            t_ida = _fit(ida, im, period, edges, n_boot, by)
+            t_str = _fit(stripes, im, period, edges, n_boot, by)
         except ValueError as err:
             page.text(f"Stripes and IDA against {im_label(im, period)}: {err}")
             continue
@@ -500,7 +457,7 @@ def _plot_pair(ax, t_ida, t_str, im):
             ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
     ax.set(xscale="log", xlabel=im_label(im), ylabel="probability of overturning")
     _log_ticks(ax)
-    ax.legend(fontsize=6)
+    ax.legend(fontsize=8)
 
 
 def _median(values) -> float:
@@ -555,7 +512,7 @@ def _self_similarity(page, ds, edges, n_boot):
         _log_ticks(ax)
         _log_ticks(ax, "y")
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7)
+            ax.legend(fontsize=8)
     fig.tight_layout()
     page.figure(
         fig,
@@ -586,119 +543,56 @@ def _self_similarity(page, ds, edges, n_boot):
     pd.concat(medians).to_csv(page.out / "size_class_medians.csv")
 
 
-#: Resamples of the records for the bands of the annual rates (:func:`_risk`).
-RISK_RESAMPLES = 200
-#: Most objects drawn in the deaggregation figure (the highest rates; all are in its CSV).
-MAX_DEAGGREGATION_LINES = 10
+#: The sections of the record report, in order: each a function (page, ctx) that writes its
+#: own heading (or nothing). Adding a section is adding one entry.
+SECTIONS = [
+    _section("Summary", lambda page, ctx: _summary(page, ctx.ds, ctx.relabel)),
+    ro.outcome,
+    ro.scale_factors,
+    _section("Records", lambda page, ctx: _record_list(page, ctx.ds)),
+    _section(
+        "Fragility",
+        lambda page, ctx: _fragility(page, ctx.ds, ctx.edges, ctx.n_boot),
+        when=lambda ctx: _fits(ctx) and not ctx.objects,
+    ),
+    ro.object_fragility,
+    risk_section,
+    _section(
+        "Intensity-measure efficiency",
+        lambda page, ctx: _efficiency(page, ctx),
+        when=_fits,
+    ),
+    ro.object_capacity,
+    ro.object_curves,
+    _section(
+        lambda ctx: {"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[ctx.design],
+        lambda page, ctx: _responses(page, ctx),
+        when=lambda ctx: not ctx.objects or ctx.design == "cloud",
+    ),
+    _section(
+        "Switch band",
+        lambda page, ctx: _switch_band(page, ctx.ds),
+        when=lambda ctx: ctx.design == "ida",
+    ),
+    _section(
+        "Stripes and IDA side by side",
+        lambda page, ctx: _compare(page, ctx),
+        when=lambda ctx: ctx.compare is not None and _fits(ctx),
+    ),
+    ro.friction_check,
+    _section("Per-record breakdown", lambda page, ctx: _per_record(page, ctx.ds)),
+    _section(
+        "Self-similarity on records",
+        lambda page, ctx: _self_similarity(page, ctx.ds, ctx.edges, ctx.n_boot),
+        when=lambda ctx: ctx.edges is not None and _fits(ctx),
+    ),
+]
 
 
-def _risk_table(out) -> pd.DataFrame:
-    """The ranked table of :func:`~rockstudy.study.analysis.risk.object_risk`, as shown."""
-    unit, y = out.attrs["units"], f"{out.attrs['years']:g}"
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ends = out["deaggregation"].isel(interval=[0, -1]).sum("interval")
-        beyond = (ends / out["annual_rate"]).values
-    counts = zip(out["n_overturning"].values, out["n_records"].values, strict=True)
-    return pd.DataFrame(
-        {
-            "status": out["status"].values,
-            f"median [{unit}]": out["theta"].values,
-            "beta": out["beta"].values,
-            "records overturning": [f"{int(a)} of {int(b)}" for a, b in counts],
-            "lambda_OT [1/yr]": out["annual_rate"].values,
-            "lambda_OT, 5 %": out["annual_rate_lo"].values,
-            "lambda_OT, 95 %": out["annual_rate_hi"].values,
-            "return period [yr]": out["return_period"].values,
-            f"P({y} yr)": out["probability"].values,
-            f"P({y} yr), 5 %": out["probability_lo"].values,
-            f"P({y} yr), 95 %": out["probability_hi"].values,
-            "share beyond the curve's levels": beyond,
-            f"uplift [{unit}]": out["uplift"].values,
-            "share below uplift": out["share_below_uplift"].values,
-            "lambda_OT above uplift only [1/yr]": out["annual_rate_above_uplift"].values,
-            "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
-            "lambda_OT at least [1/yr]": out["rate_lower_bound"].values,
-        },
-        index=pd.Index([str(v) for v in out["structure"].values], name="object"),
-    )
-
-
-def _risk(page, ds, hazard, years):
-    """Per object: lambda_OT and P(``years``) with their 90 % bands by resampling records,
-    ranked, and the deaggregation figure (:func:`~rockstudy.study.analysis.risk.object_risk`)."""
-    from ..analysis.risk import object_risk
-
-    try:
-        out = object_risk(ds, hazard, years=years, n_boot=RISK_RESAMPLES)
-    except ValueError as err:
-        page.text(f"No annual rates: {err}")
-        return
-    page.text(
-        f"Hazard: {out.attrs['hazard']} from {out.attrs['hazard_source'] or 'the study'}. "
-        f"Each object's lognormal fragility in {im_label(hazard.im, hazard.period)} is "
-        "integrated against it (Cornell et al. 2002); the 90 % bands come from "
-        f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
-        "and integrated again. Status 'few': fewer than 5 records overturned the object; "
-        "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
-        "'all': it overturned at every point (stripes give a lower bound). 'share below "
-        "uplift' is the part of the rate from intensities at which the object cannot leave "
-        "rest: the lognormal's lower tail, not a simulated overturning."
-    )
-    page.table(
-        _risk_table(out),
-        "annual_overturning",
-        f"Annual rate of overturning and probability in {years:g} years per object, ranked "
-        "(highest first)",
-    )
-    _deaggregation_figure(page, out)
-
-
-def _deaggregation_figure(page, out):
-    """One line per object: the share of lambda_OT from each interval of the hazard's levels."""
-    fitted = np.isfinite(out["annual_rate"].values)
-    if not fitted.any():
-        page.text("No object has an annual rate: no deaggregation to show.")
-        return
-    plt = _plt()
-    lo, hi = out["im_lower"].values[1:-1], out["im_upper"].values[1:-1]
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    shown = np.flatnonzero(fitted)[:MAX_DEAGGREGATION_LINES]  # ranked: the highest rates
-    for j in shown:
-        share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
-        label = _mpl_text(str(out["structure"].values[j]))
-        line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label)[0]
-        if np.isfinite(out["uplift"].values[j]):
-            ax.axvline(out["uplift"].values[j], color=line.get_color(), ls=":", lw=1)
-    ax.set_xscale("log")
-    label = im_label(out.attrs["im"], out.attrs.get("period"))
-    ax.set_xlabel(f"{label}, interval centre", fontsize=10)
-    ax.set_ylabel("share of lambda_OT from the interval", fontsize=10)
-    ax.tick_params(labelsize=9)
-    _log_ticks(ax)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    page.figure(
-        fig,
-        "deaggregation",
-        "Deaggregation: the share of each object's annual rate of overturning that comes from "
-        "each interval between the hazard curve's levels (plotted at its geometric centre); "
-        "dotted: each object's uplift PGA g tan(alpha), below which it cannot leave rest (the "
-        "share of the rate from there is the lognormal's lower tail, not a simulated "
-        "overturning: column 'share below uplift'); the shares beyond the first and last "
-        "level are in the table"
-        + (
-            f"; the {shown.size} highest rates of {int(fitted.sum())} are drawn"
-            if fitted.sum() > shown.size
-            else ""
-        ),
-    )
-    frame = out["deaggregation"].to_pandas().T
-    edges = zip(out["im_lower"].values, out["im_upper"].values, strict=True)
-    frame.index = [f"{a:.4g}-{b:.4g}" for a, b in edges]
-    frame.to_csv(page.out / "deaggregation.csv")
-
-
-# ------------------------------------------------------------------------------ page
+def _compare(page, ctx):
+    ida, stripes = (ctx.ds, ctx.compare) if ctx.design == "ida" else (ctx.compare, ctx.ds)
+    by = "structure" if ctx.objects else None
+    _side_by_side(page, ida, stripes, ctx.edges, ctx.n_boot, by)
 
 
 def record_report(
@@ -709,10 +603,19 @@ def record_report(
     n_boot: int = 50,
     appendix=None,
     compare: xr.Dataset | None = None,
+    units: str = "g",
+    max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
+    friction=None,
+    study=None,
     hazard=None,
     years: float = 50.0,
 ) -> Path:
     """Write the report of a record design into the folder ``out``; return its index.html.
+
+    The page runs the sections of :data:`SECTIONS` in order. For named objects (the
+    ``structure`` coordinate holds names) it answers per object: fragility, capacity under
+    each record with the governing record, and the IDA curves or stripes of each object.
+    When nothing overturned (or nothing rocked) it says so in words and fits nothing.
 
     Parameters
     ----------
@@ -733,6 +636,19 @@ def record_report(
         The other of an IDA and a stripes design on the same records and structures: the
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
+    units : {"g", "m/s^2"}
+        Units of the accelerations of the per-object sections and warnings (a study's
+        ``scale_to.units``).
+    max_scale_factor : float
+        A warning box lists the stripe points or IDA capacities whose record is scaled by
+        more than this (> 1; a study's ``design.max_scale_factor``).
+    friction : float or array_like, optional
+        The friction coefficient mu (one, or one per structure): with ``friction_demand`` in
+        ``ds`` (``contact=True`` of the design functions, or a study's ``friction``) the page
+        counts the scenes whose demand exceeds it or that lift off, with a warning box.
+    study : rockstudy.study.spec.Study, optional
+        The study the dataset was run from, for the sections that read its settings
+        (``ReportContext.study``).
     hazard : rockstudy.risk.HazardCurve, optional
         The site's hazard curve: the page then ranks the objects by their annual rate of
         overturning, with the probability in ``years`` [yr] (default 50) and a deaggregation
@@ -741,40 +657,23 @@ def record_report(
     design = ds.attrs.get("design")
     if design not in DESIGNS:
         raise ValueError(f"ds: attrs['design'] must be one of {DESIGNS}, got {design!r}")
+    if units not in REPORT_UNITS:
+        raise ValueError(f"units: must be one of {list(REPORT_UNITS)}, got {units!r}")
+    if not (isinstance(max_scale_factor, (int, float)) and max_scale_factor > 1):
+        raise ValueError(f"max_scale_factor: must be a number > 1, got {max_scale_factor!r}")
+    if compare is not None and {design, compare.attrs.get("design")} != {"ida", "stripes"}:
+        kinds = {design, compare.attrs.get("design")}
+        raise ValueError(
+            f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
+        )
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     page = _Page(out)
-    edges = _sizes(ds)
-    page.heading("Summary")
-    _summary(page, ds)
-    page.heading("Records")
-    _record_list(page, ds)
-    page.heading("Fragility")
-    _fragility(page, ds, edges, n_boot)
-    if hazard is not None:
-        page.heading("Annual probability of overturning")
-        _risk(page, ds, hazard, years)
-    page.heading("Intensity-measure efficiency")
-    _efficiency(page, ds, n_boot)
-    page.heading({"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[design])
-    _responses(page, ds)
-    if design == "ida":
-        page.heading("Switch band")
-        _switch_band(page, ds)
-    if compare is not None:
-        kinds = {design, compare.attrs.get("design")}
-        if kinds != {"ida", "stripes"}:
-            raise ValueError(
-                f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
-            )
-        page.heading("Stripes and IDA side by side")
-        ida, stripes = (ds, compare) if design == "ida" else (compare, ds)
-        _side_by_side(page, ida, stripes, edges, n_boot)
-    page.heading("Per-record breakdown")
-    _per_record(page, ds)
-    if edges is not None:
-        page.heading("Self-similarity on records")
-        _self_similarity(page, ds, edges, n_boot)
+    ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
+    ctx.friction, ctx.im_label, ctx.study = friction, im_label, study
+    ctx.hazard, ctx.years = hazard, years
+    for section in SECTIONS:
+        section(page, ctx)
     if appendix is not None:
         appendix(page)
     meta = f"<p>{html.escape(description)}</p>" if description else ""

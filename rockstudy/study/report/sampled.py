@@ -575,6 +575,46 @@ def _version(versions) -> str:
     return str(value.get("rockstudy", "?")) if isinstance(value, dict) else "?"
 
 
+def _contact(page, ds, study):
+    """The scenes outside the block model (friction demand above mu, or lift-off)."""
+    mu = study.friction_coefficients()
+    if mu is None or "friction_demand" not in ds:
+        return
+    from ..analysis.contact import outside_model, summary_line
+
+    line = summary_line(ds, mu)
+    if line:
+        page.warning(line)
+    else:
+        page.text("No scene needs more friction than mu or lifts off: the block model holds.")
+    flags = outside_model(ds, mu)
+    page.table(
+        pd.DataFrame(
+            {
+                "scenes": [int(ds["friction_demand"].notnull().sum())],
+                "friction coefficient mu [-]": [float(mu[0])],
+                "largest friction demand |F_h / F_v| [-]": [
+                    float(ds["friction_demand"].where(np.isfinite(ds["friction_demand"])).max())
+                ],
+                "lift-offs": [int((ds["lift_off"] == 1).sum())],
+                "scenes outside the model": [int(flags.sum())],
+            },
+            index=pd.Index(["all"], name="scenes"),
+        ),
+        "friction_check",
+        "The contact check: the friction demand max |F_h / F_v| of each scene against mu",
+    )
+
+
+def _acceleration_units(study) -> str:
+    """The units of a record study's report accelerations: those of ``scale_to.units`` for
+    an acceleration target (g, else m/s^2), g otherwise."""
+    target = getattr(study.motion, "scale_to", None)
+    if target is None or target.im not in ("pga", "sa"):
+        return "g"
+    return "g" if target.unit_label == "g" else "m/s^2"
+
+
 def _laid_out(layout):
     """Whether a study's sampler has ``layout`` (a value of
     :data:`~rockstudy.study.spec.schema.SAMPLER_LAYOUTS`)."""
@@ -596,6 +636,11 @@ _SECTIONS = (
             SAMPLER_LAYOUTS[study.sampler.kind] != "grid" and study.motion.kind == "pulse"
         ),
         _fragility,
+    ),
+    (
+        "Friction and lift-off: where the block model stops",
+        lambda study, ds: study.friction_coefficients() is not None and "friction_demand" in ds,
+        _contact,
     ),
     (
         "Self-similarity",
@@ -634,6 +679,10 @@ def make_report(result, out=None, verify: bool = True) -> Path:
             appendix=study_section,
             hazard=None if hazard is None else hazard.curve(),
             years=50.0 if hazard is None else hazard.years,
+            units=_acceleration_units(study),
+            max_scale_factor=study.design.max_scale_factor,
+            friction=study.friction_coefficients(),
+            study=study,
         )
     study = analysis.study_of(ds)
     page = _Page(out)

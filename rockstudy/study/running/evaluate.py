@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from ...constants import G
+from ...dynamics.batch import CONTACT_OUTPUTS, simulate_batch
 from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
-from ...dynamics.batch import simulate_batch
 from ...motions import stochastic_record
 from ..designs import record_rows
 from ..spec.feasibility import record_path
@@ -38,6 +38,7 @@ OUTPUTS = {
         "i1",
         -1,
     ),
+    **record_rows.CONTACT_VARIABLES,
 }
 
 
@@ -51,7 +52,7 @@ def engine_outputs(study: Study) -> tuple:
     """The outputs of :func:`simulate_batch` that the study's outputs need (``auto`` runs the
     linear model only where no output outside its bound is asked for)."""
     names = {"max_rotation" if n == "max_rotation_ratio" else n for n in study.run.outputs}
-    return tuple(n for n in BATCH_OUTPUTS if n in names or n == "status")
+    return tuple(n for n in BATCH_OUTPUTS + CONTACT_OUTPUTS if n in names or n == "status")
 
 
 def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:

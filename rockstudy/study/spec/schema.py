@@ -197,6 +197,10 @@ class EquivalentBlockSpec(_Model):
 OBJECT_KINDS = ("block", "rocking_wall")
 
 
+#: Largest friction coefficient mu taken (a study's ``friction``; no contact needs more).
+MAX_FRICTION = 10.0
+
+
 class ObjectSpec(_Model):
     """One named object: a block (by ``width`` and ``height`` [m], or ``half_diagonal`` [m] and
     ``slenderness`` [rad]; restitution by default Housner's) or an out-of-plane rocking wall
@@ -209,6 +213,8 @@ class ObjectSpec(_Model):
     half_diagonal: float | None = None
     slenderness: float | None = None
     restitution: float | None = None
+    #: The friction coefficient mu of this object's contact (overrides the study's friction).
+    friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
 
     @model_validator(mode="after")
     def _shape(self):
@@ -726,7 +732,12 @@ Output = Literal[
     "first_impact_time",
     "steps",
     "model",
+    "friction_demand",
+    "lift_off",
 ]
+#: The outputs a study's ``friction`` adds (the contact check of
+#: :func:`rockstudy.simulate_batch`).
+CONTACT_OUTPUTS = ("friction_demand", "lift_off")
 
 
 #: Smallest relative tolerance taken: that of the solvers (:data:`rockstudy._validate.RTOL_MIN`,
@@ -849,6 +860,10 @@ class Study(_Model):
     design: DesignSpec | None = None
     hazard: HazardSpec | None = None
     run: RunSpec = RunSpec()
+    #: The friction coefficient mu of the contact (per object in an objects list): each scene
+    #: then stores ``friction_demand`` and ``lift_off``, and the scenes whose demand exceeds
+    #: mu (the block would slide) or that lift off are flagged, reported and warned about.
+    friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
     #: The study file's text as read (None for a study not read from text).
     _text: str | None = PrivateAttr(default=None)
     #: What will happen that the user should know before the run (not a problem): e.g. the
@@ -885,6 +900,32 @@ class Study(_Model):
             if isinstance(st, dict) and st.get("kind") == "objects":
                 return {**data, "sampler": {"kind": "grid"}}
         return data
+
+    @model_validator(mode="before")
+    @classmethod
+    def _contact_outputs(cls, data):
+        """A Monte Carlo study that gives ``friction`` stores the contact check of every scene
+        (``friction_demand`` and ``lift_off`` join ``run.outputs``)."""
+        if not (isinstance(data, dict) and data.get("friction") is not None):
+            return data
+        run = data.get("run", {})
+        if data.get("design") is not None or not isinstance(run, dict):
+            return data
+        outputs = run.get("outputs", RunSpec.model_fields["outputs"].default)
+        if not isinstance(outputs, list):
+            return data  # the schema names the problem
+        missing = [n for n in CONTACT_OUTPUTS if n not in outputs]
+        return {**data, "run": {**run, "outputs": list(outputs) + missing}}
+
+    def friction_coefficients(self) -> np.ndarray | None:
+        """The friction coefficient of each object (NaN where none is given), the study's
+        ``friction`` for sampled structures; None when no friction is given anywhere."""
+        st = self.structure
+        if st.kind == "objects":
+            mu = [self.friction if o.friction is None else o.friction for o in st.objects]
+            mu = np.array([np.nan if m is None else m for m in mu], float)
+            return None if np.isnan(mu).all() else mu
+        return None if self.friction is None else np.array([self.friction])
 
     @model_validator(mode="after")
     def _objects(self):

@@ -1,0 +1,542 @@
+"""The per-object sections of a record design's report (issue 24 section 2).
+
+For a design of named objects (``[structure] kind = "objects"``, or a dict ``{name:
+structure}`` given to a design function) the record report answers per object, by name: its
+fragility against PGA and against the measure the efficiency table recommends, with its uplift
+level marked; its capacity under each record with the governing (lowest) record; and its IDA
+curves or stripe points with the switch band. Each section is a function ``(page, ctx)`` of
+:data:`rockstudy.study.report_records.SECTIONS`; ``ctx`` is a
+:class:`rockstudy.study.report_records.ReportContext`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from ...constants import G
+from ..analysis import record_fragility as rf
+from ..analysis import record_similarity as rsim
+from ..analysis.sampled import fragility_curve
+from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
+from ._page import _log_ticks, _mpl_text, _names, _plt
+
+#: Font size of legends and tick labels of the per-object figures [pt] (print: >= 8).
+FONT = 8
+
+
+def _sizes(ds):
+    """Size-class edges [m] of the blocks, or None when they do not span three sizes."""
+    R = ds["half_diagonal"].values if "half_diagonal" in ds else np.zeros(0)
+    if not (R.size and np.all(np.isfinite(R)) and np.unique(R).size >= 3):
+        return None
+    return rsim.size_edges(ds, 3)
+
+
+def _structure_title(ds, j) -> str:
+    alpha = float(ds["slenderness"].values[j])
+    R = float(ds["half_diagonal"].values[j]) if "half_diagonal" in ds else np.nan
+    size = f"R = {R:.3g} m, " if np.isfinite(R) else ""
+    name = ds["structure"].values[j]
+    label = name if isinstance(name, str) else f"block {j}"
+    return f"{label}: {size}alpha = {alpha:.3g} rad"
+
+
+@dataclass
+class ReportContext:
+    """What every section of :data:`SECTIONS` reads: the design, the options of the report
+    and the answers several sections share (computed once)."""
+
+    ds: xr.Dataset
+    n_boot: int = 50
+    compare: xr.Dataset | None = None
+    units: str = "g"
+    max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR
+    friction: object = None
+    #: The one lookup of a measure's name and units (:func:`.report_records.im_label`).
+    im_label: Callable[..., str] | None = None
+    #: The study the dataset was run from (None for a design made in Python): sections that
+    #: read a study's settings (e.g. a ``[hazard]`` section) find them here.
+    study: object = None
+    #: The site's hazard curve (:class:`rockstudy.risk.HazardCurve`) and the years of the
+    #: probability of overturning, for the annual-rate section.
+    hazard: object = None
+    years: float = 50.0
+    _cache: dict = field(default_factory=dict)
+
+    @property
+    def design(self) -> str:
+        return self.ds.attrs["design"]
+
+    @property
+    def objects(self) -> bool:
+        """Named objects (the ``structure`` coordinate holds names), not sampled structures."""
+        return self.ds["structure"].dtype.kind in "OUS"
+
+    @property
+    def edges(self):
+        """Size-class edges of sampled structures (None for objects or too few sizes)."""
+        return None if self.objects else _sizes(self.ds)
+
+    @property
+    def overturned(self) -> bool:
+        """Whether any point of the design overturned."""
+        if self.design == "ida":
+            return bool((self.ds["censored"].values == 0).any())
+        return bool((self.ds["overturned"].values == 1).any())
+
+    @property
+    def rocked(self) -> bool:
+        """Whether any simulated point left rest."""
+        name = "step_max_rotation" if self.design == "ida" else "max_rotation"
+        return bool((np.nan_to_num(self.ds[name].values) > 0).any()) or self.overturned
+
+    def relabel(self, label: str) -> str:
+        """An :func:`im_label` in the report's acceleration units."""
+        return label.replace(" [g]", " [m/s^2]") if self.units == "m/s^2" else label
+
+    text = staticmethod(_mpl_text)  # a name from a file, as matplotlib text
+    log_ticks = staticmethod(_log_ticks)
+
+    def record_names(self) -> list[str]:
+        return _names(self.ds)
+
+    def structure_title(self, j) -> str:
+        return _structure_title(self.ds, j)
+
+    def stripe_label(self) -> str:
+        period = self.ds.attrs.get("im_period", np.nan)
+        return self.relabel(
+            self.im_label(self.ds.attrs.get("im", "pga"), period if np.isfinite(period) else None)
+        )
+
+    def recommended(self):
+        """(im, period) of the measure of smallest dispersion per power in the efficiency
+        table, or None when it cannot be made."""
+        if "recommended" not in self._cache:
+            try:
+                table = self.efficiency()
+                label = table.index[0][0]
+                name, _, rest = label.partition("(T=")
+                self._cache["recommended"] = (name, float(rest.rstrip(" s)")) if rest else None)
+            except (ValueError, IndexError):
+                self._cache["recommended"] = None
+        return self._cache["recommended"]
+
+    def efficiency(self):
+        if "efficiency" not in self._cache:
+            self._cache["efficiency"] = rf.im_efficiency(self.ds, n_boot=self.n_boot)
+        return self._cache["efficiency"]
+
+
+def _section(heading, function, when=None):
+    """A section of :data:`SECTIONS`: ``heading`` (text, or a callable of the context),
+    then ``function(page, ctx)``; skipped where ``when(ctx)`` is False."""
+
+    def run(page, ctx):
+        if when is not None and not when(ctx):
+            return
+        page.heading(heading(ctx) if callable(heading) else heading)
+        function(page, ctx)
+
+    run.__name__ = getattr(function, "__name__", "section")
+    return run
+
+
+def _fits(ctx) -> bool:
+    return ctx.overturned
+
+
+def outcome(page, ctx):
+    """In words, when nothing rocked or nothing overturned (no fragility can be fitted)."""
+    if ctx.overturned:
+        return
+    up = ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+    if not ctx.rocked:
+        page.warning(
+            "Nothing rocked: no structure left rest under any record at any level. Every "
+            "level lies below the uplift level of every structure (g tan alpha, from "
+            f"{np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}); no fragility can be "
+            "fitted. Raise the levels (check the units of scale_to.value)."
+        )
+    else:
+        page.warning(
+            "Nothing overturned: every structure stood under every record at every level "
+            "simulated, so no fragility can be fitted; the tables below give how far the "
+            "structures rocked. Raise the levels to see overturning."
+        )
+
+
+def scale_factors(page, ctx):
+    """A warning box where records are scaled beyond ``max_scale_factor``."""
+    if ctx.design == "cloud":
+        return
+    scale = ctx.ds["scale" if ctx.design == "stripes" else "capacity_scale"].values
+    limit = ctx.max_scale_factor
+    beyond = np.abs(np.nan_to_num(scale)) > limit
+    if not beyond.any():
+        return
+    names = ctx.record_names()
+    worst = np.unravel_index(int(np.nanargmax(np.abs(scale))), scale.shape)
+    what = "stripe points" if ctx.design == "stripes" else "capacities (first overturnings)"
+    page.warning(
+        f"{int(beyond.sum())} of {scale.size} {what} scale a record by more than "
+        f"max_scale_factor = {limit:g} (largest {float(np.nanmax(np.abs(scale))):.3g} x, record "
+        f"{names[worst[0]]}): a record scaled far from what it recorded has the shape of a "
+        "weaker or stronger earthquake it is not; prefer records closer to the level."
+    )
+
+
+def _label(ctx, im, period=None):
+    return ctx.relabel(ctx.im_label(im, period))
+
+
+def _accel_factor(ctx, im) -> float:
+    """The factor from a fit's quoted units of ``im`` to the report's (g -> m/s^2)."""
+    return G if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
+
+
+def _object_fit(ctx, im, period):
+    """The fragility of each object against ``im`` (rows by name), in the report's units."""
+    fit = rf.ida_fragility if ctx.design == "ida" else rf.stripe_fragility
+    table = fit(ctx.ds, im=im, period=period, by="structure", n_boot=ctx.n_boot)
+    f = _accel_factor(ctx, im)
+    for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
+        table[col] = table[col] * f
+    table.index.name = "object"
+    return table
+
+
+def _uplift(ctx, im) -> np.ndarray | None:
+    """Each object's uplift level in ``im`` (g tan theta_cr of its equivalent block; 1 in
+    PGA / (g tan alpha)), or None where a measure has no single uplift level."""
+    if im == "pga":
+        return ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+    if im == "pga_ratio":
+        return np.ones(ctx.ds.sizes["structure"])
+    return None
+
+
+def object_fragility(page, ctx):
+    """Per object: the lognormal fragility against PGA and the recommended measure."""
+    if not ctx.objects or not ctx.overturned:
+        return
+    page.heading("Fragility of each object")
+    measures = [("pga", None)]
+    best = ctx.recommended()
+    if best is not None and best != ("pga", None):
+        measures.append(best)
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(measures), figsize=(5.2 * len(measures), 4.2), squeeze=False)
+    tables = []
+    for ax, (im, period) in zip(axes[0], measures, strict=True):
+        try:
+            t = _object_fit(ctx, im, period)
+        except ValueError as err:
+            page.text(f"Fragility of the objects against {_label(ctx, im, period)}: {err}")
+            ax.set_visible(False)
+            continue
+        if not _plot_objects(ax, ctx, t, im, period):
+            page.text(
+                f"Fragility of the objects against {_label(ctx, im, period)}: no object's fit "
+                f"is defined (records per object: {int(t['n'].max())}; a lognormal fit needs "
+                "at least two distinct capacities or outcomes)"
+            )
+            ax.set_visible(False)
+            continue
+        t.insert(0, "intensity", _label(ctx, im, period))
+        tables.append(t)
+    if not tables:
+        plt.close(fig)
+        return
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "object_fragility",
+        "Fragility of each object (lognormal fit, 90 % pointwise band) against PGA and "
+        "against the measure the efficiency table recommends; dotted vertical lines: each "
+        "object's uplift level (g tan alpha of the block or of the equivalent block of a "
+        "wall, frame or arch), drawn where the measure has one (PGA, PGA / (g tan alpha))",
+    )
+    table = pd.concat(tables)
+    cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
+    shown = table[cols].rename(
+        columns={
+            "theta": "median capacity",
+            "theta_lo": "median, lower",
+            "theta_hi": "median, upper",
+            "beta": "beta (MLE)",
+            "n": "records",
+            "theta_in_range": "median within the data",
+        }
+    )
+    up = _uplift(ctx, "pga")
+    names = list(map(str, ctx.ds["structure"].values))
+    shown.insert(1, f"uplift level, PGA [{ctx.units}]", [up[names.index(n)] for n in table.index])
+    page.table(shown, "object_fragility", "Fragility of each object, by name (90 % bands)")
+
+
+def _plot_objects(ax, ctx, t, im, period) -> bool:
+    """Each object's fitted curve and band on ``ax``; False (nothing drawn) when no fit is
+    defined."""
+    low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
+    up = _uplift(ctx, im)
+    names = list(map(str, ctx.ds["structure"].values))
+    if up is not None:
+        low = min(low, np.nanmin(up))
+    if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
+        return False
+    grid = np.geomspace(low / 1.2, high * 1.2, 200)
+    curve = fragility_curve(t, grid)
+    drawn = 0
+    for g in curve.group.values:
+        c = curve.sel(group=g)
+        if not np.isfinite(c.probability.values).any():
+            continue
+        drawn += 1
+        (line,) = ax.plot(grid, c.probability, "-", label=ctx.text(str(g)))
+        ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
+        if up is not None:
+            ax.axvline(up[names.index(str(g))], ls=":", lw=1.5, color=line.get_color())
+    if not drawn:
+        return False
+    ax.set(xscale="log", ylim=(-0.02, 1.02), ylabel="probability of overturning [-]")
+    ax.set_xlabel(_label(ctx, im, period), fontsize=FONT + 1)
+    ctx.log_ticks(ax)
+    ax.tick_params(labelsize=FONT)
+    ax.legend(fontsize=FONT, loc="upper left")
+    return True
+
+
+# ------------------------------------------------------------------------------ capacity
+
+
+def _ida_capacity(ctx):
+    """(cells, values): the PGA at first overturning of each object (rows) under each record
+    (columns); censored: 'above' the highest scale seen to stand."""
+    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    pga = ds["pga"].values[:, None] * f
+    cap = ds["capacity_scale"].values * pga
+    value = np.where(ds["censored"].values == 1, np.nan, cap).T
+    lower = (ds["capacity_scale_lower"].values * pga).T
+    cells = np.empty(value.shape, object)  # numbers, or text where censored
+    for k, v in np.ndenumerate(value):
+        cells[k] = float(v) if np.isfinite(v) else f"above {lower[k]:.3g}"
+    return cells, value
+
+
+def _stripe_capacity(ctx):
+    """(cells, values): the bracket of levels in which each object first overturned under
+    each record (the lowest overturning level, in the stripes' measure)."""
+    ds = ctx.ds
+    im = ds.attrs.get("im", "pga")
+    levels = ds["level"].values * (1.0 / G if im in ("pga", "sa") and ctx.units == "g" else 1.0)
+    over = ds["overturned"].values == 1  # (record, structure, level)
+    first = np.where(over.any(-1), over.argmax(-1), -1).T
+    cells = np.empty(first.shape, object)
+    for (j, i), k in np.ndenumerate(first):
+        if k < 0:
+            cells[j, i] = f"above {levels[-1]:.3g}"
+        elif k == 0:
+            cells[j, i] = f"at or below {levels[0]:.3g}"
+        else:
+            cells[j, i] = f"{levels[k - 1]:.3g} to {levels[k]:.3g}"
+    return cells, np.where(first >= 0, levels[np.maximum(first, 0)], np.nan)
+
+
+def _cloud_capacity(ctx):
+    """(cells, values): under the unscaled records, whether each object overturned."""
+    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    over = (ds["overturned"].values == 1).T
+    pga = np.broadcast_to(ds["pga"].values * f, over.shape)
+    cells = np.where(over, "overturned", "stands").astype(object)
+    return cells, np.where(over, pga, np.nan)
+
+
+def object_capacity(page, ctx):
+    """A table: the capacity of each object under each record, with the governing record."""
+    if not ctx.objects:
+        return
+    page.heading("Capacity of each object under each record")
+    how = {"ida": _ida_capacity, "stripes": _stripe_capacity, "cloud": _cloud_capacity}
+    cells, values = how[ctx.design](ctx)
+    records = ctx.record_names()
+    table = pd.DataFrame(cells, index=list(map(str, ctx.ds["structure"].values)), columns=records)
+    table.index.name = "object"
+    govern = [  # every record at the lowest capacity (stripes often tie)
+        (", ".join(records[k] for k in np.flatnonzero(v == np.nanmin(v))), float(np.nanmin(v)))
+        if np.isfinite(v).any()
+        else ("", np.nan)
+        for v in values
+    ]
+    table["governing record(s) (lowest capacity)"] = [g for g, _ in govern]
+    table["governing capacity"] = [v for _, v in govern]
+    what = {
+        "ida": f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
+        "(the IDA capacity; 'above': censored, standing at the highest scale reached)",
+        "stripes": f"the stripe levels, {ctx.stripe_label()}, between which the object first "
+        "overturned (the highest level below that it stood at, the lowest it overturned at)",
+        "cloud": f"whether the object overturned under the unscaled record (the governing "
+        f"capacity: the lowest PGA [{ctx.units}] of a record that overturned it)",
+    }[ctx.design]
+    page.table(table, "object_capacity", f"Capacity of each object under each record: {what}")
+    if not np.isfinite(values).any():
+        page.text("No object overturned under any record: no record governs.")
+
+
+# ------------------------------------------------------------------------------ curves
+
+
+def _panels(n):
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    plt = _plt()
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.9 * rows), squeeze=False)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    return fig, axes.ravel()[:n]
+
+
+def _ida_curve(ax, ctx, i, j, offset):
+    """Record i's IDA curve of object j: its simulated points in increasing scale, its
+    first overturning (cross) and the switch band above it (shaded)."""
+    ds = ctx.ds
+    pga = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    alpha = float(ds["slenderness"].values[j])
+    s = ds["step_scale"].values[i, j]
+    ok = np.isfinite(s)
+    order = np.argsort(s[ok], kind="stable")
+    s = s[ok][order]
+    over = ds["step_overturned"].values[i, j][ok][order] == 1
+    x = np.where(over, 1.0, np.minimum(ds["step_max_rotation"].values[i, j][ok][order] / alpha, 1))
+    cap = ds["capacity_scale"].values[i, j]
+    upto = ~(s > cap)
+    name = ctx.text(ctx.record_names()[i])
+    (line,) = ax.plot(x[upto], s[upto] * pga, "-", lw=1.2, label=name)
+    color = line.get_color()
+    ax.plot(x[over] + offset, s[over] * pga, "x", color=color, ms=5, mew=1.2)
+    above = (s > cap) & ~over
+    ax.plot(x[above] + offset, s[above] * pga, "o", mfc="none", color=color, ms=5)
+    top = ds["highest_survival_scale"].values[i, j]
+    if np.isfinite(top) and np.isfinite(cap):
+        ax.axhspan(cap * pga, top * pga, color=color, alpha=0.12, lw=0)
+
+
+def object_curves(page, ctx):
+    """Per object: the IDA curves (or the stripe points) of every record, in order of scale."""
+    if not ctx.objects or ctx.design == "cloud":
+        return
+    page.heading("IDA curves of each object" if ctx.design == "ida" else "Stripes of each object")
+    names = list(map(str, ctx.ds["structure"].values))
+    records = ctx.record_names()
+    fig, axes = _panels(len(names))
+    spread = 0.015 * (np.arange(len(records)) - (len(records) - 1) / 2)
+    uplift = _uplift(ctx, "pga")
+    for j, ax in enumerate(axes):
+        for i in range(len(records)):
+            if ctx.design == "ida":
+                _ida_curve(ax, ctx, i, j, spread[i])
+            else:
+                _stripe_points(ax, ctx, i, j, spread[i])
+        ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
+        ax.set_yscale("log")
+        ax.set_xlim(-0.04, 1.08)
+        ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
+        ax.set_xlabel("peak rotation / slenderness, theta_max / alpha [-]", fontsize=FONT + 1)
+        ax.set_ylabel(f"PGA of the scaled record [{ctx.units}]", fontsize=FONT + 1)
+        ctx.log_ticks(ax, "y")
+        ax.tick_params(labelsize=FONT)
+    _shared_legend(fig, axes[0], len(records))
+    page.figure(
+        fig,
+        f"object_{ctx.design}",
+        "Every object under every record: "
+        + (
+            "the IDA curves, each record's simulated scales in increasing order up to the "
+            "first overturning (cross, drawn at theta_max / alpha = 1); shaded: the switch "
+            "band from the first overturning to the highest scale at which the object was "
+            "seen to stand (open circles)"
+            if ctx.design == "ida"
+            else "the stripe points (open circles: stood; crosses: overturned, drawn at "
+            "theta_max / alpha = 1)"
+        )
+        + "; dotted: the object's uplift level g tan alpha; markers of the records are offset "
+        "slightly in x so that none hides another",
+    )
+
+
+def _shared_legend(fig, ax, n):
+    """One legend of the records below the panels (none hides a curve), then the layout."""
+    cols = min(n, 4)
+    height = 0.22 * -(-n // cols) + 0.1  # [in]
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=cols, fontsize=FONT)
+    fig.tight_layout(rect=(0, height / fig.get_figheight(), 1, 1))
+
+
+def _stripe_points(ax, ctx, i, j, offset):
+    ds = ctx.ds
+    y = ds["scale"].values[i, j] * ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    x = ds["max_rotation"].values[i, j] / float(ds["slenderness"].values[j])
+    over = ds["overturned"].values[i, j] == 1
+    x = np.where(over, 1.0, np.minimum(x, 1.0)) + offset
+    order = np.argsort(y)
+    name = ctx.text(ctx.record_names()[i])
+    (line,) = ax.plot(x[order], y[order], "-", lw=0.8, alpha=0.6, label=name)
+    ax.plot(x[~over], y[~over], "o", mfc="none", color=line.get_color(), ms=5)
+    ax.plot(x[over], y[over], "x", color=line.get_color(), ms=6, mew=1.2)
+
+
+# ------------------------------------------------------------------------------ friction
+
+
+def friction_check(page, ctx):
+    """Per object (or per record for sampled structures): the scenes whose friction demand
+    exceeds the friction coefficient or that lift off, with a warning box."""
+    ds = ctx.ds
+    if "friction_demand" not in ds:
+        return
+    page.heading("Friction and lift-off: where the block model stops")
+    demand = ds["friction_demand"]
+    finite = demand.where(np.isfinite(demand))
+    lift = ds["lift_off"] == 1
+    by = ("structure", "record") if ctx.objects else ("record",)
+    rest = [d for d in demand.dims if d not in by]
+    table = {
+        "scenes": demand.notnull().sum(rest).astype(int),
+        "largest finite friction demand |F_h / F_v| [-]": finite.max(rest),
+        "lift-offs": lift.sum(rest).astype(int),
+    }
+    flags = None
+    if ctx.friction is not None:
+        from ..analysis.contact import friction_array, outside_model
+
+        flags = outside_model(ds, ctx.friction)
+        table["friction coefficient mu [-]"] = (
+            friction_array(ds, ctx.friction).broadcast_like(demand).max(rest)
+        )
+        table["scenes outside the model (demand > mu or lift-off)"] = flags.sum(rest).astype(int)
+    frame = xr.Dataset(table).to_dataframe(dim_order=list(by))[list(table)]
+    names = ctx.record_names()
+    if ctx.objects:
+        frame.index = [f"{o} / {names[int(r)]}" for o, r in frame.index]
+    else:
+        frame.index = [names[int(r)] for r in frame.index]
+    frame.index.name = "object / record" if ctx.objects else "record"
+    if flags is not None and bool(flags.any()):
+        from ..analysis.contact import summary_line
+
+        page.warning(summary_line(ds, ctx.friction))
+    elif flags is not None:
+        page.text("No scene needs more friction than mu or lifts off: the block model holds.")
+    design = {"ida": " (IDA: at the highest scale below the first overturning)"}
+    page.table(
+        frame,
+        "friction_check",
+        "The contact check of each scene: the friction demand max |F_h / F_v| (below uplift "
+        "it is max |a_g| / g), the lift-offs and the scenes outside the rocking-block model"
+        + design.get(ctx.design, ""),
+    )

@@ -1,0 +1,133 @@
+"""The record report's annual-rate section: each named object's annual rate of overturning at
+the site of a hazard curve, its probability in N years with a band by resampling the records,
+ranked, and the deaggregation of the rate over the hazard's levels
+(:func:`~rockstudy.study.analysis.risk.object_risk`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..analysis.risk import object_risk
+from ._page import _log_ticks, _mpl_text, _plt
+
+
+def section(page, ctx):
+    """The annual probability of overturning of each object, when the report has a hazard."""
+    if ctx.hazard is None:
+        return
+    page.heading("Annual probability of overturning")
+    _risk(page, ctx.ds, ctx.hazard, ctx.years, ctx.im_label)
+
+
+#: Resamples of the records for the bands of the annual rates (:func:`_risk`).
+RISK_RESAMPLES = 200
+#: Most objects drawn in the deaggregation figure (the highest rates; all are in its CSV).
+MAX_DEAGGREGATION_LINES = 10
+
+
+def _risk_table(out) -> pd.DataFrame:
+    """The ranked table of :func:`~rockstudy.study.analysis.risk.object_risk`, as shown."""
+    unit, y = out.attrs["units"], f"{out.attrs['years']:g}"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = out["deaggregation"].isel(interval=[0, -1]).sum("interval")
+        beyond = (ends / out["annual_rate"]).values
+    counts = zip(out["n_overturning"].values, out["n_records"].values, strict=True)
+    return pd.DataFrame(
+        {
+            "status": out["status"].values,
+            f"median [{unit}]": out["theta"].values,
+            "beta": out["beta"].values,
+            "records overturning": [f"{int(a)} of {int(b)}" for a, b in counts],
+            "lambda_OT [1/yr]": out["annual_rate"].values,
+            "lambda_OT, 5 %": out["annual_rate_lo"].values,
+            "lambda_OT, 95 %": out["annual_rate_hi"].values,
+            "return period [yr]": out["return_period"].values,
+            f"P({y} yr)": out["probability"].values,
+            f"P({y} yr), 5 %": out["probability_lo"].values,
+            f"P({y} yr), 95 %": out["probability_hi"].values,
+            "share beyond the curve's levels": beyond,
+            f"uplift [{unit}]": out["uplift"].values,
+            "share below uplift": out["share_below_uplift"].values,
+            "lambda_OT above uplift only [1/yr]": out["annual_rate_above_uplift"].values,
+            "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
+            "lambda_OT at least [1/yr]": out["rate_lower_bound"].values,
+        },
+        index=pd.Index([str(v) for v in out["structure"].values], name="object"),
+    )
+
+
+def _risk(page, ds, hazard, years, im_label):
+    """Per object: lambda_OT and P(``years``) with their 90 % bands by resampling records,
+    ranked, and the deaggregation figure (:func:`~rockstudy.study.analysis.risk.object_risk`)."""
+    try:
+        out = object_risk(ds, hazard, years=years, n_boot=RISK_RESAMPLES)
+    except ValueError as err:
+        page.text(f"No annual rates: {err}")
+        return
+    page.text(
+        f"Hazard: {out.attrs['hazard']} from {out.attrs['hazard_source'] or 'the study'}. "
+        f"Each object's lognormal fragility in {im_label(hazard.im, hazard.period)} is "
+        "integrated against it (Cornell et al. 2002); the 90 % bands come from "
+        f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
+        "and integrated again. Status 'few': fewer than 5 records overturned the object; "
+        "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
+        "'all': it overturned at every point (stripes give a lower bound). 'share below "
+        "uplift' is the part of the rate from intensities at which the object cannot leave "
+        "rest: the lognormal's lower tail, not a simulated overturning."
+    )
+    page.table(
+        _risk_table(out),
+        "annual_overturning",
+        f"Annual rate of overturning and probability in {years:g} years per object, ranked "
+        "(highest first)",
+    )
+    _deaggregation_figure(page, out, im_label)
+
+
+def _deaggregation_figure(page, out, im_label):
+    """One line per object: the share of lambda_OT from each interval of the hazard's levels."""
+    fitted = np.isfinite(out["annual_rate"].values)
+    if not fitted.any():
+        page.text("No object has an annual rate: no deaggregation to show.")
+        return
+    plt = _plt()
+    lo, hi = out["im_lower"].values[1:-1], out["im_upper"].values[1:-1]
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    shown = np.flatnonzero(fitted)[:MAX_DEAGGREGATION_LINES]  # ranked: the highest rates
+    for j in shown:
+        share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
+        label = _mpl_text(str(out["structure"].values[j]))
+        line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label)[0]
+        if np.isfinite(out["uplift"].values[j]):
+            ax.axvline(out["uplift"].values[j], color=line.get_color(), ls=":", lw=1)
+    ax.set_xscale("log")
+    label = im_label(out.attrs["im"], out.attrs.get("period"))
+    ax.set_xlabel(f"{label}, interval centre", fontsize=10)
+    ax.set_ylabel("share of lambda_OT from the interval", fontsize=10)
+    ax.tick_params(labelsize=9)
+    _log_ticks(ax)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "deaggregation",
+        "Deaggregation: the share of each object's annual rate of overturning that comes from "
+        "each interval between the hazard curve's levels (plotted at its geometric centre); "
+        "dotted: each object's uplift PGA g tan(alpha), below which it cannot leave rest (the "
+        "share of the rate from there is the lognormal's lower tail, not a simulated "
+        "overturning: column 'share below uplift'); the shares beyond the first and last "
+        "level are in the table"
+        + (
+            f"; the {shown.size} highest rates of {int(fitted.sum())} are drawn"
+            if fitted.sum() > shown.size
+            else ""
+        ),
+    )
+    frame = out["deaggregation"].to_pandas().T
+    edges = zip(out["im_lower"].values, out["im_upper"].values, strict=True)
+    frame.index = [f"{a:.4g}-{b:.4g}" for a, b in edges]
+    frame.to_csv(page.out / "deaggregation.csv")
+
+
+# ------------------------------------------------------------------------------ page

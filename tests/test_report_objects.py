@@ -1,0 +1,297 @@
+"""The record report of named objects (issue 24 section 2): per object, by name. Oracles:
+single-scene simulations of each object under each scaled record (which record governs and
+between which levels each object first overturns), the objects' own uplift level g tan(alpha),
+and the records' own PGA (the scale factors beyond ``max_scale_factor``)."""
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import rockstudy as rs
+from rockstudy.constants import STANDARD_GRAVITY, G
+from rockstudy.motions import load_suite
+from rockstudy.study.designs.records import multiple_stripes
+from rockstudy.study.report.records import record_report
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "records"
+OBJECTS = {
+    "Statue A": rs.Block.from_dimensions(width=0.45, height=1.9),
+    "Vase": rs.Block(half_diagonal=0.4, slenderness=0.3, restitution=0.85),
+}
+
+
+@pytest.fixture(scope="module")
+def records():
+    return load_suite([DATA / "NF03_Tp0.80s_H.AT2", DATA / "NF06_Tp1.70s_H.AT2"])
+
+
+def _text(page):
+    return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.read_text()))
+
+
+def test_capacity_table_and_governing_record_per_object(tmp_path, records):
+    levels = np.array([0.2, 0.4, 0.8, 1.6]) * G
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
+    page = record_report(ds, tmp_path / "r", n_boot=5)
+    table = pd.read_csv(tmp_path / "r" / "object_capacity.csv", index_col=0)
+    assert list(table.index) == list(OBJECTS)
+    names = [r.name for r in records]
+    for obj, block in OBJECTS.items():
+        first = {}  # the oracle: each scaled record alone, level by level
+        for rec in records:
+            over = [rs.simulate(block, rec.scaled(x / rec.peak)).overturned for x in levels]
+            first[rec.name] = levels[over.index(True)] / G if any(over) else np.inf
+            k = over.index(True) if any(over) else -1
+            cell = table.loc[obj, rec.name]
+            if k < 0:
+                assert cell == f"above {levels[-1] / G:.3g}"
+            elif k == 0:
+                assert cell == f"at or below {levels[0] / G:.3g}"
+            else:
+                assert cell == f"{levels[k - 1] / G:.3g} to {levels[k] / G:.3g}"
+        lowest = min(first.values())
+        governing = table.loc[obj, "governing record(s) (lowest capacity)"]
+        if np.isfinite(lowest):
+            assert governing.split(", ") == [n for n in names if first[n] == lowest]
+            assert table.loc[obj, "governing capacity"] == pytest.approx(lowest, rel=1e-9)
+    # the per-object figures and the uplift level g tan(alpha) of each object
+    out = tmp_path / "r"
+    assert (out / "object_stripes.png").exists()
+    if (out / "object_fragility.csv").exists():
+        fit = pd.read_csv(out / "object_fragility.csv", index_col=0)
+        for obj, block in OBJECTS.items():
+            up = fit.loc[[obj], "uplift level, PGA [g]"].iloc[0]
+            assert up == pytest.approx(math.tan(block.slenderness), rel=1e-9)
+    assert "Nothing overturned" not in _text(page)
+
+
+def test_nothing_rocked_is_said_in_words(tmp_path, records):
+    # every level below the uplift level g tan(alpha) of every object: nothing can rock
+    lowest_uplift = min(G * math.tan(b.slenderness) for b in OBJECTS.values())
+    levels = np.array([0.2, 0.5]) * lowest_uplift
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
+    assert float(np.nanmax(ds["max_rotation"].values)) == 0.0  # the oracle agrees
+    page = record_report(ds, tmp_path / "r", n_boot=5)
+    text = _text(page)
+    assert "Nothing rocked" in text and "no fragility can be fitted" in text
+    assert not (tmp_path / "r" / "object_fragility.png").exists()
+    table = pd.read_csv(tmp_path / "r" / "object_capacity.csv", index_col=0)
+    assert (table.iloc[:, : len(records)] == f"above {levels[-1] / G:.3g}").all().all()
+
+
+def test_nothing_overturned_but_rocked(tmp_path, records):
+    # between uplift and overturning of the stockier Vase only: it rocks, none overturns
+    vase = OBJECTS["Vase"]
+    levels = np.array([1.05]) * G * math.tan(vase.slenderness)
+    ds = multiple_stripes(records, {"Vase": vase}, levels, rtol=1e-6)
+    if ds["overturned"].values.any() or not (ds["max_rotation"].values > 0).any():
+        pytest.skip("the level did not give rocking without overturning")
+    text = _text(record_report(ds, tmp_path / "r", n_boot=5))
+    assert "Nothing overturned" in text and "Nothing rocked" not in text
+
+
+def test_scale_factor_warning_and_units(tmp_path, records):
+    levels = np.array([0.5, 3.0]) * G
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
+    page = record_report(ds, tmp_path / "r", n_boot=5, units="m/s^2", max_scale_factor=5)
+    text = _text(page)
+    factors = np.array([[x / r.peak for x in levels] for r in records])  # the records' PGA
+    beyond = int((factors > 5).sum()) * len(OBJECTS)
+    if beyond:
+        assert f"{beyond} of {factors.size * len(OBJECTS)} stripe points" in text
+        assert "max_scale_factor = 5" in text
+    else:
+        assert "max_scale_factor" not in text
+    assert "[m/s^2]" in text and "PGA [g]" not in text.split("Records")[0]
+    quiet = record_report(ds, tmp_path / "q", n_boot=5, max_scale_factor=1e6)
+    assert "max_scale_factor" not in _text(quiet)
+    with pytest.raises(ValueError, match="units"):
+        record_report(ds, tmp_path / "bad", units="gee")
+    with pytest.raises(ValueError, match="max_scale_factor"):
+        record_report(ds, tmp_path / "bad", max_scale_factor=0.5)
+
+
+# ------------------------------------------------------------------------------ friction
+
+
+def test_friction_below_uplift_is_the_peak_ground_acceleration_and_flags(tmp_path, records):
+    """Below uplift the block moves with the ground: its friction demand is max |a_g| / g,
+    here the stripe level / g; a level whose demand exceeds mu is flagged, the others not."""
+    lowest_uplift = min(G * math.tan(b.slenderness) for b in OBJECTS.values())
+    levels = np.array([0.3, 0.6, 0.9]) * lowest_uplift
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6, contact=True)
+    expect = np.broadcast_to(levels / G, ds["friction_demand"].shape)
+    np.testing.assert_allclose(ds["friction_demand"].values, expect, rtol=1e-9)
+    assert not ds["lift_off"].values.any()
+    mu = 0.5 * (levels[1] + levels[2]) / G  # between the second and the third level
+    page = record_report(ds, tmp_path / "r", n_boot=5, friction=mu)
+    text = _text(page)
+    n_flag = len(records) * len(OBJECTS)  # the third level, every record and object
+    assert f"{n_flag} of {ds['friction_demand'].size} scenes lie outside" in text
+    table = pd.read_csv(tmp_path / "r" / "friction_check.csv", index_col=0)
+    assert (table["scenes outside the model (demand > mu or lift-off)"] == 1).all()
+    assert set(table.index) == {f"{o} / {r.name}" for o in OBJECTS for r in records}
+    # per object: the Vase alone given a friction above every demand
+    per_object = [mu, 1.0]
+    text = _text(record_report(ds, tmp_path / "p", n_boot=5, friction=per_object))
+    assert f"{len(records)} of {ds['friction_demand'].size} scenes lie outside" in text
+    text = _text(record_report(ds, tmp_path / "q", n_boot=5, friction=1.0))
+    assert "the block model holds" in text and "lie outside" not in text
+    for bad in (-0.2, [0.3, 0.4, 0.5], np.nan):
+        with pytest.raises(ValueError, match="friction"):
+            record_report(ds, tmp_path / "bad", n_boot=5, friction=bad)
+
+
+import test_record_studies  # noqa: E402
+
+from rockstudy.study import load_study, run_study  # noqa: E402
+from rockstudy.study.report import make_report  # noqa: E402
+from rockstudy.study.running.store import open_result  # noqa: E402
+
+client = test_record_studies.client  # the one-worker cluster fixture
+
+FRICTION_STUDY = """
+name = "museum friction"
+seed = 1
+friction = 0.6
+[structure]
+kind = "objects"
+objects = [
+  {{ name = "Statue A", width = 0.45, height = 1.9, friction = 0.07 }},
+  {{ name = "Vase", half_diagonal = 0.4, slenderness = 0.3, restitution = 0.85 }},
+]
+[motion]
+kind = "record"
+files = ["{a}", "{b}"]
+scale_to = {{ im = "pga", units = "g", value = {{ dist = "grid", values = [0.05, 0.1] }} }}
+[design]
+kind = "stripes"
+"""
+
+
+def test_friction_in_an_objects_study_cube_report_and_run_warning(client, tmp_path, capsys):
+    """Levels below the uplift of both objects: each scene's demand is its level in g (the
+    oracle); Statue A's mu 0.07 lies between the levels, the Vase's (the study's 0.6) above."""
+    a, b = DATA / "NF03_Tp0.80s_H.AT2", DATA / "NF06_Tp1.70s_H.AT2"
+    path = tmp_path / "museum.toml"
+    path.write_text(FRICTION_STUDY.format(a=a, b=b))
+    study = load_study(path)
+    np.testing.assert_array_equal(study.friction_coefficients(), [0.07, 0.6])
+    out = tmp_path / "cube.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    levels_g = np.array([0.05, 0.1]) * STANDARD_GRAVITY / G  # "g" of units: 9.80665 m/s^2
+    demand = cube["friction_demand"].transpose("record", "structure", "level").values
+    np.testing.assert_allclose(demand, np.broadcast_to(levels_g, demand.shape), rtol=1e-9)
+    text = _text(make_report(out, tmp_path / "report"))
+    assert "2 of 8 scenes lie outside" in text  # Statue A at 0.1 g under both records
+    table = pd.read_csv(tmp_path / "report" / "friction_check.csv", index_col=0)
+    flagged = table["scenes outside the model (demand > mu or lift-off)"]
+    assert flagged.filter(like="Statue A").tolist() == [1, 1]
+    assert flagged.filter(like="Vase").tolist() == [0, 0]
+    from rockstudy.cli import _contact_warning
+
+    _contact_warning(study, out)
+    assert "warning: 2 of 8 scenes lie outside" in capsys.readouterr().err
+
+
+def test_friction_in_a_monte_carlo_study(client, tmp_path):
+    """A Monte Carlo pulse study with friction stores the contact check: below uplift (the
+    pulse amplitude a fraction of g tan alpha) the demand is a_g / g."""
+    text = """
+name = "mc friction"
+seed = 3
+friction = 0.15
+[sampler]
+kind = "monte_carlo"
+n = 16
+[structure]
+kind = "block"
+half_diagonal = { dist = "uniform", low = 0.5, high = 2.0 }
+slenderness = { dist = "uniform", low = 0.2, high = 0.3 }
+[motion]
+kind = "pulse"
+shape = "sine"
+amplitude_ratio = { dist = "uniform", low = 0.2, high = 0.9 }
+period = { dist = "uniform", low = 0.3, high = 1.0 }
+"""
+    path = tmp_path / "mc.toml"
+    path.write_text(text)
+    study = load_study(path)
+    assert {"friction_demand", "lift_off"} <= set(study.run.outputs)
+    out = tmp_path / "mc.zarr"
+    run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    cube = open_result(out).load()
+    a_g = cube["amplitude"].values
+    np.testing.assert_allclose(cube["friction_demand"].values, a_g / G, rtol=1e-9)
+    page = make_report(out, tmp_path / "report")
+    n = int((a_g / G > 0.15).sum())
+    assert 0 < n < a_g.size
+    assert f"{n} of {a_g.size} scenes lie outside" in _text(page)
+
+
+@pytest.mark.parametrize("span", [(0.3, 0.8), (0.2, 4.0), (0.015, 40.0), (1.2, 1.9)])
+def test_every_log_axis_is_numbered(span):
+    """A logarithmic axis of the reports carries at least three numbered ticks, however
+    short its span (the right-hand panel of the size-collapse figure had none)."""
+    from rockstudy.study.report._page import _log_ticks, _plt
+
+    plt = _plt()
+    fig, ax = plt.subplots()
+    ax.plot(span, span)
+    ax.set(xscale="log", yscale="log", xlim=span, ylim=span)
+    _log_ticks(ax)
+    _log_ticks(ax, "y")
+    fig.canvas.draw()
+    for axis in (ax.xaxis, ax.yaxis):
+        labels = [t.get_text() for t in axis.get_ticklabels(minor=False)]
+        labels += [t.get_text() for t in axis.get_ticklabels(minor=True)]
+        ticks = list(axis.get_majorticklocs()) + list(axis.get_minorticklocs())
+        shown = {float(t) for t, s in zip(ticks, labels, strict=True) if s}
+        inside = [t for t in shown if span[0] <= t <= span[1]]
+        assert len(inside) >= 3, (span, labels)
+        for t in axis.get_ticklabels(minor=True) + axis.get_ticklabels():
+            assert t.get_fontsize() >= 8
+    plt.close(fig)
+
+
+def test_ida_report_of_objects_sorted_curves_and_capacity(tmp_path):
+    """An IDA of two objects under one sine cycle (overturning monotone in scale): the
+    capacity table gives the PGA at first overturning, which a single-scene simulation
+    confirms (it overturns there and stands at the lower bracket), and each drawn IDA curve
+    climbs in scale even when the stored points are shuffled."""
+    from test_objects import _sine_record
+
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+    from rockstudy.study.report import objects as ro
+    from rockstudy.study.report._page import _plt
+    from rockstudy.study.report.records import ReportContext, im_label
+
+    rec = _sine_record(1.5)
+    objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
+    ds = incremental_dynamic_analysis(rec, objects, scan=0, step=0.05, tolerance=0.01)
+    record_report(ds, tmp_path / "r", n_boot=5)
+    table = pd.read_csv(tmp_path / "r" / "object_capacity.csv", index_col=0)
+    for name, block in objects.items():
+        cap = float(table.loc[name, rec.name])
+        s_hi = cap * G / rec.peak
+        assert rs.simulate(block, rec.scaled(s_hi * (1 + 1e-9))).overturned
+        lower = float(ds["capacity_scale_lower"].sel(structure=name)[0])
+        assert not rs.simulate(block, rec.scaled(lower)).overturned
+        assert lower < s_hi <= lower * 1.0101
+    rng = np.random.default_rng(0)
+    shuffled = ds.copy(deep=True)
+    perm = rng.permutation(ds.sizes["step"])
+    for k in ("step_scale", "step_max_rotation", "step_overturned", "step_kind"):
+        shuffled[k] = ds[k].isel(step=perm)
+    ctx = ReportContext(shuffled)
+    ctx.im_label = im_label
+    fig, ax = _plt().subplots()
+    ro._ida_curve(ax, ctx, 0, 0, 0.0)
+    y = ax.lines[0].get_ydata()
+    assert y.size > 3 and np.all(np.diff(y) > 0)
+    _plt().close(fig)
