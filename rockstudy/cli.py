@@ -341,7 +341,7 @@ def _contact_warning(study, path) -> None:
     if mu is None:
         return
     from .study.analysis.contact import summary_line
-    from .study.store import open_result
+    from .study.running.store import open_result
 
     line = summary_line(open_result(path).load(), mu)
     if line:
