@@ -324,12 +324,7 @@ def simulate_batch(
         linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
         motion = pulse if record is None else None
         out, codes = _auto_rows(rows, motion, cycles, rtol, max_steps, linear_ok)
-    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
-    for name in ("status", "n_impacts", "steps"):
-        cols[name] = cols[name].astype(np.int64)
-    cols["overturned"] = cols["overturned"].astype(bool)
-    cols["model"] = codes
-    result = {name: cols[name] for name in wanted if name in cols}
+    result = _outputs(out, codes, wanted)
     if set(CONTACT_OUTPUTS) & set(wanted):
         from ._batch_contact import contact_rows
 
@@ -347,6 +342,17 @@ def simulate_batch(
     return _as_dataset(
         result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
     )
+
+
+def _outputs(out, codes, wanted) -> dict:
+    """The kernel's (n, 7) ``out`` (:data:`BATCH_COLUMNS`) and the model ``codes`` as the
+    typed output arrays named in ``wanted`` (the contact outputs apart)."""
+    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
+    for name in ("status", "n_impacts", "steps"):
+        cols[name] = cols[name].astype(np.int64)
+    cols["overturned"] = cols["overturned"].astype(bool)
+    cols["model"] = codes
+    return {name: cols[name] for name in wanted if name in cols}
 
 
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
