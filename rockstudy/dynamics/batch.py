@@ -324,12 +324,7 @@ def simulate_batch(
         linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
         motion = pulse if record is None else None
         out, codes = _auto_rows(rows, motion, cycles, rtol, max_steps, linear_ok)
-    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
-    for name in ("status", "n_impacts", "steps"):
-        cols[name] = cols[name].astype(np.int64)
-    cols["overturned"] = cols["overturned"].astype(bool)
-    cols["model"] = codes
-    result = {name: cols[name] for name in wanted if name in cols}
+    result = _outputs(out, codes, wanted)
     if set(CONTACT_OUTPUTS) & set(wanted):
         _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps)
     if not as_dataset:
@@ -343,6 +338,16 @@ def simulate_batch(
     )
 
 
+def _outputs(out, codes, wanted) -> dict:
+    """The kernel's (n, 7) ``out`` (:data:`BATCH_COLUMNS`) and the model ``codes`` as the
+    typed output arrays named in ``wanted`` (the contact outputs apart)."""
+    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
+    for name in ("status", "n_impacts", "steps"):
+        cols[name] = cols[name].astype(np.int64)
+    cols["overturned"] = cols["overturned"].astype(bool)
+    cols["model"] = codes
+    return {name: cols[name] for name in wanted if name in cols}
+
 
 def _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps):
     """Add the friction demand and lift-off of each scene to ``result`` (a scene whose contact
@@ -354,6 +359,7 @@ def _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps):
     for name, values in zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True):
         if name in wanted:
             result[name] = values
+
 
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
 _BATCH_UNITS = {
