@@ -36,12 +36,15 @@ debian:
 	  else echo "please install Debian's chromium (needed by tests/test_report.py)"; exit 1; fi; }
 
 # The demo compiles only the kernels it runs (the study primes its own before its workers
-# start); `make setup` compiles every kernel once, for the tests, the docs and the benchmarks.
+# start; the report and the single-block demo, which compile different kernels, run side by
+# side on two cores); `make setup` compiles every kernel once, for the tests, the docs and the
+# benchmarks.
 demo: $(BASE)
 	rm -rf results/quickstart.zarr results/quickstart.nc
 	$(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr
-	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report
-	$(BIN)/rockstudy demo --out results/demo
+	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report & \
+	  report=$$!; $(BIN)/rockstudy demo --out results/demo; demo=$$?; \
+	  wait $$report && exit $$demo
 
 test: $(KERNELS) debian docs
 	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q --durations=15
