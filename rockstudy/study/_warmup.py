@@ -2,7 +2,7 @@
 
 Every kernel is decorated ``cache=True``, so numba keeps its machine code next to the source
 (``__pycache__/*.nbi``, ``*.nbc``) and a new process, or a dask worker, loads it in
-milliseconds instead of compiling it again (about 10 s for ``simulate`` alone, a minute for
+milliseconds instead of compiling it again (about 10 s for ``simulate`` alone, 200 s of CPU for
 everything). The index of each source file is keyed by that file's modification time and
 size: editing a module recompiles only its kernels. :func:`compile_kernels` drives every
 kernel through the public entry points with small inputs, so the signatures it leaves in the
