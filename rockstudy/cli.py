@@ -611,9 +611,17 @@ def _refused(exc) -> int:
     return 1 if isinstance(exc, DamagedCube) else 2
 
 
+#: Commands that may compile numba kernels (and save them to numba's cache).
+_COMPILING = ("simulate", "run", "compile", "report", "verify", "figures", "demo")
+
+
 def _dispatch(args) -> int:
     """Run the command ``args.command``; a refusal is one line and exit 2."""
     _np_plain_numbers()
+    if args.command in _COMPILING:  # two commands at once (`make demo`) may compile one kernel
+        from ._numba_cache import serialize_cache_writes
+
+        serialize_cache_writes()
     try:
         if args.command == "simulate":
             return _simulate(args)

@@ -338,7 +338,8 @@ def test_a_sine_pulse_batch_compiles_no_step_it_cannot_take(tmp_path):
     none of the others (the DOP853 step of Ricker wavelets and mechanisms, the record step,
     the mechanism's free-rocking map): ``scene_batch_trig_serial`` on one thread, whose
     pruned branches halve the compile of a pulse study. Its results are the scipy
-    reference's (tests of the kernel)."""
+    reference's (tests of the kernel). ``simulate`` of a block under a sine pulse then loads
+    the scene kernel it compiled (same signature) instead of compiling the general one."""
     code = (
         COUNTER
         + """
@@ -356,3 +357,18 @@ print(json.dumps(counts["compiled"]))
     assert not names & {"_dop853_attempt", "step", "_taylor_attempt", "_free_map_table"}
     assert not names & {"scene_batch", "scene_batch_serial", "scene", "phase"}  # general ones
     assert "scene_batch_trig" not in names  # the parallel loop is not compiled for one thread
+    # simulate() of a block under a sine pulse then loads that scene kernel (the demo after
+    # the quickstart study): it compiles no scene or phase kernel of its own
+    code = (
+        COUNTER
+        + """
+import json
+from rockstudy import Block, simulate
+from rockstudy.motions import SinePulse
+r = simulate(Block(1.0, 0.2), SinePulse(5.0, 0.5), t_eval=[0.0, 0.1, 0.2])
+print(json.dumps(counts["compiled"]))
+"""
+    )
+    compiled = json.loads(run(["-c", code], tmp_path, env).strip().splitlines()[-1])
+    names = {name.rsplit(".", 1)[-1] for name in compiled}
+    assert not names & {"scene", "scene_trig", "phase", "phase_trig", "_taylor_trig_attempt"}

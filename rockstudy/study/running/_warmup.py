@@ -2,7 +2,7 @@
 
 Every kernel is decorated ``cache=True``, so numba keeps its machine code next to the source
 (``__pycache__/*.nbi``, ``*.nbc``) and a new process, or a dask worker, loads it in
-milliseconds instead of compiling it again (about 10 s for ``simulate`` alone, a minute for
+milliseconds instead of compiling it again (about 10 s for ``simulate`` alone, 200 s of CPU for
 everything). The index of each source file is keyed by that file's modification time and
 size: editing a module recompiles only its kernels. :func:`compile_kernels` drives every
 kernel through the public entry points with small inputs, so the signatures it leaves in the
@@ -15,10 +15,11 @@ file changes. So the warm-up also fingerprints every source file that holds kern
 constants, and clears the package's numba cache when the fingerprint has changed since the last
 warm-up (:func:`purge_stale_cache`).
 
-The warm-up compiles in one process. Two processes (the nonlinear kernel in one, the rest in
-the other) were tried: numba saves a function's cache index without a lock, so two processes
-compiling different signatures of one shared helper can lose an entry or map one signature to
-the other's machine code, and the gain was not measurable on the shared 2-core machine.
+The warm-up compiles its groups of kernels (:data:`GROUPS`) in a pool of processes, one per
+core, the kernels of ``make demo`` first. numba saves a function's cache index without a lock
+(two processes compiling different signatures of one shared helper could lose an entry or map
+one signature to the other's machine code): the pool's processes lock each save
+(:func:`rockstudy._numba_cache.serialize_cache_writes`).
 
 ``python -m rockstudy.study.running._warmup`` does the same as ``rockstudy compile``.
 """
@@ -127,18 +128,27 @@ def _simulate_calls():
     simulate(PointMassStrut(1.0, alpha), _with_vertical(record))
 
 
+@contextlib.contextmanager
+def _threads(n=None):
+    """numba's kernels on ``n`` threads (all if None) while the block runs."""
+    import numba
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS if n is None else n)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(threads)
+
+
 def _batch_calls(methods=("nonlinear", "linear", "auto")):
     """:func:`rockstudy.simulate_batch` on pulses and on a record, for each of ``methods``,
     in parallel and on one thread (a study's workers run the serial kernels)."""
     import numba
 
-    threads = numba.get_num_threads()
-    try:
-        for n in sorted({threads, 1}):
-            numba.set_num_threads(n)
+    for n in sorted({numba.get_num_threads(), 1}):
+        with _threads(n):
             _batch_calls_of(methods)
-    finally:
-        numba.set_num_threads(threads)
 
 
 def _batch_calls_of(methods):
@@ -177,12 +187,58 @@ def _closedform_calls():
     return names
 
 
-def _all_calls():
-    """Every call of the warm-up."""
-    _simulate_calls()
-    _batch_calls()
+def _demo_calls():
+    """What ``make demo`` runs: the quickstart study's batch kernel (sine pulses, one thread, as
+    a dask worker runs it) and the demo's :func:`rockstudy.simulate` of a block under a sine
+    pulse by each method it shows, with dense output."""
+    from ..dynamics import simulate, simulate_batch
+    from ..motions import SinePulse
+    from ..structures import Block
+
+    alpha = np.array([0.15, 0.2])
+    with _threads(1):
+        simulate_batch(
+            half_diagonal=1.0, slenderness=alpha, pulse="sine", amplitude=9.0, period=0.5
+        )
+    block = Block.from_dimensions(width=0.5, height=2.0)
+    pulse = SinePulse(1.5 * G * math.tan(block.slenderness), 0.6)
+    for method in ("nonlinear", "linear", "scipy"):
+        simulate(block, pulse, method=method, t_eval=np.linspace(0.0, 0.5, 3))
+
+
+def _batch_calls_parallel():
+    """:func:`_batch_calls_of` on every thread (the parallel batch kernels)."""
+    with _threads():
+        _batch_calls_of(("nonlinear", "linear", "auto"))
+
+
+def _batch_calls_serial():
+    """:func:`_batch_calls_of` on one thread (the kernels a study's workers run)."""
+    with _threads(1):
+        _batch_calls_of(("nonlinear", "linear", "auto"))
+
+
+def _records_and_closed_forms():
+    """:func:`_record_measure_calls` and :func:`_closedform_calls`."""
     _record_measure_calls()
     _closedform_calls()
+
+
+#: The warm-up's groups of calls, in the order they start: ``make demo``'s kernels first, then
+#: the longest groups.
+GROUPS = {
+    "demo": _demo_calls,
+    "simulate": _simulate_calls,
+    "batch-parallel": _batch_calls_parallel,
+    "batch-serial": _batch_calls_serial,
+    "records-closedforms": _records_and_closed_forms,
+}
+
+
+def _all_calls():
+    """Every call of the warm-up, in one process."""
+    for calls in GROUPS.values():
+        calls()
 
 
 def _count_compiled(calls, on_first_compile=None) -> int:
@@ -193,7 +249,54 @@ def _count_compiled(calls, on_first_compile=None) -> int:
     return counter.count
 
 
-def compile_kernels(on_first_compile=None) -> dict:
+_FIRST_COMPILE = None  # in a pool process: the event set at its first compilation
+
+
+def _pool_init(first_compile):
+    """Initializer of a warm-up pool process: locked cache saves, and the shared event."""
+    from .._numba_cache import serialize_cache_writes
+
+    global _FIRST_COMPILE
+    _FIRST_COMPILE = first_compile
+    serialize_cache_writes()
+
+
+def _run_group(name):
+    """Run the group ``name`` of :data:`GROUPS` in a pool process: (compiled, CPU seconds)."""
+    c0 = time.process_time()
+    compiled = _count_compiled(GROUPS[name], _FIRST_COMPILE.set)
+    return compiled, time.process_time() - c0
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def _compile_in_pool(processes, on_first_compile) -> dict:
+    """The groups of :data:`GROUPS` in a pool of ``processes`` spawned processes, in order;
+    ``on_first_compile`` called here once a process has started compiling."""
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    ctx = multiprocessing.get_context("spawn")  # no fork of a process with numba's threads
+    first = ctx.Event()
+    told = on_first_compile is None
+    with ProcessPoolExecutor(processes, ctx, initializer=_pool_init, initargs=(first,)) as pool:
+        futures = {pool.submit(_run_group, name): name for name in GROUPS}
+        pending = set(futures)
+        while pending:
+            _, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+            if not told and first.is_set():
+                told = True
+                on_first_compile()
+        return {futures[f]: f.result() for f in futures}
+
+
+def compile_kernels(on_first_compile=None, processes=None) -> dict:
     """Compile every numba kernel signature the package uses, or load it from numba's cache.
 
     Parameters
@@ -201,16 +304,33 @@ def compile_kernels(on_first_compile=None) -> dict:
     on_first_compile : callable, optional
         Called with no argument when the first kernel has to be compiled (not found in the
         cache), e.g. to tell the user why the wait.
+    processes : int, optional
+        Processes that compile the groups of :data:`GROUPS` in parallel (the kernels of ``make
+        demo`` first); default one per core, at most one per group; 1 compiles in this process.
+
     Returns
     -------
     dict
         ``compiled``: dispatchers compiled now (0 when the cache was already primed);
-        ``seconds``: wall time [s].
+        ``seconds``: wall time [s]; ``groups``: for each group, (compiled, CPU seconds of its
+        process).
     """
     t0 = time.perf_counter()
     purge_stale_cache()
-    compiled = _count_compiled(_all_calls, on_first_compile)
-    return {"compiled": compiled, "seconds": time.perf_counter() - t0}
+    n = min(len(GROUPS), _cores()) if processes is None else int(processes)
+    if n < 1:
+        raise ValueError(f"processes = {processes!r}: give a positive number of processes")
+    if n == 1:
+        groups = {}
+        for name, calls in GROUPS.items():
+            c0 = time.process_time()
+            groups[name] = (_count_compiled(calls, on_first_compile), time.process_time() - c0)
+            if groups[name][0]:
+                on_first_compile = None  # told once
+    else:
+        groups = _compile_in_pool(n, on_first_compile)
+    compiled = sum(count for count, _ in groups.values())
+    return {"compiled": compiled, "seconds": time.perf_counter() - t0, "groups": groups}
 
 
 def prime_study(study_json: str, columns: dict, base_dir=None, on_first_compile=None) -> dict:
@@ -247,7 +367,8 @@ def main() -> int:
 
     def note():
         print(
-            "compiling the numba kernels (once per install; about 5 minutes on 2 cores) ...",
+            f"compiling the numba kernels (once per install) in {min(len(GROUPS), _cores())} "
+            "processes ...",
             flush=True,
         )
 
