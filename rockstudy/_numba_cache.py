@@ -7,7 +7,7 @@ one function at the same time can both pick ``<name>.1.nbc``: one signature is t
 the index, or mapped to the other signature's machine code. :func:`serialize_cache_writes`
 makes that read-choose-write step exclusive between processes (``fcntl.flock`` on a lock file
 beside the index), so that processes may compile in parallel: ``rockstudy compile`` runs its
-groups of kernels in a pool of processes (:mod:`rockstudy.study._warmup`).
+groups of kernels in a pool of processes (:mod:`rockstudy.study.running._warmup`).
 """
 
 from __future__ import annotations

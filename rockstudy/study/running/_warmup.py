@@ -191,9 +191,9 @@ def _demo_calls():
     """What ``make demo`` runs: the quickstart study's batch kernel (sine pulses, one thread, as
     a dask worker runs it) and the demo's :func:`rockstudy.simulate` of a block under a sine
     pulse by each method it shows, with dense output."""
-    from ..dynamics import simulate, simulate_batch
-    from ..motions import SinePulse
-    from ..structures import Block
+    from ...dynamics import simulate, simulate_batch
+    from ...motions import SinePulse
+    from ...structures import Block
 
     alpha = np.array([0.15, 0.2])
     with _threads(1):
@@ -254,7 +254,7 @@ _FIRST_COMPILE = None  # in a pool process: the event set at its first compilati
 
 def _pool_init(first_compile):
     """Initializer of a warm-up pool process: locked cache saves, and the shared event."""
-    from .._numba_cache import serialize_cache_writes
+    from ..._numba_cache import serialize_cache_writes
 
     global _FIRST_COMPILE
     _FIRST_COMPILE = first_compile
