@@ -11,6 +11,11 @@ from pathlib import Path
 
 import pytest
 
+from rockstudy._numba_cache import serialize_cache_writes
+
+# The tests run in two processes (pytest-xdist): their numba cache saves must not race.
+serialize_cache_writes()
+
 RECORDS = Path(
     os.environ.get("ROCKSTUDY_RECORDS")
     or Path(__file__).resolve().parents[1].parent / "shared" / "records"
