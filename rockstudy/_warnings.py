@@ -1,4 +1,4 @@
-"""Warning classes: a method is asked to work where its measured accuracy is poor (issue 6).
+"""Warning classes: a method is asked to work where its measured accuracy is poor.
 
 All derive from :class:`AccuracyWarning`, so ``warnings.simplefilter("error", AccuracyWarning)``
 turns every one of them into an error.

@@ -1,4 +1,4 @@
-"""Error bounds behind ``method="auto"``: which model a scene needs (issues 6 and 11).
+"""Error bounds behind ``method="auto"``: which model a scene needs.
 
 The linearization error of eq. (3.1) of [000] against Housner's eq. (2.2) scales as alpha^2
 (both equations differ by sin x - x and cos x - 1 with |x| <= alpha, and the uplift levels by
@@ -48,7 +48,7 @@ KERNEL_RTOL_RANGE = (1e-12, 1e-3)
 #: digits the max-rotation accuracy does not need: theta_max within 1 % of alpha, or
 #: chattering through thousands of impacts under long cosine pulses just above uplift. At
 #: kernel rtol 5e-4 (auto at 1e-2) 8 robust decisions were wrong on the 400 x 400 grids of
-#: issue 11 (benchmarks/bench_auto_decisions.py), none at 5e-6; the kernel's cost hardly
+#: benchmarks/bench_auto_decisions.py, none at 5e-6; the kernel's cost hardly
 #: changes between the two (0.16 ms per work-precision scene at 1e-4 and at 1e-6).
 KERNEL_RTOL_DECISIONS = 5e-6
 

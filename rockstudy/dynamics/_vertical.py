@@ -1,7 +1,7 @@
 """Checks of a motion's vertical component before any integration (private).
 
 With a vertical ground acceleration u_v'' [m/s^2, upwards] gravity is g + u_v'' in the frame
-of the base (Housner's equation, issue 13 section 4): a record is refused where u_v'' <= -g
+of the base (Housner's equation): a record is refused where u_v'' <= -g
 (free fall, no contact force), and a block stays at rest while |u_h''| <= (g + u_v'') tan alpha.
 """
 

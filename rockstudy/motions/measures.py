@@ -101,7 +101,7 @@ class Ratio:
 #: name -> :class:`Measure`, in registration order (the order of the tables and reports).
 MEASURES: dict[str, Measure] = {}
 
-#: The dimensionless scale targets of the record designs (eqs. of issue 13 section 3).
+#: The dimensionless scale targets of the record designs (see docs/records.rst).
 RATIOS = {
     "pga_ratio": Ratio("pga", 0, "PGA / (g tan alpha)"),
     "pgv_ratio": Ratio("pgv", 1, "PGV p / (g tan alpha)"),

@@ -47,7 +47,7 @@ GAMMA_BOUNDS = (1.0, 5.0)
 #: Baker (2007): the pulse indicator above which a record is pulse-like.
 PULSE_LIKE_INDICATOR = 0.85
 #: A fitted pulse that reaches more than this many periods outside the record is not a pulse
-#: (indicator 0): white noise was fitted a 1325 s pulse starting at -196 s (issue 26).
+#: (indicator 0): white noise was fitted a 1325 s pulse starting at -196 s.
 OUTSIDE = 0.5
 
 

@@ -1,4 +1,4 @@
-"""Failure maps: where each method loses accuracy, over (psi, omega) and alpha (issue 6).
+"""Failure maps: where each method loses accuracy, over (psi, omega) and alpha.
 
 Every map is an ``xarray.Dataset`` over ``psi = |a_g| / (g tan alpha)`` (the pulse peak over
 the uplift level of Housner's block) and ``omega = omega_g / p``, against the nonlinear kernel

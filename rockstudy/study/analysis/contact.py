@@ -1,4 +1,4 @@
-"""Where the block model stops, per scene of a study: the friction check (issue 24 section 5).
+"""Where the block model stops, per scene of a study: the friction check.
 
 A rocking block is assumed not to slide and not to leave the ground. A study that gives a
 friction coefficient ``friction = mu`` (top level, or per object) stores each scene's

@@ -429,7 +429,7 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     ones k = 1, Arias intensity 2, durations and periods 0; the pulse's amplitude 1, its period
     and indicator 0); groups as in
     :func:`rockstudy.similarity.record_groups` (PGA / (g tan alpha), PGV p / (g tan alpha),
-    omega_p / p and omega_p v_p / (g tan alpha), eqs. of issue 13 section 3)."""
+    omega_p / p and omega_p v_p / (g tan alpha))."""
     ims = {k: v for k, v in record.intensity_measures().items() if k in measures.listed(False)}
     pulse = record.pulse()
     ims.update(

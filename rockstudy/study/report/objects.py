@@ -1,4 +1,4 @@
-"""The per-object sections of a record design's report (issue 24 section 2).
+"""The per-object sections of a record design's report.
 
 For a design of named objects (``[structure] kind = "objects"``, or a dict ``{name:
 structure}`` given to a design function) the record report answers per object, by name: its

@@ -1,4 +1,4 @@
-"""The report of a record design (cloud, multiple stripes or IDA; issue 13 section 8).
+"""The report of a record design (cloud, multiple stripes or IDA).
 
 From a dataset of :mod:`rockstudy.study.designs.records` (or a result cube of the same layout):
 the record list with each record's intensity measures and pulse period; fragility curves with

@@ -659,7 +659,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     out.mkdir(parents=True, exist_ok=True)
     ds = open_result(result, verify=verify).load()
-    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design (issue 13)
+    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design
         from .records import record_report
 
         if "study" not in ds.attrs:  # a design run from Python and saved: no study file

@@ -548,7 +548,7 @@ def stop_zarr_io(timeout: float = 60.0) -> None:
 
     zarr runs its IO on an event loop in a thread, and stops it at exit (``atexit``) by joining
     that thread for 0.2 s only, then closing the loop: on a busy machine the thread has not
-    stopped yet and exit prints ``RuntimeError: Cannot close a running event loop`` (issue 24).
+    stopped yet and exit prints ``RuntimeError: Cannot close a running event loop``.
     This waits up to ``timeout`` seconds instead; zarr's own clean-up then has nothing left to
     do. Does nothing if zarr never started its loop.
     """
