@@ -35,13 +35,15 @@ debian:
 	    apt-get update -qq && apt-get install -y -qq --no-install-recommends chromium; \
 	  else echo "please install Debian's chromium (needed by tests/test_report.py)"; exit 1; fi; }
 
-# The demo compiles only the kernels it runs (the study primes its own before its workers
-# start; the report and the single-block demo, which compile different kernels, run side by
-# side on two cores); `make setup` compiles every kernel once, for the tests, the docs and the
-# benchmarks.
+# The demo compiles only the kernels it runs: the study primes its own before its workers start
+# while the report's closed forms compile beside it; then the report and the single-block demo,
+# which compile different kernels, run side by side on two cores. `make setup` compiles every
+# kernel once, for the tests, the docs and the benchmarks.
 demo: $(BASE)
 	rm -rf results/quickstart.zarr results/quickstart.nc
-	$(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr
+	$(BIN)/rockstudy compile --group closedforms > /dev/null & \
+	  forms=$$!; $(BIN)/rockstudy run studies/quickstart.toml --out results/quickstart.zarr; \
+	  run=$$?; wait $$forms && exit $$run
 	$(BIN)/rockstudy report results/quickstart.zarr --out results/quickstart_report & \
 	  report=$$!; $(BIN)/rockstudy demo --out results/demo; demo=$$?; \
 	  wait $$report && exit $$demo

@@ -352,7 +352,7 @@ def _compile(args) -> int:
     """Prime numba's on-disk cache with every kernel (once per install; ``make setup``)."""
     from .study.running._warmup import main as compile_main
 
-    return compile_main()
+    return compile_main(args.group)
 
 
 def _validate(args) -> int:
@@ -446,7 +446,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     val.add_argument("study", nargs="+", help="study files (TOML)")
     sub.add_parser("schema", help="print the JSON schema of study files")
-    sub.add_parser("compile", help="compile the numba kernels into their cache (once per install)")
+    _add_compile(sub)
     rep = sub.add_parser(
         "report",
         help="an HTML report (figures, CSV tables) of a result cube",
@@ -470,6 +470,19 @@ def _parser() -> argparse.ArgumentParser:
 #: :data:`rockstudy.dynamics.methods.METHODS` that run a Block (written out here so that the
 #: parser does not load numba; a test holds the two equal).
 SIMULATE_METHODS = ["nonlinear", "linear", "scipy", "scipy-linear", "complex", "auto"]
+
+
+def _add_compile(sub) -> None:
+    """The ``compile`` command: every kernel, or the groups named."""
+    comp = sub.add_parser(
+        "compile", help="compile the numba kernels into their cache (once per install)"
+    )
+    comp.add_argument(
+        "--group",
+        action="append",
+        choices=_COMPILE_GROUPS,
+        help="only this group of kernels (repeatable; default all)",
+    )
 
 
 def _add_simulate(sub) -> None:
@@ -611,6 +624,9 @@ def _refused(exc) -> int:
     return 1 if isinstance(exc, DamagedCube) else 2
 
 
+#: The groups of ``rockstudy compile --group`` (those of ``rockstudy.study.running._warmup``,
+#: written out so that the parser loads no numba; a test holds them equal).
+_COMPILE_GROUPS = ("demo", "simulate", "batch-parallel", "batch-serial", "records", "closedforms")
 #: Commands that may compile numba kernels (and save them to numba's cache).
 _COMPILING = ("simulate", "run", "compile", "report", "verify", "figures", "demo")
 

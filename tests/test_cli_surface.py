@@ -164,3 +164,24 @@ def test_step_limit_is_one_line_and_exit_1():
         "or loosen rtol)"
     )
     assert cli(*block, "--max-steps", "100000").returncode == 0
+
+
+def test_compile_groups_are_the_warm_up_groups_and_a_group_compiles_alone(tmp_path):
+    """``rockstudy compile --group`` offers the warm-up's groups, and compiles only those: the
+    closed forms into an empty cache leave no cache entry of the rocking kernels (dynamics/)."""
+    from rockstudy.cli import _COMPILE_GROUPS
+    from rockstudy.study.running._warmup import GROUPS
+
+    assert list(_COMPILE_GROUPS) == list(GROUPS)
+    cache = tmp_path / "cache"
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "NUMBA_CACHE_DIR": str(cache)}
+    out = subprocess.run(
+        [sys.executable, "-m", "rockstudy.cli", "compile", "--group", "closedforms"],
+        capture_output=True, text=True, timeout=600, env=env,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    saved = [p.relative_to(cache).as_posix() for p in cache.rglob("*.nbi")]
+    assert any("closedform" in p for p in saved), saved
+    assert not any("dynamics" in p for p in saved), saved
+    bad = cli("compile", "--group", "nope")
+    assert bad.returncode == 2 and "invalid choice: 'nope'" in bad.stderr

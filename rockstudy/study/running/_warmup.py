@@ -218,12 +218,6 @@ def _batch_calls_serial():
         _batch_calls_of(("nonlinear", "linear", "auto"))
 
 
-def _records_and_closed_forms():
-    """:func:`_record_measure_calls` and :func:`_closedform_calls`."""
-    _record_measure_calls()
-    _closedform_calls()
-
-
 #: The warm-up's groups of calls, in the order they start: ``make demo``'s kernels first, then
 #: the longest groups.
 GROUPS = {
@@ -231,7 +225,8 @@ GROUPS = {
     "simulate": _simulate_calls,
     "batch-parallel": _batch_calls_parallel,
     "batch-serial": _batch_calls_serial,
-    "records-closedforms": _records_and_closed_forms,
+    "records": _record_measure_calls,
+    "closedforms": _closedform_calls,  # a sampled study's report draws the closed forms
 }
 
 
@@ -276,7 +271,7 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
-def _compile_in_pool(processes, on_first_compile) -> dict:
+def _compile_in_pool(processes, on_first_compile, names) -> dict:
     """The groups of :data:`GROUPS` in a pool of ``processes`` spawned processes, in order;
     ``on_first_compile`` called here once a process has started compiling."""
     import multiprocessing
@@ -286,7 +281,7 @@ def _compile_in_pool(processes, on_first_compile) -> dict:
     first = ctx.Event()
     told = on_first_compile is None
     with ProcessPoolExecutor(processes, ctx, initializer=_pool_init, initargs=(first,)) as pool:
-        futures = {pool.submit(_run_group, name): name for name in GROUPS}
+        futures = {pool.submit(_run_group, name): name for name in names}
         pending = set(futures)
         while pending:
             _, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
@@ -296,7 +291,7 @@ def _compile_in_pool(processes, on_first_compile) -> dict:
         return {futures[f]: f.result() for f in futures}
 
 
-def compile_kernels(on_first_compile=None, processes=None) -> dict:
+def compile_kernels(on_first_compile=None, processes=None, groups=None) -> dict:
     """Compile every numba kernel signature the package uses, or load it from numba's cache.
 
     Parameters
@@ -307,6 +302,9 @@ def compile_kernels(on_first_compile=None, processes=None) -> dict:
     processes : int, optional
         Processes that compile the groups of :data:`GROUPS` in parallel (the kernels of ``make
         demo`` first); default one per core, at most one per group; 1 compiles in this process.
+    groups : sequence of str, optional
+        Only these groups of :data:`GROUPS` (default all), e.g. ``["closedforms"]`` while a
+        study runs, before its report.
 
     Returns
     -------
@@ -315,20 +313,27 @@ def compile_kernels(on_first_compile=None, processes=None) -> dict:
         ``seconds``: wall time [s]; ``groups``: for each group, (compiled, CPU seconds of its
         process).
     """
+    names = list(GROUPS) if groups is None else list(groups)
+    unknown = [g for g in names if g not in GROUPS]
+    if unknown or not names:
+        raise ValueError(f"groups = {groups!r}: give names among {list(GROUPS)}")
     t0 = time.perf_counter()
     purge_stale_cache()
-    n = min(len(GROUPS), _cores()) if processes is None else int(processes)
+    n = min(len(names), _cores()) if processes is None else int(processes)
     if n < 1:
         raise ValueError(f"processes = {processes!r}: give a positive number of processes")
     if n == 1:
         groups = {}
-        for name, calls in GROUPS.items():
+        for name in names:
             c0 = time.process_time()
-            groups[name] = (_count_compiled(calls, on_first_compile), time.process_time() - c0)
+            groups[name] = (
+                _count_compiled(GROUPS[name], on_first_compile),
+                time.process_time() - c0,
+            )
             if groups[name][0]:
                 on_first_compile = None  # told once
     else:
-        groups = _compile_in_pool(n, on_first_compile)
+        groups = _compile_in_pool(n, on_first_compile, names)
     compiled = sum(count for count, _ in groups.values())
     return {"compiled": compiled, "seconds": time.perf_counter() - t0, "groups": groups}
 
@@ -361,18 +366,20 @@ def prime_study(study_json: str, columns: dict, base_dir=None, on_first_compile=
     return {"compiled": counter.count, "seconds": time.perf_counter() - t0}
 
 
-def main() -> int:
-    """``rockstudy compile``: prime numba's cache and say what it did."""
+def main(groups=None) -> int:
+    """``rockstudy compile [--group NAME ...]``: prime numba's cache and say what it did."""
     import sys
+
+    count = len(GROUPS) if groups is None else len(groups)
 
     def note():
         print(
-            f"compiling the numba kernels (once per install) in {min(len(GROUPS), _cores())} "
+            f"compiling the numba kernels (once per install) in {min(count, _cores())} "
             "processes ...",
             flush=True,
         )
 
-    r = compile_kernels(note)
+    r = compile_kernels(note, groups=groups)
     what = f"compiled {r['compiled']} kernels" if r["compiled"] else "all kernels were cached"
     print(f"rockstudy kernels ready: {what} in {r['seconds']:.1f} s", file=sys.stdout)
     return 0
