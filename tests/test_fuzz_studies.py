@@ -366,6 +366,8 @@ def mutate(g: Gen, study: dict, bad_records):
             study["motion"]["pga_ratio"] = {"dist": "uniform", "low": 1.0, "high": 3.0}
         if study["sampler"]["kind"] == "grid":
             study["motion"]["pga_ratio"] = {"dist": "grid", "values": [1.0, 2.0]}
+        if study["sampler"]["kind"] == "sobol":  # the new motion may leave Sobol' one parameter:
+            study["sampler"] = {"kind": "lhs", "n": 4}  # one fault per file, the record's
         return study, cat, f"motion.files[{i}]"
     if cat == "huge":
         choice = r.randrange(4)

@@ -147,10 +147,11 @@ def test_cli_validate(tmp_path, capsys):
 def test_every_shipped_study_validates(tmp_path, records_dir):
     for path in sorted((ROOT / "studies").glob("*.toml")):
         # record paths are relative to the study file: point them at the shared records and
-        # at the records shipped in data/records
+        # at the records and hazard curves shipped in data/
         copy = tmp_path / path.name
         text = path.read_text().replace("../../shared/records", str(records_dir))
-        copy.write_text(text.replace("../data/records", str(ROOT / "data" / "records")))
+        text = text.replace("../data/records", str(ROOT / "data" / "records"))
+        copy.write_text(text.replace("../data/hazard", str(ROOT / "data" / "hazard")))
         assert cli_main(["validate", str(copy)]) == 0, path
 
 
