@@ -199,7 +199,7 @@ class _ObjectBase(_Model):
     default Housner's), with the fields of its kind as its physics class takes them."""
 
     name: str = Field(min_length=1)
-    kind: str = "block"
+    kind: Literal[OBJECT_KINDS] = "block"
     #: The friction coefficient mu of this object's contact (overrides the study's friction).
     friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
     _params: tuple = PrivateAttr(default=None)
