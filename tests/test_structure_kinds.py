@@ -239,3 +239,37 @@ def test_an_objects_study_of_a_wall_a_frame_and_an_arch(client, tmp_path):
             rtol=1e-12,
             err_msg=name,
         )
+
+
+SAMPLED = """
+name = "sampled"
+seed = 3
+[sampler]
+kind = "monte_carlo"
+n = 6
+[structure]
+kind = "{kind}"
+half_diagonal = {{ dist = "uniform", low = 0.5, high = 3.0 }}
+slenderness = {{ dist = "uniform", low = 0.05, high = 0.3 }}
+restitution = 0.8
+[motion]
+kind = "pulse"
+shape = "sine"
+amplitude_ratio = 2.0
+period = 0.5
+"""
+
+
+@pytest.mark.parametrize("kind", [k for k, v in KINDS.items() if v.sampled is not None])
+def test_a_sampled_kind_in_a_design_has_the_parameters_of_its_class(kind):
+    from rockstudy.study.designs.sampling import make_design
+    from rockstudy.study.spec.schema import validate_text
+
+    ds = make_design(validate_text(SAMPLED.format(kind=kind)))
+    for R, a, p, theta in zip(
+        *(ds[v].values for v in ("half_diagonal", "slenderness")),
+        *(ds[v].values for v in ("frequency_parameter", "critical_rotation")),
+        strict=True,
+    ):
+        expect = _expected(KINDS[kind].structure(R, a, 0.8))  # its mechanism, not eq. (23)
+        assert (p, theta) == pytest.approx(expect[:2], rel=1e-9)

@@ -116,6 +116,17 @@ def _check_positive(name, value):
         raise FieldError(name, "the distribution must only give values > 0")
 
 
+def _sampled_geometry(spec):
+    """The half-diagonal and slenderness of a sampled kind within the ranges of its registry
+    entry (:data:`.structures.KINDS`)."""
+    kind = KINDS[spec.kind]
+    _check_positive("half_diagonal", spec.half_diagonal)
+    _span("half_diagonal", spec.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
+    top, label = kind.slenderness_top, kind.fields["slenderness"].label
+    _within("slenderness", spec.slenderness, 0.0, top, label.replace(f"[{MIN_SLENDERNESS:g}", "(0"))
+    _span("slenderness", spec.slenderness, MIN_SLENDERNESS, top, label)
+
+
 class BlockSpec(_Model):
     """A rectangular block: half-diagonal R [m], slenderness alpha [rad], restitution eta."""
 
@@ -126,10 +137,7 @@ class BlockSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _check_positive("half_diagonal", self.half_diagonal)
-        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
-        _within("slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad")
-        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 2, _ALPHA_LABEL)
+        _sampled_geometry(self)
         if self.restitution != "housner":
             _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         else:  # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
@@ -157,10 +165,7 @@ class WallSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _check_positive("half_diagonal", self.half_diagonal)
-        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
-        _within("slenderness", self.slenderness, 0.0, math.pi / 4, "(0, pi/4) rad")
-        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 4, "[1e-06, pi/4) rad")
+        _sampled_geometry(self)
         _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         return self
 
