@@ -231,9 +231,9 @@ def test_objects_study_errors_name_the_object_and_the_field(suite, tmp_path):
     text = _problems(tmp_path, suite, 'objects = [{ name = "A", width = 0.4 }]')
     assert "'A'" in text and "width and height" in text
     text = _problems(
-        tmp_path, suite, 'objects = [{ name = "A", kind = "arch", width = 0.4, height = 2.0 }]'
+        tmp_path, suite, 'objects = [{ name = "A", kind = "pyramid", width = 0.4, height = 2.0 }]'
     )
-    assert "'A'" in text and "Python API" in text
+    assert "'A'" in text and "'arch'" in text and "'pyramid'" in text
     text = _problems(
         tmp_path,
         suite,

@@ -20,6 +20,7 @@ from itertools import combinations
 import numpy as np
 
 from .. import _validate
+from ..constants import G
 from . import _jet as jt
 from .mechanism import Mechanism, RockingParameters
 
@@ -180,6 +181,18 @@ class RockingWall(_Symmetric):
 
     def restitution_value(self):
         return np.nan if self.restitution is None else self.restitution
+
+    @staticmethod
+    def equivalent_parameters(half_diagonal, slenderness):
+        r"""(p_eq [rad/s], theta_cr [rad]) of the wall's linearized equivalent block (kappa_1 =
+        1/2), on arrays: eq. (23) of [003],
+
+        .. math:: p_{eq} = \sqrt{2}\, p = \sqrt{3 g / (2 R)}, \qquad \theta_{cr} = 2 \alpha
+
+        (what :meth:`equivalent_block` gives from the mechanism, in closed form).
+        """
+        R = np.asarray(half_diagonal, float)
+        return np.sqrt(1.5 * G / R), 2.0 * np.asarray(slenderness, float)
 
 
 def _sector(r, t, psi1, psi2):

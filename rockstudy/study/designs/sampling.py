@@ -8,14 +8,14 @@ not depend on chunking or on the number of workers.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import xarray as xr
 from scipy.stats import qmc
 
 from ...constants import G
+from ...structures.block import restitution_housner
 from ..spec.schema import Study
+from ..spec.structures import KINDS
 
 #: CF-style attributes of every design variable.
 VARIABLES = {
@@ -170,13 +170,9 @@ def _structure_columns(st, cols, n) -> dict:
         return dict(frequency_parameter=p, critical_rotation=alpha, restitution=eta)
     R = _value(cols, st, "half_diagonal", n)
     alpha0 = _value(cols, st, "slenderness", n)
-    p = np.sqrt(3.0 * G / (4.0 * R))
-    alpha = alpha0
-    if st.kind == "rocking_wall":  # eq. (23) of [003]: p_wall = sqrt(2) p, theta_cr = 2 alpha
-        p = math.sqrt(2.0) * p
-        alpha = 2.0 * alpha0
+    p, alpha = KINDS[st.kind].sampled(R, alpha0)  # the equivalent block of the kind's class
     eta = (
-        1.0 - 1.5 * np.sin(alpha0) ** 2
+        np.vectorize(restitution_housner, otypes=[float])(alpha0)
         if st.restitution == "housner"
         else _value(cols, st, "restitution", n)
     )

@@ -17,6 +17,7 @@ from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, mach
 from ...constants import G
 from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs
+from .structures import KINDS
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
@@ -172,7 +173,7 @@ def _smallest_critical_rotation(study) -> float:
         return float(st.rocking()[:, 1].min())
     if st.kind == "equivalent_block":
         return draw_span(st.critical_rotation)[0]
-    return (2.0 if st.kind == "rocking_wall" else 1.0) * draw_span(st.slenderness)[0]
+    return float(KINDS[st.kind].sampled(1.0, draw_span(st.slenderness)[0])[1])
 
 
 def _named_twice(pairs) -> list[str]:

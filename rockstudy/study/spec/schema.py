@@ -59,6 +59,7 @@ from pydantic import (
     PrivateAttr,
     Tag,
     ValidationError,
+    create_model,
     field_validator,
     model_validator,
 )
@@ -73,6 +74,7 @@ from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
 from .ida_options import IdaOptionError, IdaOptions
+from .structures import KINDS, FieldError, check_object, object_fields
 
 
 def _param_tag(value):
@@ -100,15 +102,6 @@ _R_LABEL = "[{:g}, {:g}] m".format(*HALF_DIAGONAL_RANGE)
 _ALPHA_LABEL = f"[{MIN_SLENDERNESS:g}, pi/2) rad"
 
 
-class FieldError(ValueError):
-    """A problem of one field of a table, raised by a table's checks (so the message can
-    name ``table.field``)."""
-
-    def __init__(self, field, message):
-        self.field = field
-        super().__init__(message)
-
-
 class _Model(BaseModel):
     # strict: "1e-8" is not a number and true is not 1; inf and NaN are not accepted
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
@@ -123,6 +116,17 @@ def _check_positive(name, value):
         raise FieldError(name, "the distribution must only give values > 0")
 
 
+def _sampled_geometry(spec):
+    """The half-diagonal and slenderness of a sampled kind within the ranges of its registry
+    entry (:data:`.structures.KINDS`)."""
+    kind = KINDS[spec.kind]
+    _check_positive("half_diagonal", spec.half_diagonal)
+    _span("half_diagonal", spec.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
+    top, label = kind.slenderness_top, kind.fields["slenderness"].label
+    _within("slenderness", spec.slenderness, 0.0, top, label.replace(f"[{MIN_SLENDERNESS:g}", "(0"))
+    _span("slenderness", spec.slenderness, MIN_SLENDERNESS, top, label)
+
+
 class BlockSpec(_Model):
     """A rectangular block: half-diagonal R [m], slenderness alpha [rad], restitution eta."""
 
@@ -133,10 +137,7 @@ class BlockSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _check_positive("half_diagonal", self.half_diagonal)
-        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
-        _within("slenderness", self.slenderness, 0.0, math.pi / 2, "(0, pi/2) rad")
-        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 2, _ALPHA_LABEL)
+        _sampled_geometry(self)
         if self.restitution != "housner":
             _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         else:  # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
@@ -164,10 +165,7 @@ class WallSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _check_positive("half_diagonal", self.half_diagonal)
-        _span("half_diagonal", self.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
-        _within("slenderness", self.slenderness, 0.0, math.pi / 4, "(0, pi/4) rad")
-        _span("slenderness", self.slenderness, MIN_SLENDERNESS, math.pi / 4, "[1e-06, pi/4) rad")
+        _sampled_geometry(self)
         _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
         return self
 
@@ -191,100 +189,51 @@ class EquivalentBlockSpec(_Model):
         return self
 
 
-#: Kinds an object of ``[structure] kind = "objects"`` may be (frames and arches have no study
-#: spec: give them through the Python API,
-#: :func:`~rockstudy.study.designs.records.cloud` and the others).
-OBJECT_KINDS = ("block", "rocking_wall")
+#: Kinds an object of ``[structure] kind = "objects"`` may be (the registry
+#: :data:`.structures.KINDS`).
+OBJECT_KINDS = tuple(KINDS)
 
 
 #: Largest friction coefficient mu taken (a study's ``friction``; no contact needs more).
 MAX_FRICTION = 10.0
 
 
-class ObjectSpec(_Model):
-    """One named object: a block (by ``width`` and ``height`` [m], or ``half_diagonal`` [m] and
-    ``slenderness`` [rad]; restitution by default Housner's) or an out-of-plane rocking wall
-    (``half_diagonal``, ``slenderness`` and ``restitution``, as ``kind = "rocking_wall"``)."""
+class _ObjectBase(_Model):
+    """One named object of a kind of :data:`.structures.KINDS` (by default a block: ``width``
+    and ``height`` [m], or ``half_diagonal`` [m] and ``slenderness`` [rad]; restitution by
+    default Housner's), with the fields of its kind as its physics class takes them."""
 
     name: str = Field(min_length=1)
-    kind: str = "block"
-    width: float | None = None
-    height: float | None = None
-    half_diagonal: float | None = None
-    slenderness: float | None = None
-    restitution: float | None = None
+    kind: Literal[OBJECT_KINDS] = "block"
     #: The friction coefficient mu of this object's contact (overrides the study's friction).
     friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
+    _params: tuple = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _shape(self):
-        who = f"object {self.name!r}"
-        if self.kind not in OBJECT_KINDS:
-            raise FieldError(
-                "kind",
-                f"{who}: kind must be one of {list(OBJECT_KINDS)}, got {self.kind!r} (frames "
-                "and arches are studied through the Python API, with a dict of named structures)",
-            )
-        sizes, polar = (self.width, self.height), (self.half_diagonal, self.slenderness)
-        given = [
-            f
-            for f in ("width", "height", "half_diagonal", "slenderness")
-            if getattr(self, f) is not None
-        ]
-        if (None in sizes) == (None in polar) or (self.kind != "block" and None not in sizes):
-            raise FieldError(
-                given[0] if given else "half_diagonal",
-                f"{who}: give width and height, or half_diagonal and slenderness"
-                + (
-                    " (a rocking_wall: half_diagonal and slenderness)"
-                    if self.kind != "block"
-                    else ""
-                )
-                + f"; got {given or 'none'}",
-            )
-        for field in given + (["restitution"] if self.restitution is not None else []):
-            if not getattr(self, field) > 0:
-                raise FieldError(field, f"{who}: {field} must be > 0, got {getattr(self, field)!r}")
-        R, alpha = self.geometry()
-        lo, hi = HALF_DIAGONAL_RANGE
-        if not lo <= R <= hi:
-            raise FieldError(given[0], f"{who}: the half-diagonal {R:.4g} m is outside {_R_LABEL}")
-        top = math.pi / 4 if self.kind == "rocking_wall" else math.pi / 2
-        if not MIN_SLENDERNESS <= alpha < top:
-            label = "[1e-06, pi/4) rad" if top < 1 else _ALPHA_LABEL
-            raise FieldError(
-                given[-1], f"{who}: the slenderness {alpha:.4g} rad is outside {label}"
-            )
-        if self.restitution is not None and self.restitution > 1:
-            raise FieldError(
-                "restitution", f"{who}: restitution must be in (0, 1], got {self.restitution!r}"
-            )
-        if self.restitution is None and self.kind == "rocking_wall":
-            raise FieldError("restitution", f"{who}: a rocking_wall needs restitution in (0, 1]")
-        if self.restitution is None and not alpha < HOUSNER_MAX_SLENDERNESS:
-            raise FieldError(
-                given[-1],
-                f"{who}: Housner's restitution 1 - 1.5 sin^2(alpha) (eq. 2.4 of [000]) needs "
-                f"slenderness < {HOUSNER_MAX_SLENDERNESS:.4f} rad, got {alpha:.4g}; "
-                "give restitution",
-            )
+        given = {f: getattr(self, f) for f in object_fields() if getattr(self, f) is not None}
+        structure, rocking = check_object(f"object {self.name!r}", self.kind, given)
+        R = float(getattr(structure, "half_diagonal", np.nan))
+        self._params = (*rocking, R)
         return self
 
     def geometry(self) -> tuple[float, float]:
-        """(half-diagonal R [m], slenderness alpha [rad]) of the block (of each of the wall's)."""
-        if self.half_diagonal is not None:
-            return self.half_diagonal, self.slenderness
-        return 0.5 * math.hypot(self.width, self.height), math.atan2(self.width, self.height)
+        """(half-diagonal R [m], NaN for a structure without one; theta_cr [rad], the
+        equivalent block's slenderness), as the design functions store them."""
+        return self._params[3], self._params[1]
 
     def rocking(self) -> tuple[float, float, float]:
-        """(p [rad/s], theta_cr [rad], eta): a block's, or the wall's linearized equivalent
-        block, p = sqrt(2) p_block and theta_cr = 2 alpha (eq. (23) of [003])."""
-        R, alpha = self.geometry()
-        p = math.sqrt(0.75 * G / R)
-        eta = 1.0 - 1.5 * math.sin(alpha) ** 2 if self.restitution is None else self.restitution
-        if self.kind == "rocking_wall":
-            return math.sqrt(2.0) * p, 2.0 * alpha, eta
-        return p, alpha, eta
+        """(p [rad/s], theta_cr [rad], eta) of the equivalent block of the object's physics
+        class (:func:`rockstudy.structures.block_parameters`)."""
+        return self._params[:3]
+
+
+ObjectSpec = create_model(
+    "ObjectSpec",
+    __base__=_ObjectBase,
+    __doc__=_ObjectBase.__doc__,
+    **{f: (float | None, None) for f in object_fields()},
+)
 
 
 class ObjectsSpec(_Model):
@@ -1123,9 +1072,10 @@ class Study(_Model):
             return float(p.min()), float(p.max())
         if st.kind == "equivalent_block":
             return _smallest(st.frequency_parameter), _largest(st.frequency_parameter)
-        factor = math.sqrt(2.0) if st.kind == "rocking_wall" else 1.0  # eq. (23) of [003]
-        R_lo, R_hi = _smallest(st.half_diagonal), _largest(st.half_diagonal)
-        return factor * math.sqrt(0.75 * G / R_hi), factor * math.sqrt(0.75 * G / R_lo)
+        R = [_smallest(st.half_diagonal), _largest(st.half_diagonal)]
+        alpha = [_smallest(st.slenderness), _largest(st.slenderness)]
+        p, _ = KINDS[st.kind].sampled(*np.meshgrid(R, alpha))  # p is monotone in R and alpha
+        return float(p.min()), float(p.max())
 
     def largest_critical_rotation(self) -> float:
         """The largest critical rotation theta_cr [rad] the structures can have."""
@@ -1134,7 +1084,7 @@ class Study(_Model):
             return float(st.rocking()[:, 1].max())
         if st.kind == "equivalent_block":
             return _largest(st.critical_rotation)
-        return (2.0 if st.kind == "rocking_wall" else 1.0) * _largest(st.slenderness)
+        return float(KINDS[st.kind].sampled(1.0, _largest(st.slenderness))[1])
 
     def levels(self) -> int:
         """Intensity levels of each record and structure of a design (1 but for stripes)."""

@@ -1,0 +1,275 @@
+"""The registry of structure kinds of study files (``rockstudy.study.spec.structures``).
+
+Oracles: each physics class of ``rockstudy.structures`` built directly with its own
+arguments (its equivalent block, paper [003]), the closed forms of [003] (eq. 23 for the wall,
+Table I for the strut and the symmetric frame), and single-scene simulations of the frame's
+equivalent block alone under the same record ([003]'s equivalence).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import rockstudy as rs
+from rockstudy.constants import G
+from rockstudy.motions import Record
+from rockstudy.structures import (
+    Arch,
+    AsymmetricFrame,
+    Block,
+    ConicalShell,
+    PointMassStrut,
+    RockingWall,
+    SymmetricFrame,
+)
+from rockstudy.study.spec.schema import OBJECT_COLUMNS, OBJECT_KINDS, ObjectSpec, json_schema
+from rockstudy.study.spec.structures import KINDS
+
+FRAME = dict(
+    half_width=0.2,
+    height=1.5,
+    height_right=1.2,
+    beam_length=3.0,
+    beam_half_depth=0.2,
+    mass_beam=2.0,
+    restitution=0.8,
+)
+ARCH = dict(inclusion_angle=math.pi, thickness=0.2, radius=1.0, restitution=0.7)
+WALL = dict(half_diagonal=1.5, slenderness=0.12, restitution=0.85)
+
+#: kind -> (fields of a study object, the physics object built directly)
+EXAMPLES = {
+    "block": (dict(width=0.45, height=1.9), Block.from_dimensions(0.45, 1.9)),
+    "rocking_wall": (WALL, RockingWall(1.5, 0.12, 0.85)),
+    "asymmetric_frame": (
+        FRAME,
+        AsymmetricFrame(0.2, 1.5, 1.2, 3.0, 0.2, mass_beam=2.0, restitution=0.8),
+    ),
+    "arch": (ARCH, Arch(math.pi, 0.2, 1.0, restitution=0.7)),
+    "symmetric_frame": (
+        dict(half_diagonal=1.1, slenderness=0.2, mass_ratio=0.5),
+        SymmetricFrame(1.1, 0.2, 0.5),
+    ),
+    "point_mass_strut": (
+        dict(half_diagonal=0.8, slenderness=0.25),
+        PointMassStrut(0.8, 0.25),
+    ),
+    "conical_shell": (dict(height=6.0, base_radius=1.0), ConicalShell(6.0, 1.0)),
+}
+
+
+def _expected(structure):
+    b = structure if isinstance(structure, Block) else structure.equivalent_block()
+    return (b.frequency_parameter, b.slenderness, b.restitution)
+
+
+def test_every_kind_has_an_example_and_the_schema_takes_the_registry():
+    assert set(EXAMPLES) == set(KINDS) == set(OBJECT_KINDS)
+    fields = {f for k in KINDS.values() for f in k.fields}
+    assert set(OBJECT_COLUMNS) == fields | {"name", "kind", "friction"}
+    props = json_schema()["$defs"]["ObjectSpec"]["properties"]
+    assert fields <= set(props)
+
+
+@pytest.mark.parametrize("kind", list(EXAMPLES))
+def test_each_kind_in_a_design_has_the_parameters_of_its_class(kind, tmp_path):
+    from rockstudy.study.designs.sampling import _object_columns
+    from rockstudy.study.spec.schema import ObjectsSpec
+
+    values, structure = EXAMPLES[kind]
+    spec = ObjectsSpec(kind="objects", objects=[ObjectSpec(name=kind, kind=kind, **values)])
+    cols = _object_columns(spec)
+    got = (
+        cols["frequency_parameter"][0],
+        cols["critical_rotation"][0],
+        cols["restitution"][0],
+    )
+    assert got == pytest.approx(_expected(structure), rel=1e-12)
+    assert cols["slenderness"][0] == pytest.approx(got[1], rel=1e-12)  # the block's alias
+    R = getattr(structure, "half_diagonal", np.nan)
+    np.testing.assert_allclose(cols["half_diagonal"][0], R, rtol=1e-12)
+
+
+def test_closed_forms_of_the_wall_strut_and_symmetric_frame():
+    # eq. (23) of [003]: p_wall = sqrt(2) sqrt(3 g / 4 R), theta_cr = 2 alpha
+    R, a = np.array([0.5, 1.5, 4.0]), np.array([0.05, 0.12, 0.3])
+    p, theta = KINDS["rocking_wall"].sampled(R, a)
+    np.testing.assert_allclose(p, np.sqrt(2) * np.sqrt(0.75 * G / R), rtol=1e-14)
+    np.testing.assert_allclose(theta, 2 * a, rtol=1e-14)
+    for r, al in zip(R, a, strict=True):
+        eq = RockingWall(r, al, 0.9).equivalent_block()
+        assert (eq.frequency_parameter, eq.slenderness) == pytest.approx(
+            (math.sqrt(1.5 * G / r), 2 * al), rel=1e-9
+        )
+    # Table I of [003]: strut p^2 = g / R, eta = cos 2 alpha; frame p^2 = (3g/4R)(1+2g)/(1+3g)
+    strut = ObjectSpec(name="s", kind="point_mass_strut", half_diagonal=0.8, slenderness=0.25)
+    assert strut.rocking() == pytest.approx((math.sqrt(G / 0.8), 0.25, math.cos(0.5)), rel=1e-9)
+    frame = ObjectSpec(
+        name="f", kind="symmetric_frame", half_diagonal=1.1, slenderness=0.2, mass_ratio=0.5
+    )
+    p_frame = math.sqrt(0.75 * G / 1.1 * 2.0 / 2.5)
+    eta = (1 - 1.5 * math.sin(0.2) ** 2 + 1.5 * math.cos(0.4)) / 2.5
+    assert frame.rocking() == pytest.approx((p_frame, 0.2, eta), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "obj, field, words",
+    [
+        ({"kind": "arch", **ARCH, "thickness": 0.05}, "thickness", "cannot stand"),
+        ({"kind": "arch", **ARCH, "inclusion_angle": 7.0}, "inclusion_angle", "(0, 2 pi)"),
+        ({"kind": "asymmetric_frame", **FRAME, "beam_length": -3.0}, "beam_length", "(0, inf)"),
+        ({"kind": "asymmetric_frame", **FRAME, "beam_length": 0.5}, "beam_length", "exceed"),
+        (
+            {"kind": "asymmetric_frame", **{k: v for k, v in FRAME.items() if k != "restitution"}},
+            "restitution",
+            "needs",
+        ),
+        ({"kind": "rocking_wall", **WALL, "width": 0.3}, "width", "does not apply"),
+        ({"kind": "rocking_wall", **WALL, "slenderness": 0.9}, "slenderness", "pi/4"),
+        (
+            {"kind": "conical_shell", "height": 6.0, "base_radius": 1.0, "restitution": 0.5},
+            "restitution",
+            "does not apply",
+        ),
+        ({"kind": "pyramid", "height": 1.0}, "kind", "'asymmetric_frame'"),
+    ],
+)
+def test_bad_fields_are_refused_naming_the_object_and_the_field(tmp_path, obj, field, words):
+    from rockstudy.study import StudyError, load_study
+
+    cells = ", ".join(f"{k} = {v!r}".replace("'", '"') for k, v in obj.items())
+    test_record_studies.write_at2(tmp_path / "r.AT2", _sine(3.0).scaled(G))
+    path = tmp_path / "bad.toml"
+    path.write_text(
+        STUDY.format(
+            objects=f'objects = [{{ name = "Ok", width = 0.4, height = 2.0 }}, '
+            f'{{ name = "Odd", {cells} }}]',
+            folder=tmp_path,
+        )
+    )
+    with pytest.raises(StudyError) as err:
+        load_study(path)
+    text = "\n".join(err.value.problems)
+    assert f"structure.objects[1] ('Odd').{field}" in text, text
+    assert words in text, text
+
+
+# ------------------------------------------------------------------------------ a study
+
+import test_record_studies  # noqa: E402
+
+client = test_record_studies.client  # the one-worker cluster fixture
+
+STUDY = """
+name = "kinds"
+seed = 1
+[structure]
+kind = "objects"
+{objects}
+[motion]
+kind = "record"
+files = "{folder}"
+[design]
+kind = "ida"
+tolerance = 0.02
+scan = 0
+"""
+CSV = (
+    "name,kind,half_diagonal,slenderness,restitution,half_width,height,height_right,"
+    "beam_length,beam_half_depth,mass_beam,inclusion_angle,thickness,radius\n"
+    "Wall,rocking_wall,1.5,0.12,0.85,,,,,,,,,\n"
+    "Frame,asymmetric_frame,,,0.8,0.2,1.5,1.2,3.0,0.2,2.0,,,\n"
+    f"Arch,arch,,,0.7,,,,,,,{math.pi!r},0.2,1.0\n"
+)
+
+
+def _sine(p, ratio=1.5):
+    """One cycle of a unit sine at omega = ratio p, then rest: overturning is monotone in
+    its scale."""
+    T = 2 * np.pi / (ratio * p)
+    dt = 0.005
+    t = np.arange(0, 3 * T, dt)
+    return Record(np.where(t <= T, np.sin(2 * np.pi * t / T), 0.0), dt=dt, name="sine")
+
+
+def test_an_objects_study_of_a_wall_a_frame_and_an_arch(client, tmp_path):
+    from rockstudy.motions import load_suite
+    from rockstudy.study import load_study, run_study
+    from rockstudy.study.running.store import open_result
+
+    frame = EXAMPLES["asymmetric_frame"][1].equivalent_block()
+    folder = tmp_path / "records"
+    folder.mkdir()
+    test_record_studies.write_at2(folder / "sine.AT2", _sine(frame.frequency_parameter).scaled(G))
+    (tmp_path / "objects.csv").write_text(CSV)
+    path = tmp_path / "kinds.toml"
+    path.write_text(STUDY.format(objects='file = "objects.csv"', folder=folder))
+    study = load_study(path)
+    out = tmp_path / "cube.zarr"
+    report = run_study(study, out, client=client, base_dir=tmp_path, progress=False)
+    assert report.failed_samples == 0
+    cube = open_result(out).load()
+    assert list(cube["structure"].values) == ["Wall", "Frame", "Arch"]
+    for name, kind in (("Wall", "rocking_wall"), ("Frame", "asymmetric_frame"), ("Arch", "arch")):
+        row = cube.sel(structure=name)
+        assert float(row["frequency_parameter"]) == pytest.approx(
+            _expected(EXAMPLES[kind][1])[0], rel=1e-12
+        )
+    # the frame's capacity is that of its equivalent block alone ([003]): the record scaled to
+    # the capacity overturns the block, the highest surviving scale below it does not
+    rec = load_suite(folder)[0]
+    lo = float(cube["capacity_scale_lower"].sel(structure="Frame")[0])
+    hi = float(cube["capacity_scale"].sel(structure="Frame")[0])
+    assert np.isfinite(lo) and hi > lo
+    assert rs.simulate(frame, rec.scaled(hi)).overturned
+    assert not rs.simulate(frame, rec.scaled(lo)).overturned
+    # and the Python design function on the same structures gives the same cube
+    from rockstudy.study.designs import records as rd
+
+    objects = {
+        n: EXAMPLES[k][1]
+        for n, k in (("Wall", "rocking_wall"), ("Frame", "asymmetric_frame"), ("Arch", "arch"))
+    }
+    api = rd.incremental_dynamic_analysis([rec], objects, tolerance=0.02, scan=0)
+    for name in ("capacity", "capacity_scale", "capacity_scale_lower"):
+        np.testing.assert_allclose(
+            np.asarray(cube[name].values, float),
+            np.asarray(api[name].values, float),
+            rtol=1e-12,
+            err_msg=name,
+        )
+
+
+SAMPLED = """
+name = "sampled"
+seed = 3
+[sampler]
+kind = "monte_carlo"
+n = 6
+[structure]
+kind = "{kind}"
+half_diagonal = {{ dist = "uniform", low = 0.5, high = 3.0 }}
+slenderness = {{ dist = "uniform", low = 0.05, high = 0.3 }}
+restitution = 0.8
+[motion]
+kind = "pulse"
+shape = "sine"
+amplitude_ratio = 2.0
+period = 0.5
+"""
+
+
+@pytest.mark.parametrize("kind", [k for k, v in KINDS.items() if v.sampled is not None])
+def test_a_sampled_kind_in_a_design_has_the_parameters_of_its_class(kind):
+    from rockstudy.study.designs.sampling import make_design
+    from rockstudy.study.spec.schema import validate_text
+
+    ds = make_design(validate_text(SAMPLED.format(kind=kind)))
+    for R, a, p, theta in zip(
+        *(ds[v].values for v in ("half_diagonal", "slenderness")),
+        *(ds[v].values for v in ("frequency_parameter", "critical_rotation")),
+        strict=True,
+    ):
+        expect = _expected(KINDS[kind].structure(R, a, 0.8))  # its mechanism, not eq. (23)
+        assert (p, theta) == pytest.approx(expect[:2], rel=1e-9)
