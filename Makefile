@@ -10,12 +10,13 @@ KERNELS := $(VENV)/.kernels-compiled
 
 .PHONY: setup debian demo test docs bench figures lint clean
 
-# The venv's own pip (Python >= 3.11 bundles one that installs from pyproject.toml) and no
-# bytecode compiled at install: Python compiles the modules it imports on first use, and the
-# demo imports a small part of the dependencies (the pip upgrade and the compile step were 23 s of CPU of 54).
+# The venv's own pip (Python >= 3.11 bundles one that installs from pyproject.toml); the
+# bytecode is compiled at install, as every later command imports it (where
+# PYTHONDONTWRITEBYTECODE is set, as in many containers, it would otherwise be compiled again
+# on every run).
 $(BASE): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install -q --no-compile -e .
+	$(BIN)/pip install -q -e .
 	touch $(BASE)
 
 $(STAMP): $(BASE)

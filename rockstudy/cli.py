@@ -369,7 +369,8 @@ def _validate(args) -> int:
                 records = len(record_pairs(study.motion, Path(path).resolve().parent))
                 size = (
                     f"{study.design.kind} design: {records} records x "
-                    f"{study.samples() // study.levels()} structures x {study.levels()} levels"
+                    f"{study.samples() // study.levels()} structures"
+                    + ("" if study.design.kind == "ida" else f" x {study.levels()} levels")
                 )
             print(
                 f"{path}: ok ({study.sampler.kind}, {size}, "

@@ -55,10 +55,10 @@ def _units_for(im: str, units: str | None, name: str = "units") -> str:
     si = measures.measure(im).unit
     if units is None or units == si:
         return si
+    allowed = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
     if units not in UNIT_FACTORS:
-        raise ValueError(f"{name} must be one of {sorted(UNIT_FACTORS)}, got {units!r}")
+        raise ValueError(f"{name} of {im!r} must be one of {allowed}, got {units!r}")
     if UNIT_FACTORS[units][1] != si:
-        allowed = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
         raise ValueError(
             f"{name}={units!r} is not a unit of {im!r}, which is in {si}: use one of {allowed}"
         )

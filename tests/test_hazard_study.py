@@ -115,3 +115,15 @@ def test_monte_carlo_studies_refuse_a_hazard(tmp_path):
 
     text = study_text() + '\n[hazard]\nkind = "power_law"\nk0 = 1e-4\nk = 2.0\nim = "pga"\n'
     assert "hazard: applies to a record [design]" in _problems(tmp_path, None, text)
+
+
+@pytest.mark.parametrize("units", ["G", "m/s"])
+def test_a_bad_unit_of_a_hazard_file_is_the_units_field(tmp_path, units):
+    """The file is readable and its unit is what is wrong: the error names hazard.units (not
+    hazard.file) and lists only units of the measure."""
+    site = (DATA / "hazard" / "site_pga.csv").as_posix()
+    text = _problems(
+        tmp_path, f'[hazard]\nkind = "file"\nfile = "{site}"\nim = "pga"\nunits = "{units}"'
+    )
+    assert "hazard.units" in text and "hazard.file" not in text, text
+    assert "'s'" not in text and "'cm'" not in text, text  # no unit of time or length offered

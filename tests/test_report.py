@@ -212,3 +212,41 @@ def test_cells_have_three_significant_figures_and_counts_are_integers():
         _shown(0.5000531) == "0.5" and _shown(1.33309) == "1.33" and _shown(123456.0) == "1.23e+05"
     )
     assert _shown(np.nan) == "" and _shown("not reached") == "not reached"
+
+
+def test_median_in_g_reads_not_reached_where_the_median_is(tmp_path):
+    """The fragility table's median in g follows the median in m/s^2: a median beyond the
+    group's sampled intensities is 'not reached' in both columns, never a number in g."""
+    import pandas as pd
+
+    from rockstudy.constants import G
+    from rockstudy.study.analysis.fragility_fit import BAND_COLUMNS
+    from rockstudy.study.report import sampled as report
+    from rockstudy.study.report._page import NOT_REACHED
+
+    fit = pd.DataFrame(
+        {
+            "intensity": ["abs_amplitude", "abs_amplitude"],
+            "band": ["period", "period"],
+            "theta": [5.0, 80.0],  # inside [2, 20], then beyond it
+            "theta_lo": [4.0, 60.0],
+            "theta_hi": [6.0, 99.0],
+            "beta": [0.4, 0.5],
+            "im_min": [2.0, 2.0],
+            "im_max": [20.0, 20.0],
+            **{c: [0.0, 0.0] for c in BAND_COLUMNS},
+        },
+        index=pd.Index(["R 0.5 to 1 m", "R 1 to 2 m"], name="block size"),
+    )
+    shown = {}
+
+    class Page:
+        out = tmp_path
+
+        def table(self, df, name, caption):
+            shown[name] = df
+
+    report._fragility_table(Page(), fit)
+    in_g = shown["fragility"]["median capacity [g] (a_g only)"].tolist()
+    assert in_g[0] == pytest.approx(5.0 / G, rel=1e-15)
+    assert in_g[1] == NOT_REACHED

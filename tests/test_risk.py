@@ -146,7 +146,7 @@ def test_units_convert_and_cannot_trap():
         ({"rates": [1e-2, 0.0]}, r"rates must be finite and > 0; rates\[1\]"),
         ({"rates": [1e-2, 1e-2]}, "last two rates are equal"),
         ({"rates": [1e-2, 1e-3, 1e-4]}, "rates has 3 values but levels has 2"),
-        ({"units": "furlong"}, "units must be one of"),
+        ({"units": "furlong"}, "units of 'pga' must be one of"),
         ({"period": 0.5}, "period is only for the spectral"),
         ({"im": "sa"}, "period: a 'sa' hazard curve needs its period"),
     ],

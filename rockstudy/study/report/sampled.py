@@ -178,10 +178,13 @@ def _fragility_table(page, fit):
     fit.to_csv(page.out / "fragility_fit.csv")
     shown = _capacities_as_measured(fit).drop(columns=list(BAND_COLUMNS))
     dimensional = (fit["intensity"] == "abs_amplitude").to_numpy()
-    shown.insert(  # g next to m/s^2
+    shown.insert(  # g next to m/s^2, read as not reached (or below) where the median is
         shown.columns.get_loc("theta") + 1,
         "median capacity [g] (a_g only)",
-        np.where(dimensional, fit["theta"].to_numpy(float) / G, np.nan),
+        [
+            (v / G if isinstance(v, float) else v) if dim else np.nan
+            for v, dim in zip(shown["theta"], dimensional, strict=True)
+        ],
     )
     page.table(
         shown.replace({"intensity": _SHORT, "band": _BANDS}).rename(columns=_FRAGILITY_NAMES),
@@ -657,8 +660,8 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     (see :func:`~rockstudy.study.running.store.open_result`): a cube whose metadata was edited."""
     result = Path(result)
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
+    ds = open_result(result, verify=verify).load()  # a missing cube leaves no report folder
     out.mkdir(parents=True, exist_ok=True)
-    ds = open_result(result, verify=verify).load()
     if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design
         from .records import record_report
 

@@ -113,7 +113,10 @@ def _prime(study_json, columns, base_dir, progress):
         study_json,
         columns,
         base_dir,
-        lambda: say("compiling the numba kernels (once per install; `rockstudy compile`) ..."),
+        lambda: say(
+            "compiling the numba kernels this study needs (once: they are cached; "
+            "`rockstudy compile` does them all) ..."
+        ),
     )
     if r["compiled"]:
         say(f" done in {r['seconds']:.1f} s\n")

@@ -1447,7 +1447,10 @@ def _read_hazard_file(data, base_dir) -> str | None:
     try:
         curve = HazardCurve.from_csv(path, **args)
     except (TypeError, ValueError, KeyError) as exc:
-        return f"hazard.file: {exc}"
+        text = str(exc)
+        # a bad units or period is that field's problem, not the file's
+        field = next((f for f in ("units", "period") if text.startswith(f)), "file")
+        return f"hazard.{field}: {text}"
     hz["levels"], hz["rates"] = curve.levels.tolist(), curve.rates.tolist()
     hz["units"] = curve.units
     if curve.period is not None:
