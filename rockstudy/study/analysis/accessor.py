@@ -65,7 +65,7 @@ class RockingAccessor:
     >>> ds = xr.open_zarr("results/quickstart.zarr")
     >>> ds.rocking.kind
     'monte_carlo'
-    >>> ds.rocking.fragility("amplitude_ratio", by="half_diagonal", bins=[0.3, 1, 5])
+    >>> ds.rocking.fragility("amplitude_ratio", by="half_diagonal", bins=[0.5, 1, 2, 3])
     """
 
     def __init__(self, ds: xr.Dataset):
@@ -186,7 +186,7 @@ class RockingAccessor:
 
         Examples
         --------
-        >>> ds.rocking.fragility("amplitude_ratio", by="half_diagonal", bins=[0.3, 1, 5])
+        >>> ds.rocking.fragility("amplitude_ratio", by="half_diagonal", bins=[0.5, 1, 2, 3])
         >>> ida.rocking.fragility(im="pgv_ratio", by="structure")
         """
         if self.kind in RECORD_DESIGNS:
