@@ -315,3 +315,31 @@ def test_a_record_study_cube_read_by_xarray_is_folded_and_uses_its_study(raw_rec
     n_rec = len(json.loads(ds.attrs["record_names"]))
     assert flags.dims == ("record", "structure")
     np.testing.assert_array_equal(flags.values, expected.reshape(n_rec, -1))
+
+
+def test_rockstudy_study_on_first_use_registers_the_accessor(tmp_path):
+    """``import rockstudy`` stays light (no study layer, no xarray); its ``study`` attribute
+    loads the study layer, which registers ``ds.rocking``."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    code = (
+        "import sys, rockstudy as rs\n"
+        "light = 'rockstudy.study' not in sys.modules and 'xarray' not in sys.modules\n"
+        "import xarray as xr\n"
+        "before = hasattr(xr.Dataset, 'rocking')\n"
+        "rs.study\n"
+        "print(light, before, hasattr(xr.Dataset, 'rocking'))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert out.stdout.split() == ["True", "False", "True"]
