@@ -8,7 +8,12 @@ closed form of the annual rate, and flags counted by hand. Each cube kind must r
 its kind calls for, and a keyword or a Dataset the accessor cannot serve is refused by name.
 """
 
+import ast
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +27,8 @@ import rockstudy.study  # noqa: F401 - registers ds.rocking
 from rockstudy import risk
 from rockstudy.constants import G
 from rockstudy.study import load_study, make_design, validate_text
+from rockstudy.study.analysis import fragility_fit, record_fragility, record_similarity, sampled
+from rockstudy.study.analysis import risk as object_risk_module
 
 MC = """
 name = "accessor_mc"
@@ -320,11 +327,6 @@ def test_a_record_study_cube_read_by_xarray_is_folded_and_uses_its_study(raw_rec
 def test_rockstudy_study_on_first_use_registers_the_accessor(tmp_path):
     """``import rockstudy`` stays light (no study layer, no xarray); its ``study`` attribute
     loads the study layer, which registers ``ds.rocking``."""
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
-
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
     code = (
         "import sys, rockstudy as rs\n"
@@ -343,3 +345,24 @@ def test_rockstudy_study_on_first_use_registers_the_accessor(tmp_path):
         check=True,
     )
     assert out.stdout.split() == ["True", "False", "True"]
+
+
+def test_every_fragility_fit_is_the_shared_modules():
+    """One lognormal/Bernoulli fitting module: the fits every analysis calls are those of
+    fragility_fit, and no other module of the study layer runs an optimiser of its own."""
+    for module in (sampled, record_fragility, record_similarity, object_risk_module):
+        for name in ("fit_binomial", "fit_capacities"):
+            if hasattr(module, name):
+                assert getattr(module, name) is getattr(fragility_fit, name), (module, name)
+    study = Path(fragility_fit.__file__).resolve().parents[1]
+    optimisers = []
+    for path in study.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            if any(n.startswith("scipy.optimize") or n == "scipy.optimize" for n in names):
+                optimisers.append(path.name)
+    assert optimisers == ["fragility_fit.py"], optimisers
