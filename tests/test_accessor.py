@@ -204,6 +204,9 @@ def test_sobol_indices_of_the_ishigami_function():
     assert list(table.index) == names
     assert np.all(np.abs(table["S1"] - s1) <= np.maximum(2 * table["S1_conf"], 0.03))
     assert np.all(np.abs(table["ST"] - st) <= np.maximum(2 * table["ST_conf"], 0.03))
+    conv = ds.rocking.sobol_convergence("y", num_resamples=20)
+    assert list(conv.index.get_level_values("N").unique()) == [2**k for k in range(4, 13)]
+    np.testing.assert_allclose(conv.loc[2**12, "S1"].values, table["S1"].values, atol=0.02)
 
 
 def test_collapse_of_a_replicated_design(mc_cube):
@@ -215,6 +218,13 @@ def test_collapse_of_a_replicated_design(mc_cube):
     noise = np.random.default_rng(1).standard_normal(mc_cube.sizes["sample"])
     share = mc_cube.assign(noise=("sample", noise)).rocking.collapse("noise", groups)
     assert share == pytest.approx(0.75, abs=0.02)
+    # the cross-check of designs without replicates: noise is left unexplained, the law not
+    left = mc_cube.assign(law=law, noise=("sample", noise)).rocking
+    assert left.unexplained_share("noise", groups).value > 0.9
+    assert left.unexplained_share("law", groups).value < 0.05
+    # first-order indices on the groups: the law depends on uplift_ratio and omega only
+    s1 = left.first_order_given_data("law", groups)["S1"]
+    assert s1["restitution"] < 0.05 < s1["uplift_ratio"]
 
 
 def test_collapse_of_a_record_design_spreads_the_known_medians():
