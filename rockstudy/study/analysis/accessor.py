@@ -293,7 +293,20 @@ class RockingAccessor:
 
     def sobol_convergence(self, output: str, **kw):
         """Sobol' indices on nested prefixes N = 2^k of the base samples
-        (:func:`rockstudy.study.analysis.sobol_convergence`).
+        (:func:`rockstudy.study.analysis.sobol_convergence`), on a Sobol' study's cube.
+
+        Parameters
+        ----------
+        output : str
+            The output variable.
+        **kw
+            ``names``, ``second_order``, ``failed``, and ``num_resamples``, ``conf_level``,
+            ``seed`` of :meth:`sobol`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by (``N``, input), the columns of :meth:`sobol`.
 
         Examples
         --------
@@ -311,6 +324,20 @@ class RockingAccessor:
     def first_order_given_data(self, output: str, variables, **kw):
         """First-order indices of ``output`` on any variables of a sampled cube, e.g. the
         dimensionless groups (:func:`rockstudy.study.analysis.first_order_given_data`).
+
+        Parameters
+        ----------
+        output : str
+            The output variable.
+        variables : list of str
+            Variables of the cube (not necessarily the sampler's inputs).
+        **kw
+            ``failed``, ``seed``.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: the variables; columns ``S1``, ``S1_conf`` (RBD-FAST).
 
         Examples
         --------
@@ -376,6 +403,20 @@ class RockingAccessor:
         to that fit's floor (:func:`rockstudy.study.analysis.unexplained_share`): the
         self-similarity check of a sampled design that is not replicated.
 
+        Parameters
+        ----------
+        response : str
+            The response variable.
+        groups : list of str
+            The groups it should be a function of.
+        **kw
+            ``k`` (neighbours), ``failed``, ``log_groups``.
+
+        Returns
+        -------
+        UnexplainedShare
+            ``(value, floor, n, k)``.
+
         Examples
         --------
         >>> ds.rocking.unexplained_share("max_rotation_ratio", ["a", "omega", "restitution"])
@@ -395,6 +436,11 @@ class RockingAccessor:
         ----------
         friction : float or array_like, optional
             mu, one or one per structure (NaN: none); default the study's ``friction``.
+
+        Returns
+        -------
+        xarray.DataArray
+            Boolean, on the scenes of the cube.
 
         Examples
         --------
