@@ -5,8 +5,10 @@ the single-ODE formulation (Prieto & Lourenco 2005), dynamically equivalent stru
 (DeJong & Dimitrakopoulos 2014), and parametric studies on top.
 
 The subpackages and the solvers are imported on first use (PEP 562 module ``__getattr__``):
-``import rockstudy`` loads neither numba nor scipy, ``rockstudy.simulate`` does. The numba
-kernels are compiled once per install by ``rockstudy compile`` (``make setup`` runs it).
+``import rockstudy`` loads neither numba nor scipy, ``rockstudy.simulate`` does;
+``rockstudy.study`` loads the study layer and registers the ``ds.rocking`` accessor of xarray.
+The numba kernels are compiled once per install by ``rockstudy compile`` (``make setup`` runs
+it).
 """
 
 from __future__ import annotations
@@ -45,6 +47,9 @@ _LAZY = {
     "risk": (".risk", None),
     "similarity": (".similarity", None),
     "structures": (".structures", None),
+    # the study layer (xarray, dask, pydantic, scipy): on first use of ``rockstudy.study``,
+    # which also registers the ``ds.rocking`` accessor of xarray Datasets
+    "study": (".study", None),
 }
 
 __all__ = [

@@ -1,8 +1,11 @@
 """The study layer: declarative TOML studies, samplers, dask execution and zarr result cubes.
 
-Imports run one way: ``study`` uses the physics packages, never the reverse.
+Imports run one way: ``study`` uses the physics packages, never the reverse. Importing it
+registers the ``rocking`` accessor of :class:`xarray.Dataset`
+(:class:`~rockstudy.study.analysis.accessor.RockingAccessor`): ``ds.rocking.fragility()``.
 """
 
+from .analysis.accessor import RockingAccessor
 from .analysis.record_fragility import ida_fragility, im_efficiency, stripe_fragility
 from .analysis.risk import object_risk
 from .designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
@@ -12,6 +15,7 @@ from .running.store import export_netcdf, open_result
 from .spec.schema import Study, StudyError, json_schema, load_study, validate_text
 
 __all__ = [
+    "RockingAccessor",
     "RunReport",
     "cloud",
     "ida_fragility",
