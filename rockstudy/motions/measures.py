@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate
-from ..constants import STANDARD_GRAVITY, G
+from ..constants import STANDARD_GRAVITY
 from . import intensity
 
 
@@ -359,7 +359,7 @@ def _of_samples(f: Callable) -> Callable:
 def _builtins():
     """The measures of :mod:`rockstudy.motions.intensity` (see its conventions), in the order
     of the tables."""
-    to_g = {"quoted_unit": "g", "factor": 1.0 / G}  # as the fragility tables always quoted
+    to_g = {"quoted_unit": "g", "factor": 1.0 / STANDARD_GRAVITY}  # g the unit, as for records
     register_measure("pga", lambda r: r.peak, unit="m/s^2", power=1, label="PGA", **to_g)
     register_measure("pgv", _peak_ground_velocity, unit="m/s", power=1, label="PGV")
     register_measure("pgd", _peak_ground_displacement, unit="m", power=1, label="PGD")

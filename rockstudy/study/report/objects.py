@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ...constants import G
+from ...constants import STANDARD_GRAVITY
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.sampled import fragility_curve
@@ -155,7 +155,7 @@ def outcome(page, ctx):
     """In words, when nothing rocked or nothing overturned (no fragility can be fitted)."""
     if ctx.overturned:
         return
-    up = ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+    up = ctx.ds["uplift_acceleration"].values / _unit(ctx)
     if not ctx.rocked:
         page.warning(
             "Nothing rocked: no structure left rest under any record at any level. Every "
@@ -195,9 +195,15 @@ def _label(ctx, im, period=None):
     return ctx.relabel(ctx.im_label(im, period))
 
 
+def _unit(ctx) -> float:
+    """The report's unit of acceleration in m/s^2: the unit g (standard gravity, as records
+    and ``scale_to`` read it) or 1."""
+    return STANDARD_GRAVITY if ctx.units == "g" else 1.0
+
+
 def _accel_factor(ctx, im) -> float:
     """The factor from a fit's quoted units of ``im`` to the report's (g -> m/s^2)."""
-    return G if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
+    return STANDARD_GRAVITY if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
 
 
 def _object_fit(ctx, im, period):
@@ -215,7 +221,7 @@ def _uplift(ctx, im) -> np.ndarray | None:
     """Each object's uplift level in ``im`` (g tan theta_cr of its equivalent block; 1 in
     PGA / (g tan alpha)), or None where a measure has no single uplift level."""
     if im == "pga":
-        return ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+        return ctx.ds["uplift_acceleration"].values / _unit(ctx)
     if im == "pga_ratio":
         return np.ones(ctx.ds.sizes["structure"])
     return None
@@ -318,7 +324,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
 def _ida_capacity(ctx):
     """(cells, values): the PGA at first overturning of each object (rows) under each record
     (columns); censored: 'above' the highest scale seen to stand."""
-    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    ds, f = ctx.ds, 1.0 / _unit(ctx)
     pga = ds["pga"].values[:, None] * f
     cap = ds["capacity_scale"].values * pga
     value = np.where(ds["censored"].values == 1, np.nan, cap).T
@@ -334,7 +340,7 @@ def _stripe_capacity(ctx):
     each record (the lowest overturning level, in the stripes' measure)."""
     ds = ctx.ds
     im = ds.attrs.get("im", "pga")
-    levels = ds["level"].values * (1.0 / G if im in ("pga", "sa") and ctx.units == "g" else 1.0)
+    levels = ds["level"].values * (1.0 / _unit(ctx) if im in ("pga", "sa") else 1.0)
     over = ds["overturned"].values == 1  # (record, structure, level)
     first = np.where(over.any(-1), over.argmax(-1), -1).T
     cells = np.empty(first.shape, object)
@@ -350,7 +356,7 @@ def _stripe_capacity(ctx):
 
 def _cloud_capacity(ctx):
     """(cells, values): under the unscaled records, whether each object overturned."""
-    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    ds, f = ctx.ds, 1.0 / _unit(ctx)
     over = (ds["overturned"].values == 1).T
     pga = np.broadcast_to(ds["pga"].values * f, over.shape)
     cells = np.where(over, "overturned", "stands").astype(object)
@@ -405,7 +411,7 @@ def _ida_curve(ax, ctx, i, j, offset):
     """Record i's IDA curve of object j: its simulated points in increasing scale, its
     first overturning (cross) and the switch band above it (shaded)."""
     ds = ctx.ds
-    pga = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    pga = ds["pga"].values[i] / _unit(ctx)
     alpha = float(ds["slenderness"].values[j])
     s = ds["step_scale"].values[i, j]
     ok = np.isfinite(s)
@@ -481,7 +487,7 @@ def _shared_legend(fig, ax, n):
 
 def _stripe_points(ax, ctx, i, j, offset):
     ds = ctx.ds
-    y = ds["scale"].values[i, j] * ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    y = ds["scale"].values[i, j] * ds["pga"].values[i] / _unit(ctx)
     x = ds["max_rotation"].values[i, j] / float(ds["slenderness"].values[j])
     over = ds["overturned"].values[i, j] == 1
     x = np.where(over, 1.0, np.minimum(x, 1.0)) + offset

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ...constants import G
+from ...constants import STANDARD_GRAVITY, G
 from ...motions import measures
 from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS
@@ -182,7 +182,7 @@ def _fragility_table(page, fit):
         shown.columns.get_loc("theta") + 1,
         "median capacity [g] (a_g only)",
         [
-            (v / G if isinstance(v, float) else v) if dim else np.nan
+            (v / STANDARD_GRAVITY if isinstance(v, float) else v) if dim else np.nan
             for v, dim in zip(shown["theta"], dimensional, strict=True)
         ],
     )
