@@ -27,6 +27,7 @@ from .constants import G
 from .motions.pulses import PULSES, RickerWavelet
 from .motions.records import Record
 from .structures.block import Block, block_parameters
+from .structures.block import uplift_acceleration as _uplift_acceleration
 
 Law = Literal["4.10", "4.11", "5.3", "6.1"]
 LAWS = ("4.10", "4.11", "5.3", "6.1")
@@ -197,13 +198,9 @@ def uplift_acceleration(structure) -> float:
 
     g tan(alpha) for a block (section 2 of [000]) or an equivalent block; g lambda for a
     structure with rocking parameters (eq. 10 of [003]), the smaller of the two directions of
-    an asymmetric one.
+    an asymmetric one (:func:`rockstudy.structures.uplift_acceleration`).
     """
-    if hasattr(structure, "rocking_parameters"):
-        params = structure.rocking_parameters()
-        params = params if isinstance(params, tuple) else (params,)
-        return G * min(float(q.uplift) for q in params)
-    return G * math.tan(_block(structure)[1])
+    return _uplift_acceleration(structure)
 
 
 def record_groups(structure, record: Record) -> dict:

@@ -159,7 +159,8 @@ def outcome(page, ctx):
     if not ctx.rocked:
         page.warning(
             "Nothing rocked: no structure left rest under any record at any level. Every "
-            "level lies below the uplift level of every structure (g tan alpha, from "
+            "level lies below the uplift level of every structure (g tan alpha of a block, "
+            "g lambda of another structure, from "
             f"{np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}); no fragility can be "
             "fitted. Raise the levels (check the units of scale_to.value)."
         )
@@ -212,8 +213,9 @@ def _object_fit(ctx, im, period):
 
 
 def _uplift(ctx, im) -> np.ndarray | None:
-    """Each object's uplift level in ``im`` (g tan theta_cr of its equivalent block; 1 in
-    PGA / (g tan alpha)), or None where a measure has no single uplift level."""
+    """Each object's uplift level in ``im`` (its uplift acceleration a_up: g tan alpha of a
+    block, g lambda of another structure, eq. 10 of [003]; 1 in PGA / a_up), or None where
+    a measure has no single uplift level (NaN for a cube that does not say it)."""
     if im == "pga":
         return ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
     if im == "pga_ratio":
@@ -259,8 +261,9 @@ def object_fragility(page, ctx):
         "object_fragility",
         "Fragility of each object (lognormal fit, 90 % pointwise band) against PGA and "
         "against the measure the efficiency table recommends; dotted vertical lines: each "
-        "object's uplift level (g tan alpha of the block or of the equivalent block of a "
-        "wall, frame or arch), drawn where the measure has one (PGA, PGA / (g tan alpha))",
+        "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
+        "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
+        "the measure has one (PGA, PGA / uplift level)",
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
@@ -466,7 +469,8 @@ def object_curves(page, ctx):
             else "the stripe points (open circles: stood; crosses: overturned, drawn at "
             "theta_max / alpha = 1)"
         )
-        + "; dotted: the object's uplift level g tan alpha; markers of the records are offset "
+        + "; dotted: the object's uplift level (g tan alpha of a block, g lambda of another "
+        "structure); markers of the records are offset "
         "slightly in x so that none hides another",
     )
 

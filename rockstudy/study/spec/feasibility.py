@@ -17,7 +17,6 @@ from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, mach
 from ...constants import G
 from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs
-from .structures import KINDS
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
@@ -135,8 +134,9 @@ def _scaling_notes(study, base_dir) -> list[str]:
     design or Monte Carlo rows) or run unscaled (a cloud design): the records whose largest
     scale factor exceeds ``design.max_scale_factor`` (5 by default), and, when every record
     is horizontal only and even the highest level leaves every record's PGA below the lowest
-    uplift acceleration g tan(theta_cr) of the structures, that nothing can rock (every
-    point stays at rest)."""
+    uplift acceleration of the structures (:meth:`.schema.Study.uplift_span`: g tan(alpha) of
+    a block, g lambda of another structure, eq. 10 of [003]), that nothing can rock (no
+    structure leaves rest)."""
     de = study.design
     cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
     if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):
@@ -156,24 +156,15 @@ def _scaling_notes(study, base_dir) -> list[str]:
                 f"{'design.' if de else ''}max_scale_factor = {limit:g} (a record scaled far "
                 "from what it recorded)"
             )
-    uplift = G * math.tan(_smallest_critical_rotation(study))
+    uplift = study.uplift_span()[0]
     if horizontal and top_pga < uplift:
         found.append(
             f"{scaled[0]}: nothing can rock: the highest level brings every record to a PGA "
-            f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration g tan(alpha) "
-            f"= {uplift:.4g} m/s^2 of the structures (check the value and its units)"
+            f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration "
+            f"{uplift:.4g} m/s^2 of the structures (g tan(alpha) of a block, g lambda of "
+            "another structure; check the value and its units)"
         )
     return found
-
-
-def _smallest_critical_rotation(study) -> float:
-    """The smallest critical rotation theta_cr [rad] the study's structures can have."""
-    st = study.structure
-    if st.kind == "objects":
-        return float(st.rocking()[:, 1].min())
-    if st.kind == "equivalent_block":
-        return draw_span(st.critical_rotation)[0]
-    return float(KINDS[st.kind].sampled(1.0, draw_span(st.slenderness)[0])[1])
 
 
 def _named_twice(pairs) -> list[str]:
@@ -245,8 +236,8 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     peak = float(np.max(np.abs(rec.acceleration)))
     if rec.vertical is not None:
         peak = max(peak, float(np.max(np.abs(rec.vertical))))
-    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
-    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio g tan
+    uplift = study.uplift_span()[1]
+    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio a_up
         top = de.ida_options()["max_pga_ratio"] * uplift
         return "design.max_pga_ratio", top * peak / rec.peak if rec.peak > 0 else 0.0
     if mo.scale is not None:
@@ -260,7 +251,7 @@ def _largest_scale(study, rec) -> tuple[str, float] | None:
     """(field, the largest factor on ``rec`` that its target asks), over the whole support of
     the study's distributions and structures; None without a target or for a measure of 0."""
     mo = study.motion
-    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
+    uplift = study.uplift_span()[1]
     target = mo.target()
     if target is None or target.value is None:
         return None
