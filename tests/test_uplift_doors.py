@@ -401,3 +401,17 @@ def test_old_cubes_fall_back_for_blocks_and_warn_for_other_structures():
     with pytest.warns(UpliftWarning, match="g tan"):
         got = record_rows._old_uplift(ds, mixed)
     assert np.isnan(got).all()
+
+
+def test_similarity_groups_and_pulses_use_the_structures_uplift():
+    """``similarity.groups`` and ``pulse_for`` (laws 5.3, 6.1) take uplift_ratio = a_up / a_g
+    of the structure: a wall's pulse of uplift_ratio 1.001 leaves it at rest, 0.999 rocks it
+    (eq. 21 of [003]: a_up = 2 g tan alpha)."""
+    wall = STRUCTURES["Wall"][2]
+    a_up = 2 * G * math.tan(WALL["slenderness"])
+    pulse = SinePulse(3.0, 2.0)
+    assert rs.similarity.groups(wall, pulse)["uplift_ratio"] == pytest.approx(a_up / 3.0, 1e-12)
+    for ratio, rocks in ((1.001, False), (0.999, True)):
+        p = rs.similarity.pulse_for(wall, omega=0.5, ratio=ratio, law="5.3")
+        assert p.amplitude == pytest.approx(a_up / ratio, rel=1e-12)
+        assert _rocks(wall, p) == rocks
