@@ -415,3 +415,23 @@ def test_similarity_groups_and_pulses_use_the_structures_uplift():
         p = rs.similarity.pulse_for(wall, omega=0.5, ratio=ratio, law="5.3")
         assert p.amplitude == pytest.approx(a_up / ratio, rel=1e-12)
         assert _rocks(wall, p) == rocks
+
+
+def test_validate_notes_where_the_equivalent_block_lifts_off_elsewhere(folder, tmp_path):
+    """The study simulates the equivalent block, which lifts off at g tan(theta_cr): validate
+    says so where that is more than 1 % from the structure's own g lambda (the arch: 24 %
+    below; a sampled wall of alpha up to 0.4: tan(0.8) / (2 tan 0.4) - 1 = 17 % above), and
+    not for a block."""
+    from rockstudy.study.spec.feasibility import uplift_notes
+    from rockstudy.study.spec.schema import validate_text
+
+    notes = uplift_notes(_study(tmp_path, folder, design="cloud"))
+    assert len(notes) == 3, notes  # the wall (1.5 %), the frame (1.2 %), the arch
+    arch = next(n for n in notes if "'Arch'" in n)
+    assert arch.startswith("structure.objects[2] ('Arch')") and "below" in arch
+    gap = 1 - 2.1179902 / 2.7833414  # g tan(theta_cr) / g lambda, in the first test
+    assert f"{gap:.1%}" in arch
+    (wall,) = uplift_notes(validate_text(SAMPLED.replace("RATIO", "2.0")))
+    assert f"{math.tan(0.8) / (2 * math.tan(0.4)) - 1:.1%} above" in wall
+    block = '[[structure.objects]]\nname = "B"\nwidth = 0.4\nheight = 2.0'
+    assert uplift_notes(_study(tmp_path, folder, objects=block, design="cloud")) == []

@@ -17,6 +17,8 @@ from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, mach
 from ...constants import G
 from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs
+from ...structures.block import uplift_acceleration_block
+from .structures import KINDS
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
@@ -96,11 +98,13 @@ def notes(study, base_dir=None) -> list[str]:
     model no longer holds) at a scale the design reaches (those points are stored as
     censored, with their reason; the record's other points run); records scaled by more than
     ``design.max_scale_factor``; and targets so low that nothing can rock
-    (:func:`_scaling_notes`)."""
+    (:func:`_scaling_notes`); and structures whose equivalent block, which the study
+    simulates, lifts off far from the structure's own uplift acceleration
+    (:func:`uplift_notes`)."""
     mo = study.motion
     if mo.kind != "record":
-        return []
-    found = _scaling_notes(study, base_dir)
+        return uplift_notes(study)
+    found = uplift_notes(study) + _scaling_notes(study, base_dir)
     if study.design is None:
         return found
     for field, h, v in record_pairs(mo, base_dir):
@@ -120,6 +124,48 @@ def notes(study, base_dir=None) -> list[str]:
                 "above free fall are stored as censored (reason: free fall); the others run"
             )
     return found
+
+
+#: Relative gap between g tan(theta_cr) of the equivalent block and the structure's uplift
+#: acceleration g lambda above which validate notes it (a wall of alpha 0.1 reaches 1 %).
+UPLIFT_NOTE_GAP = 0.01
+
+
+def uplift_notes(study) -> list[str]:
+    """The structures whose equivalent block (what the study simulates: p, theta_cr, eta)
+    lifts off at g tan(theta_cr) more than :data:`UPLIFT_NOTE_GAP` away from the structure's
+    own uplift acceleration a_up (g lambda, eq. 10 of [003]), which the ratios, the IDA's
+    ladder, the notes and the reports use: between the two levels the simulated response is
+    the block's, not the structure's."""
+    st = study.structure
+    if st.kind == "objects":
+        found = []
+        for i, o in enumerate(st.objects):
+            eq, a_up = float(uplift_acceleration_block(o.rocking()[1])), o.uplift()
+            if abs(eq / a_up - 1.0) > UPLIFT_NOTE_GAP:
+                found.append(_uplift_note(f"structure.objects[{i}] ({o.name!r})", o.kind, eq, a_up))
+        return found
+    if st.kind == "equivalent_block":  # a block: it is what runs
+        return []
+    ends = np.array(draw_span(st.slenderness))
+    _, theta_cr, a_up = KINDS[st.kind].sampled(np.ones(2), ends)
+    eq = uplift_acceleration_block(theta_cr)
+    gap = np.abs(eq / a_up - 1.0)
+    j = int(np.argmax(gap))
+    if gap[j] <= UPLIFT_NOTE_GAP:
+        return []
+    return [_uplift_note("structure.slenderness", st.kind, float(eq[j]), float(a_up[j]))]
+
+
+def _uplift_note(field, kind, eq, a_up) -> str:
+    side = "above" if eq > a_up else "below"
+    return (
+        f"{field}: the study runs the {kind}'s equivalent block, which lifts off at g "
+        f"tan(theta_cr) = {eq:.4g} m/s^2, {abs(eq / a_up - 1):.1%} {side} the {kind}'s own "
+        f"uplift acceleration {a_up:.4g} m/s^2 (g lambda, eq. 10 of [003]) that the ratios "
+        "and uplift levels use: between the two the simulated response is the block's "
+        "(rockstudy.simulate runs the mechanism)"
+    )
 
 
 def free_fall_scale(record) -> float:
