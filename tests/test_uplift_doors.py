@@ -435,3 +435,23 @@ def test_validate_notes_where_the_equivalent_block_lifts_off_elsewhere(folder, t
     assert f"{math.tan(0.8) / (2 * math.tan(0.4)) - 1:.1%} above" in wall
     block = '[[structure.objects]]\nname = "B"\nwidth = 0.4\nheight = 2.0'
     assert uplift_notes(_study(tmp_path, folder, objects=block, design="cloud")) == []
+
+
+def test_a_report_without_uplift_levels_says_so(folder, tmp_path):
+    """An old cube of non-block structures opens with NaN uplift levels (above): the objects
+    report draws no uplift line and says the levels are not stored."""
+    import re
+
+    from rockstudy.study.designs.records import multiple_stripes
+    from rockstudy.study.report.records import record_report
+
+    rec = load_suite(folder)[0]
+    objects = {k: STRUCTURES[k][2] for k in ("Wall", "Arch")}
+    ds = multiple_stripes([rec], objects, [0.1], rtol=1e-6)  # PGA 0.1 m/s^2: nothing rocks
+    assert float(np.nanmax(ds["max_rotation"].values)) == 0.0
+    ds["uplift_acceleration"] = ds["uplift_acceleration"] * np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        page = record_report(ds, tmp_path / "r", n_boot=5)
+    text = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.read_text()))
+    assert "Nothing rocked" in text and "not stored in this cube" in text

@@ -156,13 +156,18 @@ def outcome(page, ctx):
     if ctx.overturned:
         return
     up = ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+    span = (
+        f"from {np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}"
+        if np.isfinite(up).any()
+        else "not stored in this cube"
+    )
     if not ctx.rocked:
         page.warning(
-            "Nothing rocked: no structure left rest under any record at any level. Every "
-            "level lies below the uplift level of every structure (g tan alpha of a block, "
-            "g lambda of another structure, from "
-            f"{np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}); no fragility can be "
-            "fitted. Raise the levels (check the units of scale_to.value)."
+            "Nothing rocked: no structure (as simulated: a block, or the equivalent block of "
+            "another structure) left rest under any record at any level. The uplift levels "
+            f"of the structures (g tan alpha of a block, g lambda of another) are {span}; "
+            "no fragility can be fitted. Raise the levels (check the units of "
+            "scale_to.value)."
         )
     else:
         page.warning(
@@ -289,7 +294,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
     low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
     up = _uplift(ctx, im)
     names = list(map(str, ctx.ds["structure"].values))
-    if up is not None:
+    if up is not None and np.isfinite(up).any():
         low = min(low, np.nanmin(up))
     if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
         return False
@@ -445,7 +450,8 @@ def object_curves(page, ctx):
                 _ida_curve(ax, ctx, i, j, spread[i])
             else:
                 _stripe_points(ax, ctx, i, j, spread[i])
-        ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
+        if np.isfinite(uplift[j]):  # NaN: a cube that does not say it
+            ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
         ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
