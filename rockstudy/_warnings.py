@@ -40,3 +40,8 @@ class EquivalentBlockWarning(AccuracyWarning):
 class ContactWarning(AccuracyWarning):
     """The block needs more friction than given, or lifts off: it would slide or leave the
     ground, which the rocking model (no sliding, no lift-off) does not describe."""
+
+
+class UpliftWarning(AccuracyWarning):
+    """A result's uplift level is not the structure's own: a cube written before the design
+    carried each structure's uplift acceleration (g lambda, eq. 10 of [003])."""

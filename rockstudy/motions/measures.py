@@ -24,8 +24,9 @@ integral of a_g^2, goes as s^2; durations and periods do not change (k = 0) and 
 scaled to.
 
 The dimensionless scale targets of the record designs (:data:`RATIOS`, ``pga_ratio`` = PGA /
-(g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha)) are a measure of this registry divided
-by the block's uplift acceleration; they follow their measure's power.
+a_up and ``pgv_ratio`` = PGV p / a_up) are a measure of this registry divided by the structure's
+uplift acceleration a_up (g tan alpha of a block, g lambda of another structure, eq. 10 of
+[003]); they follow their measure's power.
 """
 
 from __future__ import annotations
@@ -91,7 +92,8 @@ class Measure:
 @dataclass(frozen=True)
 class Ratio:
     """A dimensionless scale target: the measure ``base`` times p^``p_power`` divided by the
-    uplift acceleration g tan(alpha) of each block; it follows the power of ``base``."""
+    uplift acceleration a_up of each structure (g tan(alpha) of a block); it follows the power
+    of ``base``."""
 
     base: str
     p_power: int

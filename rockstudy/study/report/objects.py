@@ -156,12 +156,18 @@ def outcome(page, ctx):
     if ctx.overturned:
         return
     up = ctx.ds["uplift_acceleration"].values / _unit(ctx)
+    span = (
+        f"from {np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}"
+        if np.isfinite(up).any()
+        else "not stored in this cube"
+    )
     if not ctx.rocked:
         page.warning(
-            "Nothing rocked: no structure left rest under any record at any level. Every "
-            "level lies below the uplift level of every structure (g tan alpha, from "
-            f"{np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}); no fragility can be "
-            "fitted. Raise the levels (check the units of scale_to.value)."
+            "Nothing rocked: no structure (as simulated: a block, or the equivalent block of "
+            "another structure) left rest under any record at any level. The uplift levels "
+            f"of the structures (g tan alpha of a block, g lambda of another) are {span}; "
+            "no fragility can be fitted. Raise the levels (check the units of "
+            "scale_to.value)."
         )
     else:
         page.warning(
@@ -218,8 +224,9 @@ def _object_fit(ctx, im, period):
 
 
 def _uplift(ctx, im) -> np.ndarray | None:
-    """Each object's uplift level in ``im`` (g tan theta_cr of its equivalent block; 1 in
-    PGA / (g tan alpha)), or None where a measure has no single uplift level."""
+    """Each object's uplift level in ``im`` (its uplift acceleration a_up: g tan alpha of a
+    block, g lambda of another structure, eq. 10 of [003]; 1 in PGA / a_up), or None where
+    a measure has no single uplift level (NaN for a cube that does not say it)."""
     if im == "pga":
         return ctx.ds["uplift_acceleration"].values / _unit(ctx)
     if im == "pga_ratio":
@@ -265,8 +272,9 @@ def object_fragility(page, ctx):
         "object_fragility",
         "Fragility of each object (lognormal fit, 90 % pointwise band) against PGA and "
         "against the measure the efficiency table recommends; dotted vertical lines: each "
-        "object's uplift level (g tan alpha of the block or of the equivalent block of a "
-        "wall, frame or arch), drawn where the measure has one (PGA, PGA / (g tan alpha))",
+        "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
+        "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
+        "the measure has one (PGA, PGA / uplift level)",
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
@@ -292,7 +300,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
     low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
     up = _uplift(ctx, im)
     names = list(map(str, ctx.ds["structure"].values))
-    if up is not None:
+    if up is not None and np.isfinite(up).any():
         low = min(low, np.nanmin(up))
     if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
         return False
@@ -448,7 +456,8 @@ def object_curves(page, ctx):
                 _ida_curve(ax, ctx, i, j, spread[i])
             else:
                 _stripe_points(ax, ctx, i, j, spread[i])
-        ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
+        if np.isfinite(uplift[j]):  # NaN: a cube that does not say it
+            ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
         ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
@@ -472,7 +481,8 @@ def object_curves(page, ctx):
             else "the stripe points (open circles: stood; crosses: overturned, drawn at "
             "theta_max / alpha = 1)"
         )
-        + "; dotted: the object's uplift level g tan alpha; markers of the records are offset "
+        + "; dotted: the object's uplift level (g tan alpha of a block, g lambda of another "
+        "structure); markers of the records are offset "
         "slightly in x so that none hides another",
     )
 

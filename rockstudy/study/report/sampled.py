@@ -102,7 +102,7 @@ _FRAGILITY_VIEWS = (
     (
         "amplitude_ratio",
         "omega",
-        "amplitude ratio a_g / (g tan alpha) [-], omega_g / p in its middle third",
+        "amplitude ratio a_g / a_up (g tan alpha for a block) [-], omega_g / p in its middle third",
     ),
 )
 
@@ -189,7 +189,7 @@ def _fragility_table(page, fit):
     page.table(
         shown.replace({"intensity": _SHORT, "band": _BANDS}).rename(columns=_FRAGILITY_NAMES),
         "fragility",
-        "Fragility parameters (intensity: a_g [m/s^2] or a_g / (g tan alpha) [-]): median "
+        "Fragility parameters (intensity: a_g [m/s^2] or a_g / a_up [-]): median "
         "capacity, its 90 % bootstrap band and the log-standard deviation beta (the MLE); a "
         "median "
         f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
@@ -332,7 +332,7 @@ _SHORT = {
     "restitution": "restitution eta [-]",
     "amplitude": "pulse amplitude a_g [m/s^2]",
     "abs_amplitude": "pulse amplitude a_g [m/s^2]",
-    "amplitude_ratio": "amplitude ratio a_g / (g tan alpha) [-]",
+    "amplitude_ratio": "amplitude ratio a_g / a_up (g tan alpha for a block) [-]",
     "amplitude_a": "a = a_g / (g alpha) [-]",
     "period": "pulse period T_p [s]",
     "frequency_ratio": "frequency ratio omega_g / p [-]",
@@ -520,7 +520,7 @@ def _overturning_map(page, ds, study):
     ax.set(
         xscale="log",
         xlabel="frequency ratio omega_g / p [-]",
-        ylabel="amplitude ratio a_g / (g tan alpha) [-]",
+        ylabel="amplitude ratio a_g / a_up (g tan alpha for a block) [-]",
         ylim=(float(a.min()) * 0.95, float(a.max()) * 1.05),
         title="overturning map over the dimensionless groups",
     )
