@@ -26,8 +26,10 @@ $(BASE): pyproject.toml
 	$(call INSTALL,-e .)
 	touch $(BASE)
 
+# (the extras in a variable: a comma in $(call ...)'s arguments would split them)
+EXTRAS = -e '.[test,docs]'
 $(STAMP): $(BASE)
-	$(call INSTALL,-e '.[test,docs]')
+	$(call INSTALL,$(EXTRAS))
 	touch $(STAMP)
 
 $(KERNELS): $(STAMP) $(shell find rockstudy -name '*.py')
