@@ -40,3 +40,9 @@ class EquivalentBlockWarning(AccuracyWarning):
 class ContactWarning(AccuracyWarning):
     """The block needs more friction than given, or lifts off: it would slide or leave the
     ground, which the rocking model (no sliding, no lift-off) does not describe."""
+
+
+class SeparationWarning(AccuracyWarning):
+    """Overturned and standing outcomes are (quasi-)completely separated in the intensity: the
+    binomial (probit) likelihood of the lognormal fragility has no finite maximum, so its
+    dispersion beta is not identifiable (Albert & Anderson 1984)."""

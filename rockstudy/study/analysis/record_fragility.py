@@ -9,7 +9,9 @@ dimensionless groups of [000] as they are).
 
 Every table carries the observed intensity range (``im_min``, ``im_max``) and the flags
 ``theta_in_range`` and ``band_in_range``: a median outside the data is an extrapolation of the
-lognormal shape, to be read as "not reached within the sampled range" (or "below it").
+lognormal shape, to be read as "not reached within the sampled range" (or "below it"); and
+``separated``: outcomes separated in the intensity have no fit (theta, beta NaN; theta only
+bounded, see :func:`~rockstudy.study.analysis.fragility_fit.separation`).
 
 Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural
 analysis. Earthquake Spectra 31(1), 579-599.
@@ -27,15 +29,19 @@ from scipy import stats
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from .fragility_fit import (
+    SEPARATED,
     binomial_covariance,
     capacities_covariance,
     check_conf_level,
     check_n_boot,
     fit_binomial,
+    fit_binomial_limit,
     fit_capacities,
     fragility_row,
     percentile_intervals,
+    separated_row,
     wald_intervals,
+    warn_if_separated,
 )
 
 __all__ = [
@@ -228,7 +234,14 @@ def stripe_fragility(
         One row per group: ``theta`` [quoted unit], ``beta``, their intervals, ``n``
         (points), ``im_min``, ``im_max``, ``theta_in_range``, ``band_in_range``, the band
         columns of :func:`~rockstudy.study.analysis.fragility_fit.fragility_row` and ``unit``.
-        Points that failed (``status`` != 0) or have no finite intensity are left out.
+        Points that failed (``status`` != 0) or have no finite intensity are left out. A
+        group whose outcomes are separated in the intensity (the stripes jump from 0 % to
+        100 % overturned, or are mixed at one level only, with 0 % below and 100 % above it:
+        :func:`~rockstudy.study.analysis.fragility_fit.separation`) has no maximum of the
+        likelihood: ``separated`` True, ``theta`` and ``beta`` NaN, ``theta_lo`` /
+        ``theta_hi`` the gap in which the median lies, and a
+        :class:`~rockstudy.SeparationWarning`. Separated bootstrap resamples enter at their
+        limit (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
     """
     conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
     im, period = _measure(ds, im, period)
@@ -247,6 +260,11 @@ def stripe_fragility(
     for label, mask in _groups(ds, by, bins).items():
         x, y, keep, rec = x_all[:, mask], y_all[:, mask], ok[:, mask], record[:, mask]
         ones = np.ones(int(keep.sum()))
+        kind, low, high = warn_if_separated("stripe_fragility", label, x[keep], y[keep], ones, unit)
+        if kind in SEPARATED:  # no maximum: theta only bounded, beta not identifiable
+            row = separated_row(label, kind, low, high, keep.sum(), x[keep], by, conf_level)
+            rows.append({**row, "unit": unit})
+            continue
         fit = fit_binomial(x[keep], y[keep], ones)
         cov = binomial_covariance(x[keep], ones, *fit, y[keep], rec[keep])
         if not np.isfinite(fit[1]):
@@ -256,7 +274,8 @@ def stripe_fragility(
             for _ in range(n_boot):
                 k = rng.integers(0, n_rec, n_rec)
                 kk = keep[k]
-                boot.append(fit_binomial(x[k][kk], y[k][kk], np.ones(int(kk.sum())), np.log(fit)))
+                ones_k = np.ones(int(kk.sum()))
+                boot.append(fit_binomial_limit(x[k][kk], y[k][kk], ones_k, np.log(fit)))
             band, method = percentile_intervals(np.array(boot), conf_level), "likelihood"
         else:
             band, method = wald_intervals(*fit, cov, conf_level), "likelihood"
@@ -264,7 +283,7 @@ def stripe_fragility(
     return pd.DataFrame(rows).set_index(by or "group")
 
 
-def _fit_records(cap, top, censored, keep, rows, start=None):
+def fit_records(cap, top, censored, keep, rows, start=None):
     """fit_capacities on the records ``rows`` (an index or a resample) of (record, structure)
     arrays: capacities where not censored, censoring levels where censored."""
     kk, cc = keep[rows], censored[rows]
@@ -325,7 +344,7 @@ def ida_fragility(
     rows = []
     for label, mask in _groups(ds, by, bins).items():
         c, t, cens, keep = cap[:, mask], top[:, mask], cens_all[:, mask], ok[:, mask]
-        theta, beta = _fit_records(c, t, cens, keep, slice(None))
+        theta, beta = fit_records(c, t, cens, keep, slice(None))
         cov = capacities_covariance(c[keep & ~cens], t[keep & cens], theta, beta)
         n_unc = int((keep & ~cens).sum())
         pooled = int(mask.sum()) > 1  # several structures share each record
@@ -338,7 +357,7 @@ def ida_fragility(
         elif n_boot:
             boot = np.array(
                 [
-                    _fit_records(
+                    fit_records(
                         c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta])
                     )
                     for _ in range(n_boot)
@@ -422,7 +441,9 @@ def im_efficiency(
     pandas.DataFrame
         Index (``im``, ``group``), sorted by ``beta_linear`` within each group; columns of
         the fit, ``power``, ``beta_linear`` (with ``beta_linear_lo``/``_hi``) and
-        ``dimensionless``.
+        ``dimensionless``. A measure in which the outcomes are separated (``separated``) has
+        no beta (NaN, sorted last: not ranked), and warns
+        (:class:`~rockstudy.SeparationWarning`).
     """
     fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
     candidates = default_candidates(ds) if candidates is None else candidates
