@@ -146,6 +146,32 @@ def _label(im, period):
     return im if period is None else f"{im}(T={float(period):g} s)"
 
 
+def stripe_arrays(ds, im, period):
+    """(intensity, overturned, usable) of stripes or a cloud as arrays on the dimensions of
+    ``overturned`` (record first): each point's ``im`` in quoted units (:func:`intensity`),
+    its outcome as stored, and whether it ran (``status`` 0) at a finite, positive
+    intensity."""
+    dims = ds["overturned"].dims
+    x = intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
+    y = ds["overturned"].transpose(*dims).values
+    ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
+    return x, y, ok
+
+
+def ida_arrays(ds, im, period):
+    """(capacities, censoring levels, censored, usable) of an IDA as arrays on (record,
+    structure), in the quoted units of ``im``: the first overturning intensities, the highest
+    levels seen to stand, whether no rung overturned (boolean), and whether the ladder ran
+    (``status`` 0) with a finite, positive value of the one of the two that applies."""
+    rs = ("record", "structure")
+    cap = intensity(ds, im, period, scale="capacity_scale").transpose(*rs).values
+    top = intensity(ds, im, period, scale="capacity_scale_lower").transpose(*rs).values
+    cens = ds["censored"].transpose(*rs).values == 1  # -1 where a ladder failed
+    x = np.where(cens, top, cap)
+    ok = (ds["status"].transpose(*rs).values == 0) & np.isfinite(x) & (x > 0)
+    return cap, top, cens, ok
+
+
 # ------------------------------------------------------------------------------ tables
 
 
@@ -245,13 +271,10 @@ def stripe_fragility(
     """
     conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
     im, period = _measure(ds, im, period)
-    x_all = intensity(ds, im, period).broadcast_like(ds["overturned"])
-    dims = ds["overturned"].dims
-    x_all = x_all.transpose(*dims).values
-    y_all = ds["overturned"].transpose(*dims).values.astype(float)
-    ok = np.isfinite(x_all) & (x_all > 0) & (ds["status"].transpose(*dims).values == 0)
+    x_all, y_all, ok = stripe_arrays(ds, im, period)
+    y_all = y_all.astype(float)
     record = np.broadcast_to(
-        np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (len(dims) - 1)), x_all.shape
+        np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (x_all.ndim - 1)), x_all.shape
     )
     unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
@@ -330,14 +353,7 @@ def ida_fragility(
     """
     conf_level, n_boot = _check(ds, "ida", conf_level, n_boot)
     im, period = _measure(ds, im, period)
-    cap = intensity(ds, im, period, scale="capacity_scale").transpose("record", "structure").values
-    top = intensity(ds, im, period, scale="capacity_scale_lower")
-    top = top.transpose("record", "structure").values
-    cens_all = ds["censored"].transpose("record", "structure").values
-    ok = ds["status"].transpose("record", "structure").values == 0
-    ok &= np.where(cens_all, np.isfinite(top), np.isfinite(cap)) & (
-        np.where(cens_all, top, cap) > 0
-    )
+    cap, top, cens_all, ok = ida_arrays(ds, im, period)
     unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
     n_rec = ds.sizes["record"]

@@ -26,7 +26,7 @@ import xarray as xr
 
 from ...motions import measures
 from .fragility_fit import SEPARATED, fit_binomial_limit, separation
-from .record_fragility import fit_capacities, intensity, quoted
+from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"
@@ -121,12 +121,8 @@ def _median_fitter(ds, im, period):
     if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
     if ds.attrs.get("design") == "ida":
-        rs = ("record", "structure")
-        cap = intensity(ds, im, period, scale="capacity_scale").transpose(*rs).values
-        top = intensity(ds, im, period, scale="capacity_scale_lower").transpose(*rs).values
-        cens = ds["censored"].transpose(*rs).values == 1  # bool, or -1 where a run failed
+        cap, top, cens, ok = ida_arrays(ds, im, period)
         x = np.where(cens, top, cap)  # capacities, and the censoring levels
-        ok = (ds["status"].transpose(*rs).values == 0) & np.isfinite(x) & (x > 0)
 
         def fit(rows, mask):
             keep = (ok & mask)[rows]
@@ -135,10 +131,8 @@ def _median_fitter(ds, im, period):
             return theta, x[rows][keep], False
 
     else:
-        dims = ds["overturned"].dims
-        x = intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
-        y = ds["overturned"].values.astype(float)
-        ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
+        x, y, ok = stripe_arrays(ds, im, period)
+        y = y.astype(float)
         extra = (slice(None), slice(None)) + (None,) * (x.ndim - 2)
 
         def fit(rows, mask):

@@ -81,12 +81,7 @@ def _check_hazard(ds, hazard):
 def _ida_fitter(ds, im, period):
     """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
     level per object, separated(j) -> False) of an IDA, in quoted units."""
-    dims = ("record", "structure")
-    cap = rf.intensity(ds, im, period, scale="capacity_scale").transpose(*dims).values
-    top = rf.intensity(ds, im, period, scale="capacity_scale_lower").transpose(*dims).values
-    cens = ds["censored"].transpose(*dims).values.astype(bool)
-    ok = ds["status"].transpose(*dims).values == 0
-    ok &= np.where(cens, np.isfinite(top), np.isfinite(cap)) & (np.where(cens, top, cap) > 0)
+    cap, top, cens, ok = rf.ida_arrays(ds, im, period)
 
     def fit(j, rows):
         c, t, cc, kk = cap[:, j], top[:, j], cens[:, j], ok[:, j]
@@ -106,11 +101,9 @@ def _stripe_fitter(ds, im, period):
     """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points, a separated
     resample at its limit); the third item is the lowest intensity simulated per object, the
     fourth whether all the points of an object are separated."""
-    dims = ds["overturned"].dims
-    x = rf.intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
-    y = ds["overturned"].transpose(*dims).values.astype(bool)
-    ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
-    j_axis = dims.index("structure")
+    x, y, ok = rf.stripe_arrays(ds, im, period)
+    y = y.astype(bool)
+    j_axis = ds["overturned"].dims.index("structure")
     x, y, ok = (np.moveaxis(a, j_axis, 1) for a in (x, y, ok))  # (record, structure, ...)
 
     def fit(j, rows):
