@@ -43,6 +43,6 @@ class ContactWarning(AccuracyWarning):
 
 
 class SeparationWarning(AccuracyWarning):
-    """Overturned and standing outcomes are (quasi-)completely separated in the intensity: the
-    binomial (probit) likelihood of the lognormal fragility has no finite maximum, so its
-    dispersion beta is not identifiable (Albert & Anderson 1984)."""
+    """The binomial (probit) likelihood of a lognormal fragility has no maximum: overturned and
+    standing outcomes are (quasi-)completely separated in the intensity (Albert & Anderson
+    1984), so beta is not identifiable, or the overturned ones do not lie higher at all."""

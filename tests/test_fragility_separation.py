@@ -1,9 +1,11 @@
-"""Outcomes separated in the intensity have no maximum-likelihood fragility: they are flagged,
-warned about and shown as such, never fitted. Oracles: a brute-force profile of the binomial
-likelihood in beta towards 0 (theta optimised at each beta, written here with scipy's normal
-log-cdf), which rises monotonically if and only if no finite maximum exists (the profile of a
-concave likelihood is concave in 1 / beta); data built to be separated, whose gap is known by
-construction; data drawn from a known lognormal fragility, which must still be recovered."""
+"""Outcomes separated in the intensity (or not rising with it) have no maximum-likelihood
+fragility: they are flagged, warned about and shown as such, never fitted. Oracles: a
+brute-force profile of the binomial likelihood in beta (theta optimised at each beta, written
+here with scipy's normal log-cdf), which rises monotonically towards beta = 0 if and only if
+the outcomes are separated, and towards beta = infinity if and only if they do not rise (the
+profile of a concave likelihood is concave in 1 / beta); data built to be separated, whose gap
+is known by construction; data drawn from a known lognormal fragility, which must still be
+recovered."""
 
 import html
 import warnings
@@ -23,7 +25,7 @@ from rockstudy.study.analysis.risk import object_risk
 from rockstudy.study.report._page import _Page, separation_note
 from rockstudy.study.report.records import _fragility
 
-BETAS = np.geomspace(3.0, 1e-5, 60)  # the profile's grid, from spread out to a step
+BETAS = np.geomspace(1e3, 1e-5, 90)  # the profile's grid, from flat to a step
 
 
 def _loglik(ln_theta, beta, x, z, n):
@@ -56,6 +58,11 @@ def _rises_towards_zero(profile):
     return bool(np.all(np.diff(profile) >= -1e-6))
 
 
+def _rises_towards_infinity(profile):
+    """Whether the profile never rises as beta decreases (its maximum at the flattest curve)."""
+    return bool(np.all(np.diff(profile) <= 1e-6))
+
+
 def _random_data(rng):
     """A small dataset with both outcomes: a Bernoulli cloud, or stripes (a few levels with
     several trials, so that ties at one level occur)."""
@@ -66,7 +73,8 @@ def _random_data(rng):
         else:
             x = np.geomspace(0.2, 1.6, rng.integers(3, 6))
             n = rng.integers(2, 5, x.size).astype(float)
-        p = stats.norm.cdf(np.log(x / np.exp(rng.normal(-0.3, 0.3))) / rng.uniform(0.02, 0.8))
+        beta = rng.uniform(0.02, 0.8) * (1.0 if rng.random() < 0.8 else -1.0)  # some fall
+        p = stats.norm.cdf(np.log(x / np.exp(rng.normal(-0.3, 0.3))) / beta)
         z = rng.binomial(n.astype(int), p).astype(float)
         if 0 < z.sum() < n.sum():
             return x, z, n
@@ -79,13 +87,13 @@ def test_the_separation_check_agrees_with_the_profile_likelihood_on_random_data(
         x, z, n = _random_data(rng)
         kind, low, high = fragility_fit.separation(x, z, n)
         kinds.append(kind)
-        assert (kind in fragility_fit.SEPARATED) == _rises_towards_zero(_profile(x, z, n)), (
-            x,
-            z,
-            n,
-            kind,
-        )
-        if kind in fragility_fit.SEPARATED:
+        profile = _profile(x, z, n)
+        assert (kind in fragility_fit.SEPARATED) == _rises_towards_zero(profile), (x, z, n)
+        assert (kind == "no rise") == _rises_towards_infinity(profile), (x, z, n)
+        if kind == "no rise":
+            with pytest.warns(SeparationWarning, match="do not lie higher"):
+                assert np.isnan(fragility_fit.fit_binomial(x, z, n)).all()
+        elif kind in fragility_fit.SEPARATED:
             with pytest.warns(SeparationWarning, match="separated"):
                 theta, beta = fragility_fit.fit_binomial(x, z, n)
             assert np.isnan(theta) and np.isnan(beta)
@@ -96,10 +104,10 @@ def test_the_separation_check_agrees_with_the_profile_likelihood_on_random_data(
                 theta, beta = fragility_fit.fit_binomial(x, z, n)
             # the fit is the maximum the oracle's profile sees, within its grid
             assert np.isfinite(beta) and beta > 0
-            best = _profile(x, z, n).max()
+            best = profile.max()
             assert _loglik(np.log(theta), beta, x, z, n) >= best - 1e-6
     # the sample exercised every case
-    assert {"overlap", "quasi", "complete"} <= set(kinds), kinds
+    assert {"overlap", "quasi", "complete", "no rise"} <= set(kinds), kinds
 
 
 def test_quasi_separation_is_a_tie_at_one_level_and_its_limit_is_that_level():
@@ -110,6 +118,24 @@ def test_quasi_separation_is_a_tie_at_one_level_and_its_limit_is_that_level():
     z[1] = 1.0  # mixed at two levels: overlap, a finite fit
     assert fragility_fit.separation(x, z, n)[0] == "overlap"
     assert _rises_towards_zero(_profile(x, z, n)) is False
+
+
+def test_outcomes_that_do_not_rise_have_no_fit_and_no_rate():
+    """Overturning at the lower levels only (a falling trend), or at one level only: the
+    likelihood of an increasing fragility has its supremum at beta -> infinity."""
+    assert fragility_fit.separation([1.0, 1.0], [1.0, 2.0], [3.0, 3.0])[0] == "no rise"
+    falling = np.array([[1, 0, 1, 0], [1, 1, 0, 0], [0, 1, 0, 0]])  # 2/3, 2/3, 1/3, 0
+    ds = _stripes(falling, LEVELS)
+    with pytest.warns(SeparationWarning, match="do not lie higher"):
+        t = rf.stripe_fragility(ds, n_boot=20)
+    row = t.loc["all"]
+    assert row["no_rise"] and not row["separated"]
+    assert np.isnan([row["theta"], row["beta"], row["theta_lo"], row["theta_hi"]]).all()
+    hazard = risk.HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
+    out = object_risk(ds, hazard, n_boot=20)
+    assert str(out["status"].values[0]) == "no rise"
+    for name in ("theta", "beta", "annual_rate", "annual_rate_hi", "probability"):
+        assert np.isnan(out[name].values[0]), name
 
 
 def _stripes(overturned, levels):
@@ -203,7 +229,9 @@ def test_the_report_says_in_words_that_a_separated_fit_has_no_curve(tmp_path):
 
 def test_the_separation_note_escapes_the_names_of_the_objects(tmp_path):
     evil = "<script>alert(1)</script> & co"
-    table = pd.DataFrame({"separated": [True, False]}, index=[evil, "Vase"])
+    table = pd.DataFrame(
+        {"separated": [True, False], "no_rise": [False, False]}, index=[evil, "Vase"]
+    )
     page = _Page(tmp_path)
     separation_note(page, table, "Fragility of the objects")
     source = "".join(page.parts)

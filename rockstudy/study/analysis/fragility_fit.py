@@ -91,9 +91,12 @@ def _outcomes(im, n_overturned, n_total):
     return x, z, n
 
 
-#: What :func:`separation` says of outcome data; the middle two have no finite MLE.
-SEPARATIONS = ("overlap", "quasi", "complete", "one outcome")
+#: What :func:`separation` says of outcome data: only ``"overlap"`` has a maximum.
+SEPARATIONS = ("overlap", "quasi", "complete", "no rise", "one outcome")
+#: The kinds of :data:`SEPARATIONS` whose likelihood rises as beta -> 0 ...
 SEPARATED = ("quasi", "complete")
+#: ... and those without a maximum of the likelihood at all (no fit, but not "one outcome").
+NO_MAXIMUM = (*SEPARATED, "no rise")
 
 
 def _separation(x, z, n):
@@ -102,7 +105,14 @@ def _separation(x, z, n):
     if not (stood.size and fell.size):
         return "one outcome", np.nan, np.nan
     s, o = float(stood.max()), float(fell.min())
-    return ("complete" if s < o else "quasi" if s == o else "overlap"), s, o
+    if s < o:
+        return "complete", s, o
+    # the score of b = 1 / beta at b = 0 has the sign of this difference of mean ln x
+    rise = np.sum(z * x) / np.sum(z) - np.sum((n - z) * x) / np.sum(n - z)
+    tried = x[n > 0]
+    if tried.min() == tried.max() or rise <= 0.0:  # one level, or no rise
+        return "no rise", s, o
+    return ("quasi" if s == o else "overlap"), s, o
 
 
 def separation(im, n_overturned, n_total) -> tuple[str, float, float]:
@@ -121,15 +131,19 @@ def separation(im, n_overturned, n_total) -> tuple[str, float, float]:
       both occur, below it every trial stood and above it every one overturned; the
       log-likelihood rises as beta -> 0, theta -> s, towards the binomial log-likelihood of
       that level at its observed proportion;
-    - ``"overlap"``, s > o: a trial stood above one that overturned; the maximum over
-      (a, b) is finite and unique (with b > 0 imposed, it lies at b -> 0, a flat curve of
-      large beta, when the overturned trials do not lie higher on average in ln x than
-      those that stood: no rise with the intensity, which the fitted beta then shows);
+    - ``"no rise"``: the trials that overturned do not lie higher in ln x, on average, than
+      those that stood (or all lie at one level). The log-likelihood is concave in (a, b);
+      its derivative in b at b = 0 (a flat curve P = the overall proportion p) is
+      proportional to sum_j (z_j - n_j p) ln x_j, which is <= 0 exactly then, so the
+      maximum over b > 0 lies at b -> 0: beta -> infinity, a flat curve, theta not
+      identifiable (an optimiser stops at some large beta, which would read as a fit);
+    - ``"overlap"``, s > o with a rise: the MLE exists, finite and unique;
     - ``"one outcome"``: every trial stood or every one overturned (no fit at all).
 
     In the first two the dispersion is not identifiable: the data say that theta lies in
-    [s, o], not how spread the capacities are. The check is exact (a comparison of two order
-    statistics), not a threshold on a fitted beta.
+    [s, o], not how spread the capacities are; in the third the data show no increasing
+    fragility at all. The checks are exact (order statistics and the sign of a sum), not a
+    threshold on a fitted beta.
 
     Returns
     -------
@@ -147,23 +161,32 @@ def separation(im, n_overturned, n_total) -> tuple[str, float, float]:
 
 
 def separation_message(kind, low, high, unit="") -> str:
-    """The words of a :class:`~rockstudy.SeparationWarning` for the gap [``low``, ``high``]."""
-    how = "completely" if kind == "complete" else "quasi-completely (mixed at one level only)"
+    """The words of a :class:`~rockstudy.SeparationWarning` for ``kind`` (of
+    :data:`NO_MAXIMUM`) and the gap [``low``, ``high``]."""
+    if kind == "no rise":
+        return (
+            "the trials that overturned do not lie higher in the intensity (on average, in "
+            "ln x) than those that stood: no increasing lognormal fragility fits them; the "
+            "likelihood rises as beta -> infinity (a flat curve) and has no maximum, so "
+            "theta and beta are not identifiable (NaN)"
+        )
+    how = "completely" if kind == "complete" else "quasi-completely"
+    mixed = "" if kind == "complete" else " (both occur at one level only)"
     unit = f" {unit}" if unit and unit != "-" else ""
     return (
         f"the outcomes are {how} separated in the intensity: every trial that overturned lies "
-        f"at or above every one that stood, so the likelihood rises as beta -> 0 and has no "
-        f"maximum; beta is not identifiable (NaN) and the median lies between {low:.4g} and "
-        f"{high:.4g}{unit} (Albert and Anderson 1984)"
+        f"at or above every one that stood{mixed}, so the likelihood rises as beta -> 0 and "
+        f"has no maximum; beta is not identifiable (NaN) and the median lies between "
+        f"{low:.4g} and {high:.4g}{unit} (Albert and Anderson 1984)"
     )
 
 
 def warn_if_separated(where, label, im, n_overturned, n_total, unit="", depth=1) -> tuple:
     """:func:`separation` of the outcomes of group ``label``, with a
     :class:`~rockstudy.SeparationWarning` from ``where`` (the public function, ``depth``
-    calls up from the caller) if they are separated."""
+    calls up from the caller) if they have no maximum (:data:`NO_MAXIMUM`)."""
     kind, low, high = separation(im, n_overturned, n_total)
-    if kind in SEPARATED:
+    if kind in NO_MAXIMUM:
         message = f"{where}: group {str(label)!r}: {separation_message(kind, low, high, unit)}"
         warnings.warn(message, SeparationWarning, stacklevel=2 + depth)
     return kind, low, high
@@ -214,7 +237,7 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     kind, s, o = _separation(x, z, n)
     if kind == "one outcome":  # never (median not reached) or always (below the data)
         return (np.inf, np.nan) if z.sum() == 0 else (0.0, np.nan)
-    if kind in SEPARATED:
+    if kind in NO_MAXIMUM:
         message = separation_message(kind, np.exp(s), np.exp(o))
         warnings.warn(f"fit_binomial: {message}", SeparationWarning, stacklevel=2)
         return np.nan, np.nan
@@ -227,13 +250,18 @@ def fit_binomial_limit(im, n_overturned, n_total, start=None) -> tuple[float, fl
     warning: beta = 0 (a step) and theta the geometric middle of the gap [s, o] of
     :func:`separation` (for quasi-separation, s itself, the limit of theta). The resamples of
     a small sample are often separated; leaving them out would bias the band of beta upwards,
-    keeping whatever an optimiser stopped at would make it arbitrary."""
+    keeping whatever an optimiser stopped at would make it arbitrary. A resample without a
+    rise (``"no rise"``) enters at its own limit: beta = inf, a flat curve, theta 0 or inf
+    as its overall proportion is above or below one half (NaN at one half)."""
     x, z, n = _outcomes(im, n_overturned, n_total)
     kind, s, o = _separation(x, z, n)
     if kind == "one outcome":  # never (median not reached) or always (below the data)
         return (np.inf, np.nan) if z.sum() == 0 else (0.0, np.nan)
     if kind in SEPARATED:
         return float(np.exp(0.5 * (s + o))), 0.0
+    if kind == "no rise":  # flat at the overall proportion p: theta -> 0 (p > 1/2) or inf
+        p = z.sum() / n.sum()
+        return (0.0 if p > 0.5 else np.inf if p < 0.5 else np.nan), np.inf
     return _binomial_mle(x, z, n, start)
 
 
@@ -398,7 +426,9 @@ def fragility_row(
     the sample count, the observed intensity range of ``im`` and whether the median
     (``theta_in_range``) and its whole band (``band_in_range``) lie inside it, and whether
     the outcomes are separated (``separated``, :func:`separation`: then theta and beta are
-    NaN and the "band" of theta is the gap [s, o] in which the median lies); then what the
+    NaN and the "band" of theta is the gap [s, o] in which the median lies) and whether they
+    do not rise with the intensity at all (``no_rise``: theta, beta and band NaN; see
+    :func:`no_maximum_row`); then what the
     pointwise band of P(x) needs (:func:`probability_band`): the covariance of
     (ln theta, ln beta) (``var_ln_theta``, ``cov_ln_theta_ln_beta``, ``var_ln_beta``), the
     method (``p_band``) and ``conf_level``. ``band`` is ((theta_lo, theta_hi),
@@ -420,6 +450,7 @@ def fragility_row(
         "theta_in_range": bool(im_min <= theta <= im_max),
         "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
         "separated": bool(separated),
+        "no_rise": False,
         "var_ln_theta": cov[0, 0],
         "cov_ln_theta_ln_beta": cov[0, 1],
         "var_ln_beta": cov[1, 1],
@@ -432,15 +463,19 @@ def fragility_row(
 BAND_COLUMNS = ("var_ln_theta", "cov_ln_theta_ln_beta", "var_ln_beta", "p_band", "conf_level")
 
 
-def separated_row(label, kind, low, high, n, im, by=None, conf_level=np.nan) -> dict:
-    """The :func:`fragility_row` of separated outcomes (``kind`` of :func:`separation`): no
-    fit (theta, beta NaN), theta bounded by the gap [``low``, ``high``], no band of P."""
-    if kind not in SEPARATED:
-        raise ValueError(f"kind must be one of {SEPARATED}, got {kind!r}")
-    band = ((low, high), (np.nan, np.nan))
-    return fragility_row(
-        label, np.nan, np.nan, band, n, im, by, None, "none", conf_level, separated=True
+def no_maximum_row(label, kind, low, high, n, im, by=None, conf_level=np.nan) -> dict:
+    """The :func:`fragility_row` of outcomes without a maximum of the likelihood (``kind`` of
+    :data:`NO_MAXIMUM`): no fit (theta, beta NaN), no band of P; separated outcomes have
+    theta bounded by the gap [``low``, ``high``] (``separated``), outcomes without a rise
+    not at all (``no_rise``)."""
+    if kind not in NO_MAXIMUM:
+        raise ValueError(f"kind must be one of {NO_MAXIMUM}, got {kind!r}")
+    separated = kind in SEPARATED
+    band = ((low, high) if separated else (np.nan, np.nan), (np.nan, np.nan))
+    row = fragility_row(
+        label, np.nan, np.nan, band, n, im, by, None, "none", conf_level, separated=separated
     )
+    return {**row, "no_rise": kind == "no rise"}
 
 
 def wald_intervals(theta, beta, cov, conf_level):

@@ -29,7 +29,7 @@ from scipy import stats
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from .fragility_fit import (
-    SEPARATED,
+    NO_MAXIMUM,
     binomial_covariance,
     capacities_covariance,
     check_conf_level,
@@ -38,8 +38,8 @@ from .fragility_fit import (
     fit_binomial_limit,
     fit_capacities,
     fragility_row,
+    no_maximum_row,
     percentile_intervals,
-    separated_row,
     wald_intervals,
     warn_if_separated,
 )
@@ -284,8 +284,8 @@ def stripe_fragility(
         x, y, keep, rec = x_all[:, mask], y_all[:, mask], ok[:, mask], record[:, mask]
         ones = np.ones(int(keep.sum()))
         kind, low, high = warn_if_separated("stripe_fragility", label, x[keep], y[keep], ones, unit)
-        if kind in SEPARATED:  # no maximum: theta only bounded, beta not identifiable
-            row = separated_row(label, kind, low, high, keep.sum(), x[keep], by, conf_level)
+        if kind in NO_MAXIMUM:  # separated or no rise: no maximum, no fit
+            row = no_maximum_row(label, kind, low, high, keep.sum(), x[keep], by, conf_level)
             rows.append({**row, "unit": unit})
             continue
         fit = fit_binomial(x[keep], y[keep], ones)

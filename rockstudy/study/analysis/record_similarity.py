@@ -25,7 +25,7 @@ import pandas as pd
 import xarray as xr
 
 from ...motions import measures
-from .fragility_fit import SEPARATED, fit_binomial_limit, separation
+from .fragility_fit import NO_MAXIMUM, fit_binomial_limit, separation
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
@@ -113,10 +113,10 @@ def _frequency_bands(ds, frequency_bins) -> dict:
 
 
 def _median_fitter(ds, im, period):
-    """A function (record rows, mask on (record, structure)) -> (theta, points, separated)
-    of the design's fit (outcomes separated in the intensity: theta at the limit of
-    :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`), and the quoted unit
-    of ``im``."""
+    """A function (record rows, mask on (record, structure)) -> (theta, points, no maximum)
+    of the design's fit (outcomes separated in the intensity or without a rise: theta at the
+    limit of :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`), and the
+    quoted unit of ``im``."""
     needs_period = im in measures.MEASURES and measures.MEASURES[im].needs_period
     if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
@@ -140,8 +140,8 @@ def _median_fitter(ds, im, period):
             if not keep.any():
                 return np.nan, np.zeros(0), False
             xs, ys, ones = x[rows][keep], y[rows][keep], np.ones(int(keep.sum()))
-            separated = separation(xs, ys, ones)[0] in SEPARATED
-            return fit_binomial_limit(xs, ys, ones)[0], xs, separated
+            no_fit = separation(xs, ys, ones)[0] in NO_MAXIMUM
+            return fit_binomial_limit(xs, ys, ones)[0], xs, no_fit
 
     return fit, quoted(im)[0]
 
@@ -180,8 +180,9 @@ def size_class_medians(
     (medians, spread) : pandas.DataFrame, pandas.DataFrame
         ``medians`` indexed by (frequency band, size class): ``theta`` [quoted unit], its band
         ``theta_lo``/``theta_hi``, ``n`` (points), ``im_min``, ``im_max``, ``theta_in_range``,
-        ``separated`` (outcomes separated in the intensity: no fit, ``theta`` NaN, the class
-        left out of the spread; its resamples enter the band at their limit,
+        ``no_maximum`` (outcomes separated in the intensity, or without a rise:
+        :data:`~rockstudy.study.analysis.fragility_fit.NO_MAXIMUM`; no fit, ``theta`` NaN,
+        the class left out of the spread; its resamples enter the band at their limit,
         :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
         ``spread`` indexed by frequency band: ``ratio`` (largest over smallest median) and
         ``log_std`` (standard deviation of ln theta) over the classes whose median lies within
@@ -201,9 +202,9 @@ def size_class_medians(
         masks = {c: bmask & cmask[None, :] for c, cmask in classes.items()}
         fitted = {c: fit(every, m) for c, m in masks.items()}
         inside = {}
-        for c, (theta, xs, separated) in fitted.items():
+        for c, (theta, xs, no_fit) in fitted.items():
             lo, hi = (float(xs.min()), float(xs.max())) if xs.size else (np.nan, np.nan)
-            theta = np.nan if separated else theta  # the limit of no fit is no estimate
+            theta = np.nan if no_fit else theta  # the limit of no fit is no estimate
             # within the sampled intensities, up to rounding (a single capacity c is fitted
             # as exp(ln c))
             inside[c] = bool(xs.size and lo * (1 - 1e-12) <= theta <= hi * (1 + 1e-12))
@@ -216,7 +217,7 @@ def size_class_medians(
                     "im_min": lo,
                     "im_max": hi,
                     "theta_in_range": inside[c],
-                    "separated": separated,
+                    "no_maximum": no_fit,
                 }
             )
         used = [c for c in classes if inside[c]]

@@ -29,11 +29,15 @@ What the records cannot say is marked, not invented (``status``):
   power-law hazard of slope k). No rate is given (theta, beta and lambda_OT NaN): a step
   function would be a guess presented as an estimate. More records near the gap, or a
   fixed beta from elsewhere with :func:`rockstudy.risk.annual_rate`, are what can help;
+- ``"no rise"``: (stripes, clouds) the points at which the object overturned do not lie
+  higher in the intensity, on average, than those at which it stood: no increasing
+  fragility fits them (the likelihood rises as beta -> infinity, a flat curve), and a rate
+  from such a fit would be meaningless (infinite for a power-law hazard). No rate is given;
 - ``"no fit"``: the fit did not converge to a finite median and dispersion.
 
 In the band, a resample whose points are separated enters at its limit
 (:func:`.fragility_fit.fit_binomial_limit`: a step at the middle of its gap, rate lambda at
-that level).
+that level); one without a rise is left out (counted out of ``boot_valid``).
 
 Cornell, C. A., Jalayer, F., Hamburger, R. O. and Foutch, D. A. (2002). Probabilistic basis
 for 2000 SAC Federal Emergency Management Agency steel moment frame guidelines. Journal of
@@ -48,7 +52,7 @@ import xarray as xr
 from ... import risk
 from . import record_fragility as rf
 from .fragility_fit import (
-    SEPARATED,
+    NO_MAXIMUM,
     check_conf_level,
     check_n_boot,
     fit_binomial_limit,
@@ -58,7 +62,7 @@ from .fragility_fit import (
 __all__ = ["STATUSES", "object_risk", "share_below"]
 
 #: What ``status`` of :func:`object_risk` says of an object's rate (module docstring).
-STATUSES = ("ok", "few", "none", "all", "separated", "no fit")
+STATUSES = ("ok", "few", "none", "all", "separated", "no rise", "no fit")
 
 
 def _check_hazard(ds, hazard):
@@ -80,7 +84,7 @@ def _check_hazard(ds, hazard):
 
 def _ida_fitter(ds, im, period):
     """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
-    level per object, separated(j) -> False) of an IDA, in quoted units."""
+    level per object, no_maximum(j) -> None) of an IDA, in quoted units."""
     cap, top, cens, ok = rf.ida_arrays(ds, im, period)
 
     def fit(j, rows):
@@ -94,13 +98,14 @@ def _ida_fitter(ds, im, period):
 
     with np.errstate(invalid="ignore"):
         lowest = np.nanmin(np.where(ok & cens, top, np.nan), axis=0, initial=np.inf)
-    return fit, count, lowest, lambda j: False
+    return fit, count, lowest, lambda j: None
 
 
 def _stripe_fitter(ds, im, period):
     """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points, a separated
     resample at its limit); the third item is the lowest intensity simulated per object, the
-    fourth whether all the points of an object are separated."""
+    fourth the kind of :data:`.fragility_fit.NO_MAXIMUM` of all its points (None if they
+    have a fit)."""
     x, y, ok = rf.stripe_arrays(ds, im, period)
     y = y.astype(bool)
     j_axis = ds["overturned"].dims.index("structure")
@@ -119,11 +124,12 @@ def _stripe_fitter(ds, im, period):
 
     lowest = np.nanmin(np.where(ok, x, np.nan).reshape(x.shape[0], x.shape[1], -1), axis=(0, 2))
 
-    def separated(j):
+    def no_maximum(j):
         kk = ok[:, j]
-        return separation(x[:, j][kk], y[:, j][kk], np.ones(int(kk.sum())))[0] in SEPARATED
+        kind = separation(x[:, j][kk], y[:, j][kk], np.ones(int(kk.sum())))[0]
+        return kind if kind in NO_MAXIMUM else None
 
-    return fit, count, lowest, separated
+    return fit, count, lowest, no_maximum
 
 
 def _uplift(ds, hazard):
@@ -153,7 +159,10 @@ def share_below(theta, beta, hazard, level, units=None) -> float:
 
 
 def _rate(theta, beta, hazard, unit):
-    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit."""
+    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit or
+    for a flat one (beta inf, no rise)."""
+    if beta == np.inf:
+        return np.nan
     if theta == np.inf:
         return 0.0
     if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
@@ -161,13 +170,13 @@ def _rate(theta, beta, hazard, unit):
     return risk.annual_rate(theta, beta, hazard, units=unit)
 
 
-def _status(ida, theta, beta, n_over, n_rec, min_overturning, separated):
+def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
-    if not ida and theta == 0.0:
+    if not ida and theta == 0.0 and beta != np.inf:
         return "all"
-    if separated:
-        return "separated"
+    if no_maximum is not None:
+        return "no rise" if no_maximum == "no rise" else "separated"
     if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
         return "no fit" if n_over >= (2 if ida else 1) else "few"
     return "ok" if n_over >= min(min_overturning, n_rec) else "few"
@@ -180,12 +189,12 @@ def _probability(years, rate):
 
 def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning):
     """The point estimate, the bootstrap rates and the status of object ``j``."""
-    fit, count, _, separated = fitter
+    fit, count, _, no_maximum = fitter
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
     n_over = count(j, every)
-    status = _status(ida, theta, beta, n_over, n_rec, min_overturning, separated(j))
-    if status == "separated":  # the limit of the fit is no estimate
+    status = _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum(j))
+    if status in ("separated", "no rise"):  # the limit of the fit is no estimate
         theta, beta = np.nan, np.nan
     rate = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
     boot = np.full(len(boot_rows), np.nan)

@@ -25,16 +25,16 @@ from scipy.spatial import cKDTree
 from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
-    SEPARATED,
+    NO_MAXIMUM,
     binomial_covariance,
     check_conf_level,
     check_n_boot,
     fit_binomial,
     fit_binomial_limit,
     fragility_row,
+    no_maximum_row,
     percentile_intervals,
     probability_band,
-    separated_row,
     wald_intervals,
     warn_if_separated,
 )
@@ -252,8 +252,8 @@ def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
     """The fragility row of one group of samples: fit, intervals, covariance."""
     ones = np.ones(z.size)
     kind, low, high = warn_if_separated("fragility", name, x, z, ones, depth=2)
-    if kind in SEPARATED:  # no maximum: theta only bounded, beta not identifiable
-        return separated_row(name, kind, low, high, z.size, x, by, conf_level)
+    if kind in NO_MAXIMUM:  # separated or no rise: no maximum, no fit
+        return no_maximum_row(name, kind, low, high, z.size, x, by, conf_level)
     theta, beta = fit_binomial(x, z, ones)
     if not np.isfinite(beta):  # no fit: the median lies beyond the data, on one side
         band = ((theta, theta), (np.nan, np.nan))

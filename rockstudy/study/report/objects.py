@@ -268,7 +268,7 @@ def object_fragility(page, ctx):
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
-    cols += ["separated"]
+    cols += ["separated", "no_rise"]
     shown = table[cols].rename(
         columns={
             "theta": "median capacity",
@@ -278,6 +278,7 @@ def object_fragility(page, ctx):
             "n": "records",
             "theta_in_range": "median within the data",
             "separated": "outcomes separated (no fit)",
+            "no_rise": "no rise with the intensity (no fit)",
         }
     )
     up = _uplift(ctx, "pga")

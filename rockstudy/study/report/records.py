@@ -245,6 +245,7 @@ def _efficiency(page, ctx):
                 "points": int(r["n"]),
                 "dimensionless": bool(r["dimensionless"]),
                 "outcomes separated (no beta)": bool(r["separated"]),
+                "no rise (no beta)": bool(r["no_rise"]),
             }
         )
     page.table(
@@ -255,7 +256,8 @@ def _efficiency(page, ctx):
         "factor of the record (Arias intensity k = 2: its k-th root is as informative and "
         "linear), pooled over all blocks (smaller is better; 90 % bands), dimensional and "
         "dimensionless; a measure in which the outcomes are separated (every overturned "
-        "point at or above every one that stood) has no beta and is not ranked",
+        "point at or above every one that stood), or in which they do not rise at all, has no "
+        "beta and is not ranked",
     )
 
 
