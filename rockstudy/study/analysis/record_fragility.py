@@ -10,8 +10,9 @@ dimensionless groups of [000] as they are).
 Every table carries the observed intensity range (``im_min``, ``im_max``) and the flags
 ``theta_in_range`` and ``band_in_range``: a median outside the data is an extrapolation of the
 lognormal shape, to be read as "not reached within the sampled range" (or "below it"); and
-``separated``: outcomes separated in the intensity have no fit (theta, beta NaN; theta only
-bounded, see :func:`~rockstudy.study.analysis.fragility_fit.separation`).
+``separated`` and ``no_rise``: outcomes separated in the intensity, or not rising with it,
+have no fit (theta, beta NaN; a separated theta only bounded, see
+:func:`~rockstudy.study.analysis.fragility_fit.separation`).
 
 Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural
 analysis. Earthquake Spectra 31(1), 579-599.
@@ -266,8 +267,10 @@ def stripe_fragility(
         :func:`~rockstudy.study.analysis.fragility_fit.separation`) has no maximum of the
         likelihood: ``separated`` True, ``theta`` and ``beta`` NaN, ``theta_lo`` /
         ``theta_hi`` the gap in which the median lies, and a
-        :class:`~rockstudy.SeparationWarning`. Separated bootstrap resamples enter at their
-        limit (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
+        :class:`~rockstudy.SeparationWarning`; so does a group whose overturned points do not
+        lie higher in the intensity than those that stood (``no_rise`` True, theta, beta and
+        their band NaN). Such bootstrap resamples enter at their limit
+        (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
     """
     conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
     im, period = _measure(ds, im, period)
@@ -457,8 +460,8 @@ def im_efficiency(
     pandas.DataFrame
         Index (``im``, ``group``), sorted by ``beta_linear`` within each group; columns of
         the fit, ``power``, ``beta_linear`` (with ``beta_linear_lo``/``_hi``) and
-        ``dimensionless``. A measure in which the outcomes are separated (``separated``) has
-        no beta (NaN, sorted last: not ranked), and warns
+        ``dimensionless``. A measure in which the outcomes are separated (``separated``) or do
+        not rise (``no_rise``) has no beta (NaN, sorted last: not ranked), and warns
         (:class:`~rockstudy.SeparationWarning`).
     """
     fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility

@@ -212,10 +212,11 @@ def fragility(
         :func:`~rockstudy.study.analysis.fragility_fit.separation`) has no maximum of the
         likelihood: ``separated`` is True, ``theta`` and ``beta`` are NaN, ``theta_lo`` /
         ``theta_hi`` are the gap in which the median lies (the highest survivor, the lowest
-        overturned intensity), with a :class:`~rockstudy.SeparationWarning`. Bootstrap
-        resamples that are separated enter at their limit
-        (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`). Groups with
-        fewer than 10 samples are left out.
+        overturned intensity), with a :class:`~rockstudy.SeparationWarning`; so does a group
+        whose overturned samples do not lie higher in the intensity than the survivors
+        (``no_rise`` True; theta, beta and band NaN). Such bootstrap resamples enter at their
+        limit (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`). Groups
+        with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
     for name in (intensity, outcome) + (() if by is None else (by,)):
