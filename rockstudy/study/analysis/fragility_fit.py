@@ -212,9 +212,10 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
               + z_j \\ln \\Phi(\\ln(x_j / \\theta) / \\beta)
               + (n_j - z_j) \\ln[1 - \\Phi(\\ln(x_j / \\theta) / \\beta)]
 
-    The maximum exists only where the outcomes overlap in the intensity (:func:`separation`):
-    separated outcomes give NaN, NaN with a :class:`~rockstudy.SeparationWarning` that names
-    the interval in which theta lies.
+    The maximum exists only where the outcomes overlap in the intensity and rise with it
+    (:func:`separation`): separated outcomes give NaN, NaN with a
+    :class:`~rockstudy.SeparationWarning` that names the interval in which theta lies, and
+    outcomes without a rise NaN, NaN with one that says so.
 
     Parameters
     ----------
@@ -231,7 +232,7 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     (theta, beta)
         Median capacity in the units of ``im``, and dispersion (the MLE). ``inf``/NaN or
         0/NaN when the outcome never or always happened (no fit); NaN/NaN when the outcomes
-        are separated (no maximum).
+        are separated or do not rise (no maximum).
     """
     x, z, n = _outcomes(im, n_overturned, n_total)
     kind, s, o = _separation(x, z, n)
