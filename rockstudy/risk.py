@@ -21,14 +21,15 @@ from pathlib import Path
 import numpy as np
 from scipy.special import log_ndtr, ndtr
 
-from .constants import G
+from .constants import STANDARD_GRAVITY
 from .motions import measures
 
 #: Units a hazard curve's levels may be given in: name -> (factor to SI, SI unit). An IM's SI
 #: unit is that of the registry (:mod:`rockstudy.motions.measures`); its levels may be in any
-#: unit here of that dimension ("g" is rockstudy's g, 9.81 m/s^2).
+#: unit here of that dimension ("g" is the unit g, standard gravity 9.80665 m/s^2, as for
+#: records and ``scale_to``).
 UNIT_FACTORS = {
-    "g": (G, "m/s^2"),
+    "g": (STANDARD_GRAVITY, "m/s^2"),
     "m/s^2": (1.0, "m/s^2"),
     "m/s2": (1.0, "m/s^2"),
     "cm/s^2": (0.01, "m/s^2"),

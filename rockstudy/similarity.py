@@ -27,6 +27,7 @@ from .constants import G
 from .motions.pulses import PULSES, RickerWavelet
 from .motions.records import Record
 from .structures.block import Block, block_parameters
+from .structures.block import uplift_acceleration as _uplift_acceleration
 
 Law = Literal["4.10", "4.11", "5.3", "6.1"]
 LAWS = ("4.10", "4.11", "5.3", "6.1")
@@ -59,7 +60,9 @@ def groups(structure, pulse) -> dict:
     -------
     dict
         ``omega`` = omega_g / p (3.6); ``a`` = a_g / (g alpha) (3.6, 4.10);
-        ``inverse_a`` = g alpha / a_g (4.11); ``uplift_ratio`` = g tan(alpha) / a_g (5.3, 6.1);
+        ``inverse_a`` = g alpha / a_g (4.11); ``uplift_ratio`` = a_up / a_g (5.3, 6.1), with
+        a_up the uplift acceleration (:func:`uplift_acceleration`: g tan(alpha) of a block,
+        g lambda of another structure, eq. 10 of [003]);
         ``cos_alpha`` (5.3); ``eta``; and the scales ``p`` [rad/s] (tau = p t) and
         ``alpha`` [rad].
     """
@@ -69,7 +72,7 @@ def groups(structure, pulse) -> dict:
         "omega": w_g / p,
         "a": a_g / (G * alpha),
         "inverse_a": G * alpha / a_g,
-        "uplift_ratio": G * math.tan(alpha) / a_g,
+        "uplift_ratio": uplift_acceleration(structure) / a_g,
         "cos_alpha": math.cos(alpha),
         "eta": eta,
         "p": p,
@@ -142,7 +145,8 @@ def pulse_for(
         omega_g / p > 0.
     ratio : float
         The slenderness group of the law: a = a_g / (g alpha) for 4.10, g alpha / a_g for 4.11,
-        g tan(alpha) / a_g for 5.3 and 6.1; > 0.
+        a_up / a_g for 5.3 and 6.1 (:func:`uplift_acceleration`: g tan(alpha) of a block);
+        > 0.
     shape : {"sine", "cosine", "half-sine", "ricker"}
     sign : float
         +1 or -1: the direction of the pulse.
@@ -160,7 +164,7 @@ def pulse_for(
     elif law == "4.11":
         a_g = G * alpha / ratio
     else:
-        a_g = G * math.tan(alpha) / ratio
+        a_g = uplift_acceleration(structure) / ratio
     period = 2.0 * math.pi / (omega * p)
     cls = PULSES[shape]
     if cls is RickerWavelet:
@@ -197,13 +201,9 @@ def uplift_acceleration(structure) -> float:
 
     g tan(alpha) for a block (section 2 of [000]) or an equivalent block; g lambda for a
     structure with rocking parameters (eq. 10 of [003]), the smaller of the two directions of
-    an asymmetric one.
+    an asymmetric one (:func:`rockstudy.structures.uplift_acceleration`).
     """
-    if hasattr(structure, "rocking_parameters"):
-        params = structure.rocking_parameters()
-        params = params if isinstance(params, tuple) else (params,)
-        return G * min(float(q.uplift) for q in params)
-    return G * math.tan(_block(structure)[1])
+    return _uplift_acceleration(structure)
 
 
 def record_groups(structure, record: Record) -> dict:

@@ -25,6 +25,7 @@ from test_records_similarity import constructed_ida
 
 import rockstudy.study  # noqa: F401 - registers ds.rocking
 from rockstudy import risk
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.constants import G
 from rockstudy.study import load_study, make_design, validate_text
 from rockstudy.study.analysis import fragility_fit, record_fragility, record_similarity, sampled
@@ -84,7 +85,7 @@ def test_the_fit_of_an_ida_is_scipys_lognormal_mle_of_the_capacities():
     rng = np.random.default_rng(3)
     n_rec, pga = 40, rng.uniform(2.0, 6.0, 40)
     cap_g = 0.35 * np.exp(0.45 * rng.standard_normal(n_rec))  # capacities in g of PGA
-    ds = _ida_dataset((cap_g * G / pga)[:, None], pga, pga / 8, [1.0], [2.0])
+    ds = _ida_dataset((cap_g * G_UNIT / pga)[:, None], pga, pga / 8, [1.0], [2.0])
     assert ds.rocking.kind == "ida"
     row = ds.rocking.fragility(n_boot=0).loc["all"]
     mu, sigma = stats.norm.fit(np.log(cap_g))  # scipy's MLE (dividing by n)
@@ -101,10 +102,10 @@ def _stripes(levels, overturned, pga):
             "overturned": (("record", "structure", "level"), y),
             "status": (("record", "structure", "level"), np.zeros(y.shape, np.int64)),
         },
-        coords={"level": levels * G, "structure": [0]},
+        coords={"level": levels * G_UNIT, "structure": [0]},
         attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
     )
-    scale = xr.DataArray(levels * G, dims="level") / ds["pga"]
+    scale = xr.DataArray(levels * G_UNIT, dims="level") / ds["pga"]
     return ds.assign(scale=scale.broadcast_like(ds["overturned"]))
 
 
@@ -141,7 +142,7 @@ def test_stripes_and_clouds_get_the_binomial_fit():
     over = rng.random(400) < _probit(level_g, 0.5, 0.6)
     cloud = xr.Dataset(
         {
-            "pga": ("record", level_g * G),
+            "pga": ("record", level_g * G_UNIT),
             "overturned": (("record", "structure"), over[:, None]),
             "status": (("record", "structure"), np.zeros((400, 1), np.int64)),
         },
@@ -298,8 +299,8 @@ def raw_record_cube(records_dir, tmp_path):
     ds = make_design(study, tmp_path)
     rng = np.random.default_rng(5)
     n, n_rec = ds.sizes["sample"], len(json.loads(ds.attrs["record_names"]))
-    pga = np.geomspace(0.05, 0.8, n_rec)[ds["record"].values] * G
-    over = rng.random(n) < _probit(pga / G, 0.25, 0.5)
+    pga = np.geomspace(0.05, 0.8, n_rec)[ds["record"].values] * G_UNIT
+    over = rng.random(n) < _probit(pga / G_UNIT, 0.25, 0.5)
     ds = ds.assign(
         pga=("sample", pga),
         overturned=("sample", over.astype(np.int8)),
@@ -311,7 +312,7 @@ def raw_record_cube(records_dir, tmp_path):
     )
     ds.attrs["study"] = study.normalized()
     ds.to_zarr(tmp_path / "cube.zarr", zarr_format=2)
-    return xr.open_zarr(tmp_path / "cube.zarr"), pga / G, over
+    return xr.open_zarr(tmp_path / "cube.zarr"), pga / G_UNIT, over
 
 
 def test_a_record_study_cube_read_by_xarray_is_folded_and_uses_its_study(raw_record_cube):

@@ -17,7 +17,7 @@ import xarray as xr
 from scipy import optimize, stats
 
 from rockstudy import SeparationWarning, risk
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.study import analysis
 from rockstudy.study.analysis import fragility_fit
 from rockstudy.study.analysis import record_fragility as rf
@@ -145,12 +145,12 @@ def _stripes(overturned, levels):
     shape = (n_rec, 1, levels.size)
     return xr.Dataset(
         {
-            "pga": ("record", np.full(n_rec, G)),
+            "pga": ("record", np.full(n_rec, G_UNIT)),
             "overturned": (("record", "structure", "level"), y),
             "status": (("record", "structure", "level"), np.zeros(shape, np.int64)),
             "scale": (("record", "structure", "level"), np.broadcast_to(levels, shape)),
         },
-        coords={"level": levels * G, "structure": ["Vase"]},
+        coords={"level": levels * G_UNIT, "structure": ["Vase"]},
         attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
     )
 

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from test_record_studies import rows_study, run_rows, suite  # noqa: F401  (a fixture)
 
-from rockstudy.constants import STANDARD_GRAVITY, G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
+from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite, measures, register_measure
 from rockstudy.study.analysis import record_fragility as rf
 from rockstudy.study.designs.records import cloud, multiple_stripes
@@ -39,7 +40,7 @@ def registered():
         unit="m/s^2",
         power=1,
         quoted_unit="g",
-        factor=1.0 / STANDARD_GRAVITY,
+        factor=1.0 / G_UNIT,
         label="PGA of the first half",
     )
     register_measure("pga_squared", lambda r: r.peak**2, unit="m^2/s^4", power=2)
@@ -80,9 +81,7 @@ def test_a_design_scales_each_record_to_the_level_of_the_new_measure(registered,
                 assert first_half_peak(rec.scaled(s)) == pytest.approx(level, rel=1e-12)
     # the measure of the scaled points in quoted units: the levels in g
     x = rf.intensity(ds, "pga_first_half")
-    np.testing.assert_allclose(
-        x.values, np.broadcast_to(levels / STANDARD_GRAVITY, x.shape), rtol=1e-12
-    )
+    np.testing.assert_allclose(x.values, np.broadcast_to(levels / G_UNIT, x.shape), rtol=1e-12)
     assert x.attrs["unit"] == "g"
 
 
@@ -99,7 +98,7 @@ def test_power_two_scales_by_the_square_root_and_fits_as_the_square(registered, 
     by_pga = rf.stripe_fragility(ds, im="pga", n_boot=0)
     by_sq = rf.stripe_fragility(ds, n_boot=0)  # the stripes' own: pga_squared
     assert by_sq["unit"].iloc[0] == "m^2/s^4" and by_pga["unit"].iloc[0] == "g"
-    theta_si = by_pga["theta"].iloc[0] * G  # PGA is quoted in g (1 / G)
+    theta_si = by_pga["theta"].iloc[0] * G_UNIT  # PGA is quoted in the unit g
     assert by_sq["theta"].iloc[0] == pytest.approx(theta_si**2, rel=1e-5)
     assert by_sq["beta"].iloc[0] == pytest.approx(2 * by_pga["beta"].iloc[0], rel=1e-5)
     table = rf.im_efficiency(ds, n_boot=10)  # the defaults take every stored scalable measure
@@ -121,7 +120,7 @@ def test_a_cloud_stores_the_measure_and_fits_it(registered, records):
     expected = [first_half_peak(r.scaled(3.0)) for r in records]
     np.testing.assert_allclose(ds["pga_first_half"].values, expected, rtol=1e-12)
     x = rf.intensity(ds, "pga_first_half")
-    np.testing.assert_allclose(x.values, np.array(expected) / STANDARD_GRAVITY, rtol=1e-12)
+    np.testing.assert_allclose(x.values, np.array(expected) / G_UNIT, rtol=1e-12)
 
 
 def test_a_study_scales_rows_to_the_new_measure(registered, suite, tmp_path):  # noqa: F811
@@ -145,13 +144,13 @@ def test_a_study_scales_rows_to_the_new_measure(registered, suite, tmp_path):  #
         assert out["pga_squared"][i] == pytest.approx(
             (np.max(np.abs(rec.acceleration)) * out["scale"][i]) ** 2, rel=1e-12
         )
-    assert 0.2 * STANDARD_GRAVITY <= design["target"].min() <= design["target"].max()
-    assert design["target"].max() <= 0.6 * STANDARD_GRAVITY
+    assert 0.2 * G_UNIT <= design["target"].min() <= design["target"].max()
+    assert design["target"].max() <= 0.6 * G_UNIT
 
 
 def test_scale_to_reads_the_registry(registered):
     t = ScaleTo.model_validate({"im": "pga_first_half", "units": "g", "value": 0.3})
-    assert t.si_factor() == STANDARD_GRAVITY
+    assert t.si_factor() == G_UNIT
     t = ScaleTo.model_validate({"im": "pga_squared", "value": 4.0})
     assert t.unit_label == "m^2/s^4"
     with pytest.raises(ValueError, match="units"):

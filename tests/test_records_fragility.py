@@ -7,6 +7,7 @@ import pytest
 import xarray as xr
 from scipy import optimize, stats
 
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.constants import G
 from rockstudy.study import analysis
 from rockstudy.study.analysis import fragility_fit
@@ -102,7 +103,7 @@ def test_ida_fragility_units_closed_form_and_band_coverage():
     rng = np.random.default_rng(7)
     pga = rng.uniform(2.0, 6.0, 30)
     cap_g = rng.lognormal(np.log(0.5), 0.3, 30)  # capacities in g
-    ds = _ida_dataset((cap_g * G / pga)[:, None], pga, pga / 10, [G * 0.2], [2.7])
+    ds = _ida_dataset((cap_g * G_UNIT / pga)[:, None], pga, pga / 10, [G_UNIT * 0.2], [2.7])
     t = rf.ida_fragility(ds)
     assert t.loc["all", "unit"] == "g"
     assert t.loc["all", "theta"] == pytest.approx(np.exp(np.mean(np.log(cap_g))), rel=1e-12)
@@ -113,7 +114,7 @@ def test_ida_fragility_units_closed_form_and_band_coverage():
     for seed in range(300):
         c = np.random.default_rng(seed).lognormal(np.log(0.5), 0.3, 12)
         r = rf.ida_fragility(
-            _ida_dataset((c * G)[:, None], np.full(12, 1.0), np.ones(12), [1.0], [1.0])
+            _ida_dataset((c * G_UNIT)[:, None], np.full(12, 1.0), np.ones(12), [1.0], [1.0])
         )
         hits += r.loc["all", "theta_lo"] <= 0.5 <= r.loc["all", "theta_hi"]
     assert 0.85 <= hits / 300 <= 0.95
@@ -124,7 +125,7 @@ def test_fragility_median_outside_the_data_is_flagged():
     cap = rng.lognormal(0.0, 0.5, (40, 1))
     top = 0.6  # most blocks stand at the top of the range: the median lies above it
     ds = _ida_dataset(
-        np.minimum(cap, top), np.full(40, G), np.ones(40), [1.0], [1.0], censored=cap > top
+        np.minimum(cap, top), np.full(40, G_UNIT), np.ones(40), [1.0], [1.0], censored=cap > top
     )
     ds["capacity_scale_lower"] = ds["capacity_scale_lower"].where(~ds["censored"], top)
     t = rf.ida_fragility(ds, n_boot=50)
@@ -134,7 +135,7 @@ def test_fragility_median_outside_the_data_is_flagged():
     levels = np.array([0.1, 0.15, 0.2])
     stripes = xr.Dataset(
         {
-            "pga": ("record", np.full(50, G)),
+            "pga": ("record", np.full(50, G_UNIT)),
             "overturned": (
                 ("record", "structure", "level"),
                 (rng.random((50, 1, 3)) < stats.norm.cdf(np.log(levels / 1.0) / 0.4)),
@@ -142,7 +143,7 @@ def test_fragility_median_outside_the_data_is_flagged():
             "status": (("record", "structure", "level"), np.zeros((50, 1, 3), np.int64)),
             "scale": (("record", "structure", "level"), np.broadcast_to(levels, (50, 1, 3))),
         },
-        coords={"level": levels * G, "structure": [0]},
+        coords={"level": levels * G_UNIT, "structure": [0]},
         attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
     )
     s = rf.stripe_fragility(stripes, n_boot=50)
@@ -162,10 +163,10 @@ def test_stripe_fragility_recovers_the_fragility_of_its_points():
             "overturned": (("record", "structure", "level"), y),
             "status": (("record", "structure", "level"), np.zeros(y.shape, np.int64)),
         },
-        coords={"level": levels * G, "structure": [0]},
+        coords={"level": levels * G_UNIT, "structure": [0]},
         attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
     )
-    ds["scale"] = (xr.DataArray(levels * G, dims="level") / ds["pga"]).broadcast_like(
+    ds["scale"] = (xr.DataArray(levels * G_UNIT, dims="level") / ds["pga"]).broadcast_like(
         ds["overturned"]
     )
     t = rf.stripe_fragility(ds, n_boot=40)
@@ -203,7 +204,7 @@ def test_im_efficiency_ranks_the_collapsing_measure_first():
 
 
 def test_intensity_in_quoted_units_and_bad_names():
-    ds = _ida_dataset([[2.0]], [G / 2], [0.3], [G * 0.2], [2.0])
+    ds = _ida_dataset([[2.0]], [G_UNIT / 2], [0.3], [G_UNIT * 0.2], [2.0])
     ds["arias"] = ("record", [0.5])
     assert rf.intensity(ds, "pga", scale="capacity_scale").item() == pytest.approx(1.0)
     assert rf.intensity(ds, "pgv", scale="capacity_scale").item() == pytest.approx(0.6)
@@ -246,7 +247,7 @@ def test_ida_bands_of_p_cover_the_true_fragility(n):
     tables = []
     for _ in range(150):
         c = 0.5 * np.exp(0.4 * rng.standard_normal(n))
-        ds = _ida_dataset((c * G)[:, None], np.ones(n), np.ones(n), [1.0], [1.0])
+        ds = _ida_dataset((c * G_UNIT)[:, None], np.ones(n), np.ones(n), [1.0], [1.0])
         tables.append(rf.ida_fragility(ds))
     assert tables[0].loc["all", "p_band"] == "noncentral_t"
     assert np.all(_coverage(tables) >= 0.85)
@@ -266,14 +267,14 @@ def test_censored_ida_bands_of_p_cover_the_true_fragility():
     assert np.all(np.mean(hits, axis=0) >= 0.85)
     # the IDA table of the last draw says the same through its band columns
     ds = _ida_dataset(
-        (np.minimum(c, top) * G)[:, None],
+        (np.minimum(c, top) * G_UNIT)[:, None],
         np.ones(30),
         np.ones(30),
         [1.0],
         [1.0],
         (c > top)[:, None],
     )
-    ds["capacity_scale_lower"] = ds["capacity_scale_lower"].where(~ds["censored"], top * G)
+    ds["capacity_scale_lower"] = ds["capacity_scale_lower"].where(~ds["censored"], top * G_UNIT)
     table = rf.ida_fragility(ds, n_boot=0)
     assert table.loc["all", "p_band"] == "likelihood"
     curve = analysis.fragility_curve(table, _X).isel(group=0)
@@ -284,7 +285,7 @@ def _cloud(level_g, overturned):
     y = np.asarray(overturned, bool)[:, None]
     return xr.Dataset(
         {
-            "pga": ("record", np.asarray(level_g, float) * G),
+            "pga": ("record", np.asarray(level_g, float) * G_UNIT),
             "overturned": (("record", "structure"), y),
             "status": (("record", "structure"), np.zeros(y.shape, np.int64)),
         },
@@ -362,7 +363,7 @@ def test_the_scaling_power_is_the_measures_own():
 
 
 def test_bad_fragility_arguments_are_named():
-    ida = _ida_dataset([[1.0], [2.0], [3.0]], [G] * 3, [1.0] * 3, [1.0], [1.0])
+    ida = _ida_dataset([[1.0], [2.0], [3.0]], [G_UNIT] * 3, [1.0] * 3, [1.0], [1.0])
     cloud = _cloud([0.1, 0.2, 0.3], [0, 1, 1])
     with pytest.raises(ValueError, match="ds: stripe_fragility needs a stripes or cloud"):
         rf.stripe_fragility(ida)
@@ -408,7 +409,9 @@ def test_capacities_that_share_a_record_are_not_counted_as_independent():
     hits, runs = 0, 120
     for seed in range(runs):
         c = np.random.default_rng(seed).lognormal(np.log(0.5), 0.3, 12)  # per record [g]
-        ds = _ida_dataset((c * G)[:, None] * blocks, np.ones(12), np.ones(12), [1.0] * 6, [1.0] * 6)
+        ds = _ida_dataset(
+            (c * G_UNIT)[:, None] * blocks, np.ones(12), np.ones(12), [1.0] * 6, [1.0] * 6
+        )
         r = rf.ida_fragility(ds, n_boot=200, seed=seed).loc["all"]
         assert r["p_band"] == "record_bootstrap"
         hits += r["theta_lo"] <= 0.5 * 1.01 <= r["theta_hi"]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.motions import Record, synthetic_near_fault
 from rockstudy.structures.block import frequency_parameter
 from rockstudy.study.analysis.record_similarity import size_class_medians, size_classes
@@ -76,7 +76,7 @@ def constructed_ida(theta, beta=0.4, n_rec=7):
     n = len(theta)
     ds = xr.Dataset(
         {
-            "pga": ("record", np.full(n_rec, G)),  # 1 g: the scale is the capacity in g
+            "pga": ("record", np.full(n_rec, G_UNIT)),  # 1 g: the scale is the capacity in g
             "half_diagonal": ("structure", np.geomspace(0.3, 5.0, n)),
             "capacity_scale": (("record", "structure"), cap),
             "capacity_scale_lower": (("record", "structure"), cap / (1 + TOL)),

@@ -219,7 +219,7 @@ def test_median_in_g_reads_not_reached_where_the_median_is(tmp_path):
     group's sampled intensities is 'not reached' in both columns, never a number in g."""
     import pandas as pd
 
-    from rockstudy.constants import G
+    from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
     from rockstudy.study.analysis.fragility_fit import BAND_COLUMNS
     from rockstudy.study.report import sampled as report
     from rockstudy.study.report._page import NOT_REACHED
@@ -248,5 +248,5 @@ def test_median_in_g_reads_not_reached_where_the_median_is(tmp_path):
 
     report._fragility_table(Page(), fit)
     in_g = shown["fragility"]["median capacity [g] (a_g only)"].tolist()
-    assert in_g[0] == pytest.approx(5.0 / G, rel=1e-15)
+    assert in_g[0] == pytest.approx(5.0 / G_UNIT, rel=1e-15)
     assert in_g[1] == NOT_REACHED

@@ -12,7 +12,8 @@ import pandas as pd
 import pytest
 
 import rockstudy as rs
-from rockstudy.constants import STANDARD_GRAVITY, G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
+from rockstudy.constants import G
 from rockstudy.motions import load_suite
 from rockstudy.study.designs.records import multiple_stripes
 from rockstudy.study.report.records import record_report
@@ -34,7 +35,7 @@ def _text(page):
 
 
 def test_capacity_table_and_governing_record_per_object(tmp_path, records):
-    levels = np.array([0.2, 0.4, 0.8, 1.6]) * G
+    levels = np.array([0.2, 0.4, 0.8, 1.6]) * G_UNIT
     ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
     page = record_report(ds, tmp_path / "r", n_boot=5)
     table = pd.read_csv(tmp_path / "r" / "object_capacity.csv", index_col=0)
@@ -44,15 +45,15 @@ def test_capacity_table_and_governing_record_per_object(tmp_path, records):
         first = {}  # the oracle: each scaled record alone, level by level
         for rec in records:
             over = [rs.simulate(block, rec.scaled(x / rec.peak)).overturned for x in levels]
-            first[rec.name] = levels[over.index(True)] / G if any(over) else np.inf
+            first[rec.name] = levels[over.index(True)] / G_UNIT if any(over) else np.inf
             k = over.index(True) if any(over) else -1
             cell = table.loc[obj, rec.name]
             if k < 0:
-                assert cell == f"above {levels[-1] / G:.3g}"
+                assert cell == f"above {levels[-1] / G_UNIT:.3g}"
             elif k == 0:
-                assert cell == f"at or below {levels[0] / G:.3g}"
+                assert cell == f"at or below {levels[0] / G_UNIT:.3g}"
             else:
-                assert cell == f"{levels[k - 1] / G:.3g} to {levels[k] / G:.3g}"
+                assert cell == f"{levels[k - 1] / G_UNIT:.3g} to {levels[k] / G_UNIT:.3g}"
         lowest = min(first.values())
         governing = table.loc[obj, "governing record(s) (lowest capacity)"]
         if np.isfinite(lowest):
@@ -65,7 +66,8 @@ def test_capacity_table_and_governing_record_per_object(tmp_path, records):
         fit = pd.read_csv(out / "object_fragility.csv", index_col=0)
         for obj, block in OBJECTS.items():
             up = fit.loc[[obj], "uplift level, PGA [g]"].iloc[0]
-            assert up == pytest.approx(math.tan(block.slenderness), rel=1e-9)
+            # g tan(alpha) with the physics' g, quoted in the unit g (standard gravity)
+            assert up == pytest.approx(G * math.tan(block.slenderness) / G_UNIT, rel=1e-9)
     assert "Nothing overturned" not in _text(page)
 
 
@@ -80,7 +82,7 @@ def test_nothing_rocked_is_said_in_words(tmp_path, records):
     assert "Nothing rocked" in text and "no fragility can be fitted" in text
     assert not (tmp_path / "r" / "object_fragility.png").exists()
     table = pd.read_csv(tmp_path / "r" / "object_capacity.csv", index_col=0)
-    assert (table.iloc[:, : len(records)] == f"above {levels[-1] / G:.3g}").all().all()
+    assert (table.iloc[:, : len(records)] == f"above {levels[-1] / G_UNIT:.3g}").all().all()
 
 
 def test_nothing_overturned_but_rocked(tmp_path, records):
@@ -95,7 +97,7 @@ def test_nothing_overturned_but_rocked(tmp_path, records):
 
 
 def test_scale_factor_warning_and_units(tmp_path, records):
-    levels = np.array([0.5, 3.0]) * G
+    levels = np.array([0.5, 3.0]) * G_UNIT
     ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
     page = record_report(ds, tmp_path / "r", n_boot=5, units="m/s^2", max_scale_factor=5)
     text = _text(page)
@@ -184,7 +186,7 @@ def test_friction_in_an_objects_study_cube_report_and_run_warning(client, tmp_pa
     out = tmp_path / "cube.zarr"
     run_study(study, out, client=client, base_dir=tmp_path, progress=False)
     cube = open_result(out).load()
-    levels_g = np.array([0.05, 0.1]) * STANDARD_GRAVITY / G  # "g" of units: 9.80665 m/s^2
+    levels_g = np.array([0.05, 0.1]) * G_UNIT / G  # "g" of units: 9.80665 m/s^2
     demand = cube["friction_demand"].transpose("record", "structure", "level").values
     np.testing.assert_allclose(demand, np.broadcast_to(levels_g, demand.shape), rtol=1e-9)
     text = _text(make_report(out, tmp_path / "report"))

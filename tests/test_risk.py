@@ -17,7 +17,7 @@ from scipy.integrate import quad
 from scipy.stats import norm
 
 from rockstudy import risk
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.risk import HazardCurve, annual_rate, probability_in, rate_deaggregation
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "hazard"
@@ -121,13 +121,15 @@ def test_units_convert_and_cannot_trap():
     hazard = HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
     si = hazard.to_si()
     assert si.units == "m/s^2"
-    np.testing.assert_allclose(si.levels, hazard.levels * G)
-    np.testing.assert_allclose(si.rate(0.3 * G), hazard.rate(0.3), rtol=1e-12)
+    np.testing.assert_allclose(si.levels, hazard.levels * G_UNIT)
+    np.testing.assert_allclose(si.rate(0.3 * G_UNIT), hazard.rate(0.3), rtol=1e-12)
     # a median given in m/s^2 against a hazard in g
-    assert annual_rate(0.3 * G, 0.4, hazard, units="m/s^2") == pytest.approx(
+    assert annual_rate(0.3 * G_UNIT, 0.4, hazard, units="m/s^2") == pytest.approx(
         annual_rate(0.3, 0.4, hazard), rel=1e-12
     )
-    assert annual_rate(0.3 * G, 0.4, si) == pytest.approx(annual_rate(0.3, 0.4, hazard), rel=1e-12)
+    assert annual_rate(0.3 * G_UNIT, 0.4, si) == pytest.approx(
+        annual_rate(0.3, 0.4, hazard), rel=1e-12
+    )
     with pytest.raises(ValueError, match="units='m/s' is not a unit of 'pga'"):
         HazardCurve("pga", [0.1, 0.2], [1e-2, 1e-3], units="m/s")
     with pytest.raises(ValueError, match="units='g' is not a unit of 'pgv'"):

@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from rockstudy import risk
-from rockstudy.constants import G
+from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.study.analysis.risk import object_risk
 
 K0, K = 2e-4, 2.3  # lambda(x) = k0 x^-k, x in g
@@ -26,7 +26,7 @@ def _ida(capacities_g, censored=None, names=None):
     names = names or [f"object {j}" for j in range(n_st)]
     ds = xr.Dataset(
         {
-            "pga": ("record", np.full(n_rec, G)),
+            "pga": ("record", np.full(n_rec, G_UNIT)),
             "capacity_scale": (("record", "structure"), np.where(cens, np.nan, cap)),
             "capacity_scale_lower": (("record", "structure"), cap / 1.001),
             "censored": (("record", "structure"), cens),
@@ -88,7 +88,7 @@ def test_units_g_or_si_give_the_same_rate():
     a = object_risk(_ida(cap), in_g, n_boot=20)
     b = object_risk(_ida(cap), in_si, n_boot=20)
     assert b["annual_rate"].item() == pytest.approx(a["annual_rate"].item(), rel=1e-10)
-    assert b["theta"].item() == pytest.approx(a["theta"].item() * G, rel=1e-12)
+    assert b["theta"].item() == pytest.approx(a["theta"].item() * G_UNIT, rel=1e-12)
 
 
 def test_a_tabulated_curve_gives_the_rate_of_its_power_law_source():
@@ -133,7 +133,7 @@ def test_stripes_overturned_everywhere_give_a_lower_bound():
     n_rec = 4
     ds = xr.Dataset(
         {
-            "pga": ("record", np.full(n_rec, G)),
+            "pga": ("record", np.full(n_rec, G_UNIT)),
             "scale": (("record", "structure", "level"), np.broadcast_to(levels, (n_rec, 1, 3))),
             "overturned": (("record", "structure", "level"), np.ones((n_rec, 1, 3), bool)),
             "status": (("record", "structure", "level"), np.zeros((n_rec, 1, 3), int)),

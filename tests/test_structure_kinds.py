@@ -94,13 +94,19 @@ def test_each_kind_in_a_design_has_the_parameters_of_its_class(kind, tmp_path):
 def test_closed_forms_of_the_wall_strut_and_symmetric_frame():
     # eq. (23) of [003]: p_wall = sqrt(2) sqrt(3 g / 4 R), theta_cr = 2 alpha
     R, a = np.array([0.5, 1.5, 4.0]), np.array([0.05, 0.12, 0.3])
-    p, theta = KINDS["rocking_wall"].sampled(R, a)
+    # and its uplift acceleration g lambda, eq. (21) at phi = 0: lambda = 2 tan(alpha)
+    p, theta, a_up = KINDS["rocking_wall"].sampled(R, a)
     np.testing.assert_allclose(p, np.sqrt(2) * np.sqrt(0.75 * G / R), rtol=1e-14)
     np.testing.assert_allclose(theta, 2 * a, rtol=1e-14)
+    np.testing.assert_allclose(a_up, 2 * G * np.tan(a), rtol=1e-14)
     for r, al in zip(R, a, strict=True):
-        eq = RockingWall(r, al, 0.9).equivalent_block()
+        wall = RockingWall(r, al, 0.9)
+        eq = wall.equivalent_block()
         assert (eq.frequency_parameter, eq.slenderness) == pytest.approx(
             (math.sqrt(1.5 * G / r), 2 * al), rel=1e-9
+        )
+        assert rs.structures.uplift_acceleration(wall) == pytest.approx(
+            2 * G * math.tan(al), rel=1e-12
         )
     # Table I of [003]: strut p^2 = g / R, eta = cos 2 alpha; frame p^2 = (3g/4R)(1+2g)/(1+3g)
     strut = ObjectSpec(name="s", kind="point_mass_strut", half_diagonal=0.8, slenderness=0.25)

@@ -49,8 +49,6 @@ from ._rocking import (
 )
 from ._taylor import NO_REFCOUNT
 
-_NO_SAMPLES = np.empty(0)  # times and samples of a motion that is not a record; no vertical
-
 # Impacts, peaks and falls are located to rounding: sigma is a time inside one phase, and the
 # root is the next phase's initial state, so its error would carry on through the history.
 ROOT_TOL = 1e-16
@@ -316,25 +314,17 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
     v = om_init / p
     s = math.copysign(1.0, th_init if th_init != 0.0 else om_init)
     code = PH_END
+    # the lift-off kernels take the argument types of the nonlinear scene (run-time ints and
+    # writable arrays, not literals and constants): one compiled signature serves both models
+    kind, model, none = np.int64(KIND_TRIG), np.int64(MODEL_LINEAR), mp[:0]
     while True:
         lifted = not rocking  # this phase starts from rest
         if not rocking:
-            t_up = next_uplift(
-                KIND_TRIG,
-                mp,
-                _NO_SAMPLES,
-                _NO_SAMPLES,
-                _NO_SAMPLES,
-                p,
-                alpha,
-                MODEL_LINEAR,
-                NO_TABLE,
-                t,
-            )
+            t_up = next_uplift(kind, mp, none, none, none, p, alpha, model, NO_TABLE, t)
             if t_up >= dur:  # the still ground after the motion never lifts a block
                 peak, n_imp, first, _ = _tallied(tallies)
                 return STATUS_OK, peak, False, n_imp, np.nan, first
-            a_up = ground_acceleration(KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, t_up, 0)
+            a_up = ground_acceleration(kind, mp, none, none, t_up, np.int64(0))
             s = -1.0 if a_up > 0.0 else 1.0
             t = t_up
             th = 0.0
@@ -347,11 +337,11 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
             break
         t = tau / p
         if lifted:
-            t = max(t, _lift_ends(KIND_TRIG, mp, _NO_SAMPLES, _NO_SAMPLES, p, alpha, t_up))
+            t = max(t, _lift_ends(kind, mp, none, none, p, alpha, t_up))
     if code == PH_END:
         if use_map and eta < 1.0:  # eta = 1 never rests: followed up to t_tail instead
             over, peak, n_post = free_rocking_map(
-                s * th, s * v * p, p, alpha, eta, MODEL_LINEAR, REST_FRACTION * p * alpha
+                s * th, s * v * p, p, alpha, eta, model, REST_FRACTION * p * alpha
             )
             n_before = ta.n_impacts
             tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, p, ta, over)

@@ -24,8 +24,9 @@ integral of a_g^2, goes as s^2; durations and periods do not change (k = 0) and 
 scaled to.
 
 The dimensionless scale targets of the record designs (:data:`RATIOS`, ``pga_ratio`` = PGA /
-(g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha)) are a measure of this registry divided
-by the block's uplift acceleration; they follow their measure's power.
+a_up and ``pgv_ratio`` = PGV p / a_up) are a measure of this registry divided by the structure's
+uplift acceleration a_up (g tan alpha of a block, g lambda of another structure, eq. 10 of
+[003]); they follow their measure's power.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate
-from ..constants import STANDARD_GRAVITY, G
+from ..constants import STANDARD_GRAVITY
 from . import intensity
 
 
@@ -91,7 +92,8 @@ class Measure:
 @dataclass(frozen=True)
 class Ratio:
     """A dimensionless scale target: the measure ``base`` times p^``p_power`` divided by the
-    uplift acceleration g tan(alpha) of each block; it follows the power of ``base``."""
+    uplift acceleration a_up of each structure (g tan(alpha) of a block); it follows the power
+    of ``base``."""
 
     base: str
     p_power: int
@@ -359,7 +361,7 @@ def _of_samples(f: Callable) -> Callable:
 def _builtins():
     """The measures of :mod:`rockstudy.motions.intensity` (see its conventions), in the order
     of the tables."""
-    to_g = {"quoted_unit": "g", "factor": 1.0 / G}  # as the fragility tables always quoted
+    to_g = {"quoted_unit": "g", "factor": 1.0 / STANDARD_GRAVITY}  # g the unit, as for records
     register_measure("pga", lambda r: r.peak, unit="m/s^2", power=1, label="PGA", **to_g)
     register_measure("pgv", _peak_ground_velocity, unit="m/s", power=1, label="PGV")
     register_measure("pgd", _peak_ground_displacement, unit="m", power=1, label="PGD")

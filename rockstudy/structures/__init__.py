@@ -1,6 +1,13 @@
 """Rocking structures reduced to the parameters the solvers need (paper [003])."""
 
-from .block import Block, block_parameters, frequency_parameter, restitution_housner
+from .block import (
+    Block,
+    block_parameters,
+    frequency_parameter,
+    restitution_housner,
+    uplift_acceleration,
+    uplift_acceleration_block,
+)
 from .equivalent import (
     Arch,
     AsymmetricFrame,
@@ -27,4 +34,6 @@ __all__ = [
     "frequency_parameter",
     "restitution_housner",
     "restitution_symmetric_body",
+    "uplift_acceleration",
+    "uplift_acceleration_block",
 ]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from .. import _validate
 from ..constants import G
 
@@ -51,6 +53,21 @@ def frequency_parameter(half_diagonal: float) -> float:
         R, half the diagonal of the block [m].
     """
     return math.sqrt(3.0 * G / (4.0 * half_diagonal))
+
+
+def uplift_acceleration_block(slenderness):
+    r"""Ground acceleration that lifts a rectangular block off its base [m/s^2], on arrays.
+
+    eq. (1) of [003] (section 2 of [000]):
+
+    .. math:: \ddot u_{g,\min} = g \lambda = g \tan\alpha
+
+    Parameters
+    ----------
+    slenderness : array_like
+        alpha [rad] (theta_cr of an equivalent block, which is a block).
+    """
+    return G * np.tan(np.asarray(slenderness, dtype=float))
 
 
 def restitution_housner(slenderness: float) -> float:
@@ -150,6 +167,21 @@ class Block:
     def uplift_acceleration(self) -> float:
         """Ground acceleration that starts rocking, g tan(alpha) [m/s^2], section 2 of [000]."""
         return G * math.tan(self.slenderness)
+
+
+def uplift_acceleration(structure) -> float:
+    """Ground acceleration that starts a structure rocking [m/s^2].
+
+    g lambda with lambda = G_nl(0) / B_nl(0), eq. (10) of [003], for a structure with
+    ``rocking_parameters()`` (the smaller of the two directions of an asymmetric one: the
+    ground pushes both ways); g tan(alpha), eq. (1) of [003], for a block or an
+    :class:`~rockstudy.structures.EquivalentBlock` (whose alpha is theta_cr).
+    """
+    if hasattr(structure, "rocking_parameters"):
+        params = structure.rocking_parameters()
+        params = params if isinstance(params, tuple) else (params,)
+        return G * min(float(q.uplift) for q in params)
+    return float(uplift_acceleration_block(block_parameters(structure)[1]))
 
 
 def block_parameters(structure) -> tuple[float, float, float]:

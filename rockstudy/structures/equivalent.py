@@ -194,6 +194,18 @@ class RockingWall(_Symmetric):
         R = np.asarray(half_diagonal, float)
         return np.sqrt(1.5 * G / R), 2.0 * np.asarray(slenderness, float)
 
+    @staticmethod
+    def uplift_acceleration_of(slenderness):
+        r"""The wall's uplift acceleration g lambda [m/s^2], on arrays: eq. (10) of [003] on
+        eq. (21) at phi = 0, where sin(alpha) = (u_g'' / 2 g) cos(alpha):
+
+        .. math:: \lambda = 2 \tan\alpha
+
+        (what :func:`rockstudy.structures.uplift_acceleration` gives from the mechanism, in
+        closed form; not g tan(theta_cr) = g tan(2 alpha) of the equivalent block).
+        """
+        return 2.0 * G * np.tan(np.asarray(slenderness, float))
+
 
 def _sector(r, t, psi1, psi2):
     """Area, centroid (x, y) and polar moment about the centroid of an annular sector between

@@ -133,10 +133,17 @@ def _stripe_fitter(ds, im, period):
 
 
 def _uplift(ds, hazard):
-    """Each structure's uplift PGA g tan(alpha) in the hazard's units (NaN for another IM, or
-    where the design does not say it): below it a block cannot even leave rest."""
+    """Each structure's uplift PGA in the hazard's units: the design's ``uplift_acceleration``
+    (g tan(alpha) of a block, g lambda of another structure, eq. 10 of [003]), else PGA /
+    pga_ratio (NaN for another IM, or where the design does not say it): below it a
+    structure cannot even leave rest."""
     n = ds.sizes["structure"]
-    if hazard.im != "pga" or not {"pga", "pga_ratio"} <= set(ds.variables):
+    if hazard.im != "pga":
+        return np.full(n, np.nan)
+    if "uplift_acceleration" in ds.variables:
+        level = ds["uplift_acceleration"].transpose("structure").values.astype(float)
+        return level / risk.UNIT_FACTORS[hazard.units][0]
+    if not {"pga", "pga_ratio"} <= set(ds.variables):
         return np.full(n, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         level = (ds["pga"] / ds["pga_ratio"]).transpose("structure", ...).values.reshape(n, -1)
@@ -251,7 +258,8 @@ def object_risk(
         ``probability`` in ``years`` with ``probability_lo``/``_hi``, ``return_period`` [yr],
         ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
         ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
-        PGA g tan(alpha), in ``hazard.units``) and ``share_below_uplift`` (the share of
+        PGA, g tan(alpha) of a block and g lambda of another structure, eq. 10 of [003], in
+        ``hazard.units``) and ``share_below_uplift`` (the share of
         ``annual_rate`` from PGA below it, where the block cannot leave rest: what the
         lognormal's lower tail adds, not what a simulation saw), ``annual_rate_above_uplift``
         (the rate of the fragility set to 0 below the uplift PGA); and on (``structure``,

@@ -18,14 +18,17 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from ..._warnings import UpliftWarning
 from ...motions import measures
 from ...motions.suites import read_pair
+from ...structures.block import uplift_acceleration_block
 from ..spec.feasibility import record_pairs
 from . import records as rd
 
@@ -44,12 +47,13 @@ def record_variables() -> dict:
     return {**{k: (ms[k].label, ms[k].unit) for k in measures.listed(False)}, **PULSE_VARIABLES}
 
 
-#: (record, structure) groups of the unscaled record (:func:`rockstudy.similarity.record_groups`).
+#: (record, structure) groups of the unscaled record (:func:`rockstudy.similarity.record_groups`),
+#: relative to the structure's uplift acceleration a_up (g tan alpha for a block).
 GROUP_VARIABLES = {
-    "pga_ratio": ("PGA / (g tan alpha)", "1"),
-    "pgv_ratio": ("PGV p / (g tan alpha)", "1"),
+    "pga_ratio": ("PGA / a_up", "1"),
+    "pgv_ratio": ("PGV p / a_up", "1"),
     "pulse_frequency_ratio": ("omega_p / p = 2 pi / (T_p p)", "1"),
-    "pulse_amplitude_ratio": ("pulse amplitude omega_p v_p / (g tan alpha)", "1"),
+    "pulse_amplitude_ratio": ("pulse amplitude omega_p v_p / a_up", "1"),
 }
 #: Per-structure variables taken from the design (not the chunks).
 STRUCTURE_VARIABLES = (
@@ -58,6 +62,7 @@ STRUCTURE_VARIABLES = (
     "restitution",
     "frequency_parameter",
     "critical_rotation",
+    "uplift_acceleration",
 )
 _RUN = {
     "max_rotation": ("max |theta| (pi/2 if overturned)", "rad", "f8", np.nan),
@@ -169,12 +174,11 @@ def outputs(study) -> dict:
 
 def ida_steps(study) -> int:
     """Most simulations one structure of the study can take in the IDA: the ladder (from at
-    least half the rest scale g alpha / PGA, which a downward vertical can lower by at most
-    that, up to max_pga_ratio g tan alpha, in steps of ``1 + step``), the bisection (from
+    least half the rest scale g theta_cr / PGA, which a downward vertical can lower by at
+    most that, up to max_pga_ratio a_up, in steps of ``1 + step``), the bisection (from
     ``1 + step`` down to ``1 + tolerance``) and the scan."""
     o = study.design.ida()
-    alpha = study.largest_critical_rotation()
-    span = 2.0 * o.max_pga_ratio * math.tan(alpha) / alpha
+    span = 2.0 * o.max_pga_ratio * study.largest_uplift_over_rest()
     ladder = math.ceil(math.log(span) / math.log1p(o.step)) + 2
     ratio = math.log1p(o.step) / math.log1p(o.tolerance)
     bisect = math.ceil(math.log2(ratio)) + 1 if ratio > 1 else 0
@@ -290,6 +294,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "frequency_parameter": cols["frequency_parameter"][first],
             "critical_rotation": cols["critical_rotation"][first],
             "restitution": cols["restitution"][first],
+            "uplift_acceleration": uplift_column(study, cols, first),
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
         ds = _run_design(study, rec, structures, levels_all[lev_ids])
@@ -367,7 +372,8 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             .reshape(text.shape)
             .astype(object),
         )
-    ds["uplift_acceleration"] = ("structure", _uplift(ds))
+    if "uplift_acceleration" not in ds:  # a cube written before the design carried it
+        ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
     de = study["design"]
     attrs.update(
@@ -395,11 +401,48 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     return ds
 
 
-def _uplift(ds):
-    """g tan(theta_cr) [m/s^2] of each structure, as :mod:`.records` forms it."""
-    from ...constants import G
+def _old_uplift(ds, study: dict):
+    """The uplift acceleration [m/s^2] of each structure of a cube written before the design
+    carried it: g tan(theta_cr) for blocks (exact); for other structures NaN, with an
+    :class:`UpliftWarning` (their stored PGA ratios are relative to g tan(theta_cr) of the
+    equivalent block, not to the structure's own g lambda: run the study again)."""
+    kinds = _structure_kinds(study)
+    if kinds <= {"block", "equivalent_block"}:
+        return uplift_acceleration_block(ds["critical_rotation"].values)
+    warnings.warn(
+        "the cube was written before the design carried each structure's uplift acceleration; "
+        f"its structures of kind {sorted(kinds - {'block', 'equivalent_block'})} lift off at g "
+        "lambda (eq. 10 of [003]), not at the g tan(theta_cr) of their equivalent block that "
+        "its pga_ratio, pgv_ratio and pulse_amplitude_ratio are relative to: uplift_acceleration "
+        "is NaN (no uplift level is drawn); run the study again for the right ones",
+        UpliftWarning,
+        stacklevel=3,
+    )
+    return np.full(ds.sizes["structure"], np.nan)
 
-    return G * np.tan(ds["critical_rotation"].values)
+
+def _structure_kinds(study: dict) -> set:
+    """The structure kinds of a (normalised) study's structures."""
+    st = study["structure"]
+    if st["kind"] != "objects":
+        return {st["kind"]}
+    return {o.get("kind") or "block" for o in st["objects"]}
+
+
+def uplift_column(study, cols: dict, idx) -> np.ndarray:
+    """The uplift acceleration a_up [m/s^2] of the design rows ``idx``: the design column
+    (:func:`rockstudy.structures.uplift_acceleration` of each structure); g tan(theta_cr) for
+    blocks of a design made without it; a ValueError for other structures (their uplift is
+    not g tan(theta_cr))."""
+    if "uplift_acceleration" in cols:
+        return cols["uplift_acceleration"][idx]
+    kinds = _structure_kinds(json.loads(study.normalized()))
+    if kinds <= {"block", "equivalent_block"}:
+        return uplift_acceleration_block(cols["critical_rotation"][idx])
+    raise ValueError(
+        "the design has no uplift_acceleration column, and structures of kind "
+        f"{sorted(kinds)} do not lift off at g tan(theta_cr): make the design again"
+    )
 
 
 # ------------------------------------------------------------------ Monte Carlo rows
@@ -428,8 +471,8 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     unscaled record's (cached) measures times |scale|^k, their power in the registry (linear
     ones k = 1, Arias intensity 2, durations and periods 0; the pulse's amplitude 1, its period
     and indicator 0); groups as in
-    :func:`rockstudy.similarity.record_groups` (PGA / (g tan alpha), PGV p / (g tan alpha),
-    omega_p / p and omega_p v_p / (g tan alpha))."""
+    :func:`rockstudy.similarity.record_groups` (PGA / a_up, PGV p / a_up, omega_p / p and
+    omega_p v_p / a_up, with ``uplift`` = a_up [m/s^2] the structures' uplift acceleration)."""
     ims = {k: v for k, v in record.intensity_measures().items() if k in measures.listed(False)}
     pulse = record.pulse()
     ims.update(
@@ -450,9 +493,10 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
 
 def scale_factors(study, record, cols, idx) -> np.ndarray:
     """The factor on ``record`` of the rows ``idx``: ``scale``; or the factor that brings
-    its PGA to ``pga_ratio`` g tan(alpha); or its ``scale_to.im`` to ``target``."""
+    its PGA to ``pga_ratio`` a_up (the structure's uplift acceleration, :func:`uplift_column`);
+    or its ``scale_to.im`` to ``target``."""
     alpha = cols["critical_rotation"][idx]
-    uplift = rd.G * np.tan(alpha)
+    uplift = uplift_column(study, cols, idx)
     if "scale" in cols:
         return cols["scale"][idx]
     if "pga_ratio" in cols:

@@ -23,7 +23,6 @@ import math
 import numpy as np
 import xarray as xr
 
-from ... import similarity
 from ...constants import G
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
@@ -32,7 +31,13 @@ from ...dynamics.methods import MAX_STEPS
 from ...motions import Record
 from ...motions import intensity as _im
 from ...motions import measures as _ms
-from ...structures.block import block_parameters, frequency_parameter, restitution_housner
+from ...structures.block import (
+    block_parameters,
+    frequency_parameter,
+    restitution_housner,
+    uplift_acceleration,
+    uplift_acceleration_block,
+)
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
 
@@ -42,6 +47,7 @@ _STRUCTURE_KEYS = (
     "critical_rotation",
     "slenderness",  # the block's name of critical_rotation (an alias)
     "restitution",
+    "uplift_acceleration",  # a_up [m/s^2]; g tan(critical_rotation) (a block's) if not given
 )
 
 
@@ -77,8 +83,9 @@ def _named(structures: dict) -> tuple[list[str], list]:
 
 def _structures(structures) -> dict:
     """Arrays over ``structure``: p [rad/s], alpha [rad], eta, R [m] (NaN if unknown) and the
-    uplift acceleration [m/s^2] (:func:`rockstudy.similarity.uplift_acceleration`); and
-    ``names`` (a list of str, or None) for a dict ``{name: structure}``."""
+    uplift acceleration [m/s^2] (:func:`rockstudy.structures.uplift_acceleration` of a
+    structure; of a dict of arrays, its ``uplift_acceleration`` or else a block's g tan(alpha));
+    and ``names`` (a list of str, or None) for a dict ``{name: structure}``."""
     names = None
     if isinstance(structures, dict) and not structures:
         raise ValueError("structures: give at least one structure")
@@ -116,7 +123,11 @@ def _structures(structures) -> dict:
             _check("structures.restitution", eta, 0.0, 1.0 + 1e-300)
         else:
             eta = np.array([restitution_housner(a) for a in alpha])
-        uplift = G * np.tan(alpha)
+        if "uplift_acceleration" in arrays:
+            uplift = arrays["uplift_acceleration"]
+            _check("structures.uplift_acceleration", uplift, 0.0, math.inf)
+        else:
+            uplift = uplift_acceleration_block(alpha)
     else:
         items = list(structures)
         if not items:
@@ -124,7 +135,7 @@ def _structures(structures) -> dict:
         params = np.array([block_parameters(s) for s in items], float).reshape(-1, 3)
         p, alpha, eta = params.T
         R = np.array([float(getattr(s, "half_diagonal", np.nan)) for s in items])
-        uplift = np.array([similarity.uplift_acceleration(s) for s in items])
+        uplift = np.array([uplift_acceleration(s) for s in items])
     return {
         "frequency_parameter": p,
         "critical_rotation": alpha,
@@ -307,8 +318,12 @@ def cloud(
         every output keeps them); or a dict of arrays (broadcast) with
         ``critical_rotation`` [rad] (or its alias for a block, ``slenderness``), one of
         ``half_diagonal`` [m] or ``frequency_parameter`` [rad/s], and optionally
-        ``restitution`` (default Housner's). The dataset carries it as
-        ``critical_rotation`` and as ``slenderness``.
+        ``restitution`` (default Housner's) and ``uplift_acceleration`` [m/s^2], the ground
+        acceleration that starts each structure rocking (default g tan(critical_rotation), a
+        block's; give g lambda, eq. 10 of [003], for another structure). The dataset carries
+        the critical rotation as ``critical_rotation`` and as ``slenderness``, and the uplift
+        acceleration (:func:`rockstudy.structures.uplift_acceleration` of each structure) as
+        ``uplift_acceleration``: the groups ``pga_ratio`` etc. are relative to it.
     periods : array_like
         Periods T [s] of the stored spectral accelerations ``sa``.
     damping : float
@@ -457,7 +472,9 @@ def incremental_dynamic_analysis(
        (PGA = g alpha without a vertical component; with one, the exact scale at which
        abs(u_h'') first reaches (g + u_v'') alpha, lower under a downward vertical); it is
        simulated like every other rung. Successive rungs differ by the factor ``1 + step``
-       (1 % by default) up to PGA = ``max_pga_ratio`` g tan(alpha). The climb stops at the
+       (1 % by default) up to PGA = ``max_pga_ratio`` a_up, the structure's uplift
+       acceleration (g tan(alpha) of a block, g lambda of another structure, eq. 10 of
+       [003]). The climb stops at the
        first rung that overturns; a block standing on every rung is *censored* (reason 1).
     2. **Bisect** (geometrically) between the last surviving rung and the first overturning
        one until their ratio is at most ``1 + tolerance``: the capacity is the upper end.
@@ -684,7 +701,7 @@ def _ida_record(record, st, options, method, rtol, max_steps):
     if not pga > 0:
         raise ValueError(f"records: the record {record.name!r} has PGA 0; it cannot be scaled")
     ceiling = free_fall_scale(record)
-    top = options.max_pga_ratio * G * np.tan(st["critical_rotation"]) / pga
+    top = options.max_pga_ratio * st["uplift_acceleration"] / pga
     low = np.broadcast_to(_rest_scale(record, st["critical_rotation"], ceiling), (n,))
     ladders = [_ladder(low[j], top[j], ceiling, 1.0 + options.step) for j in range(n)]
     points = _Points(record, st, method, rtol, max_steps)

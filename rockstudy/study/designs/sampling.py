@@ -13,7 +13,7 @@ import xarray as xr
 from scipy.stats import qmc
 
 from ...constants import G
-from ...structures.block import restitution_housner
+from ...structures.block import restitution_housner, uplift_acceleration_block
 from ..spec.schema import Study
 from ..spec.structures import KINDS
 
@@ -24,18 +24,23 @@ VARIABLES = {
     "restitution": ("coefficient of restitution eta", "1"),
     "frequency_parameter": ("frequency parameter p", "rad s-1"),
     "critical_rotation": ("critical rotation theta_cr of the equivalent block", "rad"),
+    "uplift_acceleration": (
+        "uplift acceleration a_up of the structure: g tan(alpha) of a block, g lambda of "
+        "another structure (eq. 10 of [003])",
+        "m s-2",
+    ),
     "amplitude": ("pulse amplitude a_g (signed)", "m s-2"),
-    "amplitude_ratio": ("a_g / (g tan alpha)", "1"),
+    "amplitude_ratio": ("a_g / a_up (a_up = g tan alpha for a block)", "1"),
     "amplitude_a": ("a = a_g / (g alpha), eq. (3.6) of [000]", "1"),
     "period": ("pulse period T_p", "s"),
     "frequency_ratio": ("omega_g / p", "1"),
     "scale": ("factor on the record", "1"),
-    "pga_ratio": ("peak ground acceleration / (g tan alpha)", "1"),
+    "pga_ratio": ("peak ground acceleration / a_up (a_up = g tan alpha for a block)", "1"),
     "record": ("index of the record in the study's files", "1"),
     "omega": ("omega_g / p, eq. (3.6) of [000]", "1"),
     "a": ("a_g / (g alpha), eq. (3.6) of [000]", "1"),
     "inverse_a": ("g alpha / a_g, eq. (4.11) of [000]", "1"),
-    "uplift_ratio": ("g tan(alpha) / a_g, eqs. (5.3), (6.1) of [000]", "1"),
+    "uplift_ratio": ("a_up / a_g (g tan(alpha) / a_g for a block, eqs. 5.3, 6.1 of [000])", "1"),
     "cos_alpha": ("cos(alpha), eq. (5.3) of [000]", "1"),
     "group_point": ("index of the group point (replicated designs)", "1"),
     "target": ("scale target of the record, in the units of motion.scale_to.im", "1"),
@@ -161,16 +166,22 @@ def make_design(study: Study, base_dir=None) -> xr.Dataset:
 
 
 def _structure_columns(st, cols, n) -> dict:
-    """The rocking parameters (p, theta_cr, eta) of each row, and the half-diagonal and
-    slenderness of a block or a wall."""
+    """The rocking parameters (p, theta_cr, eta) and the uplift acceleration of each row,
+    and the half-diagonal and slenderness of a block or a wall."""
     if st.kind == "equivalent_block":
         p = _value(cols, st, "frequency_parameter", n)
         alpha = _value(cols, st, "critical_rotation", n)
         eta = _value(cols, st, "restitution", n)
-        return dict(frequency_parameter=p, critical_rotation=alpha, restitution=eta)
+        return dict(
+            frequency_parameter=p,
+            critical_rotation=alpha,
+            restitution=eta,
+            uplift_acceleration=uplift_acceleration_block(alpha),  # a block: g tan(theta_cr)
+        )
     R = _value(cols, st, "half_diagonal", n)
     alpha0 = _value(cols, st, "slenderness", n)
-    p, alpha = KINDS[st.kind].sampled(R, alpha0)  # the equivalent block of the kind's class
+    # the equivalent block of the kind's class, and the structure's own uplift acceleration
+    p, alpha, uplift = KINDS[st.kind].sampled(R, alpha0)
     eta = (
         np.vectorize(restitution_housner, otypes=[float])(alpha0)
         if st.restitution == "housner"
@@ -182,14 +193,17 @@ def _structure_columns(st, cols, n) -> dict:
         restitution=eta,
         frequency_parameter=p,
         critical_rotation=alpha,
+        uplift_acceleration=uplift,
     )
 
 
 def _pulse_columns(study, cols, n, data, base_dir) -> dict:
-    """A pulse's amplitude and period in SI units, and the groups of eq. (3.6) of [000]."""
+    """A pulse's amplitude and period in SI units, and the groups of eq. (3.6) of [000]; the
+    amplitude ratio and uplift_ratio relative to the structure's uplift acceleration a_up
+    (g tan(alpha) for a block)."""
     mo, p, alpha = study.motion, data["frequency_parameter"], data["critical_rotation"]
     out = {}
-    uplift = G * np.tan(alpha)
+    uplift = data["uplift_acceleration"]
     if mo.amplitude is not None:
         ratio = _value(cols, mo, "amplitude", n) / uplift
     elif mo.amplitude_a is not None:
@@ -259,6 +273,7 @@ def _object_columns(objects) -> dict:
         restitution=eta,
         frequency_parameter=p,
         critical_rotation=theta_cr,
+        uplift_acceleration=objects.uplift(),
     )
 
 

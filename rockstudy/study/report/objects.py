@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ...constants import G
+from ...constants import STANDARD_GRAVITY
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.sampled import fragility_curve
@@ -157,13 +157,19 @@ def outcome(page, ctx):
     """In words, when nothing rocked or nothing overturned (no fragility can be fitted)."""
     if ctx.overturned:
         return
-    up = ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+    up = ctx.ds["uplift_acceleration"].values / _unit(ctx)
+    span = (
+        f"from {np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}"
+        if np.isfinite(up).any()
+        else "not stored in this cube"
+    )
     if not ctx.rocked:
         page.warning(
-            "Nothing rocked: no structure left rest under any record at any level. Every "
-            "level lies below the uplift level of every structure (g tan alpha, from "
-            f"{np.nanmin(up):.3g} to {np.nanmax(up):.3g} {ctx.units}); no fragility can be "
-            "fitted. Raise the levels (check the units of scale_to.value)."
+            "Nothing rocked: no structure (as simulated: a block, or the equivalent block of "
+            "another structure) left rest under any record at any level. The uplift levels "
+            f"of the structures (g tan alpha of a block, g lambda of another) are {span}; "
+            "no fragility can be fitted. Raise the levels (check the units of "
+            "scale_to.value)."
         )
     else:
         page.warning(
@@ -197,9 +203,15 @@ def _label(ctx, im, period=None):
     return ctx.relabel(ctx.im_label(im, period))
 
 
+def _unit(ctx) -> float:
+    """The report's unit of acceleration in m/s^2: the unit g (standard gravity, as records
+    and ``scale_to`` read it) or 1."""
+    return STANDARD_GRAVITY if ctx.units == "g" else 1.0
+
+
 def _accel_factor(ctx, im) -> float:
     """The factor from a fit's quoted units of ``im`` to the report's (g -> m/s^2)."""
-    return G if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
+    return STANDARD_GRAVITY if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
 
 
 def _object_fit(ctx, im, period):
@@ -215,10 +227,11 @@ def _object_fit(ctx, im, period):
 
 
 def _uplift(ctx, im) -> np.ndarray | None:
-    """Each object's uplift level in ``im`` (g tan theta_cr of its equivalent block; 1 in
-    PGA / (g tan alpha)), or None where a measure has no single uplift level."""
+    """Each object's uplift level in ``im`` (its uplift acceleration a_up: g tan alpha of a
+    block, g lambda of another structure, eq. 10 of [003]; 1 in PGA / a_up), or None where
+    a measure has no single uplift level (NaN for a cube that does not say it)."""
     if im == "pga":
-        return ctx.ds["uplift_acceleration"].values / (G if ctx.units == "g" else 1.0)
+        return ctx.ds["uplift_acceleration"].values / _unit(ctx)
     if im == "pga_ratio":
         return np.ones(ctx.ds.sizes["structure"])
     return None
@@ -263,8 +276,9 @@ def object_fragility(page, ctx):
         "object_fragility",
         "Fragility of each object (lognormal fit, 90 % pointwise band) against PGA and "
         "against the measure the efficiency table recommends; dotted vertical lines: each "
-        "object's uplift level (g tan alpha of the block or of the equivalent block of a "
-        "wall, frame or arch), drawn where the measure has one (PGA, PGA / (g tan alpha))",
+        "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
+        "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
+        "the measure has one (PGA, PGA / uplift level)",
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
@@ -293,7 +307,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
     low, high = np.nanmin(t["im_min"]), np.nanmax(t["im_max"])
     up = _uplift(ctx, im)
     names = list(map(str, ctx.ds["structure"].values))
-    if up is not None:
+    if up is not None and np.isfinite(up).any():
         low = min(low, np.nanmin(up))
     if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
         return False
@@ -325,7 +339,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
 def _ida_capacity(ctx):
     """(cells, values): the PGA at first overturning of each object (rows) under each record
     (columns); censored: 'above' the highest scale seen to stand."""
-    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    ds, f = ctx.ds, 1.0 / _unit(ctx)
     pga = ds["pga"].values[:, None] * f
     cap = ds["capacity_scale"].values * pga
     value = np.where(ds["censored"].values == 1, np.nan, cap).T
@@ -341,7 +355,7 @@ def _stripe_capacity(ctx):
     each record (the lowest overturning level, in the stripes' measure)."""
     ds = ctx.ds
     im = ds.attrs.get("im", "pga")
-    levels = ds["level"].values * (1.0 / G if im in ("pga", "sa") and ctx.units == "g" else 1.0)
+    levels = ds["level"].values * (1.0 / _unit(ctx) if im in ("pga", "sa") else 1.0)
     over = ds["overturned"].values == 1  # (record, structure, level)
     first = np.where(over.any(-1), over.argmax(-1), -1).T
     cells = np.empty(first.shape, object)
@@ -357,7 +371,7 @@ def _stripe_capacity(ctx):
 
 def _cloud_capacity(ctx):
     """(cells, values): under the unscaled records, whether each object overturned."""
-    ds, f = ctx.ds, 1.0 / G if ctx.units == "g" else 1.0
+    ds, f = ctx.ds, 1.0 / _unit(ctx)
     over = (ds["overturned"].values == 1).T
     pga = np.broadcast_to(ds["pga"].values * f, over.shape)
     cells = np.where(over, "overturned", "stands").astype(object)
@@ -412,7 +426,7 @@ def _ida_curve(ax, ctx, i, j, offset):
     """Record i's IDA curve of object j: its simulated points in increasing scale, its
     first overturning (cross) and the switch band above it (shaded)."""
     ds = ctx.ds
-    pga = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    pga = ds["pga"].values[i] / _unit(ctx)
     alpha = float(ds["slenderness"].values[j])
     s = ds["step_scale"].values[i, j]
     ok = np.isfinite(s)
@@ -449,7 +463,8 @@ def object_curves(page, ctx):
                 _ida_curve(ax, ctx, i, j, spread[i])
             else:
                 _stripe_points(ax, ctx, i, j, spread[i])
-        ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
+        if np.isfinite(uplift[j]):  # NaN: a cube that does not say it
+            ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
         ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
@@ -473,7 +488,8 @@ def object_curves(page, ctx):
             else "the stripe points (open circles: stood; crosses: overturned, drawn at "
             "theta_max / alpha = 1)"
         )
-        + "; dotted: the object's uplift level g tan alpha; markers of the records are offset "
+        + "; dotted: the object's uplift level (g tan alpha of a block, g lambda of another "
+        "structure); markers of the records are offset "
         "slightly in x so that none hides another",
     )
 
@@ -488,7 +504,7 @@ def _shared_legend(fig, ax, n):
 
 def _stripe_points(ax, ctx, i, j, offset):
     ds = ctx.ds
-    y = ds["scale"].values[i, j] * ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    y = ds["scale"].values[i, j] * ds["pga"].values[i] / _unit(ctx)
     x = ds["max_rotation"].values[i, j] / float(ds["slenderness"].values[j])
     over = ds["overturned"].values[i, j] == 1
     x = np.where(over, 1.0, np.minimum(x, 1.0)) + offset

@@ -119,7 +119,8 @@ def _deaggregation_figure(page, out, im_label):
         "deaggregation",
         "Deaggregation: the share of each object's annual rate of overturning that comes from "
         "each interval between the hazard curve's levels (plotted at its geometric centre); "
-        "dotted: each object's uplift PGA g tan(alpha), below which it cannot leave rest (the "
+        "dotted: each object's uplift PGA (g tan alpha of a block, g lambda of another "
+        "structure), below which it cannot leave rest (the "
         "share of the rate from there is the lognormal's lower tail, not a simulated "
         "overturning: column 'share below uplift'); the shares beyond the first and last "
         "level are in the table"

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import html
 import json
+import math
 import textwrap
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ...constants import G
+from ...constants import STANDARD_GRAVITY, G
 from ...motions import measures
 from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS
@@ -105,7 +106,7 @@ _FRAGILITY_VIEWS = (
     (
         "amplitude_ratio",
         "omega",
-        "amplitude ratio a_g / (g tan alpha) [-], omega_g / p in its middle third",
+        "amplitude ratio a_g / a_up [-], omega_g / p in its middle third",
     ),
 )
 
@@ -141,7 +142,8 @@ def _fragility(page, ds, study=None):
         "the median and beta) by "
         "block size: in dimensional terms the sizes spread apart, in the groups they "
         "collapse (to the extent the groups make the response self-similar); dashed: the "
-        "median lies outside the sampled intensities",
+        "median lies outside the sampled intensities; a_up is the uplift acceleration (g tan "
+        "alpha for a block)",
     )
     _fragility_table(page, pd.concat(tables))
     _fragility_spread(page, tables)
@@ -183,14 +185,14 @@ def _fragility_table(page, fit):
         shown.columns.get_loc("theta") + 1,
         "median capacity [g] (a_g only)",
         [
-            (v / G if isinstance(v, float) else v) if dim else np.nan
+            (v / STANDARD_GRAVITY if isinstance(v, float) else v) if dim else np.nan
             for v, dim in zip(shown["theta"], dimensional, strict=True)
         ],
     )
     page.table(
         shown.replace({"intensity": _SHORT, "band": _BANDS}).rename(columns=_FRAGILITY_NAMES),
         "fragility",
-        "Fragility parameters (intensity: a_g [m/s^2] or a_g / (g tan alpha) [-]): median "
+        "Fragility parameters (intensity: a_g [m/s^2] or a_g / a_up [-]): median "
         "capacity, its 90 % bootstrap band and the log-standard deviation beta (the MLE); a "
         "median "
         f"or band limit outside the group's sampled intensities (im_min-im_max) reads "
@@ -333,7 +335,7 @@ _SHORT = {
     "restitution": "restitution eta [-]",
     "amplitude": "pulse amplitude a_g [m/s^2]",
     "abs_amplitude": "pulse amplitude a_g [m/s^2]",
-    "amplitude_ratio": "amplitude ratio a_g / (g tan alpha) [-]",
+    "amplitude_ratio": "amplitude ratio a_g / a_up (g tan alpha for a block) [-]",
     "amplitude_a": "a = a_g / (g alpha) [-]",
     "period": "pulse period T_p [s]",
     "frequency_ratio": "frequency ratio omega_g / p [-]",
@@ -359,12 +361,15 @@ def _label(name):
 
 
 def _plain_log_ticks(ax):
-    """Tick labels of a logarithmic x axis as plain numbers (2, 3, 10), not 2 x 10^0."""
+    """Tick labels of a logarithmic x axis as plain numbers (2, 3, 10), not 2 x 10^0; the
+    minor ticks just below a decade (0.9, 9) unlabelled, where they would crowd its label."""
     from matplotlib.ticker import FuncFormatter
 
-    plain = FuncFormatter(lambda v, _: f"{v:g}")
-    ax.xaxis.set_major_formatter(plain)
-    ax.xaxis.set_minor_formatter(plain)
+    def minor(v, _):
+        return "" if round(v / 10.0 ** math.floor(math.log10(v))) == 9 else f"{v:g}"
+
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(FuncFormatter(minor))
     ax.tick_params(axis="x", which="minor", labelsize=7)
 
 
@@ -521,14 +526,19 @@ def _overturning_map(page, ds, study):
     ax.set(
         xscale="log",
         xlabel="frequency ratio omega_g / p [-]",
-        ylabel="amplitude ratio a_g / (g tan alpha) [-]",
+        ylabel="amplitude ratio a_g / a_up [-]",
         ylim=(float(a.min()) * 0.95, float(a.max()) * 1.05),
         title="overturning map over the dimensionless groups",
     )
     _plain_log_ticks(ax)
     ax.legend(fontsize=8, markerscale=4, loc="upper left")
     fig.tight_layout()
-    page.figure(fig, "overturning_map", "Samples in the plane of the groups, by outcome. " + note)
+    page.figure(
+        fig,
+        "overturning_map",
+        "Samples in the plane of the groups, by outcome (a_up: the uplift acceleration, g tan "
+        "alpha for a block). " + note,
+    )
 
 
 def _first_order(page, ds, study):

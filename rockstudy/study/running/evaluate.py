@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ...constants import G
 from ...dynamics.batch import CONTACT_OUTPUTS, simulate_batch
 from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ...motions import stochastic_record
@@ -75,7 +74,7 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
             cycles=mo.cycles,
             **common,
         )
-    uplift = G * np.tan(cols["critical_rotation"][idx])
+    uplift = record_rows.uplift_column(study, cols, idx)  # a_up: g tan(alpha) for a block
     if mo.kind == "record":
         out = {}
         rec_idx = cols["record"][idx]

@@ -826,6 +826,12 @@ def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
 
     path = Path(path)
     meta = _consolidated(path)
+    missing = [n for n in design.data_vars if f"{n}/.zarray" not in meta]
+    if missing:  # a store written before the design had them (e.g. uplift_acceleration)
+        raise StoreError(
+            f"{path}: the store lacks the design variable(s) {missing} that this rockstudy "
+            "writes (it was made by an earlier version); run the study into a new store"
+        )
     _restore_metadata(path, meta)
     group = zarr.open_group(str(path), mode="r+", zarr_format=2)
     for name in design.variables:

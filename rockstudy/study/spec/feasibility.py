@@ -17,6 +17,7 @@ from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, mach
 from ...constants import G
 from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs
+from ...structures.block import uplift_acceleration_block
 from .structures import KINDS
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
@@ -97,11 +98,13 @@ def notes(study, base_dir=None) -> list[str]:
     model no longer holds) at a scale the design reaches (those points are stored as
     censored, with their reason; the record's other points run); records scaled by more than
     ``design.max_scale_factor``; and targets so low that nothing can rock
-    (:func:`_scaling_notes`)."""
+    (:func:`_scaling_notes`); and structures whose equivalent block, which the study
+    simulates, lifts off far from the structure's own uplift acceleration
+    (:func:`uplift_notes`)."""
     mo = study.motion
     if mo.kind != "record":
-        return []
-    found = _scaling_notes(study, base_dir)
+        return uplift_notes(study)
+    found = uplift_notes(study) + _scaling_notes(study, base_dir)
     if study.design is None:
         return found
     for field, h, v in record_pairs(mo, base_dir):
@@ -123,6 +126,48 @@ def notes(study, base_dir=None) -> list[str]:
     return found
 
 
+#: Relative gap between g tan(theta_cr) of the equivalent block and the structure's uplift
+#: acceleration g lambda above which validate notes it (a wall of alpha 0.1 reaches 1 %).
+UPLIFT_NOTE_GAP = 0.01
+
+
+def uplift_notes(study) -> list[str]:
+    """The structures whose equivalent block (what the study simulates: p, theta_cr, eta)
+    lifts off at g tan(theta_cr) more than :data:`UPLIFT_NOTE_GAP` away from the structure's
+    own uplift acceleration a_up (g lambda, eq. 10 of [003]), which the ratios, the IDA's
+    ladder, the notes and the reports use: between the two levels the simulated response is
+    the block's, not the structure's."""
+    st = study.structure
+    if st.kind == "objects":
+        found = []
+        for i, o in enumerate(st.objects):
+            eq, a_up = float(uplift_acceleration_block(o.rocking()[1])), o.uplift()
+            if abs(eq / a_up - 1.0) > UPLIFT_NOTE_GAP:
+                found.append(_uplift_note(f"structure.objects[{i}] ({o.name!r})", o.kind, eq, a_up))
+        return found
+    if st.kind == "equivalent_block":  # a block: it is what runs
+        return []
+    ends = np.array(draw_span(st.slenderness))
+    _, theta_cr, a_up = KINDS[st.kind].sampled(np.ones(2), ends)
+    eq = uplift_acceleration_block(theta_cr)
+    gap = np.abs(eq / a_up - 1.0)
+    j = int(np.argmax(gap))
+    if gap[j] <= UPLIFT_NOTE_GAP:
+        return []
+    return [_uplift_note("structure.slenderness", st.kind, float(eq[j]), float(a_up[j]))]
+
+
+def _uplift_note(field, kind, eq, a_up) -> str:
+    side = "above" if eq > a_up else "below"
+    return (
+        f"{field}: the study runs the {kind}'s equivalent block, which lifts off at g "
+        f"tan(theta_cr) = {eq:.4g} m/s^2, {abs(eq / a_up - 1):.1%} {side} the {kind}'s own "
+        f"uplift acceleration {a_up:.4g} m/s^2 (g lambda, eq. 10 of [003]) that the ratios "
+        "and uplift levels use: between the two the simulated response is the block's "
+        "(rockstudy.simulate runs the mechanism)"
+    )
+
+
 def free_fall_scale(record) -> float:
     """The lowest |scale| at which the record's vertical u_v'' reaches -g (inf if never)."""
     v = record.vertical
@@ -135,8 +180,9 @@ def _scaling_notes(study, base_dir) -> list[str]:
     design or Monte Carlo rows) or run unscaled (a cloud design): the records whose largest
     scale factor exceeds ``design.max_scale_factor`` (5 by default), and, when every record
     is horizontal only and even the highest level leaves every record's PGA below the lowest
-    uplift acceleration g tan(theta_cr) of the structures, that nothing can rock (every
-    point stays at rest)."""
+    uplift acceleration of the structures (:meth:`.schema.Study.uplift_span`: g tan(alpha) of
+    a block, g lambda of another structure, eq. 10 of [003]), that nothing can rock (no
+    structure leaves rest)."""
     de = study.design
     cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
     if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):
@@ -156,24 +202,15 @@ def _scaling_notes(study, base_dir) -> list[str]:
                 f"{'design.' if de else ''}max_scale_factor = {limit:g} (a record scaled far "
                 "from what it recorded)"
             )
-    uplift = G * math.tan(_smallest_critical_rotation(study))
+    uplift = study.uplift_span()[0]
     if horizontal and top_pga < uplift:
         found.append(
             f"{scaled[0]}: nothing can rock: the highest level brings every record to a PGA "
-            f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration g tan(alpha) "
-            f"= {uplift:.4g} m/s^2 of the structures (check the value and its units)"
+            f"of at most {top_pga:.4g} m/s^2, below the lowest uplift acceleration "
+            f"{uplift:.4g} m/s^2 of the structures (g tan(alpha) of a block, g lambda of "
+            "another structure; check the value and its units)"
         )
     return found
-
-
-def _smallest_critical_rotation(study) -> float:
-    """The smallest critical rotation theta_cr [rad] the study's structures can have."""
-    st = study.structure
-    if st.kind == "objects":
-        return float(st.rocking()[:, 1].min())
-    if st.kind == "equivalent_block":
-        return draw_span(st.critical_rotation)[0]
-    return float(KINDS[st.kind].sampled(1.0, draw_span(st.slenderness)[0])[1])
 
 
 def _named_twice(pairs) -> list[str]:
@@ -245,8 +282,8 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     peak = float(np.max(np.abs(rec.acceleration)))
     if rec.vertical is not None:
         peak = max(peak, float(np.max(np.abs(rec.vertical))))
-    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
-    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio g tan
+    uplift = study.uplift_span()[1]
+    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio a_up
         top = de.ida_options()["max_pga_ratio"] * uplift
         return "design.max_pga_ratio", top * peak / rec.peak if rec.peak > 0 else 0.0
     if mo.scale is not None:
@@ -260,7 +297,7 @@ def _largest_scale(study, rec) -> tuple[str, float] | None:
     """(field, the largest factor on ``rec`` that its target asks), over the whole support of
     the study's distributions and structures; None without a target or for a measure of 0."""
     mo = study.motion
-    uplift = G * math.tan(min(study.largest_critical_rotation(), math.pi / 2 - 1e-9))
+    uplift = study.uplift_span()[1]
     target = mo.target()
     if target is None or target.value is None:
         return None

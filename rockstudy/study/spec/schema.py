@@ -69,7 +69,12 @@ from ...constants import G
 from ...dynamics.methods import MAX_STEPS
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
-from ...structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
+from ...structures.block import (
+    FREQUENCY_PARAMETER_RANGE,
+    HALF_DIAGONAL_RANGE,
+    MIN_SLENDERNESS,
+    uplift_acceleration_block,
+)
 from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
@@ -220,7 +225,13 @@ class _ObjectBase(_Model):
     def geometry(self) -> tuple[float, float]:
         """(half-diagonal R [m], NaN for a structure without one; theta_cr [rad], the
         equivalent block's slenderness), as the design functions store them."""
-        return self._params[3], self._params[1]
+        return self._params[4], self._params[1]
+
+    def uplift(self) -> float:
+        """The ground acceleration that starts the object rocking [m/s^2]: g tan(alpha) of a
+        block, g lambda of another structure (eq. 10 of [003];
+        :func:`rockstudy.structures.uplift_acceleration`)."""
+        return self._params[3]
 
     def rocking(self) -> tuple[float, float, float]:
         """(p [rad/s], theta_cr [rad], eta) of the equivalent block of the object's physics
@@ -260,6 +271,10 @@ class ObjectsSpec(_Model):
     def rocking(self) -> np.ndarray:
         """(n, 3) array of (p [rad/s], theta_cr [rad], eta) of the objects, in order."""
         return np.array([o.rocking() for o in self.objects], float)
+
+    def uplift(self) -> np.ndarray:
+        """(n,) array of the objects' uplift accelerations [m/s^2] (:meth:`ObjectSpec.uplift`)."""
+        return np.array([o.uplift() for o in self.objects], float)
 
 
 #: Largest dimensionless intensity (amplitude_ratio, amplitude_a, pga_ratio, pgv_ratio) and
@@ -325,9 +340,10 @@ def _nonzero(name, value):
 
 class PulseSpec(_Model):
     """An analytic pulse. Give the amplitude in m/s^2 (``amplitude``), as a multiple of the
-    uplift acceleration g tan(alpha) (``amplitude_ratio``, the groups of eqs. 5.3 and 6.1 of
-    [000]) or of g alpha (``amplitude_a``, a of eq. 3.6: the groups of 4.10 and 4.11), and the
-    period in seconds (``period``) or as omega_g / p (``frequency_ratio``)."""
+    uplift acceleration a_up (``amplitude_ratio``: g tan(alpha) of a block, the groups of eqs.
+    5.3 and 6.1 of [000]; g lambda of a wall, eq. 10 of [003]) or of g alpha (``amplitude_a``,
+    a of eq. 3.6: the groups of 4.10 and 4.11), and the period in seconds (``period``) or as
+    omega_g / p (``frequency_ratio``)."""
 
     kind: Literal["pulse"]
     shape: Literal["sine", "cosine", "half-sine", "ricker"] = "sine"
@@ -382,7 +398,8 @@ def _scale_im(name: str) -> str:
 
 #: Intensity measures a record can be scaled to: the registry's measures of power > 0 (see
 #: :func:`rockstudy.motions.register_measure`) and the dimensionless targets ``pga_ratio`` =
-#: PGA / (g tan alpha) and ``pgv_ratio`` = PGV p / (g tan alpha); ``sa``, ``psv`` and ``sd``
+#: PGA / a_up and ``pgv_ratio`` = PGV p / a_up (a_up the structure's uplift acceleration: g tan
+#: alpha of a block, g lambda of another structure, eq. 10 of [003]); ``sa``, ``psv`` and ``sd``
 #: (any measure that needs one) need a ``period``.
 ScaleIM = Annotated[str, AfterValidator(_scale_im)]
 #: The damping ratio of ``sa``, ``psv``, ``sd`` and the spectrum intensity in record studies.
@@ -485,7 +502,8 @@ class RecordSpec(_Model):
     vertical components: a list as long as ``files`` (of plain files), or ``{ match, replace }``
     naming each vertical file after its horizontal one. Monte Carlo rows pick one record per
     sample (uniformly) and scale it, either by ``scale`` (a factor != 0; negative mirrors), to
-    ``pga_ratio`` x g tan(alpha), or to ``scale_to``; a ``[design]`` runs every record.
+    ``pga_ratio`` x a_up (the structure's uplift acceleration: g tan(alpha) of a block, g lambda
+    of another structure, eq. 10 of [003]), or to ``scale_to``; a ``[design]`` runs every record.
 
     A path is absolute as written, or relative to the study file's folder (never to the
     working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
@@ -1035,18 +1053,18 @@ class Study(_Model):
         """The amplitudes and periods that the ratios give must lie in the solver's ranges
         (over the whole support of the structure's distributions)."""
         mo, top = self.motion, _validate.MAX_ACCELERATION
-        tan_max = math.tan(min(self.largest_critical_rotation(), math.pi / 2 - 1e-9))
+        up_max = self.uplift_span()[1]
         for name, uplift in (
-            ("amplitude_ratio", G * tan_max),
+            ("amplitude_ratio", up_max),
             ("amplitude_a", G * self.largest_critical_rotation()),
-            ("pga_ratio", G * tan_max),
+            ("pga_ratio", up_max),
         ):
             value = getattr(mo, name, None)
             if value is not None and _largest(value) * uplift > top:
                 raise FieldError(
                     f"motion.{name}",
                     f"reaches {_largest(value):g} x {uplift:.4g} m/s^2 = "
-                    f"{_largest(value) * uplift:.4g} m/s^2 with the largest critical rotation, "
+                    f"{_largest(value) * uplift:.4g} m/s^2 with the largest uplift level, "
                     f"beyond the {top:.0e} m/s^2 the solvers take",
                 )
         ratio = getattr(mo, "frequency_ratio", None)
@@ -1074,7 +1092,7 @@ class Study(_Model):
             return _smallest(st.frequency_parameter), _largest(st.frequency_parameter)
         R = [_smallest(st.half_diagonal), _largest(st.half_diagonal)]
         alpha = [_smallest(st.slenderness), _largest(st.slenderness)]
-        p, _ = KINDS[st.kind].sampled(*np.meshgrid(R, alpha))  # p is monotone in R and alpha
+        p = KINDS[st.kind].sampled(*np.meshgrid(R, alpha))[0]  # p is monotone in R and alpha
         return float(p.min()), float(p.max())
 
     def largest_critical_rotation(self) -> float:
@@ -1085,6 +1103,35 @@ class Study(_Model):
         if st.kind == "equivalent_block":
             return _largest(st.critical_rotation)
         return float(KINDS[st.kind].sampled(1.0, _largest(st.slenderness))[1])
+
+    def uplift_span(self) -> tuple[float, float]:
+        """The smallest and largest uplift acceleration a_up [m/s^2] the structures can have:
+        the ground acceleration that starts each rocking (g tan(alpha) of a block or an
+        equivalent block, g lambda of another structure, eq. 10 of [003]; at most
+        g tan(pi/2 - 1e-9) where theta_cr reaches pi/2)."""
+        st = self.structure
+        if st.kind == "objects":
+            up = st.uplift()
+            return float(up.min()), float(up.max())
+        if st.kind == "equivalent_block":
+            ends = np.array(_draw_span(st.critical_rotation))
+        else:
+            ends = np.array(_draw_span(st.slenderness))
+        ends = np.minimum(ends, math.pi / 2 - 1e-9)
+        if st.kind == "equivalent_block":
+            up = uplift_acceleration_block(ends)
+        else:  # a_up is monotone in the slenderness (not in R) of every sampled kind
+            up = KINDS[st.kind].sampled(np.ones(2), ends)[2]
+        return float(up[0]), float(up[1])
+
+    def largest_uplift_over_rest(self) -> float:
+        """The largest a_up / (g theta_cr) of the structures: the uplift acceleration over
+        the linearized model's rest level g theta_cr (the IDA ladder's span)."""
+        st = self.structure
+        if st.kind == "objects":
+            return float(np.max(st.uplift() / (G * st.rocking()[:, 1])))
+        top = min(self.largest_critical_rotation(), math.pi / 2 - 1e-9)
+        return self.uplift_span()[1] / (G * top)  # increasing in the slenderness for each kind
 
     def levels(self) -> int:
         """Intensity levels of each record and structure of a design (1 but for stripes)."""

@@ -7,9 +7,11 @@ their ranges), whether its restitution is Housner's by default, required, or der
 class, and, for the kinds a ``[structure]`` table may sample from distributions, the
 vectorized map from (half-diagonal, slenderness) to the equivalent block's (p, theta_cr).
 The rocking parameters (p, theta_cr, eta) of an object are those of the equivalent block of its
-physics class (:func:`rockstudy.structures.block_parameters`, paper [003]): no formula is
-written here. A new structure kind is its class in :mod:`rockstudy.structures` plus one entry
-of :data:`KINDS`.
+physics class (:func:`rockstudy.structures.block_parameters`, paper [003]), and its uplift
+acceleration is the structure's own (:func:`rockstudy.structures.uplift_acceleration`: g lambda,
+eq. 10 of [003], which differs from g tan(theta_cr) of the equivalent block but for a block and
+the structures of Table I): no formula is written here. A new structure kind is its class in
+:mod:`rockstudy.structures` plus one entry of :data:`KINDS`.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ from ...structures import (
     SymmetricFrame,
     block_parameters,
     frequency_parameter,
+    uplift_acceleration,
+    uplift_acceleration_block,
 )
 from ...structures.block import HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 
@@ -104,8 +108,9 @@ class StructureKind:
     build : callable, optional
         ``build(values) -> structure`` from the given fields; the class's constructor if None.
     sampled : callable, optional
-        ``sampled(half_diagonal, slenderness) -> (p, theta_cr)`` on arrays, for the kinds a
-        ``[structure]`` table samples from distributions.
+        ``sampled(half_diagonal, slenderness) -> (p, theta_cr, a_up)`` on arrays, for the
+        kinds a ``[structure]`` table samples from distributions: the equivalent block's p
+        [rad/s] and theta_cr [rad], and the structure's uplift acceleration a_up [m/s^2].
     slenderness_top : float
         The (open) upper end of the slenderness of a sampled kind [rad].
     """
@@ -124,10 +129,11 @@ class StructureKind:
         """The physics object of the given field values (a ValueError if the class refuses)."""
         return (self.build or self.structure)(**values)
 
-    def parameters(self, values: dict) -> tuple[object, tuple[float, float, float]]:
-        """The physics object and its equivalent block's (p [rad/s], theta_cr [rad], eta)."""
+    def parameters(self, values: dict) -> tuple[object, tuple[float, float, float, float]]:
+        """The physics object, its equivalent block's (p [rad/s], theta_cr [rad], eta) and its
+        own uplift acceleration a_up [m/s^2] (:func:`rockstudy.structures.uplift_acceleration`)."""
         structure = self.make(values)
-        return structure, block_parameters(structure)
+        return structure, (*block_parameters(structure), uplift_acceleration(structure))
 
 
 def _block(width=None, height=None, half_diagonal=None, slenderness=None, restitution=None):
@@ -138,7 +144,12 @@ def _block(width=None, height=None, half_diagonal=None, slenderness=None, restit
 
 def _block_sampled(half_diagonal, slenderness):
     p = np.vectorize(frequency_parameter, otypes=[float])(half_diagonal)
-    return p, np.asarray(slenderness, float)
+    return p, np.asarray(slenderness, float), uplift_acceleration_block(slenderness)
+
+
+def _wall_sampled(half_diagonal, slenderness):
+    p, theta_cr = RockingWall.equivalent_parameters(half_diagonal, slenderness)
+    return p, theta_cr, RockingWall.uplift_acceleration_of(slenderness)
 
 
 _MASS = FieldRange(0.0, math.inf, f"{_POSITIVE}", "mass (any consistent unit)")
@@ -173,7 +184,7 @@ KINDS: dict[str, StructureKind] = {
             },
             (("half_diagonal", "slenderness", "restitution"),),
             "required",
-            sampled=RockingWall.equivalent_parameters,
+            sampled=_wall_sampled,
             slenderness_top=math.pi / 4,
             doc="out-of-plane wall restrained at the top, eq. (21)-(23) of [003]",
         ),
@@ -289,7 +300,8 @@ def _check_required(who, kind, values):
 
 
 def check_object(who: str, kind_name: str, values: dict):
-    """Validate an object's fields against its kind; return (structure, (p, theta_cr, eta)).
+    """Validate an object's fields against its kind; return (structure, (p, theta_cr, eta,
+    a_up)) (see :meth:`StructureKind.parameters`).
 
     ``values`` holds the given fields (None left out). Every problem is a :class:`FieldError`
     naming ``who`` (the object) and the field.
