@@ -110,6 +110,13 @@ def test_the_separation_check_agrees_with_the_profile_likelihood_on_random_data(
     assert {"overlap", "quasi", "complete", "no rise"} <= set(kinds), kinds
 
 
+@pytest.mark.parametrize("bad", [0.0, -1.0, np.nan, np.inf])
+def test_an_intensity_that_is_not_positive_and_finite_is_refused_by_name(bad):
+    for fit in (fragility_fit.separation, fragility_fit.fit_binomial):
+        with pytest.raises(ValueError, match="im: intensities must be finite and > 0"):
+            fit([0.5, bad], [0.0, 1.0], [1.0, 1.0])
+
+
 def test_quasi_separation_is_a_tie_at_one_level_and_its_limit_is_that_level():
     x = np.array([0.1, 0.2, 0.4, 0.8])
     z, n = np.array([0.0, 0.0, 2.0, 5.0]), np.full(4, 5.0)  # mixed at 0.4 only

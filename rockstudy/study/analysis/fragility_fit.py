@@ -83,12 +83,15 @@ def _binomial_nll(q, x, z, n):
 
 def _outcomes(im, n_overturned, n_total):
     """(ln x, z, n) of outcome data as float arrays, or a ValueError."""
-    x = np.log(np.asarray(im, float))
+    im = np.asarray(im, float)
     z = np.asarray(n_overturned, float)
     n = np.asarray(n_total, float)
-    if not (x.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
+    if not (im.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
         raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
-    return x, z, n
+    bad = im[~(np.isfinite(im) & (im > 0))]
+    if bad.size:
+        raise ValueError(f"im: intensities must be finite and > 0, got {bad[:3].tolist()}")
+    return np.log(im), z, n
 
 
 #: What :func:`separation` says of outcome data: only ``"overlap"`` has a maximum.
