@@ -26,6 +26,7 @@ from ._warnings import (
     IncompleteReferenceWarning,
     LinearizationWarning,
     LooseToleranceWarning,
+    SeparationWarning,
 )
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
@@ -64,6 +65,7 @@ __all__ = [
     "LooseToleranceWarning",
     "IncompleteReferenceWarning",
     "RockingResult",
+    "SeparationWarning",
     "StepLimitError",
     "closedform",
     "motions",

@@ -42,6 +42,12 @@ class ContactWarning(AccuracyWarning):
     ground, which the rocking model (no sliding, no lift-off) does not describe."""
 
 
+class SeparationWarning(AccuracyWarning):
+    """The binomial (probit) likelihood of a lognormal fragility has no maximum: overturned and
+    standing outcomes are (quasi-)completely separated in the intensity (Albert & Anderson
+    1984), so beta is not identifiable, or the overturned ones do not lie higher at all."""
+
+
 class UpliftWarning(AccuracyWarning):
     """A result's uplift level is not the structure's own: a cube written before the design
     carried each structure's uplift acceleration (g lambda, eq. 10 of [003])."""

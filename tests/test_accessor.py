@@ -362,7 +362,7 @@ def test_every_fragility_fit_is_the_shared_modules():
     """One lognormal/Bernoulli fitting module: the fits every analysis calls are those of
     fragility_fit, and no other module of the study layer runs an optimiser of its own."""
     for module in (sampled, record_fragility, record_similarity, object_risk_module):
-        for name in ("fit_binomial", "fit_capacities"):
+        for name in ("fit_binomial", "fit_binomial_limit", "fit_capacities", "separation"):
             if hasattr(module, name):
                 assert getattr(module, name) is getattr(fragility_fit, name), (module, name)
     study = Path(fragility_fit.__file__).resolve().parents[1]

@@ -6,6 +6,9 @@ A lognormal fragility is P(x) = Phi(ln(x / theta) / beta): theta the median capa
 dispersion. **beta is the maximum-likelihood estimate everywhere**: for capacities (IDA), the
 standard deviation of ln c dividing by n, not n - 1; for outcomes (stripes, clouds, Monte Carlo
 samples), the binomial MLE of Baker (2015), eq. (11). Every band is built on the same estimate.
+Outcomes separated in the intensity (every overturned trial at or above every one that stood)
+have no MLE: :func:`separation` says so exactly, and the fits return NaN and warn
+(:class:`~rockstudy.SeparationWarning`) instead of the step an optimiser would stop near.
 
 Pointwise bands of P(x) vary **both** parameters (a band that moves theta alone and keeps the
 point beta is far too narrow in the tails, where the uncertainty of beta dominates):
@@ -36,9 +39,12 @@ t-distribution. Technometrics 10(3), 445-478.
 from __future__ import annotations
 
 import numbers
+import warnings
 
 import numpy as np
 from scipy import optimize, special
+
+from ..._warnings import SeparationWarning
 
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: how the pointwise band of P(x) of a fitted row is formed (see the module docstring).
@@ -75,12 +81,144 @@ def _binomial_nll(q, x, z, n):
     return -np.sum(z * lp + (n - z) * lq) / m, np.array([np.sum(r) / beta, np.sum(r * u)])
 
 
+def _outcomes(im, n_overturned, n_total):
+    """(ln x, z, n) of outcome data as float arrays, or a ValueError."""
+    im = np.asarray(im, float)
+    z = np.asarray(n_overturned, float)
+    n = np.asarray(n_total, float)
+    if not (im.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
+        raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
+    bad = im[~(np.isfinite(im) & (im > 0))]
+    if bad.size:
+        raise ValueError(f"im: intensities must be finite and > 0, got {bad[:3].tolist()}")
+    return np.log(im), z, n
+
+
+#: What :func:`separation` says of outcome data: only ``"overlap"`` has a maximum.
+SEPARATIONS = ("overlap", "quasi", "complete", "no rise", "one outcome")
+#: The kinds of :data:`SEPARATIONS` whose likelihood rises as beta -> 0 ...
+SEPARATED = ("quasi", "complete")
+#: ... and those without a maximum of the likelihood at all (no fit, but not "one outcome").
+NO_MAXIMUM = (*SEPARATED, "no rise")
+
+
+def _separation(x, z, n):
+    """(kind, ln s, ln o) of :func:`separation` on validated log data."""
+    stood, fell = x[z < n], x[z > 0]
+    if not (stood.size and fell.size):
+        return "one outcome", np.nan, np.nan
+    s, o = float(stood.max()), float(fell.min())
+    if s < o:
+        return "complete", s, o
+    # the score of b = 1 / beta at b = 0 has the sign of this difference of mean ln x
+    rise = np.sum(z * x) / np.sum(z) - np.sum((n - z) * x) / np.sum(n - z)
+    tried = x[n > 0]
+    if tried.min() == tried.max() or rise <= 0.0:  # one level, or no rise
+        return "no rise", s, o
+    return ("quasi" if s == o else "overlap"), s, o
+
+
+def separation(im, n_overturned, n_total) -> tuple[str, float, float]:
+    """Whether outcomes are separated in the intensity: whether :func:`fit_binomial` has an MLE.
+
+    The fragility is the probit model P = Phi(a + b ln x) with a = -ln(theta) / beta and
+    b = 1 / beta > 0. Its binomial MLE exists (finite and unique) if and only if the data
+    *overlap*, that is, are neither completely nor quasi-completely separated (Albert and
+    Anderson 1984 for the logistic link; Silvapulle 1981 for binomial response models, the
+    probit among them). With one covariate and b > 0, and s the highest intensity at which a
+    trial stood (z_j < n_j), o the lowest at which one overturned (z_j > 0):
+
+    - ``"complete"``, s < o: a step at any theta in (s, o) classifies every trial; the
+      log-likelihood rises to 0 as beta -> 0, with theta anywhere in [s, o];
+    - ``"quasi"``, s = o: the outcomes are mixed at exactly one level, the only level at which
+      both occur, below it every trial stood and above it every one overturned; the
+      log-likelihood rises as beta -> 0, theta -> s, towards the binomial log-likelihood of
+      that level at its observed proportion;
+    - ``"no rise"``: the trials that overturned do not lie higher in ln x, on average, than
+      those that stood (or all lie at one level). The log-likelihood is concave in (a, b);
+      its derivative in b at b = 0 (a flat curve P = the overall proportion p) is
+      proportional to sum_j (z_j - n_j p) ln x_j, which is <= 0 exactly then, so the
+      maximum over b > 0 lies at b -> 0: beta -> infinity, a flat curve, theta not
+      identifiable (an optimiser stops at some large beta, which would read as a fit);
+    - ``"overlap"``, s > o with a rise: the MLE exists, finite and unique;
+    - ``"one outcome"``: every trial stood or every one overturned (no fit at all).
+
+    In the first two the dispersion is not identifiable: the data say that theta lies in
+    [s, o], not how spread the capacities are; in the third the data show no increasing
+    fragility at all. The checks are exact (order statistics and the sign of a sum), not a
+    threshold on a fitted beta.
+
+    Returns
+    -------
+    (kind, s, o)
+        ``kind`` one of :data:`SEPARATIONS`; s and o in the units of ``im`` (NaN for
+        ``"one outcome"``).
+
+    Albert, A. and Anderson, J. A. (1984). On the existence of maximum likelihood estimates in
+    logistic regression models. Biometrika 71(1), 1-10.
+    Silvapulle, M. J. (1981). On the existence of maximum likelihood estimators for the
+    binomial response models. Journal of the Royal Statistical Society B 43(3), 310-313.
+    """
+    kind, s, o = _separation(*_outcomes(im, n_overturned, n_total))
+    return kind, float(np.exp(s)), float(np.exp(o))
+
+
+def separation_message(kind, low, high, unit="") -> str:
+    """The words of a :class:`~rockstudy.SeparationWarning` for ``kind`` (of
+    :data:`NO_MAXIMUM`) and the gap [``low``, ``high``]."""
+    if kind == "no rise":
+        return (
+            "the trials that overturned do not lie higher in the intensity (on average, in "
+            "ln x) than those that stood: no increasing lognormal fragility fits them; the "
+            "likelihood rises as beta -> infinity (a flat curve) and has no maximum, so "
+            "theta and beta are not identifiable (NaN)"
+        )
+    how = "completely" if kind == "complete" else "quasi-completely"
+    mixed = "" if kind == "complete" else " (both occur at one level only)"
+    unit = f" {unit}" if unit and unit != "-" else ""
+    return (
+        f"the outcomes are {how} separated in the intensity: every trial that overturned lies "
+        f"at or above every one that stood{mixed}, so the likelihood rises as beta -> 0 and "
+        f"has no maximum; beta is not identifiable (NaN) and the median lies between "
+        f"{low:.4g} and {high:.4g}{unit} (Albert and Anderson 1984)"
+    )
+
+
+def warn_if_separated(where, label, im, n_overturned, n_total, unit="", depth=1) -> tuple:
+    """:func:`separation` of the outcomes of group ``label``, with a
+    :class:`~rockstudy.SeparationWarning` from ``where`` (the public function, ``depth``
+    calls up from the caller) if they have no maximum (:data:`NO_MAXIMUM`)."""
+    kind, low, high = separation(im, n_overturned, n_total)
+    if kind in NO_MAXIMUM:
+        message = f"{where}: group {str(label)!r}: {separation_message(kind, low, high, unit)}"
+        warnings.warn(message, SeparationWarning, stacklevel=2 + depth)
+    return kind, low, high
+
+
+def _binomial_mle(x, z, n, start):
+    """The BFGS maximum of the binomial likelihood of overlapping log data."""
+    if start is None:
+        w = n / n.sum()
+        sd = np.sqrt(np.sum(w * (x - np.sum(w * x)) ** 2))
+        start = np.array([np.sum(w * x), np.log(max(sd, 0.1))])
+    res = optimize.minimize(
+        _binomial_nll, start, args=(x, z, n), jac=True, method="BFGS", options={"gtol": 1e-9}
+    )
+    with np.errstate(over="ignore"):  # a median far above the data: inf, flagged by callers
+        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+
+
 def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     """Maximum-likelihood lognormal fragility of outcome data, eq. (11) of Baker (2015).
 
     .. math:: \\max_{\\theta, \\beta} \\sum_j \\ln \\binom{n_j}{z_j}
               + z_j \\ln \\Phi(\\ln(x_j / \\theta) / \\beta)
               + (n_j - z_j) \\ln[1 - \\Phi(\\ln(x_j / \\theta) / \\beta)]
+
+    The maximum exists only where the outcomes overlap in the intensity and rise with it
+    (:func:`separation`): separated outcomes give NaN, NaN with a
+    :class:`~rockstudy.SeparationWarning` that names the interval in which theta lies, and
+    outcomes without a rise NaN, NaN with one that says so.
 
     Parameters
     ----------
@@ -96,26 +234,39 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
     -------
     (theta, beta)
         Median capacity in the units of ``im``, and dispersion (the MLE). ``inf``/NaN or
-        0/NaN when the outcome never or always happened (no fit).
+        0/NaN when the outcome never or always happened (no fit); NaN/NaN when the outcomes
+        are separated or do not rise (no maximum).
     """
-    x = np.log(np.asarray(im, float))
-    z = np.asarray(n_overturned, float)
-    n = np.asarray(n_total, float)
-    if not (x.shape == z.shape == n.shape) or np.any(z > n) or np.any(z < 0):
-        raise ValueError("im, n_overturned and n_total must match, with 0 <= n_overturned <= n")
-    if z.sum() == 0:
-        return np.inf, np.nan
-    if z.sum() == n.sum():
-        return 0.0, np.nan
-    if start is None:
-        w = n / n.sum()
-        sd = np.sqrt(np.sum(w * (x - np.sum(w * x)) ** 2))
-        start = np.array([np.sum(w * x), np.log(max(sd, 0.1))])
-    res = optimize.minimize(
-        _binomial_nll, start, args=(x, z, n), jac=True, method="BFGS", options={"gtol": 1e-9}
-    )
-    with np.errstate(over="ignore"):  # a median far above the data: inf, flagged by callers
-        return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+    x, z, n = _outcomes(im, n_overturned, n_total)
+    kind, s, o = _separation(x, z, n)
+    if kind == "one outcome":  # never (median not reached) or always (below the data)
+        return (np.inf, np.nan) if z.sum() == 0 else (0.0, np.nan)
+    if kind in NO_MAXIMUM:
+        message = separation_message(kind, np.exp(s), np.exp(o))
+        warnings.warn(f"fit_binomial: {message}", SeparationWarning, stacklevel=2)
+        return np.nan, np.nan
+    return _binomial_mle(x, z, n, start)
+
+
+def fit_binomial_limit(im, n_overturned, n_total, start=None) -> tuple[float, float]:
+    """:func:`fit_binomial` for the resamples of a bootstrap: the MLE where it exists, and
+    where the resample is separated, the limit its likelihood rises towards, without a
+    warning: beta = 0 (a step) and theta the geometric middle of the gap [s, o] of
+    :func:`separation` (for quasi-separation, s itself, the limit of theta). The resamples of
+    a small sample are often separated; leaving them out would bias the band of beta upwards,
+    keeping whatever an optimiser stopped at would make it arbitrary. A resample without a
+    rise (``"no rise"``) enters at its own limit: beta = inf, a flat curve, theta 0 or inf
+    as its overall proportion is above or below one half (NaN at one half)."""
+    x, z, n = _outcomes(im, n_overturned, n_total)
+    kind, s, o = _separation(x, z, n)
+    if kind == "one outcome":  # never (median not reached) or always (below the data)
+        return (np.inf, np.nan) if z.sum() == 0 else (0.0, np.nan)
+    if kind in SEPARATED:
+        return float(np.exp(0.5 * (s + o))), 0.0
+    if kind == "no rise":  # flat at the overall proportion p: theta -> 0 (p > 1/2) or inf
+        p = z.sum() / n.sum()
+        return (0.0 if p > 0.5 else np.inf if p < 0.5 else np.nan), np.inf
+    return _binomial_mle(x, z, n, start)
 
 
 def _censored_nll(q, c, cens):
@@ -263,11 +414,25 @@ def probability_band(x, theta, beta, n, cov, method, conf_level):
 
 
 def fragility_row(
-    label, theta, beta, band, n, im, by=None, cov=None, method="none", conf_level=np.nan
+    label,
+    theta,
+    beta,
+    band,
+    n,
+    im,
+    by=None,
+    cov=None,
+    method="none",
+    conf_level=np.nan,
+    separated=False,
 ) -> dict:
     """One row of a fragility table: the fit (``beta`` the MLE), the bands of theta and beta,
     the sample count, the observed intensity range of ``im`` and whether the median
-    (``theta_in_range``) and its whole band (``band_in_range``) lie inside it; then what the
+    (``theta_in_range``) and its whole band (``band_in_range``) lie inside it, and whether
+    the outcomes are separated (``separated``, :func:`separation`: then theta and beta are
+    NaN and the "band" of theta is the gap [s, o] in which the median lies) and whether they
+    do not rise with the intensity at all (``no_rise``: theta, beta and band NaN; see
+    :func:`no_maximum_row`); then what the
     pointwise band of P(x) needs (:func:`probability_band`): the covariance of
     (ln theta, ln beta) (``var_ln_theta``, ``cov_ln_theta_ln_beta``, ``var_ln_beta``), the
     method (``p_band``) and ``conf_level``. ``band`` is ((theta_lo, theta_hi),
@@ -288,6 +453,8 @@ def fragility_row(
         "im_max": im_max,
         "theta_in_range": bool(im_min <= theta <= im_max),
         "band_in_range": bool(im_min <= theta_lo and theta_hi <= im_max),
+        "separated": bool(separated),
+        "no_rise": False,
         "var_ln_theta": cov[0, 0],
         "cov_ln_theta_ln_beta": cov[0, 1],
         "var_ln_beta": cov[1, 1],
@@ -298,6 +465,21 @@ def fragility_row(
 
 #: columns of a fragility row that only serve the pointwise band of P(x).
 BAND_COLUMNS = ("var_ln_theta", "cov_ln_theta_ln_beta", "var_ln_beta", "p_band", "conf_level")
+
+
+def no_maximum_row(label, kind, low, high, n, im, by=None, conf_level=np.nan) -> dict:
+    """The :func:`fragility_row` of outcomes without a maximum of the likelihood (``kind`` of
+    :data:`NO_MAXIMUM`): no fit (theta, beta NaN), no band of P; separated outcomes have
+    theta bounded by the gap [``low``, ``high``] (``separated``), outcomes without a rise
+    not at all (``no_rise``)."""
+    if kind not in NO_MAXIMUM:
+        raise ValueError(f"kind must be one of {NO_MAXIMUM}, got {kind!r}")
+    separated = kind in SEPARATED
+    band = ((low, high) if separated else (np.nan, np.nan), (np.nan, np.nan))
+    row = fragility_row(
+        label, np.nan, np.nan, band, n, im, by, None, "none", conf_level, separated=separated
+    )
+    return {**row, "no_rise": kind == "no rise"}
 
 
 def wald_intervals(theta, beta, cov, conf_level):

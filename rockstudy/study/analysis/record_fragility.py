@@ -9,7 +9,10 @@ dimensionless groups of [000] as they are).
 
 Every table carries the observed intensity range (``im_min``, ``im_max``) and the flags
 ``theta_in_range`` and ``band_in_range``: a median outside the data is an extrapolation of the
-lognormal shape, to be read as "not reached within the sampled range" (or "below it").
+lognormal shape, to be read as "not reached within the sampled range" (or "below it"); and
+``separated`` and ``no_rise``: outcomes separated in the intensity, or not rising with it,
+have no fit (theta, beta NaN; a separated theta only bounded, see
+:func:`~rockstudy.study.analysis.fragility_fit.separation`).
 
 Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural
 analysis. Earthquake Spectra 31(1), 579-599.
@@ -27,15 +30,19 @@ from scipy import stats
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from .fragility_fit import (
+    NO_MAXIMUM,
     binomial_covariance,
     capacities_covariance,
     check_conf_level,
     check_n_boot,
     fit_binomial,
+    fit_binomial_limit,
     fit_capacities,
     fragility_row,
+    no_maximum_row,
     percentile_intervals,
     wald_intervals,
+    warn_if_separated,
 )
 
 __all__ = [
@@ -140,6 +147,32 @@ def _label(im, period):
     return im if period is None else f"{im}(T={float(period):g} s)"
 
 
+def stripe_arrays(ds, im, period):
+    """(intensity, overturned, usable) of stripes or a cloud as arrays on the dimensions of
+    ``overturned`` (record first): each point's ``im`` in quoted units (:func:`intensity`),
+    its outcome as stored, and whether it ran (``status`` 0) at a finite, positive
+    intensity."""
+    dims = ds["overturned"].dims
+    x = intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
+    y = ds["overturned"].transpose(*dims).values
+    ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
+    return x, y, ok
+
+
+def ida_arrays(ds, im, period):
+    """(capacities, censoring levels, censored, usable) of an IDA as arrays on (record,
+    structure), in the quoted units of ``im``: the first overturning intensities, the highest
+    levels seen to stand, whether no rung overturned (boolean), and whether the ladder ran
+    (``status`` 0) with a finite, positive value of the one of the two that applies."""
+    rs = ("record", "structure")
+    cap = intensity(ds, im, period, scale="capacity_scale").transpose(*rs).values
+    top = intensity(ds, im, period, scale="capacity_scale_lower").transpose(*rs).values
+    cens = ds["censored"].transpose(*rs).values == 1  # -1 where a ladder failed
+    x = np.where(cens, top, cap)
+    ok = (ds["status"].transpose(*rs).values == 0) & np.isfinite(x) & (x > 0)
+    return cap, top, cens, ok
+
+
 # ------------------------------------------------------------------------------ tables
 
 
@@ -228,17 +261,23 @@ def stripe_fragility(
         One row per group: ``theta`` [quoted unit], ``beta``, their intervals, ``n``
         (points), ``im_min``, ``im_max``, ``theta_in_range``, ``band_in_range``, the band
         columns of :func:`~rockstudy.study.analysis.fragility_fit.fragility_row` and ``unit``.
-        Points that failed (``status`` != 0) or have no finite intensity are left out.
+        Points that failed (``status`` != 0) or have no finite intensity are left out. A
+        group whose outcomes are separated in the intensity (the stripes jump from 0 % to
+        100 % overturned, or are mixed at one level only, with 0 % below and 100 % above it:
+        :func:`~rockstudy.study.analysis.fragility_fit.separation`) has no maximum of the
+        likelihood: ``separated`` True, ``theta`` and ``beta`` NaN, ``theta_lo`` /
+        ``theta_hi`` the gap in which the median lies, and a
+        :class:`~rockstudy.SeparationWarning`; so does a group whose overturned points do not
+        lie higher in the intensity than those that stood (``no_rise`` True, theta, beta and
+        their band NaN). Such bootstrap resamples enter at their limit
+        (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
     """
     conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
     im, period = _measure(ds, im, period)
-    x_all = intensity(ds, im, period).broadcast_like(ds["overturned"])
-    dims = ds["overturned"].dims
-    x_all = x_all.transpose(*dims).values
-    y_all = ds["overturned"].transpose(*dims).values.astype(float)
-    ok = np.isfinite(x_all) & (x_all > 0) & (ds["status"].transpose(*dims).values == 0)
+    x_all, y_all, ok = stripe_arrays(ds, im, period)
+    y_all = y_all.astype(float)
     record = np.broadcast_to(
-        np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (len(dims) - 1)), x_all.shape
+        np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (x_all.ndim - 1)), x_all.shape
     )
     unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
@@ -247,6 +286,11 @@ def stripe_fragility(
     for label, mask in _groups(ds, by, bins).items():
         x, y, keep, rec = x_all[:, mask], y_all[:, mask], ok[:, mask], record[:, mask]
         ones = np.ones(int(keep.sum()))
+        kind, low, high = warn_if_separated("stripe_fragility", label, x[keep], y[keep], ones, unit)
+        if kind in NO_MAXIMUM:  # separated or no rise: no maximum, no fit
+            row = no_maximum_row(label, kind, low, high, keep.sum(), x[keep], by, conf_level)
+            rows.append({**row, "unit": unit})
+            continue
         fit = fit_binomial(x[keep], y[keep], ones)
         cov = binomial_covariance(x[keep], ones, *fit, y[keep], rec[keep])
         if not np.isfinite(fit[1]):
@@ -256,7 +300,8 @@ def stripe_fragility(
             for _ in range(n_boot):
                 k = rng.integers(0, n_rec, n_rec)
                 kk = keep[k]
-                boot.append(fit_binomial(x[k][kk], y[k][kk], np.ones(int(kk.sum())), np.log(fit)))
+                ones_k = np.ones(int(kk.sum()))
+                boot.append(fit_binomial_limit(x[k][kk], y[k][kk], ones_k, np.log(fit)))
             band, method = percentile_intervals(np.array(boot), conf_level), "likelihood"
         else:
             band, method = wald_intervals(*fit, cov, conf_level), "likelihood"
@@ -264,7 +309,7 @@ def stripe_fragility(
     return pd.DataFrame(rows).set_index(by or "group")
 
 
-def _fit_records(cap, top, censored, keep, rows, start=None):
+def fit_records(cap, top, censored, keep, rows, start=None):
     """fit_capacities on the records ``rows`` (an index or a resample) of (record, structure)
     arrays: capacities where not censored, censoring levels where censored."""
     kk, cc = keep[rows], censored[rows]
@@ -311,21 +356,14 @@ def ida_fragility(
     """
     conf_level, n_boot = _check(ds, "ida", conf_level, n_boot)
     im, period = _measure(ds, im, period)
-    cap = intensity(ds, im, period, scale="capacity_scale").transpose("record", "structure").values
-    top = intensity(ds, im, period, scale="capacity_scale_lower")
-    top = top.transpose("record", "structure").values
-    cens_all = ds["censored"].transpose("record", "structure").values
-    ok = ds["status"].transpose("record", "structure").values == 0
-    ok &= np.where(cens_all, np.isfinite(top), np.isfinite(cap)) & (
-        np.where(cens_all, top, cap) > 0
-    )
+    cap, top, cens_all, ok = ida_arrays(ds, im, period)
     unit = quoted(im)[0]
     rng = np.random.default_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
     for label, mask in _groups(ds, by, bins).items():
         c, t, cens, keep = cap[:, mask], top[:, mask], cens_all[:, mask], ok[:, mask]
-        theta, beta = _fit_records(c, t, cens, keep, slice(None))
+        theta, beta = fit_records(c, t, cens, keep, slice(None))
         cov = capacities_covariance(c[keep & ~cens], t[keep & cens], theta, beta)
         n_unc = int((keep & ~cens).sum())
         pooled = int(mask.sum()) > 1  # several structures share each record
@@ -338,7 +376,7 @@ def ida_fragility(
         elif n_boot:
             boot = np.array(
                 [
-                    _fit_records(
+                    fit_records(
                         c, t, cens, keep, rng.integers(0, n_rec, n_rec), np.log([theta, beta])
                     )
                     for _ in range(n_boot)
@@ -422,7 +460,9 @@ def im_efficiency(
     pandas.DataFrame
         Index (``im``, ``group``), sorted by ``beta_linear`` within each group; columns of
         the fit, ``power``, ``beta_linear`` (with ``beta_linear_lo``/``_hi``) and
-        ``dimensionless``.
+        ``dimensionless``. A measure in which the outcomes are separated (``separated``) or do
+        not rise (``no_rise``) has no beta (NaN, sorted last: not ranked), and warns
+        (:class:`~rockstudy.SeparationWarning`).
     """
     fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
     candidates = default_candidates(ds) if candidates is None else candidates

@@ -25,7 +25,8 @@ import pandas as pd
 import xarray as xr
 
 from ...motions import measures
-from .record_fragility import fit_binomial, fit_capacities, intensity, quoted
+from .fragility_fit import NO_MAXIMUM, fit_binomial_limit, separation
+from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"
@@ -112,38 +113,35 @@ def _frequency_bands(ds, frequency_bins) -> dict:
 
 
 def _median_fitter(ds, im, period):
-    """A function (record rows, mask on (record, structure)) -> (theta, points, im range)
-    of the design's fit, and the quoted unit of ``im``."""
+    """A function (record rows, mask on (record, structure)) -> (theta, points, no maximum)
+    of the design's fit (outcomes separated in the intensity or without a rise: theta at the
+    limit of :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`), and the
+    quoted unit of ``im``."""
     needs_period = im in measures.MEASURES and measures.MEASURES[im].needs_period
     if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
     if ds.attrs.get("design") == "ida":
-        rs = ("record", "structure")
-        cap = intensity(ds, im, period, scale="capacity_scale").transpose(*rs).values
-        top = intensity(ds, im, period, scale="capacity_scale_lower").transpose(*rs).values
-        cens = ds["censored"].transpose(*rs).values == 1  # bool, or -1 where a run failed
+        cap, top, cens, ok = ida_arrays(ds, im, period)
         x = np.where(cens, top, cap)  # capacities, and the censoring levels
-        ok = (ds["status"].transpose(*rs).values == 0) & np.isfinite(x) & (x > 0)
 
         def fit(rows, mask):
             keep = (ok & mask)[rows]
             c, t, z = cap[rows], top[rows], cens[rows]
             theta = fit_capacities(c[keep & ~z], t[keep & z])[0] if keep.any() else np.nan
-            return theta, x[rows][keep]
+            return theta, x[rows][keep], False
 
     else:
-        dims = ds["overturned"].dims
-        x = intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
-        y = ds["overturned"].values.astype(float)
-        ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
+        x, y, ok = stripe_arrays(ds, im, period)
+        y = y.astype(float)
         extra = (slice(None), slice(None)) + (None,) * (x.ndim - 2)
 
         def fit(rows, mask):
             keep = (ok & mask[extra])[rows]
             if not keep.any():
-                return np.nan, np.zeros(0)
-            xs = x[rows][keep]
-            return fit_binomial(xs, y[rows][keep], np.ones(xs.size))[0], xs
+                return np.nan, np.zeros(0), False
+            xs, ys, ones = x[rows][keep], y[rows][keep], np.ones(int(keep.sum()))
+            no_fit = separation(xs, ys, ones)[0] in NO_MAXIMUM
+            return fit_binomial_limit(xs, ys, ones)[0], xs, no_fit
 
     return fit, quoted(im)[0]
 
@@ -181,7 +179,11 @@ def size_class_medians(
     -------
     (medians, spread) : pandas.DataFrame, pandas.DataFrame
         ``medians`` indexed by (frequency band, size class): ``theta`` [quoted unit], its band
-        ``theta_lo``/``theta_hi``, ``n`` (points), ``im_min``, ``im_max``, ``theta_in_range``.
+        ``theta_lo``/``theta_hi``, ``n`` (points), ``im_min``, ``im_max``, ``theta_in_range``,
+        ``no_maximum`` (outcomes separated in the intensity, or without a rise:
+        :data:`~rockstudy.study.analysis.fragility_fit.NO_MAXIMUM`; no fit, ``theta`` NaN,
+        the class left out of the spread; its resamples enter the band at their limit,
+        :func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
         ``spread`` indexed by frequency band: ``ratio`` (largest over smallest median) and
         ``log_std`` (standard deviation of ln theta) over the classes whose median lies within
         their sampled intensities (``classes`` of them; NaN if fewer than 2), with bands, and
@@ -200,8 +202,9 @@ def size_class_medians(
         masks = {c: bmask & cmask[None, :] for c, cmask in classes.items()}
         fitted = {c: fit(every, m) for c, m in masks.items()}
         inside = {}
-        for c, (theta, xs) in fitted.items():
+        for c, (theta, xs, no_fit) in fitted.items():
             lo, hi = (float(xs.min()), float(xs.max())) if xs.size else (np.nan, np.nan)
+            theta = np.nan if no_fit else theta  # the limit of no fit is no estimate
             # within the sampled intensities, up to rounding (a single capacity c is fitted
             # as exp(ln c))
             inside[c] = bool(xs.size and lo * (1 - 1e-12) <= theta <= hi * (1 + 1e-12))
@@ -214,6 +217,7 @@ def size_class_medians(
                     "im_min": lo,
                     "im_max": hi,
                     "theta_in_range": inside[c],
+                    "no_maximum": no_fit,
                 }
             )
         used = [c for c in classes if inside[c]]

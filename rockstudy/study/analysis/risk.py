@@ -1,7 +1,7 @@
 """The annual probability of overturning of each object of a record design at a site.
 
 Each object's lognormal fragility is fitted in the hazard curve's intensity measure (the IDA
-capacities, or the binomial fit of stripes and clouds: :mod:`.records_fragility`), then
+capacities, or the binomial fit of stripes and clouds: :mod:`.record_fragility`), then
 integrated against the site's hazard curve (:func:`rockstudy.risk.annual_rate`, Cornell et al.
 2002): the mean annual rate of overturning lambda_OT and the probability of at least one
 overturning in a number of years, 1 - exp(-lambda_OT t). The band of lambda_OT comes from
@@ -22,7 +22,22 @@ What the records cannot say is marked, not invented (``status``):
 - ``"all"``: (stripes, clouds) the object overturned at every point: no fit; the rate of
   exceeding the lowest intensity simulated, ``rate_lower_bound``, is what it is at least,
   as far as the points say;
+- ``"separated"``: (stripes, clouds) every point at which the object overturned lies at or
+  above every point at which it stood (:func:`.fragility_fit.separation`): the likelihood
+  has no maximum, the data bound the median but not the dispersion beta, and lambda_OT of a
+  lognormal fragility depends on beta strongly (Cornell et al.'s exp(k^2 beta^2 / 2) for a
+  power-law hazard of slope k). No rate is given (theta, beta and lambda_OT NaN): a step
+  function would be a guess presented as an estimate. More records near the gap, or a
+  fixed beta from elsewhere with :func:`rockstudy.risk.annual_rate`, are what can help;
+- ``"no rise"``: (stripes, clouds) the points at which the object overturned do not lie
+  higher in the intensity, on average, than those at which it stood: no increasing
+  fragility fits them (the likelihood rises as beta -> infinity, a flat curve), and a rate
+  from such a fit would be meaningless (infinite for a power-law hazard). No rate is given;
 - ``"no fit"``: the fit did not converge to a finite median and dispersion.
+
+In the band, a resample whose points are separated enters at its limit
+(:func:`.fragility_fit.fit_binomial_limit`: a step at the middle of its gap, rate lambda at
+that level); one without a rise is left out (counted out of ``boot_valid``).
 
 Cornell, C. A., Jalayer, F., Hamburger, R. O. and Foutch, D. A. (2002). Probabilistic basis
 for 2000 SAC Federal Emergency Management Agency steel moment frame guidelines. Journal of
@@ -36,12 +51,18 @@ import xarray as xr
 
 from ... import risk
 from . import record_fragility as rf
-from .fragility_fit import check_conf_level, check_n_boot, fit_binomial
+from .fragility_fit import (
+    NO_MAXIMUM,
+    check_conf_level,
+    check_n_boot,
+    fit_binomial_limit,
+    separation,
+)
 
 __all__ = ["STATUSES", "object_risk", "share_below"]
 
 #: What ``status`` of :func:`object_risk` says of an object's rate (module docstring).
-STATUSES = ("ok", "few", "none", "all", "no fit")
+STATUSES = ("ok", "few", "none", "all", "separated", "no rise", "no fit")
 
 
 def _check_hazard(ds, hazard):
@@ -63,36 +84,31 @@ def _check_hazard(ds, hazard):
 
 def _ida_fitter(ds, im, period):
     """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
-    level per object) of an IDA, in quoted units."""
-    dims = ("record", "structure")
-    cap = rf.intensity(ds, im, period, scale="capacity_scale").transpose(*dims).values
-    top = rf.intensity(ds, im, period, scale="capacity_scale_lower").transpose(*dims).values
-    cens = ds["censored"].transpose(*dims).values.astype(bool)
-    ok = ds["status"].transpose(*dims).values == 0
-    ok &= np.where(cens, np.isfinite(top), np.isfinite(cap)) & (np.where(cens, top, cap) > 0)
+    level per object, no_maximum(j) -> None) of an IDA, in quoted units."""
+    cap, top, cens, ok = rf.ida_arrays(ds, im, period)
 
     def fit(j, rows):
         c, t, cc, kk = cap[:, j], top[:, j], cens[:, j], ok[:, j]
         if not (kk[rows] & ~cc[rows]).any():  # none overturned in these records
             return np.inf, np.nan
-        return rf._fit_records(c, t, cc, kk, rows)
+        return rf.fit_records(c, t, cc, kk, rows)
 
     def count(j, rows):
         return int((ok[rows, j] & ~cens[rows, j]).sum())
 
     with np.errstate(invalid="ignore"):
         lowest = np.nanmin(np.where(ok & cens, top, np.nan), axis=0, initial=np.inf)
-    return fit, count, lowest
+    return fit, count, lowest, lambda j: None
 
 
 def _stripe_fitter(ds, im, period):
-    """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points); the third
-    item is the lowest intensity simulated per object."""
-    dims = ds["overturned"].dims
-    x = rf.intensity(ds, im, period).broadcast_like(ds["overturned"]).transpose(*dims).values
-    y = ds["overturned"].transpose(*dims).values.astype(bool)
-    ok = np.isfinite(x) & (x > 0) & (ds["status"].transpose(*dims).values == 0)
-    j_axis = dims.index("structure")
+    """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points, a separated
+    resample at its limit); the third item is the lowest intensity simulated per object, the
+    fourth the kind of :data:`.fragility_fit.NO_MAXIMUM` of all its points (None if they
+    have a fit)."""
+    x, y, ok = rf.stripe_arrays(ds, im, period)
+    y = y.astype(bool)
+    j_axis = ds["overturned"].dims.index("structure")
     x, y, ok = (np.moveaxis(a, j_axis, 1) for a in (x, y, ok))  # (record, structure, ...)
 
     def fit(j, rows):
@@ -100,14 +116,20 @@ def _stripe_fitter(ds, im, period):
         xs, ys = x[rows, j][kk], y[rows, j][kk]
         if not ys.any():
             return np.inf, np.nan
-        return fit_binomial(xs, ys.astype(float), np.ones(xs.size))
+        return fit_binomial_limit(xs, ys.astype(float), np.ones(xs.size))
 
     def count(j, rows):
         hit = (ok & y)[rows, j]
         return int(hit.reshape(hit.shape[0], -1).any(axis=1).sum())
 
     lowest = np.nanmin(np.where(ok, x, np.nan).reshape(x.shape[0], x.shape[1], -1), axis=(0, 2))
-    return fit, count, lowest
+
+    def no_maximum(j):
+        kk = ok[:, j]
+        kind = separation(x[:, j][kk], y[:, j][kk], np.ones(int(kk.sum())))[0]
+        return kind if kind in NO_MAXIMUM else None
+
+    return fit, count, lowest, no_maximum
 
 
 def _uplift(ds, hazard):
@@ -144,7 +166,10 @@ def share_below(theta, beta, hazard, level, units=None) -> float:
 
 
 def _rate(theta, beta, hazard, unit):
-    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit."""
+    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit or
+    for a flat one (beta inf, no rise)."""
+    if beta == np.inf:
+        return np.nan
     if theta == np.inf:
         return 0.0
     if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
@@ -152,11 +177,13 @@ def _rate(theta, beta, hazard, unit):
     return risk.annual_rate(theta, beta, hazard, units=unit)
 
 
-def _status(ida, theta, beta, n_over, n_rec, min_overturning):
+def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
-    if not ida and theta == 0.0:
+    if not ida and theta == 0.0 and beta != np.inf:
         return "all"
+    if no_maximum is not None:
+        return "no rise" if no_maximum == "no rise" else "separated"
     if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
         return "no fit" if n_over >= (2 if ida else 1) else "few"
     return "ok" if n_over >= min(min_overturning, n_rec) else "few"
@@ -167,12 +194,15 @@ def _probability(years, rate):
     return np.where(np.isfinite(rate), risk.probability_in(years, np.nan_to_num(rate)), np.nan)
 
 
-def _one_object(j, fit, count, n_rec, boot_rows, hazard, unit, ida, min_overturning):
+def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning):
     """The point estimate, the bootstrap rates and the status of object ``j``."""
+    fit, count, _, no_maximum = fitter
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
     n_over = count(j, every)
-    status = _status(ida, theta, beta, n_over, n_rec, min_overturning)
+    status = _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum(j))
+    if status in ("separated", "no rise"):  # the limit of the fit is no estimate
+        theta, beta = np.nan, np.nan
     rate = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
     boot = np.full(len(boot_rows), np.nan)
     if np.isfinite(rate):
@@ -245,17 +275,17 @@ def object_risk(
     im, period = _check_hazard(ds, hazard)
     unit = rf.quoted(im)[0]
     ida = design == "ida"
-    fit, count, lowest = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
+    fitter = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
     n_rec = ds.sizes["record"]
     rng = np.random.default_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
     to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
     rows = [
-        _one_object(j, fit, count, n_rec, boot_rows, hazard, unit, ida, int(min_overturning))
+        _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, int(min_overturning))
         for j in range(ds.sizes["structure"])
     ]
     attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
-    return _risk_dataset(ds, rows, lowest * to_hazard, hazard, years, to_hazard, attrs)
+    return _risk_dataset(ds, rows, fitter[2] * to_hazard, hazard, years, to_hazard, attrs)
 
 
 def _bands(boot, conf_level):

@@ -25,14 +25,18 @@ from scipy.spatial import cKDTree
 from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
+    NO_MAXIMUM,
     binomial_covariance,
     check_conf_level,
     check_n_boot,
     fit_binomial,
+    fit_binomial_limit,
     fragility_row,
+    no_maximum_row,
     percentile_intervals,
     probability_band,
     wald_intervals,
+    warn_if_separated,
 )
 
 FailedPolicy = Literal["error", "drop", "impute"]
@@ -203,7 +207,16 @@ def fragility(
         measurement: read it as "not reached within the sampled range" (or "below it").
         A group whose outcome never changes has no fit: its ``theta`` and band are ``inf``
         (the outcome never happened: not reached) or ``0`` (it always happened: below the
-        sampled range), its ``beta`` NaN. Groups with fewer than 10 samples are left out.
+        sampled range), its ``beta`` NaN. A group whose outcomes are separated in the
+        intensity (every overturned sample at or above every survivor:
+        :func:`~rockstudy.study.analysis.fragility_fit.separation`) has no maximum of the
+        likelihood: ``separated`` is True, ``theta`` and ``beta`` are NaN, ``theta_lo`` /
+        ``theta_hi`` are the gap in which the median lies (the highest survivor, the lowest
+        overturned intensity), with a :class:`~rockstudy.SeparationWarning`; so does a group
+        whose overturned samples do not lie higher in the intensity than the survivors
+        (``no_rise`` True; theta, beta and band NaN). Such bootstrap resamples enter at their
+        limit (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`). Groups
+        with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
     for name in (intensity, outcome) + (() if by is None else (by,)):
@@ -239,6 +252,9 @@ def fragility(
 def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
     """The fragility row of one group of samples: fit, intervals, covariance."""
     ones = np.ones(z.size)
+    kind, low, high = warn_if_separated("fragility", name, x, z, ones, depth=2)
+    if kind in NO_MAXIMUM:  # separated or no rise: no maximum, no fit
+        return no_maximum_row(name, kind, low, high, z.size, x, by, conf_level)
     theta, beta = fit_binomial(x, z, ones)
     if not np.isfinite(beta):  # no fit: the median lies beyond the data, on one side
         band = ((theta, theta), (np.nan, np.nan))
@@ -248,7 +264,7 @@ def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
         start = np.log([theta, beta])
         boot = np.array(
             [
-                fit_binomial(x[k], z[k], ones, start)
+                fit_binomial_limit(x[k], z[k], ones, start)
                 for k in (rng.integers(0, z.size, z.size) for _ in range(n_boot))
             ]
         )

@@ -4,12 +4,16 @@ escaped text, tables as the page shows them (CSV beside), and figures embedded a
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import io
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from ..._warnings import SeparationWarning
 
 
 def _plt():
@@ -31,6 +35,82 @@ def _shown(value):
     if isinstance(value, (float, np.floating)):
         return "" if np.isnan(value) else f"{value:.3g}"
     return value
+
+
+def curve_note(inside, separated, no_rise=False) -> str:
+    """The legend's words on a fitted curve: why it is dashed (median outside the data) or
+    missing (outcomes separated, or not rising with the intensity: no fit), else none."""
+    if separated:
+        return " (outcomes separated: no fit)"
+    if no_rise:
+        return " (no rise with the intensity: no fit)"
+    return "" if inside else " (median outside the data)"
+
+
+def draw_fits(ax, grid, curve, table, ticks) -> bool:
+    """The curves of a fragility ``table`` (``curve``: :func:`fragility_curve` on ``grid``) on
+    a logarithmic ``ax`` with their bands, dashed where the median lies outside the data,
+    labelled with :func:`curve_note`; False, with ``ax`` hidden, when no group has a curve
+    (every one separated or without a fit). ``ticks`` labels the log axis."""
+    if not np.isfinite(curve["probability"].values).any():
+        ax.set_visible(False)
+        return False
+    flags = zip(
+        curve.group.values,
+        table["theta_in_range"],
+        table["separated"],
+        table["no_rise"],
+        strict=True,
+    )
+    for g, inside, separated, no_rise in flags:
+        c = curve.sel(group=g)
+        note = curve_note(inside, separated, no_rise)
+        ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
+        ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
+    ax.set_xscale("log")
+    ticks(ax)
+    ax.legend(fontsize=8)
+    return True
+
+
+@contextlib.contextmanager
+def shown_separation():
+    """A context in which :class:`~rockstudy.SeparationWarning` is not repeated on the console:
+    for the fits whose separated groups the page names (:func:`separation_note`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SeparationWarning)
+        yield
+
+
+def _named(table, column) -> str:
+    """The groups of ``table`` flagged in ``column``, listed in words ("" for none)."""
+    if column not in table:
+        return ""
+    return ", ".join(str(g) for g in table.index[table[column].to_numpy(bool)])
+
+
+def separation_note(page, table, what) -> None:
+    """A boxed warning naming the groups of a fragility ``table`` whose outcomes are
+    separated in the intensity (column ``separated``) or do not rise with it (``no_rise``),
+    in words: why they have no curve."""
+    if flat := _named(table, "no_rise"):
+        page.warning(
+            f"{what}: the points of {flat} at which the block overturned do not lie higher in "
+            "the intensity, on average, than those at which it stood: no increasing "
+            "fragility curve fits them (the likelihood has no maximum), so neither the "
+            "median nor beta is estimated and no curve is drawn."
+        )
+    groups = _named(table, "separated")
+    if not groups:
+        return
+    page.warning(
+        f"{what}: the outcomes of {groups} are separated in the intensity: every "
+        "point that overturned lies at or above every point that stood. The likelihood then "
+        "has no maximum, so the dispersion beta cannot be estimated and no curve is drawn; "
+        "the data only bound the median between the highest intensity at which the block "
+        "stood and the lowest at which it overturned (the lower and upper median columns). "
+        "Points between these two intensities would make the fit identifiable."
+    )
 
 
 class _Page:
@@ -168,5 +248,7 @@ _FRAGILITY_NAMES = {
     "im_max": "highest intensity",
     "theta_in_range": "median within the samples",
     "band_in_range": "band within the samples",
+    "separated": "outcomes separated (no fit)",
+    "no_rise": "no rise with the intensity (no fit)",
     "band": "subset of the samples",
 }

@@ -23,7 +23,7 @@ from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
-from ._page import _log_ticks, _mpl_text, _names, _plt
+from ._page import _log_ticks, _mpl_text, _names, _plt, separation_note, shown_separation
 
 #: Font size of legends and tick labels of the per-object figures [pt] (print: >= 8).
 FONT = 8
@@ -120,6 +120,7 @@ class ReportContext:
         if "recommended" not in self._cache:
             try:
                 table = self.efficiency()
+                table = table[np.isfinite(table["beta_linear"].to_numpy(float))]
                 label = table.index[0][0]
                 name, _, rest = label.partition("(T=")
                 self._cache["recommended"] = (name, float(rest.rstrip(" s)")) if rest else None)
@@ -129,7 +130,8 @@ class ReportContext:
 
     def efficiency(self):
         if "efficiency" not in self._cache:
-            self._cache["efficiency"] = rf.im_efficiency(self.ds, n_boot=self.n_boot)
+            with shown_separation():  # a separated measure: no beta, column "separated"
+                self._cache["efficiency"] = rf.im_efficiency(self.ds, n_boot=self.n_boot)
         return self._cache["efficiency"]
 
 
@@ -215,7 +217,8 @@ def _accel_factor(ctx, im) -> float:
 def _object_fit(ctx, im, period):
     """The fragility of each object against ``im`` (rows by name), in the report's units."""
     fit = rf.ida_fragility if ctx.design == "ida" else rf.stripe_fragility
-    table = fit(ctx.ds, im=im, period=period, by="structure", n_boot=ctx.n_boot)
+    with shown_separation():  # said on the page (separation_note)
+        table = fit(ctx.ds, im=im, period=period, by="structure", n_boot=ctx.n_boot)
     f = _accel_factor(ctx, im)
     for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
         table[col] = table[col] * f
@@ -253,6 +256,7 @@ def object_fragility(page, ctx):
             page.text(f"Fragility of the objects against {_label(ctx, im, period)}: {err}")
             ax.set_visible(False)
             continue
+        separation_note(page, t, f"Fragility of the objects against {_label(ctx, im, period)}")
         if not _plot_objects(ax, ctx, t, im, period):
             page.text(
                 f"Fragility of the objects against {_label(ctx, im, period)}: no object's fit "
@@ -278,6 +282,7 @@ def object_fragility(page, ctx):
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
+    cols += ["separated", "no_rise"]
     shown = table[cols].rename(
         columns={
             "theta": "median capacity",
@@ -286,6 +291,8 @@ def object_fragility(page, ctx):
             "beta": "beta (MLE)",
             "n": "records",
             "theta_in_range": "median within the data",
+            "separated": "outcomes separated (no fit)",
+            "no_rise": "no rise with the intensity (no fit)",
         }
     )
     up = _uplift(ctx, "pga")

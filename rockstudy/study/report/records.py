@@ -33,6 +33,9 @@ from ._page import (
     _names,
     _Page,
     _plt,
+    draw_fits,
+    separation_note,
+    shown_separation,
 )
 from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
@@ -85,7 +88,8 @@ def _fit(ds, im, period, edges, n_boot, by=None):
     ``by`` a coordinate, e.g. ``"structure"`` for named objects)."""
     fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
     by = by if edges is None else "half_diagonal"
-    table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
+    with shown_separation():  # said on the page (separation_note)
+        table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
     if edges is not None:  # analysis labels bins "lo-hi" in %g: name them in words
         table.index = [
             rsim.size_label(lo, hi)
@@ -174,15 +178,9 @@ def _fragility(page, ds, edges, n_boot):
             ax.set_visible(False)
             continue
         grid = np.geomspace(low, high, 200)
-        curve = fragility_curve(t, grid)
-        for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
-            c = curve.sel(group=g)
-            note = "" if inside else " (median outside the data)"
-            ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
-            ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
-        ax.set(xscale="log", xlabel=im_label(im, period), ylabel="probability of overturning")
-        _log_ticks(ax)
-        ax.legend(fontsize=8)
+        separation_note(page, t, f"Fragility against {im_label(im, period)}")
+        if draw_fits(ax, grid, fragility_curve(t, grid), t, _log_ticks):
+            ax.set(xlabel=im_label(im, period), ylabel="probability of overturning")
         t.insert(0, "intensity", im_label(im, period))
         tables.append(t)
     for ax in axes[len(measures) :]:
@@ -190,6 +188,14 @@ def _fragility(page, ds, edges, n_boot):
     if not tables:
         plt.close(fig)
         return
+    if not any(ax.get_visible() for ax in axes):  # every fit separated: no curve to show
+        plt.close(fig)
+    else:
+        _record_fragility_figure(page, fig, ds, edges)
+    _record_fragility_table(page, tables)
+
+
+def _record_fragility_figure(page, fig, ds, edges):
     fig.tight_layout()
     page.figure(
         fig,
@@ -204,6 +210,9 @@ def _fragility(page, ds, edges, n_boot):
         )
         + "; dashed: the median lies outside the observed intensities",
     )
+
+
+def _record_fragility_table(page, tables):
     fit = pd.concat(tables)
     fit.to_csv(page.out / "record_fragility_fit.csv")
     page.table(
@@ -235,6 +244,8 @@ def _efficiency(page, ctx):
                 "median capacity": r["theta"],
                 "points": int(r["n"]),
                 "dimensionless": bool(r["dimensionless"]),
+                "outcomes separated (no beta)": bool(r["separated"]),
+                "no rise (no beta)": bool(r["no_rise"]),
             }
         )
     page.table(
@@ -244,7 +255,9 @@ def _efficiency(page, ctx):
         "against each measure divided by the power k with which the measure follows a scale "
         "factor of the record (Arias intensity k = 2: its k-th root is as informative and "
         "linear), pooled over all blocks (smaller is better; 90 % bands), dimensional and "
-        "dimensionless",
+        "dimensionless; a measure in which the outcomes are separated (every overturned "
+        "point at or above every one that stood), or in which they do not rise at all, has no "
+        "beta and is not ranked",
     )
 
 

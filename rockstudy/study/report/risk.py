@@ -72,7 +72,12 @@ def _risk(page, ds, hazard, years, im_label):
         f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
         "and integrated again. Status 'few': fewer than 5 records overturned the object; "
         "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
-        "'all': it overturned at every point (stripes give a lower bound). 'share below "
+        "'all': it overturned at every point (stripes give a lower bound); 'separated': "
+        "every point at which it overturned lies at or above every point at which it stood, "
+        "so the fragility's dispersion cannot be estimated and no rate is given (a step "
+        "function would be a guess, not an estimate); 'no rise': the points at which it "
+        "overturned do not lie higher in the intensity than those at which it stood, so no "
+        "increasing fragility fits them and no rate is given. 'share below "
         "uplift' is the part of the rate from intensities at which the object cannot leave "
         "rest: the lognormal's lower tail, not a simulated overturning."
     )

@@ -31,6 +31,9 @@ from ._page import (
     _Page,
     _plt,
     _shown,
+    draw_fits,
+    separation_note,
+    shown_separation,
 )
 
 
@@ -123,8 +126,11 @@ def _fragility(page, ds, study=None):
         for ax, view in zip(axes, _FRAGILITY_VIEWS, strict=True)
         if (t := _fragility_view(page, ax, d, bins, *view)) is not None
     ]
-    if not tables:
+    if not tables or not any(ax.get_visible() for ax in axes):
         plt.close(fig)
+        if tables:  # every fit separated: the table, no curve
+            _fragility_table(page, pd.concat(tables))
+            _fragility_spread(page, tables)
         return
     axes[0].set_title("dimensional intensity")
     axes[1].set_title("dimensionless groups (6.1)")
@@ -149,7 +155,8 @@ def _fragility_view(page, ax, d, bins, im, band, label):
     size saw both outcomes."""
     sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
     try:
-        t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
+        with shown_separation():  # said on the page (separation_note)
+            t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
     except ValueError as err:  # no block size saw both outcomes
         page.text(f"Fragility against {im}: {err}")
         return None
@@ -162,15 +169,9 @@ def _fragility_view(page, ax, d, bins, im, band, label):
     t.insert(0, "intensity", im)
     t.insert(1, "band", band)
     grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
-    curve = analysis.fragility_curve(t, grid)
-    for g, inside in zip(curve.group.values, t["theta_in_range"], strict=True):
-        c = curve.sel(group=g)
-        note = "" if inside else " (median outside the data)"
-        ax.plot(grid, c.probability, "-" if inside else "--", label=f"{g}{note}")
-        ax.fill_between(grid, c.lower, c.upper, alpha=0.2)
-    ax.set(xscale="log", xlabel=label, ylabel="probability of overturning")
-    _plain_log_ticks(ax)
-    ax.legend(fontsize=8)
+    separation_note(page, t, f"Fragility against {im}")
+    if draw_fits(ax, grid, analysis.fragility_curve(t, grid), t, _plain_log_ticks):
+        ax.set(xlabel=label, ylabel="probability of overturning")
     return t
 
 
