@@ -27,6 +27,7 @@ from ._warnings import (
     LinearizationWarning,
     LooseToleranceWarning,
     SeparationWarning,
+    UpliftWarning,
 )
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
@@ -66,6 +67,7 @@ __all__ = [
     "IncompleteReferenceWarning",
     "RockingResult",
     "SeparationWarning",
+    "UpliftWarning",
     "StepLimitError",
     "closedform",
     "motions",
