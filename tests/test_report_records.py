@@ -53,7 +53,7 @@ def check_page(page, tmp_path, figures, tables):
         assert len(digits) <= 3, c
     assert "<td>3</td>" in text  # three records
     assert "print(" not in text and "DEBUG" not in text
-    for name in ("PGA [g]", "PGV [m/s]", "PGA / (g tan alpha) [-]", "PGV p / (g tan alpha) [-]"):
+    for name in ("PGA [g]", "PGV [m/s]", "PGA / a_up [-]", "PGV p / a_up [-]"):
         assert html_mod.escape(name) in text
     assert "pulse period T_p [s]" in text
     return text
@@ -94,7 +94,7 @@ def test_ida_report(tmp_path, records, ida):
     assert "<b>test</b>" not in text
     assert html_mod.escape("Sa(T = 0.5 s) [g]") in text
     eff = (tmp_path / "report" / "im_efficiency.csv").read_text()
-    assert "PGV p / (g tan alpha) [-]" in eff and "dimensionless" in eff
+    assert "PGV p / a_up [-]" in eff and "dimensionless" in eff
     medians = (tmp_path / "report" / "size_class_medians.csv").read_text()
     assert "R 0.3 to" in medians
 

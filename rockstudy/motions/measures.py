@@ -105,8 +105,8 @@ MEASURES: dict[str, Measure] = {}
 
 #: The dimensionless scale targets of the record designs (see docs/records.rst).
 RATIOS = {
-    "pga_ratio": Ratio("pga", 0, "PGA / (g tan alpha)"),
-    "pgv_ratio": Ratio("pgv", 1, "PGV p / (g tan alpha)"),
+    "pga_ratio": Ratio("pga", 0, "PGA / a_up"),
+    "pgv_ratio": Ratio("pgv", 1, "PGV p / a_up"),
 }
 
 #: Names the designs store beside the measures (a measure may not take them).

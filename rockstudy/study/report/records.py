@@ -2,10 +2,10 @@
 
 From a dataset of :mod:`rockstudy.study.designs.records` (or a result cube of the same layout):
 the record list with each record's intensity measures and pulse period; fragility curves with
-bands against PGA [g], PGV [m/s], Sa(T) [g], PGA / (g tan alpha) and PGV p / (g tan alpha), by
-block size; the efficiency of the intensity measures; IDA curves, stripe points or the cloud;
-a per-record breakdown; and, when the blocks span sizes, the self-similarity of the fragility
-on records (:mod:`rockstudy.study.analysis.record_similarity`).
+bands against PGA [g], PGV [m/s], Sa(T) [g], PGA / a_up and PGV p / a_up (a_up the uplift
+acceleration), by block size; the efficiency of the intensity measures; IDA curves, stripe
+points or the cloud; a per-record breakdown; and, when the blocks span sizes, the
+self-similarity of the fragility on records (:mod:`rockstudy.study.analysis.record_similarity`).
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ DESIGNS = ("cloud", "stripes", "ida")
 
 #: The dimensionless group of the pulse in words (the measures' and ratios' labels are those of
 #: the registry, :func:`rockstudy.motions.measures.label`).
-GROUP_NAMES = {"pulse_amplitude_ratio": "pulse amplitude omega_p A_p / (g tan alpha) [-]"}
+GROUP_NAMES = {"pulse_amplitude_ratio": "pulse amplitude omega_p A_p / a_up [-]"}
 _DESIGN_NAMES = {
     "cloud": "cloud (records unscaled)",
     "stripes": "multiple-stripe analysis",
@@ -53,7 +53,13 @@ _DESIGN_NAMES = {
 }
 #: Units of the report's accelerations: as given (a study's scale_to.units) -> as shown.
 REPORT_UNITS = {"g": "g", "m/s^2": "m/s^2", "m/s2": "m/s^2"}
-#: Frequency bins of omega_p / p (of equal count) within which PGA / (g tan alpha) is compared.
+#: What the page's ratios divide by, said once at its top.
+UPLIFT_NOTE = (
+    "a_up is each structure's uplift acceleration: g tan alpha of a block, g lambda of another "
+    "structure (eq. 10 of [003]); p its frequency parameter."
+)
+
+#: Frequency bins of omega_p / p (of equal count) within which PGA / a_up is compared.
 FREQUENCY_BINS = 3
 
 
@@ -342,7 +348,7 @@ def _per_record(page, ds):
             ratio = ratio.values[0]
             row["simulations"] = int(ds["simulations"].values[i].sum())
             row["median capacity, PGA [g]"] = _median(cap)
-            row["median capacity, PGA / (g tan alpha) [-]"] = _median(ratio)
+            row["median capacity, PGA / a_up [-]"] = _median(ratio)
             row["lowest capacity, PGA [g]"] = (
                 float(np.nanmin(cap)) if np.isfinite(cap).any() else np.nan
             )
@@ -480,8 +486,8 @@ def _median(values) -> float:
 
 
 def _self_similarity(page, ds, edges, n_boot):
-    """Medians of the size classes against PGA [g] (pooled), PGA / (g tan alpha) within bins
-    of omega_p / p, and PGV p / (g tan alpha) (pooled), and their spread."""
+    """Medians of the size classes against PGA [g] (pooled), PGA / a_up within bins
+    of omega_p / p, and PGV p / a_up (pooled), and their spread."""
     cases = [
         ("pga", None),
         ("pga_ratio", FREQUENCY_BINS if np.isfinite(ds["pulse_frequency_ratio"]).any() else None),
@@ -690,4 +696,5 @@ def record_report(
     if appendix is not None:
         appendix(page)
     meta = f"<p>{html.escape(description)}</p>" if description else ""
+    meta += f"<p class='cap'>{html.escape(UPLIFT_NOTE)}</p>"
     return page.write(f"rockstudy report: {title}", meta)
