@@ -261,7 +261,8 @@ class HazardCurve:
                 f"im: {path.name} is a two-column file, which does not name its intensity "
                 f"measure: give im= (one of {list(measures.MEASURES)}) and units="
             )
-        levels, rates = _two_columns(path, lines)
+        levels, rates, header = _two_columns(path, lines)
+        _check_header_units(path, header, im, units)
         return cls(im, levels, rates, units, period, str(path))
 
 
@@ -278,14 +279,17 @@ def _slopes(log_levels, log_rates):
 
 
 def _two_columns(path, lines):
+    """(levels, rates, the first column's name or None) of a two-column file."""
     rows = [ln for ln in lines if not ln.startswith("#")]
-    values = []
+    values, header = [], None
     for i, ln in enumerate(rows):
         cells = [c for c in re.split(r"[,;\s]+", ln) if c]
         try:
             nums = [float(c) for c in cells]
         except ValueError:
             if i == 0:  # a row of column names
+                sep = r"[,;]" if re.search(r"[,;]", ln) else r"\s+"
+                header = re.split(sep, ln)[0].strip() or None
                 continue
             raise ValueError(f"path: {path.name}: line {ln!r} is not two numbers") from None
         if len(nums) != 2:
@@ -297,7 +301,35 @@ def _two_columns(path, lines):
     if len(values) < 2:
         raise ValueError(f"path: {path.name} holds fewer than 2 rows of level, rate")
     arr = np.array(values)
-    return arr[:, 0], arr[:, 1]
+    return arr[:, 0], arr[:, 1], header
+
+
+#: Units a level column's name may state (``pga_g``, ``PGA [g]``, ``pgv (cm/s)``, ``sa_gal``):
+#: the unit, and the pattern that finds it in the lowercased name, the longer units first.
+_HEADER_UNITS = (
+    ("cm/s^2", r"cm/s\^?2|gal\b"),
+    ("m/s^2", r"(?<!c)m/s\^?2"),
+    ("cm/s", r"cm/s(?!\^?2)"),
+    ("m/s", r"(?<!c)m/s(?!\^?2)"),
+    ("g", r"(?:^|[_\s\[(])g(?:$|[\])\s])"),
+)
+
+
+def _check_header_units(path, header, im, units) -> None:
+    """A ValueError naming ``units`` where the level column's name states another unit (a
+    column ``pga_g`` read as m/s^2 would shift every level by a factor of 9.8)."""
+    if not header:
+        return
+    name = header.lower()
+    stated = next((u for u, pattern in _HEADER_UNITS if re.search(pattern, name)), None)
+    given = measures.measure(im).unit if units is None else units
+    if stated is None or stated not in UNIT_FACTORS or given not in UNIT_FACTORS:
+        return
+    if UNIT_FACTORS[stated] != UNIT_FACTORS[given]:
+        raise ValueError(
+            f"units: {path.name} names its level column {header!r}, in {stated}, but the "
+            f"levels are read in {given!r}; give units = {stated!r} (or rename the column)"
+        )
 
 
 _META = re.compile(r"(\w+)\s*=\s*('[^']*'|\"[^\"]*\"|[^,\s\"']+)")

@@ -645,3 +645,31 @@ def test_validate_notes_a_cloud_of_records_that_cannot_rock_the_objects(suite, t
         )
         notes = _notes(tmp_path, text)
         assert noted == any("nothing can rock" in n for n in notes), notes
+
+
+def test_units_other_than_g_on_at2_files_alone_are_refused(suite, tmp_path):
+    """PEER's .AT2 files are in g whatever motion.units says: a setting that would change
+    nothing is refused by name; g, and the units of text records, are taken."""
+    for units, refused in (('"m/s2"', True), ('"m/s^2"', True), ('"g"', False)):
+        text = HEAD + MOTION.replace("RECORDS", str(suite)) + f"units = {units}\n"
+        text += '[design]\nkind = "cloud"\n'
+        (tmp_path / "u.toml").write_text(text)
+        if refused:
+            with pytest.raises(StudyError) as err:
+                load_study(tmp_path / "u.toml")
+            assert any(p.startswith("motion.units:") for p in err.value.problems)
+        else:
+            load_study(tmp_path / "u.toml")
+    # a text record in m/s^2 (either spelling): the same peak as its .AT2 in g
+    rec = load_suite(str(suite / "nf0_H.AT2"))[0]
+    text_file = tmp_path / "nf0.txt"
+    rows = zip(rec.time, rec.acceleration, strict=True)
+    text_file.write_text("\n".join(f"{t!r} {a!r}" for t, a in rows))
+    for units in ("m/s2", "m/s^2"):
+        text = HEAD + f'[motion]\nkind = "record"\nfiles = ["{text_file.as_posix()}"]\n'
+        text += f'units = "{units}"\n[design]\nkind = "cloud"\n'
+        (tmp_path / "t.toml").write_text(text)
+        study = load_study(tmp_path / "t.toml")
+        assert study.motion.units == units
+        again = load_suite([text_file], units=units)[0]
+        assert again.peak == pytest.approx(rec.peak, rel=1e-15)

@@ -9,6 +9,7 @@ by hand).
 """
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -284,3 +285,29 @@ def test_shipped_site_curve_in_both_formats():
         # log-log chords of a curve with k2 = 0.29 on steps d = 0.22 in ln x: k2 d^2 / 4 low
         assert two.rate(level) * period == pytest.approx(1.0, rel=4e-3)
     assert risk.probability_in(50, two.rate(0.25)) == pytest.approx(0.1, rel=0.01)
+
+
+@pytest.mark.parametrize(
+    "header, units, stated",
+    [
+        ("pga_g", "m/s2", "g"),
+        ("pga_g", None, "g"),
+        ("PGA [m/s^2]", "g", "m/s^2"),
+        ("sa_gal", "g", "cm/s^2"),
+    ],
+)
+def test_a_level_column_named_in_other_units_is_refused(tmp_path, header, units, stated):
+    """A column ``pga_g`` read as m/s^2 would shift every level by 9.8: refused by name."""
+    path = tmp_path / "h.csv"
+    path.write_text(f"{header},annual_rate\n0.1,1e-2\n0.2,1e-3\n")
+    with pytest.raises(ValueError, match=rf"^units: .*in {re.escape(stated)},"):
+        HazardCurve.from_csv(path, im="pga", units=units)
+
+
+@pytest.mark.parametrize("header, units", [("pga_g", "g"), ("PGA [m/s^2]", "m/s2"), ("level", "g")])
+def test_a_level_column_in_its_own_units_reads(tmp_path, header, units):
+    path = tmp_path / "h.csv"
+    path.write_text(f"{header},annual_rate\n0.1,1e-2\n0.2,1e-3\n")
+    curve = HazardCurve.from_csv(path, im="pga", units=units)
+    np.testing.assert_array_equal(curve.levels, [0.1, 0.2])
+    np.testing.assert_array_equal(curve.rates, [1e-2, 1e-3])

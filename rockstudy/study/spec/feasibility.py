@@ -74,7 +74,7 @@ def problems(study, base_dir=None) -> list[str]:
             pairs = record_pairs(mo, base_dir)
         except ValueError as exc:
             return [*found, str(exc)]
-        found += _record_problems(study, pairs)
+        found += _units_problem(mo, pairs) + _record_problems(study, pairs)
         if study.design is not None:
             found += _named_twice(pairs)
         refusal = None if all(v is None for _, _, v in pairs) else vertical_refusal()
@@ -227,6 +227,20 @@ def _named_twice(pairs) -> list[str]:
             )
         first.setdefault(key, field)
     return found
+
+
+def _units_problem(motion, pairs) -> list[str]:
+    """``motion.units`` other than g on a suite of ``.AT2`` files alone, which PEER's format
+    gives in g (they are read in g whatever the field says): a setting that would change
+    nothing is refused rather than ignored."""
+    files = [p for _, h, v in pairs for p in (h, v) if p is not None]
+    if motion.units == "g" or any(p.suffix.lower() != ".at2" for p in files):
+        return []
+    return [
+        f"motion.units: {motion.units!r} does not apply to .AT2 files, which are in g (PEER's "
+        "format, read in g whatever the units); units is the unit of text records' "
+        "acceleration column: remove it, or give text files"
+    ]
 
 
 def _record_problems(study, pairs) -> list[str]:

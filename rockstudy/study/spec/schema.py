@@ -505,6 +505,10 @@ class RecordSpec(_Model):
     ``pga_ratio`` x a_up (the structure's uplift acceleration: g tan(alpha) of a block, g lambda
     of another structure, eq. 10 of [003]), or to ``scale_to``; a ``[design]`` runs every record.
 
+    ``units`` is the unit of the acceleration column of text records (``g``, ``m/s2`` or
+    ``m/s^2``, ``cm/s2`` or ``cm/s^2``); ``.AT2`` files are in g (PEER's format), and a
+    suite of ``.AT2`` files alone with other units is refused.
+
     A path is absolute as written, or relative to the study file's folder (never to the
     working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
     are read. No record is skipped: every file named, matched or found must read.
@@ -513,7 +517,7 @@ class RecordSpec(_Model):
     kind: Literal["record"]
     files: Annotated[str, Field(min_length=1)] | Annotated[list[str | HVPair], Field(min_length=1)]
     vertical: list[str] | VerticalRule | None = None
-    units: Literal["g", "m/s2", "cm/s2"] = "g"
+    units: Literal["g", "m/s2", "m/s^2", "cm/s2", "cm/s^2"] = "g"
     scale: Param | None = None
     pga_ratio: Param | None = None
     scale_to: ScaleTo | None = None
@@ -1497,6 +1501,7 @@ def _read_hazard_file(data, base_dir) -> str | None:
         text = str(exc)
         # a bad units or period is that field's problem, not the file's
         field = next((f for f in ("units", "period") if text.startswith(f)), "file")
+        text = text.removeprefix(f"{field}: ") if field != "file" else text
         return f"hazard.{field}: {text}"
     hz["levels"], hz["rates"] = curve.levels.tolist(), curve.rates.tolist()
     hz["units"] = curve.units
