@@ -377,3 +377,10 @@ def test_every_fragility_fit_is_the_shared_modules():
             if any(n.startswith("scipy.optimize") or n == "scipy.optimize" for n in names):
                 optimisers.append(path.name)
     assert optimisers == ["fragility_fit.py"], optimisers
+
+
+def test_bins_without_by_and_misspelt_variables_are_refused_by_name(mc_cube):
+    with pytest.raises(ValueError, match=r"^bins: .*give by="):
+        mc_cube.rocking.fragility("uplift_ratio", bins=[0.5, 1.0, 2.0])
+    with pytest.raises(ValueError, match=r"^by: 'restitutoin' .*did you mean 'restitution'"):
+        mc_cube.rocking.fragility("uplift_ratio", by="restitutoin")

@@ -377,7 +377,8 @@ class RockingAccessor:
 
         Examples
         --------
-        >>> ds.rocking.collapse("max_rotation_ratio", ["a", "omega", "restitution"])
+        >>> rep = xr.open_zarr("replicated.zarr")  # a study with [sampler] replicates = 4
+        >>> rep.rocking.collapse("max_rotation_ratio", ["a", "omega", "restitution"])
         >>> medians, spread = ida.rocking.collapse(im="pgv_ratio", size_bins=3)
         """
         if self.kind in RECORD_DESIGNS:

@@ -12,6 +12,7 @@ failure.
 
 from __future__ import annotations
 
+import difflib
 import json
 from itertools import combinations_with_replacement
 from typing import Literal, NamedTuple
@@ -219,9 +220,13 @@ def fragility(
         with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
-    for name in (intensity, outcome) + (() if by is None else (by,)):
-        if name not in ds:
-            raise ValueError(f"{name!r} is not a variable of the dataset")
+    for field, name in (("intensity", intensity), ("outcome", outcome), ("by", by)):
+        if name is not None and name not in ds:
+            close = difflib.get_close_matches(str(name), [str(v) for v in ds.data_vars], 3)
+            hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+            raise ValueError(f"{field}: {name!r} is not a variable of the dataset{hint}")
+    if bins is not None and by is None:
+        raise ValueError("bins: bins the variable given as by=; give by= too, or no bins")
     y, bad = _values(ds, outcome, failed)
     im = np.asarray(ds[intensity].values, float)
     keep = ~bad & np.isfinite(im) & (im > 0)
