@@ -205,11 +205,11 @@ def _fragility_spread(page, tables):
     spread = []
     for t in tables:
         inside = t["theta"][t["theta_in_range"]]
+        name = _SHORT.get(t["intensity"].iloc[0], t["intensity"].iloc[0])
         spread.append(
-            f"{t['intensity'].iloc[0]}: {inside.max() / inside.min():.2f}"
+            f"{name}: {inside.max() / inside.min():.2f}"
             if inside.size >= 2
-            else f"{t['intensity'].iloc[0]}: not measured (fewer than two medians within "
-            "the sampled range)"
+            else f"{name}: not measured (fewer than two medians within the sampled range)"
         )
     page.text(
         "Spread of the median capacity between block sizes (largest over smallest, medians within "
