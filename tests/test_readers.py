@@ -8,6 +8,8 @@ trailing blanks, as in the distributed files. Two-column text: commas or blanks,
 comments, and a first row of column names.
 """
 
+import re
+
 import numpy as np
 import pytest
 
@@ -98,6 +100,21 @@ def test_at2_count_mismatch_and_units_are_refused(tmp_path):
     bad = write_at2(tmp_path / "bad.AT2", "no counts here")
     with pytest.raises(ValueError, match="NPTS and DT"):
         Record.from_at2(bad)
+
+
+def test_units_other_than_g_on_at2_files_alone_are_refused_by_load_suite(tmp_path):
+    """An .AT2 file is in g whatever units says: a suite of them alone with other units is
+    refused (the setting would change nothing), and read in g with units g."""
+    from rockstudy.motions import load_suite
+
+    folder = tmp_path / "suite"
+    folder.mkdir()
+    write_at2(folder / "a.AT2", "NPTS=   {n}, DT=   .0050 SEC,", VALUES_G)
+    for units in ("m/s2", "m/s^2", "cm/s2"):
+        with pytest.raises(ValueError, match=rf"^units: '{re.escape(units)}' does not apply"):
+            load_suite(folder, units=units)
+    (rec,) = load_suite(folder, units="g")
+    np.testing.assert_allclose(rec.acceleration, np.asarray(VALUES_G) * STANDARD_GRAVITY)
 
 
 TIMES = np.array([0.0, 0.02, 0.04, 0.06, 0.08])

@@ -107,8 +107,9 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
         ``RSN126_GAZLI_GAZ-UP.AT2``. Files that are some record's vertical component are not
         read as horizontal records. A horizontal file whose name the expression does not match,
         or whose vertical file is missing, is an error.
-    units : {"g", "m/s2", "cm/s2"}
-        Units of the acceleration column of text files (``.AT2`` files are in g).
+    units : {"g", "m/s2", "m/s^2", "cm/s2", "cm/s^2"}
+        Units of the acceleration column of text files (``.AT2`` files are in g: units other
+        than g on ``.AT2`` files alone are refused).
 
     Returns
     -------
@@ -121,9 +122,29 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
     ValueError
         Naming the field (``source`` or ``vertical``) and the file: a folder or glob without
         record files, a file that cannot be read, a file listed twice, a missing vertical
-        file, or an H/V pair of different lengths or steps.
+        file, an H/V pair of different lengths or steps, or ``units`` other than g on
+        ``.AT2`` files alone (``units``).
     """
-    return [read_pair(h, v, units) for h, v in suite_pairs(source, vertical)]
+    pairs = suite_pairs(source, vertical)
+    refusal = units_refusal(pairs, units)
+    if refusal:
+        raise ValueError(f"units: {refusal}")
+    return [read_pair(h, v, units) for h, v in pairs]
+
+
+def units_refusal(pairs, units: str) -> str | None:
+    """Why ``units`` other than g cannot apply to a suite of ``.AT2`` files alone (None if it
+    can): PEER's format is in g and is read in g whatever ``units`` says, so a setting that
+    would change nothing is refused rather than ignored. ``pairs``: (horizontal, vertical or
+    None) paths, as :func:`suite_pairs` gives them."""
+    files = [p for pair in pairs for p in pair if p is not None]
+    if units == "g" or any(Path(p).suffix.lower() != ".at2" for p in files):
+        return None
+    return (
+        f"{units!r} does not apply to .AT2 files, which are in g (PEER's format, read in g "
+        "whatever the units); units is the unit of text records' acceleration column: "
+        "remove it, or give text files"
+    )
 
 
 def suite_pairs(

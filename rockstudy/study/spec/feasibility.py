@@ -16,7 +16,7 @@ import numpy as np
 from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, machine_memory
 from ...constants import G
 from ...motions import measures
-from ...motions.suites import read_pair, suite_pairs
+from ...motions.suites import read_pair, suite_pairs, units_refusal
 from ...structures.block import uplift_acceleration_block
 from .structures import KINDS
 
@@ -230,17 +230,9 @@ def _named_twice(pairs) -> list[str]:
 
 
 def _units_problem(motion, pairs) -> list[str]:
-    """``motion.units`` other than g on a suite of ``.AT2`` files alone, which PEER's format
-    gives in g (they are read in g whatever the field says): a setting that would change
-    nothing is refused rather than ignored."""
-    files = [p for _, h, v in pairs for p in (h, v) if p is not None]
-    if motion.units == "g" or any(p.suffix.lower() != ".at2" for p in files):
-        return []
-    return [
-        f"motion.units: {motion.units!r} does not apply to .AT2 files, which are in g (PEER's "
-        "format, read in g whatever the units); units is the unit of text records' "
-        "acceleration column: remove it, or give text files"
-    ]
+    """``motion.units`` that cannot apply to the suite (:func:`units_refusal`)."""
+    refusal = units_refusal([(h, v) for _, h, v in pairs], motion.units)
+    return [f"motion.units: {refusal}"] if refusal else []
 
 
 def _record_problems(study, pairs) -> list[str]:
