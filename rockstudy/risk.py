@@ -455,23 +455,47 @@ def _bins(hazard):
     return lower, upper, log_rate, anchor, slope
 
 
-def _capacity_expectations(mu, beta, hazard):
-    """E[lambda(C); C in bin] per bin (last axis) for a lognormal capacity C (ln C ~ N(mu,
-    beta^2)), in closed form: on a bin where lambda = lambda_a (x / x_a)^-k,
+def _capacity_expectations(mu, beta, hazard, cut=None):
+    """E[lambda(C); C in bin, C > x_u] per bin (last axis) for a lognormal capacity C (ln C ~
+    N(mu, beta^2)), in closed form: on a bin where lambda = lambda_a (x / x_a)^-k,
     E[C^-k; a < C < b] = exp(-k mu + k^2 beta^2 / 2) [Phi(z_b) - Phi(z_a)],
-    z = (ln x - mu + k beta^2) / beta."""
+    z = (ln x - mu + k beta^2) / beta. ``cut`` is ln x_u (broadcast with ``mu``; None: no
+    cut): each bin's lower edge is raised to it, and a bin wholly below it gives 0."""
     lower, upper, log_rate, anchor, k = _bins(hazard)
     mu, beta = mu[..., None], beta[..., None]
+    if cut is not None:
+        lower = np.maximum(lower, cut[..., None])
     spread = np.where(beta > 0.0, beta, 1.0)
     shift = mu - k * beta**2
-    mass = _log_normal_mass((lower - shift) / spread, (upper - shift) / spread)
+    below = lower >= upper  # (a bin under the cut)
+    with np.errstate(invalid="ignore"):
+        za = np.where(below, -np.inf, (lower - shift) / spread)
+        mass = _log_normal_mass(za, np.where(below, np.inf, (upper - shift) / spread))
     log_e = log_rate + k * (anchor - mu) + 0.5 * (k * beta) ** 2 + mass
     sharp = log_rate - k * (mu - anchor)  # beta = 0: lambda(theta) in the bin holding theta
     inside = (lower < mu) & (mu <= upper)
-    return np.where(beta > 0.0, np.exp(log_e), np.where(inside, np.exp(sharp), 0.0))
+    out = np.where(beta > 0.0, np.exp(log_e), np.where(inside, np.exp(sharp), 0.0))
+    return np.where(below, 0.0, out)
 
 
-def annual_rate(median, dispersion, hazard: HazardCurve, units: str | None = None):
+def _threshold(threshold, units, hazard, shape):
+    """ln x_u of ``threshold`` (in ``units``) in the hazard's units, broadcast to ``shape``;
+    None for no threshold."""
+    if threshold is None:
+        return None
+    units = _units_for(hazard.im, units or hazard.units)
+    x_u = _array("threshold", threshold, True, f" (in {units})")
+    factor = UNIT_FACTORS[units][0] / UNIT_FACTORS[hazard.units][0]
+    return np.broadcast_to(np.log(x_u * factor), shape)
+
+
+def _fragility_at(log_x, mu, beta):
+    """The lognormal fragility Phi((ln x - mu) / beta) (a step at mu for beta = 0)."""
+    spread = np.where(beta > 0.0, beta, 1.0)
+    return np.where(beta > 0.0, ndtr((log_x - mu) / spread), (log_x >= mu).astype(float))
+
+
+def annual_rate(median, dispersion, hazard: HazardCurve, units: str | None = None, threshold=None):
     """The mean annual rate of overturning [1/yr] of a lognormal fragility at a site.
 
     .. math:: \\lambda_{OT} = \\int_0^\\infty \\Phi\\left(\\frac{\\ln(x/\\theta)}{\\beta}
@@ -491,6 +515,18 @@ def annual_rate(median, dispersion, hazard: HazardCurve, units: str | None = Non
     lambda_OT low by about k2 d^2 / 6, at most k2 d^2 / 4, relatively). How much comes from
     beyond the grid is given by :func:`rate_deaggregation`.
 
+    With a ``threshold`` x_u the fragility is 0 below it (an intensity at which the structure
+    cannot overturn: below its uplift PGA a rocking structure without vertical shaking does
+    not even leave rest) and the lognormal above it:
+
+    .. math:: \\lambda_{OT} = \\int_{x_u}^\\infty \\Phi\\left(\\frac{\\ln(x/\\theta)}{\\beta}
+              \\right) |d\\lambda(x)| = \\lambda(x_u) \\Phi\\left(\\frac{\\ln(x_u/\\theta)}
+              {\\beta}\\right) + \\int_{x_u}^\\infty \\lambda(x) \\, dF_C(x)
+
+    each interval's part again in closed form (for a power-law hazard k0 x^-k:
+    k0 [x_u^-k Phi(z_u) + theta^-k exp(k^2 beta^2 / 2) Phi(-z_u - k beta)],
+    z_u = ln(x_u / theta) / beta).
+
     Parameters
     ----------
     median : float or array_like
@@ -500,30 +536,41 @@ def annual_rate(median, dispersion, hazard: HazardCurve, units: str | None = Non
     hazard : HazardCurve
         The site's hazard curve of the same IM.
     units : str, optional
-        The units of ``median`` (default: the hazard's, ``hazard.units``).
+        The units of ``median`` and ``threshold`` (default: the hazard's, ``hazard.units``).
+    threshold : float or array_like, optional
+        x_u > 0, in ``units``: the fragility is 0 below it (default: none, the whole
+        lognormal).
 
     Returns
     -------
     float or ndarray
-        lambda_OT [1/yr], of the broadcast shape of ``median`` and ``dispersion``.
+        lambda_OT [1/yr], of the broadcast shape of ``median``, ``dispersion`` and
+        ``threshold``.
     """
+    if threshold is not None:
+        out = rate_deaggregation(median, dispersion, hazard, units, threshold)[2].sum(axis=-1)
+        return float(out) if out.ndim == 0 else out
     mu, beta = _fragility(median, dispersion, hazard, units)
     out = _capacity_expectations(mu, beta, hazard).sum(axis=-1)
     return float(out) if out.ndim == 0 else out
 
 
-def rate_deaggregation(median, dispersion, hazard: HazardCurve, units: str | None = None):
+def rate_deaggregation(
+    median, dispersion, hazard: HazardCurve, units: str | None = None, threshold=None
+):
     """Which IM levels the annual rate of overturning comes from.
 
     The contribution of each interval of the hazard curve's levels to
     ``lambda_OT = int P(OT | x) |d lambda(x)|`` (:func:`annual_rate`): for [a, b],
     lambda(a) F(a) - lambda(b) F(b) + int_a^b lambda dF (by parts, each term in closed form on
     the interval's power law), with F the fragility. The first interval is (0, x_0] and the
-    last [x_{n-1}, inf): what the extrapolation beyond the grid contributes.
+    last [x_{n-1}, inf): what the extrapolation beyond the grid contributes. With a
+    ``threshold`` x_u (the fragility 0 below it) the intervals below x_u give 0 and the one
+    holding it lambda(x_u) F(x_u) - lambda(b) F(b) + int_{x_u}^b lambda dF.
 
     Parameters
     ----------
-    median, dispersion, hazard, units
+    median, dispersion, hazard, units, threshold
         As for :func:`annual_rate`.
 
     Returns
@@ -535,14 +582,25 @@ def rate_deaggregation(median, dispersion, hazard: HazardCurve, units: str | Non
         broadcast shape of ``median`` and ``dispersion`` plus (n + 1,).
     """
     mu, beta = _fragility(median, dispersion, hazard, units)
-    parts = _capacity_expectations(mu, beta, hazard)
+    cut = _threshold(threshold, units, hazard, np.broadcast_shapes(mu.shape, np.shape(threshold)))
+    if cut is not None:
+        mu, beta, cut = np.broadcast_arrays(mu, beta, cut)
+    parts = _capacity_expectations(mu, beta, hazard, cut)
     lev = np.log(hazard.levels)
-    spread = np.where(beta > 0.0, beta, 1.0)[..., None]
-    z = (lev - mu[..., None]) / spread
-    cdf = np.where(beta[..., None] > 0.0, ndtr(z), (lev >= mu[..., None]).astype(float))
+    cdf = _fragility_at(lev, mu[..., None], beta[..., None])
+    if cut is not None:
+        cdf = np.where(lev >= cut[..., None], cdf, 0.0)
     edge = hazard.rates * cdf  # lambda(x_i) F(x_i) at each level
     zero = np.zeros(edge.shape[:-1] + (1,))
     parts = parts + np.concatenate([zero, edge], axis=-1) - np.concatenate([edge, zero], axis=-1)
+    if cut is not None:  # lambda(x_u) F(x_u) opens the interval x_u lies inside (at a
+        # level, the edge term there opens the next), and those below x_u give nothing
+        holds = np.searchsorted(lev, cut, side="right")[..., None]
+        on_level = np.take(np.append(-np.inf, lev), holds) == cut[..., None]
+        start = (hazard.rate(np.exp(cut)) * _fragility_at(cut, mu, beta))[..., None]
+        start = np.where(on_level, 0.0, start)
+        np.put_along_axis(parts, holds, np.take_along_axis(parts, holds, -1) + start, -1)
+        parts = np.where(np.append(lev, np.inf) <= cut[..., None], 0.0, parts)
     lower = np.concatenate([[0.0], hazard.levels])
     upper = np.concatenate([hazard.levels, [np.inf]])
     return lower, upper, parts

@@ -11,6 +11,7 @@ its kind calls for, and a keyword or a Dataset the accessor cannot serve is refu
 import ast
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -160,8 +161,16 @@ def test_keywords_that_do_not_apply_to_the_kind_are_named(mc_cube):
         ida.rocking.fragility(outcome="overturned")
     with pytest.raises(ValueError, match="'period' does not apply to a 'monte_carlo' cube"):
         mc_cube.rocking.fragility("amplitude_ratio", period=1.0)
-    with pytest.raises(ValueError, match="im is required"):
+    with pytest.raises(ValueError, match="im is required") as err:
         mc_cube.rocking.fragility()
+    named = re.search(r"inputs (\[.*\])", str(err.value)).group(1)
+    for name in ast.literal_eval(named):  # only the cube's own inputs, no outputs
+        assert name in mc_cube.data_vars and name not in mc_cube.rocking.study.run.outputs
+    assert "amplitude_ratio" in named
+    with pytest.raises(
+        ValueError, match=r"^im: 'amplitud_ratio' is not a variable.*'amplitude_ratio'"
+    ):
+        mc_cube.rocking.fragility("amplitud_ratio")
     with pytest.raises(ValueError, match="efficiency: needs a record design"):
         mc_cube.rocking.efficiency()
     with pytest.raises(ValueError, match="risk: needs a record design"):
@@ -326,7 +335,14 @@ def test_a_record_study_cube_read_by_xarray_is_folded_and_uses_its_study(raw_rec
     t, b = out["theta"].values, out["beta"].values
     fitted = np.isfinite(b)
     exact = 2e-4 * t[fitted] ** -2.3 * np.exp(0.5 * (2.3 * b[fitted]) ** 2)
-    np.testing.assert_allclose(out["annual_rate"].values[fitted], exact, rtol=1e-3)
+    np.testing.assert_allclose(out["annual_rate_lognormal"].values[fitted], exact, rtol=1e-3)
+    # horizontal records and a PGA hazard: the fragility is 0 below each uplift PGA
+    assert out["truncated_at_uplift"].values.all()
+    t, b, u = t[fitted], b[fitted], out["uplift"].values[fitted]
+    z = np.log(u / t) / b
+    below = 2e-4 * u**-2.3 * stats.norm.cdf(z)
+    above = 2e-4 * t**-2.3 * np.exp(0.5 * (2.3 * b) ** 2) * stats.norm.cdf(-z - 2.3 * b)
+    np.testing.assert_allclose(out["annual_rate"].values[fitted], below + above, rtol=1e-9)
     # the study's friction (0.4) is the default of contact: demand above it, or lift-off
     flags = ds.rocking.contact()
     expected = (ds["friction_demand"].values > 0.4) | (ds["lift_off"].values == 1)

@@ -83,8 +83,16 @@ def test_reduced_museum_runs_and_reports_a_ranked_escaped_table(tmp_path):
     hazard = risk.HazardCurve.from_csv(
         ROOT / "data" / "hazard" / "site_pga.csv", im="pga", units="g"
     )
+    # horizontal records: each fragility is 0 below the object's uplift PGA g tan(alpha) =
+    # g b / h (the study's blocks are given by width 2b and height 2h), quoted in the unit g
+    objects = {o.name: o for o in load_study(path).structure.objects}
     for name, row in table.iterrows():
         if row["status"] in ("ok", "few") and np.isfinite(row["lambda_OT [1/yr]"]):
-            expected = risk.annual_rate(fit.loc[name, "theta"], fit.loc[name, "beta"], hazard)
+            o = objects[name]
+            a_up = 9.81 * o.width / o.height / 9.80665
+            theta, beta = fit.loc[name, "theta"], fit.loc[name, "beta"]
+            expected = risk.annual_rate(theta, beta, hazard, threshold=a_up)
             assert np.isclose(row["lambda_OT [1/yr]"], expected, rtol=1e-9), name
+            whole = risk.annual_rate(theta, beta, hazard)
+            assert np.isclose(row["lambda_OT, whole lognormal [1/yr]"], whole, rtol=1e-9), name
     assert (tmp_path / "report" / "deaggregation.png").stat().st_size > 10_000

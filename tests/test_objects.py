@@ -245,6 +245,14 @@ def test_objects_study_errors_name_the_object_and_the_field(suite, tmp_path):
     assert "sampler.kind" in text
     text = _problems(tmp_path, suite, 'file = "missing.csv"')
     assert "structure.file" in text and "missing.csv" in text
+    path = tmp_path / "typo.toml"  # a misspelt kind: the missing sampler says why it is needed
+    path.write_text(
+        STUDY_OBJECTS.format(objects=LISTED, folder=suite).replace('"objects"', '"objetcs"')
+    )
+    with pytest.raises(StudyError) as err:
+        load_study(path)
+    assert "structure.kind" in str(err.value) and "'objetcs'" in str(err.value)
+    assert 'sampler: is required (unless [structure] kind = "objects")' in err.value.problems
     (tmp_path / "o.csv").write_text("name,colour\nA,red\n")
     text = _problems(tmp_path, suite, 'file = "o.csv"')
     assert "unknown columns ['colour']" in text

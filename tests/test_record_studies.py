@@ -204,6 +204,7 @@ def test_hv_pairs_run_with_their_vertical_or_are_refused_before_the_run(suite, c
     assert all(r.vertical is not None for r in records) and len(records) == 3
     api = python_api("cloud", records, cube)
     np.testing.assert_allclose(cube["max_rotation"], api["max_rotation"], rtol=1e-12)
+    assert cube["vertical_component"].values.all() and api["vertical_component"].values.all()
 
 
 def test_stripes_levels_at_free_fall_are_stored_censored_and_the_others_run(

@@ -297,3 +297,23 @@ def test_ida_report_of_objects_sorted_curves_and_capacity(tmp_path):
     y = ax.lines[0].get_ydata()
     assert y.size > 3 and np.all(np.diff(y) > 0)
     _plt().close(fig)
+
+
+def test_an_object_that_never_overturned_reads_not_reached(tmp_path, records):
+    """A stocky object beside a slender one: where (by the oracle, each scaled record alone)
+    it never overturned, its median capacity is said in words, not as inf."""
+    objects = {"Statue A": OBJECTS["Statue A"], "Plinth": rs.Block(2.0, 0.5)}
+    levels = np.array([0.2, 0.4, 0.8]) * G_UNIT
+    stood = all(
+        not rs.simulate(objects["Plinth"], rec.scaled(x / rec.peak)).overturned
+        for rec in records
+        for x in levels
+    )
+    assert stood
+    ds = multiple_stripes(records, objects, levels, rtol=1e-6)
+    record_report(ds, tmp_path / "r", n_boot=5)
+    fit = pd.read_csv(tmp_path / "r" / "object_fragility.csv", index_col=0)
+    plinth = fit.loc[["Plinth"]]
+    assert (plinth["median capacity"] == "not reached (never overturned)").all()
+    statue = pd.to_numeric(fit.loc[["Statue A"], "median capacity"])
+    assert np.isfinite(statue).all()

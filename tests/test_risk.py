@@ -109,6 +109,65 @@ def test_deaggregation_sums_and_matches_quadrature_on_each_interval():
         assert part == pytest.approx(expected, rel=1e-6, abs=1e-14)
 
 
+def truncated_cornell(k0, k, theta, beta, x_u):
+    """The power-law rate of a lognormal fragility set to 0 below x_u, by parts:
+    lambda(x_u) F(x_u) + E[k0 C^-k; C > x_u], the second a shifted normal's tail."""
+    z = np.log(x_u / theta) / beta
+    return k0 * x_u**-k * norm.cdf(z) + cornell(k0, k, theta, beta) * norm.cdf(-z - k * beta)
+
+
+@pytest.mark.parametrize("x_u", [0.004, 0.1, 0.25, 0.3, 0.8, 9.0])
+def test_a_threshold_gives_the_truncated_closed_form(x_u):
+    """Below, on, between and beyond the tabulated levels of a power law."""
+    k0, k, theta, beta = 2e-4, 2.3, 0.5, 0.6
+    hazard = HazardCurve.power_law(k0, k, im="pga", units="g", levels=[0.01, 0.1, 0.3, 1.0, 5.0])
+    exact = truncated_cornell(k0, k, theta, beta, x_u)
+    assert annual_rate(theta, beta, hazard, threshold=x_u) == pytest.approx(exact, rel=1e-12)
+    lower, upper, parts = rate_deaggregation(theta, beta, hazard, threshold=x_u)
+    assert parts.sum() == pytest.approx(exact, rel=1e-12)
+    assert np.all(parts[upper <= x_u] == 0.0) and np.all(parts >= -1e-18)
+    # the same threshold in m/s^2 with the median in m/s^2
+    si = annual_rate(theta * G_UNIT, beta, hazard, units="m/s^2", threshold=x_u * G_UNIT)
+    assert si == pytest.approx(exact, rel=1e-12)
+
+
+def test_a_threshold_on_a_curved_hazard_matches_quadrature_interval_by_interval():
+    hazard = HazardCurve("pga", [0.1, 0.2, 0.4, 0.8], [1e-2, 3e-3, 5e-4, 4e-5], units="g")
+    theta, beta, x_u = 0.35, 0.4, 0.27
+    lower, upper, parts = rate_deaggregation(theta, beta, hazard, threshold=x_u)
+
+    def integrand(x):  # P(OT | x) |d lambda / dx| above x_u, by central differences
+        h = 1e-6 * x
+        return (
+            norm.cdf(np.log(x / theta) / beta) * (hazard.rate(x - h) - hazard.rate(x + h)) / (2 * h)
+        )
+
+    for a, b, part in zip(lower, upper, parts, strict=True):
+        expected = quad(integrand, max(a, x_u), b, epsrel=1e-10, limit=200)[0] if b > x_u else 0
+        assert part == pytest.approx(expected, rel=1e-6, abs=1e-14)
+    assert annual_rate(theta, beta, hazard, threshold=x_u) == pytest.approx(parts.sum(), rel=1e-12)
+
+
+def test_a_threshold_with_a_sharp_capacity_is_the_hazard_at_the_larger():
+    hazard = HazardCurve("pga", [0.1, 0.2, 0.4], [1e-2, 3e-3, 5e-4], units="g")
+    for theta, x_u in [(0.15, 0.3), (0.3, 0.15), (0.05, 0.07)]:
+        got = annual_rate(theta, 0.0, hazard, threshold=x_u)
+        assert got == pytest.approx(hazard.rate(max(theta, x_u)), rel=1e-12)
+
+
+def test_a_threshold_broadcasts_and_is_checked():
+    hazard = HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
+    got = annual_rate([0.3, 0.5], [0.4, 0.6], hazard, threshold=[[0.1], [0.2]])
+    expected = truncated_cornell(
+        2e-4, 2.3, np.array([0.3, 0.5]), np.array([0.4, 0.6]), np.array([[0.1], [0.2]])
+    )
+    assert got.shape == (2, 2)
+    np.testing.assert_allclose(got, expected, rtol=1e-12)
+    for bad in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(ValueError, match="threshold"):
+            annual_rate(0.3, 0.4, hazard, threshold=bad)
+
+
 def test_probability_in_years():
     assert probability_in(50, 1 / 475) == pytest.approx(1 - math.exp(-50 / 475), rel=1e-15)
     assert probability_in(50, 0.0) == 0.0

@@ -195,3 +195,74 @@ def test_the_uplift_share_is_given_for_a_pga_hazard():
     expected = share_below(row["theta"].item(), row["beta"].item(), hazard, 0.2)
     assert row["share_below_uplift"].item() == pytest.approx(expected, rel=1e-12)
     assert 0 < expected < 1
+
+
+def _truncated_cornell(theta, beta, x_u):
+    """lambda(x_u) F(x_u) + E[k0 C^-k; C > x_u] of the power law k0 x^-k (by parts): the rate
+    of the lognormal fragility set to 0 below x_u."""
+    from scipy.stats import norm
+
+    z = np.log(x_u / theta) / beta
+    full = K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
+    return K0 * x_u**-K * norm.cdf(z) + full * norm.cdf(-z - K * beta)
+
+
+def _two_objects(vertical):
+    """A: capacities about 0.5 g with beta 1 and uplift at 0.45 g; B: about 0.45 g with beta
+    0.3 and uplift at 0.05 g. The whole lognormal ranks A first (its wide lower tail); with
+    the fragility 0 below uplift, B."""
+    cap = np.column_stack([_lognormal(0.5, 1.0, 300, 21), _lognormal(0.45, 0.3, 300, 22)])
+    ds = _ida(cap, names=["A", "B"])
+    ds["uplift_acceleration"] = ("structure", np.array([0.45, 0.05]) * G_UNIT)
+    ds["vertical_component"] = ("record", np.arange(300) == 7 if vertical else np.zeros(300, bool))
+    return ds
+
+
+def test_without_vertical_shaking_the_fragility_is_zero_below_uplift():
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(_two_objects(False), hazard, n_boot=50, seed=3)
+    assert list(out["structure"].values) == ["B", "A"]  # ranked by the truncated rate
+    for name, x_u in (("A", 0.45), ("B", 0.05)):
+        row = out.sel(structure=name)
+        t, b = float(row["theta"]), float(row["beta"])
+        assert bool(row["truncated_at_uplift"]) and float(row["uplift"]) == pytest.approx(x_u)
+        rate = float(row["annual_rate"])
+        assert rate == pytest.approx(_truncated_cornell(t, b, x_u), rel=1e-9)
+        whole = K0 * t**-K * np.exp(0.5 * (K * b) ** 2)
+        assert float(row["annual_rate_lognormal"]) == pytest.approx(whole, rel=1e-9)
+        # what the truncation removed is the lognormal's share below uplift
+        share = float(row["share_below_uplift"])
+        assert rate == pytest.approx(whole * (1.0 - share), rel=1e-9)
+        assert float(row["probability"]) == pytest.approx(-np.expm1(-50 * rate), rel=1e-12)
+        assert float(row["annual_rate_lo"]) <= rate <= float(row["annual_rate_hi"])
+        parts = row["deaggregation"].values
+        assert parts.sum() == pytest.approx(rate, rel=1e-9)
+        assert np.all(parts[out["im_upper"].values <= x_u] == 0.0)
+    whole = out["annual_rate_lognormal"]
+    assert float(whole.sel(structure="A")) > float(whole.sel(structure="B"))
+
+
+def test_a_vertical_component_or_another_measure_keeps_the_whole_lognormal():
+    """A vertical component can lift a block under a PGA below g tan(alpha); a PGV hazard has
+    no uplift level: neither is truncated."""
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(_two_objects(True), hazard, n_boot=0)
+    assert not out["truncated_at_uplift"].values.any()
+    np.testing.assert_array_equal(out["annual_rate"], out["annual_rate_lognormal"])
+    assert list(out["structure"].values) == ["A", "B"]
+    # a design that does not say whether its records have a vertical component
+    out = object_risk(_two_objects(False).drop_vars("vertical_component"), hazard, n_boot=0)
+    assert not out["truncated_at_uplift"].values.any()
+
+
+def test_record_designs_say_which_records_have_a_vertical_component():
+    from rockstudy.motions import Record, stochastic_record
+    from rockstudy.structures import Block
+    from rockstudy.study.designs import records as rd
+
+    h = stochastic_record(peak=2.0, duration=2.0, dt=0.01, seed=0)
+    hv = Record(h.acceleration, dt=h.dt, vertical=h.acceleration / 4.0)
+    ds = rd.cloud([h, hv], {"block": Block(1.0, 0.2)})
+    np.testing.assert_array_equal(ds["vertical_component"].values, [False, True])
+    ds = rd.cloud([h], {"block": Block(1.0, 0.2)})
+    np.testing.assert_array_equal(ds["vertical_component"].values, [False])

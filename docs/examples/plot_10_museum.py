@@ -76,7 +76,7 @@ risk_stripes = object_risk(stripes, hazard, years=50, n_boot=100, seed=0)
 
 columns = ["status", "theta", "beta", "n_overturning", "annual_rate", "annual_rate_lo",
            "annual_rate_hi", "probability", "probability_lo", "probability_hi",
-           "share_below_uplift", "annual_rate_above_uplift"]
+           "annual_rate_lognormal", "share_below_uplift"]
 table = risk_ida[columns].to_pandas()
 table = table.rename(columns={"theta": "median PGA [g]", "annual_rate": "lambda_OT [1/yr]",
                               "probability": "P(50 yr)"})
@@ -92,9 +92,11 @@ print(risk_stripes[["status", "theta", "beta", "annual_rate", "probability", "sh
 # How to read it. PGA is a poor predictor of rocking under pulse-like records (the short
 # 0.4 s pulse of NF01 needs several g to overturn anything), so beta is near 1 and the
 # lognormal puts probability below each object's uplift PGA g tan(alpha), where it cannot even
-# leave rest: ``share_below_uplift`` is that part of lambda_OT, and ``annual_rate_above_uplift``
-# the rate without it. The stripes fit differs from the IDA's: the stripes see the survivals
-# above the first overturning (rocking is not monotonic in intensity), which the IDA's
+# leave rest. The records are horizontal, so each fragility is set to 0 there
+# (``truncated_at_uplift``): ``annual_rate`` and the ranking are those of that fragility,
+# ``annual_rate_lognormal`` is the whole lognormal's rate and ``share_below_uplift`` the part of
+# it that the truncation removed. The stripes fit differs from the IDA's: the stripes see the
+# survivals above the first overturning (rocking is not monotonic in intensity), which the IDA's
 # "first overturning" capacity does not count, and they have six levels only.
 #
 # Ranked probabilities in 50 years, with their bands

@@ -195,10 +195,17 @@ class RockingAccessor:
         takes = _takes(sampled.fragility, {"intensity": "im"})
         _keywords("fragility", self.kind, sampled.fragility, kw, takes)
         if im is None:
+            outputs = set(self.study.run.outputs) | {"status", "kernel_status", "error"}
+            inputs = [
+                str(n)
+                for n, v in self._ds.data_vars.items()
+                if v.dims == ("sample",) and v.dtype.kind == "f" and n not in outputs
+            ]
             raise ValueError(
                 f"ds.rocking.fragility: im is required for a {self.kind!r} cube: name its "
-                "intensity variable (e.g. 'amplitude_ratio', 'pga_ratio', 'amplitude')"
+                f"intensity variable, one of the cube's inputs {inputs}"
             )
+        sampled.check_variables(self._ds, im=im)
         return sampled.fragility(self._ds, im, by=by, **kw)
 
     def efficiency(self, candidates=None, by=None, **kw):

@@ -4,8 +4,10 @@ Each object's lognormal fragility is fitted in the hazard curve's intensity meas
 capacities, or the binomial fit of stripes and clouds: :mod:`.record_fragility`), then
 integrated against the site's hazard curve (:func:`rockstudy.risk.annual_rate`, Cornell et al.
 2002): the mean annual rate of overturning lambda_OT and the probability of at least one
-overturning in a number of years, 1 - exp(-lambda_OT t). The band of lambda_OT comes from
-resampling the records with replacement (the records are what the fragility is uncertain
+overturning in a number of years, 1 - exp(-lambda_OT t). Where the intensity is PGA and no
+record has a vertical component, the fragility is 0 below each object's uplift PGA (the ground
+cannot lift it there, eq. 10 of [003]) and the fitted lognormal above it. The band of lambda_OT
+comes from resampling the records with replacement (the records are what the fragility is uncertain
 about), refitting the fragility and integrating again; the deaggregation
 (:func:`rockstudy.risk.rate_deaggregation`) says which intensity levels the rate comes from.
 
@@ -165,16 +167,29 @@ def share_below(theta, beta, hazard, level, units=None) -> float:
     return float(parts[upper <= level].sum() / total) if total > 0 else np.nan
 
 
-def _rate(theta, beta, hazard, unit):
-    """lambda_OT of one fit; 0 for a median not reached (theta inf), NaN without a fit or
-    for a flat one (beta inf, no rise)."""
+def _rate(theta, beta, hazard, unit, cut=None):
+    """lambda_OT of one fit, its fragility 0 below ``cut`` (in ``unit``; None: the whole
+    lognormal); 0 for a median not reached (theta inf), NaN without a fit or for a flat one
+    (beta inf, no rise)."""
     if beta == np.inf:
         return np.nan
     if theta == np.inf:
         return 0.0
     if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
         return np.nan
-    return risk.annual_rate(theta, beta, hazard, units=unit)
+    return risk.annual_rate(theta, beta, hazard, units=unit, threshold=cut)
+
+
+def _cuts(ds, hazard, uplift):
+    """Where each object's fragility is exactly 0 below its uplift PGA (in the hazard's units;
+    NaN: not truncated): for a PGA hazard, when no record of the design has a vertical
+    component (``vertical_component`` on ``record``; a design that does not say is not
+    truncated). Below g tan(alpha) of a block, g lambda of another structure (eq. 10 of
+    [003]), the ground never lifts it, so it cannot overturn: P(OT | PGA < a_up) = 0. A
+    vertical component can lift it under a lower PGA."""
+    horizontal = "vertical_component" in ds and not bool(ds["vertical_component"].any())
+    exact = hazard.im == "pga" and horizontal
+    return np.where(exact & np.isfinite(uplift) & (uplift > 0), uplift, np.nan)
 
 
 def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
@@ -194,8 +209,10 @@ def _probability(years, rate):
     return np.where(np.isfinite(rate), risk.probability_in(years, np.nan_to_num(rate)), np.nan)
 
 
-def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning):
-    """The point estimate, the bootstrap rates and the status of object ``j``."""
+def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning, cut):
+    """The point estimate, the bootstrap rates and the status of object ``j`` (its fragility
+    0 below ``cut``, in ``unit``; None: the whole lognormal); and the rate of the whole
+    lognormal."""
     fit, count, _, no_maximum = fitter
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
@@ -203,11 +220,12 @@ def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning)
     status = _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum(j))
     if status in ("separated", "no rise"):  # the limit of the fit is no estimate
         theta, beta = np.nan, np.nan
-    rate = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
+    whole = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
+    rate = whole if cut is None or not np.isfinite(whole) else _rate(theta, beta, hazard, unit, cut)
     boot = np.full(len(boot_rows), np.nan)
     if np.isfinite(rate):
-        boot = np.array([_rate(*fit(j, rows), hazard, unit) for rows in boot_rows])
-    return theta, beta, n_over, status, rate, boot
+        boot = np.array([_rate(*fit(j, rows), hazard, unit, cut) for rows in boot_rows])
+    return theta, beta, n_over, status, rate, boot, whole
 
 
 def object_risk(
@@ -259,10 +277,15 @@ def object_risk(
         ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
         ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
         PGA, g tan(alpha) of a block and g lambda of another structure, eq. 10 of [003], in
-        ``hazard.units``) and ``share_below_uplift`` (the share of
-        ``annual_rate`` from PGA below it, where the block cannot leave rest: what the
-        lognormal's lower tail adds, not what a simulation saw), ``annual_rate_above_uplift``
-        (the rate of the fragility set to 0 below the uplift PGA); and on (``structure``,
+        ``hazard.units``), ``truncated_at_uplift`` (True where the fragility is 0 below the
+        uplift PGA: a PGA hazard and no record with a vertical component (the design's
+        ``vertical_component``), where P(OT | PGA < uplift) = 0 exactly; ``annual_rate``, its
+        band and the probabilities are then those of the truncated fragility,
+        :func:`rockstudy.risk.annual_rate` with ``threshold``), ``annual_rate_lognormal``
+        (the rate of the whole lognormal, Cornell et al.'s integral) and
+        ``share_below_uplift`` (the share of ``annual_rate_lognormal`` from PGA below the
+        uplift PGA: what the lognormal's lower tail adds, not what a simulation saw); and on
+        (``structure``,
         ``interval``) ``deaggregation`` [1/yr], each interval's share of ``annual_rate``,
         with the edges ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard,
         ``years``, ``n_boot``, ``conf_level`` and ``seed``.
@@ -280,8 +303,19 @@ def object_risk(
     rng = np.random.default_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
     to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
+    cuts = _cuts(ds, hazard, _uplift(ds, hazard)) / to_hazard  # in the fragility's unit
     rows = [
-        _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, int(min_overturning))
+        _one_object(
+            j,
+            fitter,
+            n_rec,
+            boot_rows,
+            hazard,
+            unit,
+            ida,
+            int(min_overturning),
+            cuts[j] if np.isfinite(cuts[j]) else None,
+        )
         for j in range(ds.sizes["structure"])
     ]
     attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
@@ -312,8 +346,9 @@ def _bounds(status, lowest, hazard, ida):
 def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
     """The Dataset of :func:`object_risk` from the objects' rows, ranked."""
     uplift = _uplift(ds, hazard)
-    theta, beta, n_over, status, rate, boot = (list(c) for c in zip(*rows, strict=True))
-    theta, beta, rate = (np.array(v, float) for v in (theta, beta, rate))
+    cut = _cuts(ds, hazard, uplift)
+    theta, beta, n_over, status, rate, boot, whole = (list(c) for c in zip(*rows, strict=True))
+    theta, beta, rate, whole = (np.array(v, float) for v in (theta, beta, rate, whole))
     boot = np.array(boot, float).reshape(len(rows), -1)
     lo, hi, valid = _bands(boot, attrs["conf_level"])
     fitted = np.isfinite(rate)
@@ -321,6 +356,14 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
     edge_lo, edge_hi, parts = risk.rate_deaggregation(
         deagg_median, np.where(fitted, beta, 0.0), hazard
     )
+    cut_rows = np.flatnonzero(np.isfinite(cut))
+    if cut_rows.size:  # the fragility 0 below the uplift PGA
+        parts[cut_rows] = risk.rate_deaggregation(
+            deagg_median[cut_rows],
+            np.where(fitted, beta, 0.0)[cut_rows],
+            hazard,
+            threshold=cut[cut_rows],
+        )[2]
     parts = np.where(fitted[:, None], parts, np.nan)
     status = np.array(status, dtype=object)
     upper, lower = _bounds(status, lowest, hazard, attrs["design"] == "ida")
@@ -341,6 +384,8 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
         "rate_lower_bound": lower,
         "boot_valid": valid,
         "uplift": uplift,
+        "truncated_at_uplift": np.isfinite(cut),
+        "annual_rate_lognormal": whole,
         "share_below_uplift": np.array(
             [
                 share_below(t * to_hazard, b, hazard, u) if f else np.nan
@@ -348,7 +393,6 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
             ]
         ),
     }
-    v["annual_rate_above_uplift"] = rate * (1.0 - v["share_below_uplift"])
     out = xr.Dataset(
         {k: ("structure", a) for k, a in v.items()},
         coords={"structure": ds["structure"].values},

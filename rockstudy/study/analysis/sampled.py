@@ -165,6 +165,16 @@ def first_order_given_data(
 # ------------------------------------------------------------------------------ fragility
 
 
+def check_variables(ds, **fields) -> None:
+    """A ValueError naming the keyword whose variable (a name, or None: not given) ``ds``
+    lacks, with the closest names it has."""
+    for field, name in fields.items():
+        if name is not None and name not in ds:
+            close = difflib.get_close_matches(str(name), [str(v) for v in ds.data_vars], 3)
+            hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+            raise ValueError(f"{field}: {name!r} is not a variable of the dataset{hint}")
+
+
 def fragility(
     ds: xr.Dataset,
     intensity: str,
@@ -220,11 +230,7 @@ def fragility(
         with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
-    for field, name in (("intensity", intensity), ("outcome", outcome), ("by", by)):
-        if name is not None and name not in ds:
-            close = difflib.get_close_matches(str(name), [str(v) for v in ds.data_vars], 3)
-            hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
-            raise ValueError(f"{field}: {name!r} is not a variable of the dataset{hint}")
+    check_variables(ds, intensity=intensity, outcome=outcome, by=by)
     if bins is not None and by is None:
         raise ValueError("bins: bins the variable given as by=; give by= too, or no bins")
     y, bad = _values(ds, outcome, failed)

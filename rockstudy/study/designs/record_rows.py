@@ -372,6 +372,8 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             .reshape(text.shape)
             .astype(object),
         )
+    files = json.loads(cube.attrs["record_files"])  # [horizontal, vertical] for a pair
+    ds["vertical_component"] = ("record", np.array([isinstance(f, list) for f in files]))
     if "uplift_acceleration" not in ds:  # a cube written before the design carried it
         ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}

@@ -210,6 +210,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     data["pulse_period"] = ("record", np.array([q.period for q in pulses], float))
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
+    data["vertical_component"] = ("record", np.array([r.vertical is not None for r in records]))
     for k, v in structures.items():
         if k != "names":
             data[k] = ("structure", v)

@@ -295,6 +295,10 @@ def object_fragility(page, ctx):
             "no_rise": "no rise with the intensity (no fit)",
         }
     )
+    for col in ("median capacity", "median, lower", "median, upper"):
+        shown[col] = [  # an object that never overturned: its median is not reached
+            "not reached (never overturned)" if v == np.inf else v for v in shown[col]
+        ]
     up = _uplift(ctx, "pga")
     names = list(map(str, ctx.ds["structure"].values))
     shown.insert(1, f"uplift level, PGA [{ctx.units}]", [up[names.index(n)] for n in table.index])

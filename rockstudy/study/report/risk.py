@@ -48,8 +48,9 @@ def _risk_table(out) -> pd.DataFrame:
             f"P({y} yr), 95 %": out["probability_hi"].values,
             "share beyond the curve's levels": beyond,
             f"uplift [{unit}]": out["uplift"].values,
+            "0 below uplift": np.where(out["truncated_at_uplift"].values, "yes", "no"),
+            "lambda_OT, whole lognormal [1/yr]": out["annual_rate_lognormal"].values,
             "share below uplift": out["share_below_uplift"].values,
-            "lambda_OT above uplift only [1/yr]": out["annual_rate_above_uplift"].values,
             "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
             "lambda_OT at least [1/yr]": out["rate_lower_bound"].values,
         },
@@ -77,9 +78,13 @@ def _risk(page, ds, hazard, years, im_label):
         "so the fragility's dispersion cannot be estimated and no rate is given (a step "
         "function would be a guess, not an estimate); 'no rise': the points at which it "
         "overturned do not lie higher in the intensity than those at which it stood, so no "
-        "increasing fragility fits them and no rate is given. 'share below "
-        "uplift' is the part of the rate from intensities at which the object cannot leave "
-        "rest: the lognormal's lower tail, not a simulated overturning."
+        "increasing fragility fits them and no rate is given. Below its uplift PGA (g "
+        "tan alpha of a block, g lambda of another structure) an object cannot leave rest: "
+        "where the hazard is in PGA and no record has a vertical component, its fragility is "
+        "0 there and the fitted lognormal above it (column '0 below uplift'), and lambda_OT, "
+        "its band and P are those of that fragility; 'lambda_OT, whole lognormal' is Cornell "
+        "et al.'s integral of the lognormal alone, and 'share below uplift' the part of it "
+        "from below uplift (the lognormal's lower tail, not a simulated overturning)."
     )
     page.table(
         _risk_table(out),
@@ -120,10 +125,10 @@ def _deaggregation_figure(page, out, im_label):
         "Deaggregation: the share of each object's annual rate of overturning that comes from "
         "each interval between the hazard curve's levels (plotted at its geometric centre); "
         "dotted: each object's uplift PGA (g tan alpha of a block, g lambda of another "
-        "structure), below which it cannot leave rest (the "
-        "share of the rate from there is the lognormal's lower tail, not a simulated "
-        "overturning: column 'share below uplift'); the shares beyond the first and last "
-        "level are in the table"
+        "structure), below which it cannot leave rest (where the table says '0 below "
+        "uplift', nothing comes from there; elsewhere that share is the lognormal's lower "
+        "tail, not a simulated overturning); the shares beyond the first and last level are "
+        "in the table"
         + (
             f"; the {shown.size} highest rates of {int(fitted.sum())} are drawn"
             if fitted.sum() > shown.size

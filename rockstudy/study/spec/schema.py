@@ -1265,6 +1265,8 @@ def _sentence(e: dict, keys: list) -> str:
     got = _describe(value)
     if kind == "missing":
         keys.append(e["loc"][-1])
+        if tuple(e["loc"]) == ("sampler",):  # (a misspelt "objects" lands here too)
+            return 'is required (unless [structure] kind = "objects")'
         return "is required"
     if kind == "extra_forbidden":
         return "is not a setting here (a typo?); `rockstudy schema` lists the settings"
