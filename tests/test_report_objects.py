@@ -317,3 +317,28 @@ def test_an_object_that_never_overturned_reads_not_reached(tmp_path, records):
     assert (plinth["median capacity"] == "not reached (never overturned)").all()
     statue = pd.to_numeric(fit.loc[["Statue A"], "median capacity"])
     assert np.isfinite(statue).all()
+
+
+def test_an_ida_friction_warning_says_which_scenes_and_a_lift_off_reads_in_words(tmp_path):
+    """The contact check of an IDA is at each record's highest scale below the first
+    overturning: the warning says so, with the PGA range of those scenes; a scene that lifted
+    off has no finite friction demand and its row says why."""
+    from test_objects import _sine_record
+
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+
+    rec = _sine_record(1.5)
+    objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
+    ds = incremental_dynamic_analysis(rec, objects, scan=0, step=0.05, contact=True)
+    text = _text(record_report(ds, tmp_path / "r", n_boot=5, friction=0.05))
+    scenes = ds["capacity_scale_lower"].values * rec.peak / G_UNIT  # the PGA of each scene [g]
+    assert "IDA: each scene is a record at the highest scale simulated below" in text
+    assert f"here PGA {scenes.min():.3g} to {scenes.max():.3g} g" in text
+    lifted = ds.copy(deep=True)
+    lifted["friction_demand"][0, 1] = np.nan
+    lifted["lift_off"][0, 1] = True
+    record_report(lifted, tmp_path / "l", n_boot=5, friction=0.05)
+    table = pd.read_csv(tmp_path / "l" / "friction_check.csv", index_col=0)
+    column = "largest finite friction demand |F_h / F_v| [-]"
+    assert table.loc[f"Urn / {rec.name}", column] == "lifted off (F_v < 0)"
+    assert float(table.loc[f"Stele / {rec.name}", column]) > 0.05

@@ -132,13 +132,17 @@ class _Page:
     def preformatted(self, text):
         self.parts.append(f"<pre>{html.escape(text)}</pre>")
 
-    def table(self, frame: pd.DataFrame, name: str, caption: str):
+    def table(self, frame: pd.DataFrame, name: str, caption: str, hide_empty=()):
+        """``frame`` into ``name``.csv and onto the page; the columns of ``hide_empty`` that
+        hold nothing (all NaN) are left off the page (not the CSV)."""
         frame.to_csv(self.out / f"{name}.csv")
         self.parts.append(
             f"<p class='cap'>{html.escape(caption)} (<a href='{name}.csv'>{name}.csv</a>)</p>"
         )
+        frame = frame.drop(columns=[c for c in hide_empty if frame[c].isna().all()])
         shown = frame.map(_shown).rename(index=_shown, columns=_shown)
-        self.parts.append(shown.to_html(classes="t"))  # to_html escapes every cell
+        # to_html escapes every cell; a table wider than the page scrolls inside its box
+        self.parts.append(f"<div class='wide'>{shown.to_html(classes='t')}</div>")
 
     def figure(self, fig, name: str, caption: str):
         buf = io.BytesIO()
@@ -158,6 +162,7 @@ class _Page:
             f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
             "img{max-width:100%}table.t{border-collapse:collapse;font-size:12px}"
+            ".wide{overflow-x:auto;max-width:100%}"
             "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
             ".cap{color:#555}.warn{border:2px solid #c60;background:#fff4e5;padding:6px 10px;"
             "margin:8px 0}</style></head><body>"

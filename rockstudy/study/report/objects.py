@@ -522,6 +522,20 @@ def _stripe_points(ax, ctx, i, j, offset):
 # ------------------------------------------------------------------------------ friction
 
 
+def _ida_scenes(ctx) -> str:
+    """What the scenes of an IDA's contact check are, with their PGA range; '' otherwise."""
+    ds = ctx.ds
+    if ctx.design != "ida" or "capacity_scale_lower" not in ds:
+        return ""
+    pga = (ds["capacity_scale_lower"] * ds["pga"]).values / _unit(ctx)
+    pga = pga[np.isfinite(pga) & np.isfinite(ds["friction_demand"].values)]
+    span = f", here PGA {pga.min():.3g} to {pga.max():.3g} {ctx.units}" if pga.size else ""
+    return (
+        " (IDA: each scene is a record at the highest scale simulated below the object's first "
+        f"overturning{span}: the strongest shaking each object was seen to stand)"
+    )
+
+
 def friction_check(page, ctx):
     """Per object (or per record for sampled structures): the scenes whose friction demand
     exceeds the friction coefficient or that lift off, with a warning box."""
@@ -555,10 +569,15 @@ def friction_check(page, ctx):
     else:
         frame.index = [names[int(r)] for r in frame.index]
     frame.index.name = "object / record" if ctx.objects else "record"
+    top = frame["largest finite friction demand |F_h / F_v| [-]"]
+    frame["largest finite friction demand |F_h / F_v| [-]"] = [  # no finite demand: F_v < 0
+        "lifted off (F_v < 0)" if np.isnan(v) and n > 0 else v
+        for v, n in zip(top, frame["lift-offs"], strict=True)
+    ]
     if flags is not None and bool(flags.any()):
         from ..analysis.contact import summary_line
 
-        page.warning(summary_line(ds, ctx.friction))
+        page.warning(summary_line(ds, ctx.friction) + _ida_scenes(ctx))
     elif flags is not None:
         page.text("No scene needs more friction than mu or lifts off: the block model holds.")
     design = {"ida": " (IDA: at the highest scale below the first overturning)"}

@@ -86,11 +86,14 @@ def _risk(page, ds, hazard, years, im_label):
         "et al.'s integral of the lognormal alone, and 'share below uplift' the part of it "
         "from below uplift (the lognormal's lower tail, not a simulated overturning)."
     )
+    table = _risk_table(out)
+    optional = [c for c in table if "at most" in c or "at least" in c or "uplift" in c]
     page.table(
-        _risk_table(out),
+        table,
         "annual_overturning",
         f"Annual rate of overturning and probability in {years:g} years per object, ranked "
         "(highest first)",
+        hide_empty=optional,
     )
     _deaggregation_figure(page, out, im_label)
 
