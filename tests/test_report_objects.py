@@ -342,3 +342,35 @@ def test_an_ida_friction_warning_says_which_scenes_and_a_lift_off_reads_in_words
     column = "largest finite friction demand |F_h / F_v| [-]"
     assert table.loc[f"Urn / {rec.name}", column] == "lifted off (F_v < 0)"
     assert float(table.loc[f"Stele / {rec.name}", column]) > 0.05
+
+
+def test_the_pga_fragility_drawn_is_zero_below_uplift_under_horizontal_records(records):
+    """Drawn solid: 0 below each object's uplift PGA g tan(alpha) (nothing can rock there)
+    and the fitted lognormal Phi(ln(x / theta) / beta) above it; with a vertical component
+    in the design, the whole lognormal."""
+    from scipy.stats import norm
+
+    from rockstudy.study.report import objects as ro
+    from rockstudy.study.report._page import _plt
+    from rockstudy.study.report.records import ReportContext, im_label
+
+    levels = np.array([0.2, 0.4, 0.8, 1.6]) * G_UNIT
+    ds = multiple_stripes(records, OBJECTS, levels, rtol=1e-6)
+    for vertical in (False, True):
+        ds["vertical_component"] = ("record", np.full(ds.sizes["record"], vertical))
+        ctx = ReportContext(ds, n_boot=0)
+        ctx.im_label = im_label
+        t = ro._object_fit(ctx, "pga", None)  # two records: separated, so a fit is given
+        t["theta"], t["beta"], t["p_band"] = [0.5, 0.8], [0.6, 0.4], "none"
+        t[["var_ln_theta", "var_ln_beta", "cov_ln_theta_ln_beta"]] = 0.0
+        fig, ax = _plt().subplots()
+        assert ro._plot_objects(ax, ctx, t, "pga", None)
+        solid = [ln for ln in ax.lines if ln.get_linestyle() == "-"]
+        for name, line in zip(t.index, solid, strict=True):
+            x, y = line.get_xdata(), line.get_ydata()
+            fit = norm.cdf(np.log(x / t.loc[name, "theta"]) / t.loc[name, "beta"])
+            x_u = G * math.tan(OBJECTS[name].slenderness) / G_UNIT
+            expected = fit if vertical else np.where(x >= x_u, fit, 0.0)
+            np.testing.assert_allclose(y, expected, rtol=1e-9, atol=1e-15)
+            assert vertical or (x < x_u).any()
+        _plt().close(fig)

@@ -278,7 +278,14 @@ def object_fragility(page, ctx):
         "against the measure the efficiency table recommends; dotted vertical lines: each "
         "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
         "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
-        "the measure has one (PGA, PGA / uplift level)",
+        "the measure has one (PGA, PGA / uplift level)"
+        + (
+            "; under these horizontal records nothing can overturn below it, so the fragility "
+            "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "
+            "leave out)"
+            if _horizontal(ctx)
+            else ""
+        ),
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
@@ -317,24 +324,40 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
         return False
     grid = np.geomspace(low / 1.2, high * 1.2, 200)
     curve = fragility_curve(t, grid)
+    cut = im == "pga" and _horizontal(ctx)  # nothing overturns below uplift
+    shade = 0.15 if curve.sizes["group"] <= 3 else 0.07  # many bands overlap
     drawn = 0
     for g in curve.group.values:
         c = curve.sel(group=g)
         if not np.isfinite(c.probability.values).any():
             continue
         drawn += 1
-        (line,) = ax.plot(grid, c.probability, "-", label=ctx.text(str(g)))
-        ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
+        x_u = up[names.index(str(g))] if up is not None else np.nan
+        above = grid >= x_u if cut and np.isfinite(x_u) else np.ones(grid.size, bool)
+        p = np.where(above, c.probability, 0.0)
+        (line,) = ax.plot(grid, p, "-", label=ctx.text(str(g)))
+        if not above.all():  # the fitted lognormal's tail, where the object cannot rock
+            ax.plot(grid[~above], c.probability[~above], "--", lw=0.8, color=line.get_color())
+        ax.fill_between(
+            grid[above], c.lower[above], c.upper[above], alpha=shade, color=line.get_color()
+        )
         if up is not None:
-            ax.axvline(up[names.index(str(g))], ls=":", lw=1.5, color=line.get_color())
+            ax.axvline(x_u, ls=":", lw=1.5, color=line.get_color())
     if not drawn:
         return False
     ax.set(xscale="log", ylim=(-0.02, 1.02), ylabel="probability of overturning [-]")
     ax.set_xlabel(_label(ctx, im, period), fontsize=FONT + 1)
     ctx.log_ticks(ax)
     ax.tick_params(labelsize=FONT)
-    ax.legend(fontsize=FONT, loc="upper left")
+    ax.legend(fontsize=FONT, loc="lower right")  # (an S-curve leaves that corner empty)
     return True
+
+
+def _horizontal(ctx) -> bool:
+    """True when no record of the design has a vertical component (the design says so): then
+    a PGA below an object's uplift level cannot lift it, and it cannot overturn there."""
+    ds = ctx.ds
+    return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
 # ------------------------------------------------------------------------------ capacity
