@@ -277,6 +277,11 @@ def four_bar_mechanism(A, B0, C0, D, bodies, phi_max=math.pi / 4) -> Mechanism:
     return Mechanism(masses, inertias, lambda phi: pose(phi, sense, mirror), phi_max=phi_max)
 
 
+#: Spacing [rad] of the joint angles at which the arch's hinge search stops refining: lambda
+#: is then within about its square (relative) of its least value.
+HINGE_TOLERANCE = 1e-9
+
+
 @dataclass(frozen=True)
 class Arch(_Symmetric):
     """A circular masonry arch rocking as a four-hinge (three-block) mechanism, sec. 5.2 of [003].
@@ -362,8 +367,8 @@ class Arch(_Symmetric):
 
     def _search(self):
         """Least lambda over admissible hinge sets: all sets of 4 of 25 joints for both face
-        patterns, then three levels of local refinement of the best (each a 7^4 grid at a third
-        of the previous spacing)."""
+        patterns, then levels of local refinement of the best (each a 7^4 grid at a third of
+        the previous spacing) until the spacing is below :data:`HINGE_TOLERANCE`."""
         beta = self.inclusion_angle
         grid = np.linspace(-beta / 2, beta / 2, 25)
         psi = grid[np.array(list(combinations(range(grid.size), 4))).T]
@@ -375,7 +380,7 @@ class Arch(_Symmetric):
         if best is None:
             raise ValueError("no admissible four-hinge mechanism: check the arch geometry")
         h = grid[1] - grid[0]
-        for _level in range(3):
+        while h > HINGE_TOLERANCE:  # lambda is quadratic about its least: error ~ h^2
             h /= 3
             local = [
                 np.clip(best[1][i] + h * np.arange(-3, 4), -beta / 2, beta / 2) for i in range(4)
