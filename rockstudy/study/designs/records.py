@@ -7,7 +7,9 @@ step) and returns an :class:`xarray.Dataset` on the dimensions
 ``record`` and ``structure`` (and ``level`` for stripes, ``step`` for the IDA points), with each
 record's intensity measures (:meth:`rockstudy.motions.Record.intensity_measures`), its pulse
 (:meth:`rockstudy.motions.Record.pulse`) and its dimensionless groups for each structure
-(:func:`rockstudy.similarity.record_groups`) as variables, all of the unscaled record. The
+(:func:`rockstudy.similarity.record_groups`) as variables, all of the unscaled record, and
+``vertical_component`` (whether the record has one: without, nothing overturns below a
+structure's uplift PGA, which :func:`rockstudy.study.analysis.risk.object_risk` uses). The
 intensity of a scaled record is its unscaled value times ``scale`` (``scale`` squared for Arias
 intensity); :func:`rockstudy.study.analysis.record_fragility.intensity` forms it in quoted units.
 
