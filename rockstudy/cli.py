@@ -325,8 +325,13 @@ def _run(args) -> int:
         return 1
     print(
         f"{study.name}: {report.samples} samples in {report.chunks_total} chunks; computed "
-        f"{len(report.chunks_computed)} chunks in {report.seconds:.1f} s; "
-        f"{report.failed_samples} failed samples"
+        f"{len(report.chunks_computed)} chunks in {report.seconds:.1f} s"
+        + (
+            f" ({report.compile_seconds:.1f} s of it compiling kernels, once)"
+            if report.compile_seconds
+            else ""
+        )
+        + f"; {report.failed_samples} failed samples"
     )
     print(
         f"cube: {report.path} (xarray.open_zarr)" + (f", {report.netcdf}" if report.netcdf else "")
@@ -454,7 +459,9 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=_Help,
     )
     rep.add_argument("result", help="a zarr store (or .nc) written by 'rockstudy run'")
-    rep.add_argument("--out", help="directory (default: RESULT_report)")
+    rep.add_argument(
+        "--out", help="directory (default: RESULT without its suffix + _report: a.zarr -> a_report)"
+    )
     ver = sub.add_parser(
         "verify",
         help="check a result cube against the checksums written with it",

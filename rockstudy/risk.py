@@ -143,6 +143,7 @@ class HazardCurve:
                 "level would never fall to zero; end the curve where it still falls"
             )
         self._check_period()
+        _check_plausible(self.im, levels, units)
         for arr in (levels, rates):
             arr.flags.writeable = False
         object.__setattr__(self, "units", units)
@@ -161,11 +162,15 @@ class HazardCurve:
             )
 
     def __repr__(self) -> str:
-        where = f" T={self.period:g} s" if self.period is not None else ""
+        return f"<HazardCurve {self.describe()}>"
+
+    def describe(self) -> str:
+        """The curve in words: its measure, levels and rates (as the reports quote it)."""
+        at = f" at T = {self.period:g} s" if self.period is not None else ""
         return (
-            f"<HazardCurve {self.im}{where}: {self.levels.size} levels "
-            f"{self.levels[0]:.4g}-{self.levels[-1]:.4g} {self.units}, rates "
-            f"{self.rates[0]:.4g}-{self.rates[-1]:.4g} /yr>"
+            f"{self.im.upper()}{at} hazard curve of {self.levels.size} levels, "
+            f"{self.levels[0]:.4g} to {self.levels[-1]:.4g} {self.units}, annual rates of "
+            f"exceedance {self.rates[0]:.4g} to {self.rates[-1]:.4g} /yr"
         )
 
     def to_si(self) -> HazardCurve:
@@ -266,6 +271,29 @@ class HazardCurve:
         return cls(im, levels, rates, units, period, str(path))
 
 
+#: Levels no ground motion reaches, in SI (the largest PGA recorded is about 4 g, the largest
+#: PGV about 4 m/s): a hazard curve beyond them has its levels in other units than declared.
+IMPOSSIBLE_LEVELS = {"pga": 10.0 * STANDARD_GRAVITY, "sa": 30.0 * STANDARD_GRAVITY, "pgv": 10.0}
+
+
+def _check_plausible(im, levels, units) -> None:
+    """A ValueError naming ``units`` where the highest level, read in ``units``, is beyond any
+    ground motion (:data:`IMPOSSIBLE_LEVELS`): a curve in cm/s^2 read as g reaches
+    hundreds of g."""
+    limit = IMPOSSIBLE_LEVELS.get(im)
+    top = float(levels[-1]) * UNIT_FACTORS[units][0]
+    if limit is None or top <= limit:
+        return
+    quoted = "g" if UNIT_FACTORS[units][1] == "m/s^2" else UNIT_FACTORS[units][1]
+    shown = "" if units == quoted else f" = {top / UNIT_FACTORS[quoted][0]:.4g} {quoted}"
+    raise ValueError(
+        f"units: the levels reach {float(levels[-1]):.4g} {units}{shown} of "
+        f"{im}, beyond any ground motion (above {limit / UNIT_FACTORS[quoted][0]:.3g} "
+        f"{quoted}): are they in other units (cm/s^2 or gal read as g, cm/s as m/s)? give "
+        "the units the levels are in"
+    )
+
+
 def _positive(name, value) -> float:
     value = float(value)
     if not math.isfinite(value) or value <= 0.0:
@@ -321,6 +349,12 @@ def _check_header_units(path, header, im, units) -> None:
     if not header:
         return
     name = header.lower()
+    named = re.match(r"(pga|pgv|pgd|sa|psv|sd)(?![a-z])", name)
+    if named and named.group(1) != im:
+        raise ValueError(
+            f"im: {path.name} names its level column {header!r}, a {named.group(1)} curve, "
+            f"but it is read as {im!r}; give im = {named.group(1)!r} (or rename the column)"
+        )
     stated = next((u for u, pattern in _HEADER_UNITS if re.search(pattern, name)), None)
     given = measures.measure(im).unit if units is None else units
     if stated is None or stated not in UNIT_FACTORS or given not in UNIT_FACTORS:
@@ -404,6 +438,11 @@ def _from_openquake(path, lines, im, units, site) -> HazardCurve:
         raise ValueError(
             f"path: {path.name}: probabilities of exceedance of 1 stand above lower levels "
             f"with less: {poe!r}"
+        )
+    if units is not None and UNIT_FACTORS.get(units) != UNIT_FACTORS[oq_units]:
+        raise ValueError(
+            f"units: OpenQuake writes the levels of {imt} in {oq_units}, so {path.name} is "
+            f"read in {oq_units}, not {units!r}; leave units out (or give {oq_units!r})"
         )
     rates = -np.log1p(-poe[first:keep]) / years
     source = f"{path} (OpenQuake, {imt}, investigation_time {years:g} yr, site {i})"

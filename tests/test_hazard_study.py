@@ -127,3 +127,24 @@ def test_a_bad_unit_of_a_hazard_file_is_the_units_field(tmp_path, units):
     )
     assert "hazard.units" in text and "hazard.file" not in text, text
     assert "'s'" not in text and "'cm'" not in text, text  # no unit of time or length offered
+
+
+def test_a_file_in_other_units_or_of_another_measure_is_refused_naming_the_field(tmp_path):
+    """A curve in cm/s^2 (a neutral column name) declared in g reaches hundreds of g: refused
+    as hazard.units; a column named for PGA read as PGV: refused as hazard.im; an OpenQuake
+    PGA curve (in g) declared in m/s^2: hazard.units."""
+    levels = np.geomspace(0.01, 2.0, 25) * 980.665  # cm/s^2
+    rows = "".join(f"{x},{1e-3 * (x / 980.665) ** -2.3}\n" for x in levels)
+    (tmp_path / "cms.csv").write_text("pga,annual_rate\n" + rows)
+    hazard = '[hazard]\nkind = "file"\nfile = "cms.csv"\nim = "pga"\nunits = "{}"'
+    text = _problems(tmp_path, hazard.format("g"))
+    assert text.startswith("hazard.units: the levels reach 1961 g of pga, beyond any"), text
+    assert _study(tmp_path, hazard.format("cm/s^2")).hazard.curve().units == "cm/s^2"
+    (tmp_path / "g.csv").write_bytes((DATA / "hazard" / "site_pga.csv").read_bytes())
+    text = _problems(tmp_path, '[hazard]\nkind = "file"\nfile = "g.csv"\nim = "pgv"\nunits = "m/s"')
+    assert text.startswith("hazard.im: g.csv names its level column 'pga_g', a pga curve"), text
+    oq = DATA / "hazard" / "site_pga_openquake.csv"
+    text = _problems(
+        tmp_path, f'[hazard]\nkind = "file"\nfile = "{oq}"\nim = "pga"\nunits = "m/s^2"'
+    )
+    assert text.startswith("hazard.units: OpenQuake writes the levels of PGA in g"), text

@@ -352,7 +352,7 @@ def test_shipped_site_curve_in_both_formats():
         ("pga_g", "m/s2", "g"),
         ("pga_g", None, "g"),
         ("PGA [m/s^2]", "g", "m/s^2"),
-        ("sa_gal", "g", "cm/s^2"),
+        ("pga_gal", "g", "cm/s^2"),
     ],
 )
 def test_a_level_column_named_in_other_units_is_refused(tmp_path, header, units, stated):
@@ -361,6 +361,45 @@ def test_a_level_column_named_in_other_units_is_refused(tmp_path, header, units,
     path.write_text(f"{header},annual_rate\n0.1,1e-2\n0.2,1e-3\n")
     with pytest.raises(ValueError, match=rf"^units: .*in {re.escape(stated)},"):
         HazardCurve.from_csv(path, im="pga", units=units)
+
+
+@pytest.mark.parametrize("header, im", [("pga_g", "pgv"), ("sa_gal", "pga"), ("PGV [cm/s]", "pga")])
+def test_a_level_column_named_for_another_measure_is_refused_naming_im(tmp_path, header, im):
+    """The column says which measure the curve is of: read as another, the message names im
+    (not the units, which would send the user round in circles)."""
+    path = tmp_path / "h.csv"
+    path.write_text(f"{header},annual_rate\n0.1,1e-2\n0.2,1e-3\n")
+    named = header.split("_")[0].split(" ")[0].lower()
+    with pytest.raises(ValueError, match=rf"^im: .*a {named} curve, but it is read as '{im}'"):
+        HazardCurve.from_csv(path, im=im, units=None)
+
+
+@pytest.mark.parametrize(
+    "im, levels, units",
+    [
+        ("pga", [9.807, 98.07, 1961.0], "g"),  # cm/s^2 read as g
+        ("pga", [0.5, 5.0, 20.0], "g"),  # m/s^2 read as g, to 2 g
+        ("sa", [10.0, 100.0, 500.0], "g"),
+        ("pgv", [1.0, 50.0, 300.0], "m/s"),  # cm/s read as m/s
+    ],
+)
+def test_levels_beyond_any_ground_motion_are_refused_naming_units(im, levels, units):
+    """The largest PGA ever recorded is about 4 g and PGV about 4 m/s: a curve reaching 20 g,
+    or 300 m/s, is in other units than declared."""
+    period = 0.5 if im == "sa" else None
+    with pytest.raises(ValueError, match=r"^units: the levels reach .*beyond any ground motion"):
+        HazardCurve(im, levels, [1e-1, 1e-3, 1e-5], units=units, period=period)
+    # in their own units they read
+    own = {"g": "cm/s^2", "m/s": "cm/s"}[units]
+    curve = HazardCurve(im, levels, [1e-1, 1e-3, 1e-5], units=own, period=period)
+    assert curve.levels[-1] == levels[-1]
+
+
+def test_an_openquake_curve_in_other_units_than_openquake_writes_is_refused(tmp_path):
+    with pytest.raises(ValueError, match=r"^units: OpenQuake writes the levels of PGA in g"):
+        HazardCurve.from_csv(DATA / "site_pga_openquake.csv", units="m/s^2")
+    curve = HazardCurve.from_csv(DATA / "site_pga_openquake.csv", units="g")
+    assert curve.units == "g"
 
 
 @pytest.mark.parametrize("header, units", [("pga_g", "g"), ("PGA [m/s^2]", "m/s2"), ("level", "g")])

@@ -225,6 +225,37 @@ def test_failed_samples_are_recorded(tmp_path):
     assert np.all(np.isnan(ds.max_rotation.values[failed]))
 
 
+def test_the_run_says_how_much_of_its_time_was_compiling(tmp_path, monkeypatch, capsys):
+    """The compile happens once, inside the run's time: the summary line says how much of it
+    (the priming's own count of seconds), and nothing when every kernel was cached."""
+    from rockstudy.study.running import runner
+
+    (tmp_path / "s.toml").write_text(study_text(chunk=300))
+    real = runner.prime_study
+    assert (
+        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "a.zarr"), "--quiet"])
+        == 0
+    )
+    capsys.readouterr()
+    assert (
+        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "c.zarr"), "--quiet"])
+        == 0
+    )
+    assert "compiling" not in capsys.readouterr().out  # all cached by the first run
+
+    def cold(*args):  # as the priming reports a compile of 2.5 s
+        real(*args)
+        return {"compiled": 7, "seconds": 2.5}
+
+    monkeypatch.setattr(runner, "prime_study", cold)
+    assert (
+        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "b.zarr"), "--quiet"])
+        == 0
+    )
+    line = capsys.readouterr().out.splitlines()[0]
+    assert "computed 2 chunks in " in line and "s (2.5 s of it compiling kernels, once);" in line
+
+
 def test_resume_refuses_another_study(reference_run):
     ref, _ = reference_run
     with pytest.raises(ValueError, match="different study"):

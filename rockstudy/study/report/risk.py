@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy import special
 
 from ..analysis.risk import object_risk
 from ._page import _log_ticks, _mpl_text, _plt
@@ -26,12 +27,25 @@ RISK_RESAMPLES = 200
 MAX_DEAGGREGATION_LINES = 10
 
 
+#: Share of an object's annual rate from beyond the hazard curve's levels above which the
+#: report warns (:func:`_risk`).
+EXTRAPOLATED_SHARE = 0.1
+
+
+def _share_beyond(out) -> np.ndarray:
+    """Each object's share of lambda_OT from below the curve's first level and above its last
+    (NaN without a rate)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ends = out["deaggregation"].isel(interval=[0, -1]).sum("interval")
+        return (ends / out["annual_rate"]).values
+
+
 def _risk_table(out) -> pd.DataFrame:
     """The ranked table of :func:`~rockstudy.study.analysis.risk.object_risk`, as shown."""
     unit, y = out.attrs["units"], f"{out.attrs['years']:g}"
+    beyond = _share_beyond(out)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ends = out["deaggregation"].isel(interval=[0, -1]).sum("interval")
-        beyond = (ends / out["annual_rate"]).values
+        at_uplift = special.ndtr(np.log(out["uplift"] / out["theta"]) / out["beta"]).values
     counts = zip(out["n_overturning"].values, out["n_records"].values, strict=True)
     return pd.DataFrame(
         {
@@ -48,7 +62,12 @@ def _risk_table(out) -> pd.DataFrame:
             f"P({y} yr), 95 %": out["probability_hi"].values,
             "share beyond the curve's levels": beyond,
             f"uplift [{unit}]": out["uplift"].values,
-            "0 below uplift": np.where(out["truncated_at_uplift"].values, "yes", "no"),
+            "fragility 0 below uplift": np.where(
+                out["truncated_at_uplift"].values,
+                "yes",
+                np.where(np.isfinite(out["uplift"].values), "no", None),
+            ),
+            "P(OT) at uplift": at_uplift,
             "lambda_OT, whole lognormal [1/yr]": out["annual_rate_lognormal"].values,
             "share below uplift": out["share_below_uplift"].values,
             "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
@@ -67,25 +86,46 @@ def _risk(page, ds, hazard, years, im_label):
         page.text(f"No annual rates: {err}")
         return
     page.text(
-        f"Hazard: {out.attrs['hazard']} from {out.attrs['hazard_source'] or 'the study'}. "
+        f"Hazard: the {hazard.describe()}, from {out.attrs['hazard_source'] or 'the study'}. "
         f"Each object's lognormal fragility in {im_label(hazard.im, hazard.period)} is "
         "integrated against it (Cornell et al. 2002); the 90 % bands come from "
         f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
-        "and integrated again. Status 'few': fewer than 5 records overturned the object; "
+        "and integrated again."
+    )
+    page.text(
+        "Status 'ok': at least 5 records overturned the object; 'few': fewer; "
         "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
         "'all': it overturned at every point (stripes give a lower bound); 'separated': "
         "every point at which it overturned lies at or above every point at which it stood, "
         "so the fragility's dispersion cannot be estimated and no rate is given (a step "
         "function would be a guess, not an estimate); 'no rise': the points at which it "
         "overturned do not lie higher in the intensity than those at which it stood, so no "
-        "increasing fragility fits them and no rate is given. Below its uplift PGA (g "
-        "tan alpha of a block, g lambda of another structure) an object cannot leave rest: "
-        "where the hazard is in PGA and no record has a vertical component, its fragility is "
-        "0 there and the fitted lognormal above it (column '0 below uplift'), and lambda_OT, "
-        "its band and P are those of that fragility; 'lambda_OT, whole lognormal' is Cornell "
-        "et al.'s integral of the lognormal alone, and 'share below uplift' the part of it "
-        "from below uplift (the lognormal's lower tail, not a simulated overturning)."
+        "increasing fragility fits them and no rate is given."
     )
+    if out["truncated_at_uplift"].values.any():
+        page.text(
+            "Below its uplift PGA (g tan alpha of a block, g lambda of another structure) an "
+            "object cannot leave rest, so under these horizontal records (no vertical "
+            "component) it cannot overturn there: its fragility is 0 below the uplift PGA and "
+            "the lognormal fitted to all its records above it (the median and beta are that "
+            "fit's, not refitted for the cut), so P(OT) jumps at the uplift PGA from 0 to the "
+            "lognormal's value there (column 'P(OT) at uplift'). lambda_OT, its band, P and "
+            "the ranking are those of this fragility. 'lambda_OT, whole lognormal' is Cornell "
+            "et al.'s integral of the lognormal alone, and 'share below uplift' the part of it "
+            "from below the uplift PGA, which the cut leaves out: the lognormal's lower tail, "
+            "not a simulated overturning. A large jump says the lognormal fits these records "
+            "poorly near uplift."
+        )
+    beyond = _share_beyond(out)
+    wide = np.flatnonzero(beyond > EXTRAPOLATED_SHARE)
+    if wide.size:
+        names = ", ".join(str(out["structure"].values[j]) for j in wide)
+        page.warning(
+            f"More than {EXTRAPOLATED_SHARE:.0%} of the annual rate of {names} comes from "
+            "beyond the hazard curve's levels, where it is extrapolated as the power law of its "
+            "end interval (column 'share beyond the curve's levels'): extend the curve (or "
+            "check its units)."
+        )
     table = _risk_table(out)
     optional = [c for c in table if "at most" in c or "at least" in c or "uplift" in c]
     page.table(
@@ -140,7 +180,10 @@ def _deaggregation_figure(page, out, im_label):
     )
     frame = out["deaggregation"].to_pandas().T
     edges = zip(out["im_lower"].values, out["im_upper"].values, strict=True)
-    frame.index = [f"{a:.4g}-{b:.4g}" for a, b in edges]
+    frame.index = pd.Index(
+        [f"{a:.4g}-{b:.4g}" for a, b in edges],
+        name=f"{out.attrs['im']} interval [{out.attrs['units']}]; its part of lambda_OT [1/yr]",
+    )
     frame.to_csv(page.out / "deaggregation.csv")
 
 

@@ -37,6 +37,8 @@ class RunReport:
     chunks_computed: list = field(default_factory=list)
     failed_samples: int = 0
     seconds: float = 0.0
+    #: Of ``seconds``, those spent compiling the study's numba kernels (0 when cached).
+    compile_seconds: float = 0.0
     netcdf: Path | None = None
     damaged_chunks: list = field(default_factory=list)
     errors: dict = field(default_factory=dict)
@@ -83,11 +85,11 @@ class _Priming(threading.Thread):
 
     def __init__(self, *args):
         super().__init__(daemon=True, name="rockstudy-prime")
-        self.args, self.error = args, None
+        self.args, self.error, self.seconds = args, None, 0.0
 
     def run(self):
         try:
-            _prime(*self.args)
+            self.seconds = _prime(*self.args)
         except BaseException as exc:  # noqa: BLE001 - raised again in the calling thread
             self.error = exc
 
@@ -102,7 +104,8 @@ def _start_prime(study_json, columns, base_dir, progress) -> _Priming:
 
 def _prime(study_json, columns, base_dir, progress):
     """Compile the study's kernels in this process, once, before the workers start: they then
-    load them from numba's cache instead of each compiling them (see :mod:`._warmup`)."""
+    load them from numba's cache instead of each compiling them (see :mod:`._warmup`);
+    returns the seconds it compiled (0 when all were cached)."""
 
     def say(text):
         if progress:
@@ -120,6 +123,7 @@ def _prime(study_json, columns, base_dir, progress):
     )
     if r["compiled"]:
         say(f" done in {r['seconds']:.1f} s\n")
+    return r["seconds"] if r["compiled"] else 0.0
 
 
 _GUARD = (
@@ -416,6 +420,7 @@ def _run_locked(study, out, design, bounds, inputs, complete, base_dir, progress
             priming.join()  # only then do the workers get a chunk: they load the kernels
             if priming.error is not None:
                 raise priming.error
+            report.compile_seconds = priming.seconds
         except BaseException:  # also Ctrl-C while the client compiles
             if own:
                 _close(client, cluster)

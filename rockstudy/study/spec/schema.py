@@ -1501,8 +1501,8 @@ def _read_hazard_file(data, base_dir) -> str | None:
         curve = HazardCurve.from_csv(path, **args)
     except (TypeError, ValueError, KeyError) as exc:
         text = str(exc)
-        # a bad units or period is that field's problem, not the file's
-        field = next((f for f in ("units", "period") if text.startswith(f)), "file")
+        # a bad units, period or im is that field's problem, not the file's
+        field = next((f for f in ("units", "period", "im") if text.startswith(f)), "file")
         text = text.removeprefix(f"{field}: ") if field != "file" else text
         return f"hazard.{field}: {text}"
     hz["levels"], hz["rates"] = curve.levels.tolist(), curve.rates.tolist()
