@@ -132,14 +132,15 @@ class _Page:
     def preformatted(self, text):
         self.parts.append(f"<pre>{html.escape(text)}</pre>")
 
-    def table(self, frame: pd.DataFrame, name: str, caption: str, hide_empty=()):
-        """``frame`` into ``name``.csv and onto the page; the columns of ``hide_empty`` that
-        hold nothing (all NaN) are left off the page (not the CSV)."""
+    def table(self, frame: pd.DataFrame, name: str, caption: str, hide_empty=(), show=None):
+        """``frame`` into ``name``.csv and onto the page: its columns ``show`` (default all),
+        less those of ``hide_empty`` that hold nothing (all NaN); the CSV keeps them all."""
         frame.to_csv(self.out / f"{name}.csv")
         self.parts.append(
             f"<p class='cap'>{html.escape(caption)} (<a href='{name}.csv'>{name}.csv</a>)</p>"
         )
-        frame = frame.drop(columns=[c for c in hide_empty if frame[c].isna().all()])
+        frame = frame if show is None else frame[[c for c in frame if c in show]]
+        frame = frame.drop(columns=[c for c in hide_empty if c in frame and frame[c].isna().all()])
         shown = frame.map(_shown).rename(index=_shown, columns=_shown)
         # to_html escapes every cell; a table wider than the page scrolls inside its box
         self.parts.append(f"<div class='wide'>{shown.to_html(classes='t')}</div>")

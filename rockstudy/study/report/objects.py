@@ -421,8 +421,9 @@ def object_capacity(page, ctx):
         else ("", np.nan)
         for v in values
     ]
-    table["governing record(s) (lowest capacity)"] = [g for g, _ in govern]
-    table["governing capacity"] = [v for _, v in govern]
+    # first: a wide table scrolls, and these are what the table is read for
+    table.insert(0, "governing capacity", [v for _, v in govern])
+    table.insert(0, "governing record(s) (lowest capacity)", [g for g, _ in govern])
     what = {
         "ida": f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
         "(the IDA capacity; 'above': censored, standing at the highest scale reached)",

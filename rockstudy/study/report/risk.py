@@ -128,12 +128,22 @@ def _risk(page, ds, hazard, years, im_label):
         )
     table = _risk_table(out)
     optional = [c for c in table if "at most" in c or "at least" in c or "uplift" in c]
+    terms = [c for c in table if "uplift" in c or "whole" in c or "beyond" in c]
     page.table(
         table,
         "annual_overturning",
         f"Annual rate of overturning and probability in {years:g} years per object, ranked "
         "(highest first)",
         hide_empty=optional,
+        show=[c for c in table if c not in terms],
+    )
+    page.table(
+        table,
+        "annual_overturning",
+        "How each rate is made: the share from beyond the hazard curve's levels, the uplift "
+        "level and the fragility's cut there, and the whole lognormal's rate",
+        hide_empty=optional,
+        show=terms,
     )
     _deaggregation_figure(page, out, im_label)
 

@@ -490,7 +490,7 @@ def _overturning_map(page, ds, study):
     d = _computed(ds)
     w, a, over = d["omega"].values, d["amplitude_ratio"].values, d["overturned"].values == 1
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = plt.subplots(figsize=(8, 5.6))
     ax.scatter(w[~over], a[~over], s=3, c="C0", alpha=0.4, lw=0, label="survived")
     ax.scatter(w[over], a[over], s=3, c="C3", alpha=0.4, lw=0, label="overturned")
     applies = (
@@ -531,7 +531,8 @@ def _overturning_map(page, ds, study):
         title="overturning map over the dimensionless groups",
     )
     _plain_log_ticks(ax)
-    ax.legend(fontsize=8, markerscale=4, loc="upper left")
+    # below the axes: inside, it would hide the points and curves it explains
+    ax.legend(fontsize=8, markerscale=4, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
     fig.tight_layout()
     page.figure(
         fig,
