@@ -272,3 +272,19 @@ def test_objects_geometry_is_that_of_the_block():
     )
     # eq. (23) of [003]: the wall's equivalent block has p sqrt(2) and theta_cr 2 alpha
     assert wall.rocking() == pytest.approx((math.sqrt(2) * frequency_parameter(1.0), 0.2, 0.9))
+
+
+def test_validate_notes_an_object_given_in_centimetres(suite, tmp_path):
+    """45 x 190 typed for a statue 45 cm wide and 190 cm high: a block of R = sqrt(22.5^2 +
+    95^2) m; validate says the sizes are read in metres (a note: a spire may be large)."""
+    from rockstudy.study.spec.feasibility import notes
+
+    path = tmp_path / "cm.toml"
+    objects = (
+        'objects = [{ name = "A", width = 45, height = 190 }, '
+        '{ name = "B", width = 0.45, height = 1.9 }]'
+    )
+    path.write_text(STUDY_OBJECTS.format(objects=objects, folder=suite))
+    found = [n for n in notes(load_study(path)) if "sizes are in metres" in n]
+    assert len(found) == 1 and found[0].startswith("structure.objects[0] ('A')"), found
+    assert f"R = {math.hypot(22.5, 95.0):.4g} m" in found[0]

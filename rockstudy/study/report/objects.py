@@ -426,7 +426,14 @@ def object_capacity(page, ctx):
     table.insert(0, "governing record(s) (lowest capacity)", [g for g, _ in govern])
     what = {
         "ida": f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
-        "(the IDA capacity; 'above': censored, standing at the highest scale reached)",
+        "(the IDA capacity; 'above': censored, standing at the highest scale reached"
+        + (
+            f", the ladder's top at {ctx.ds.attrs['max_pga_ratio']:g} times the object's "
+            "uplift PGA, unless the record's free fall stopped it lower"
+            if "max_pga_ratio" in ctx.ds.attrs
+            else ""
+        )
+        + ")",
         "stripes": f"the stripe levels, {ctx.stripe_label()}, between which the object first "
         "overturned (the highest level below that it stood at, the lowest it overturned at)",
         "cloud": f"whether the object overturned under the unscaled record (the governing "

@@ -98,13 +98,14 @@ def notes(study, base_dir=None) -> list[str]:
     model no longer holds) at a scale the design reaches (those points are stored as
     censored, with their reason; the record's other points run); records scaled by more than
     ``design.max_scale_factor``; and targets so low that nothing can rock
-    (:func:`_scaling_notes`); and structures whose equivalent block, which the study
+    (:func:`_scaling_notes`); named objects larger than any rocking object
+    (:func:`size_notes`); and structures whose equivalent block, which the study
     simulates, lifts off far from the structure's own uplift acceleration
     (:func:`uplift_notes`)."""
     mo = study.motion
     if mo.kind != "record":
-        return uplift_notes(study)
-    found = uplift_notes(study) + _scaling_notes(study, base_dir)
+        return uplift_notes(study) + size_notes(study)
+    found = uplift_notes(study) + size_notes(study) + _scaling_notes(study, base_dir)
     if study.design is None:
         return found
     for field, h, v in record_pairs(mo, base_dir):
@@ -155,6 +156,28 @@ def uplift_notes(study) -> list[str]:
     if gap[j] <= UPLIFT_NOTE_GAP:
         return []
     return [_uplift_note("structure.slenderness", st.kind, float(eq[j]), float(a_up[j]))]
+
+
+#: Half-diagonal [m] of an equivalent block above which validate asks whether the sizes of
+#: an object were given in metres (a statue 45 x 190 cm typed as 45 x 190 is 97.6 m).
+LARGE_OBJECT = 50.0
+
+
+def size_notes(study) -> list[str]:
+    """Named objects whose equivalent block is larger than :data:`LARGE_OBJECT` (R = 3 g /
+    (4 p^2)): sizes are read in metres, so centimetres give a block a hundred times too big."""
+    if study.structure.kind != "objects":
+        return []
+    found = []
+    for i, o in enumerate(study.structure.objects):
+        half_diagonal = 0.75 * G / o.rocking()[0] ** 2
+        if half_diagonal > LARGE_OBJECT:
+            found.append(
+                f"structure.objects[{i}] ({o.name!r}): its equivalent block has R = "
+                f"{half_diagonal:.4g} m: sizes are in metres (centimetres would make it a "
+                "hundred times too big)"
+            )
+    return found
 
 
 def _uplift_note(field, kind, eq, a_up) -> str:
