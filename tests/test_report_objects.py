@@ -405,3 +405,39 @@ def test_the_risk_section_says_the_jump_at_uplift_and_warns_of_extrapolated_rate
     wide = risk.HazardCurve.power_law(1e-4, 2.5, im="pga", units="g", levels=[0.01, 9.0])
     text = _text(record_report(ds, tmp_path / "w", n_boot=5, hazard=wide))
     assert "comes from beyond the hazard curve" not in text
+
+
+def test_the_rate_without_records_outside_the_model_is_refitted_without_them(tmp_path):
+    """With a friction coefficient that the strongest-pulse records exceed, each object's
+    rate is given again without the records under which it would slide: the lognormal
+    refitted to the other capacities (scipy's normal fit of their logarithms) and integrated
+    with its cut at g tan(alpha)."""
+    from scipy.stats import norm
+    from test_objects import _sine_record
+
+    from rockstudy import risk
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+
+    recs = [_sine_record(tp) for tp in (0.6, 0.9, 1.2, 1.5, 2.0, 2.5)]
+    objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
+    ds = incremental_dynamic_analysis(
+        recs, objects, scan=0, step=0.05, tolerance=0.01, contact=True
+    )
+    demand = ds["friction_demand"].values  # (record, structure)
+    mu = float(np.sort(demand.max(axis=1))[-2])  # the record of the largest demand exceeds it
+    hazard = risk.HazardCurve.power_law(1e-4, 2.5, im="pga", units="g")
+    record_report(ds, tmp_path / "r", n_boot=5, hazard=hazard, friction=mu)
+    table = pd.read_csv(tmp_path / "r" / "annual_overturning_within_model.csv", index_col=0)
+    assert len(table) >= 1
+    for name, row in table.iterrows():
+        j = list(objects).index(name)
+        outside = (demand[:, j] > mu) | ds["lift_off"].values[:, j]
+        assert row["records outside the model"].split(", ") == [
+            r.name for r, o in zip(recs, outside, strict=True) if o
+        ]
+        pga = np.array([r.peak for r in recs]) / G_UNIT
+        caps = np.log(ds["capacity_scale"].values[~outside, j] * pga[~outside])
+        mu_ln, beta = norm.fit(caps)
+        x_u = G * math.tan(objects[name].slenderness) / G_UNIT
+        expected = risk.annual_rate(np.exp(mu_ln), beta, hazard, threshold=x_u)
+        assert row["lambda_OT without them [1/yr]"] == pytest.approx(expected, rel=1e-9)
