@@ -282,7 +282,7 @@ def _check_plausible(im, levels, units) -> None:
     hundreds of g."""
     limit = IMPOSSIBLE_LEVELS.get(im)
     top = float(levels[-1]) * UNIT_FACTORS[units][0]
-    if limit is None or top <= limit:
+    if limit is None or top <= limit * (1.0 + 1e-9):  # (10 g in cm/s^2 rounds above it)
         return
     quoted = "g" if UNIT_FACTORS[units][1] == "m/s^2" else UNIT_FACTORS[units][1]
     shown = "" if units == quoted else f" = {top / UNIT_FACTORS[quoted][0]:.4g} {quoted}"

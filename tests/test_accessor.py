@@ -336,13 +336,25 @@ def test_a_record_study_cube_read_by_xarray_is_folded_and_uses_its_study(raw_rec
     fitted = np.isfinite(b)
     exact = 2e-4 * t[fitted] ** -2.3 * np.exp(0.5 * (2.3 * b[fitted]) ** 2)
     np.testing.assert_allclose(out["annual_rate_lognormal"].values[fitted], exact, rtol=1e-3)
-    # horizontal records and a PGA hazard: the fragility is 0 below each uplift PGA
-    assert out["truncated_at_uplift"].values.all()
-    t, b, u = t[fitted], b[fitted], out["uplift"].values[fitted]
+    # horizontal records and a PGA hazard: the fragility is 0 below each uplift PGA (g
+    # tan(alpha) of these blocks), except for the objects that these drawn outcomes
+    # overturned below it (which the physics forbids): those keep the whole lognormal
+    up_g = ds["uplift_acceleration"].values / G_UNIT  # per sample
+    st = ds["structure"].values
+    impossible = {j: bool(np.any(over[st == j] & (pga_g[st == j] < up_g[st == j]))) for j in st}
+    refused = np.array([impossible[j] for j in out["structure"].values])
+    np.testing.assert_array_equal(out["overturned_below_uplift"].values, refused)
+    np.testing.assert_array_equal(out["truncated_at_uplift"].values, ~refused)
+    assert refused.any() and not refused.all()
+    cut = fitted & ~refused
+    t, b, u = out["theta"].values[cut], out["beta"].values[cut], out["uplift"].values[cut]
     z = np.log(u / t) / b
     below = 2e-4 * u**-2.3 * stats.norm.cdf(z)
     above = 2e-4 * t**-2.3 * np.exp(0.5 * (2.3 * b) ** 2) * stats.norm.cdf(-z - 2.3 * b)
-    np.testing.assert_allclose(out["annual_rate"].values[fitted], below + above, rtol=1e-9)
+    np.testing.assert_allclose(out["annual_rate"].values[cut], below + above, rtol=1e-9)
+    kept = fitted & refused
+    whole = out["annual_rate_lognormal"].values[kept]
+    np.testing.assert_array_equal(out["annual_rate"].values[kept], whole)
     # the study's friction (0.4) is the default of contact: demand above it, or lift-off
     flags = ds.rocking.contact()
     expected = (ds["friction_demand"].values > 0.4) | (ds["lift_off"].values == 1)

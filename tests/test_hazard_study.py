@@ -148,3 +148,15 @@ def test_a_file_in_other_units_or_of_another_measure_is_refused_naming_the_field
         tmp_path, f'[hazard]\nkind = "file"\nfile = "{oq}"\nim = "pga"\nunits = "m/s^2"'
     )
     assert text.startswith("hazard.units: OpenQuake writes the levels of PGA in g"), text
+
+
+def test_a_bad_hazard_unit_does_not_hide_a_bad_motion_unit(tmp_path):
+    """Both units wrong (.AT2 records are in g; the hazard file's column says g): both named."""
+    site = (DATA / "hazard" / "site_pga.csv").as_posix()
+    hazard = f'[hazard]\nkind = "file"\nfile = "{site}"\nim = "pga"\nunits = "m/s2"'
+    text = STUDY.format(records=DATA / "records", hazard=hazard).replace(
+        'kind = "record"\n', 'kind = "record"\nunits = "m/s2"\n'
+    )
+    found = _problems(tmp_path, None, text)
+    assert "hazard.units: site_pga.csv names its level column 'pga_g'" in found, found
+    assert "motion.units: 'm/s2' does not apply to .AT2 files" in found, found

@@ -378,9 +378,10 @@ def test_the_pga_fragility_drawn_is_zero_below_uplift_under_horizontal_records(r
 
 
 def test_the_risk_section_says_the_jump_at_uplift_and_warns_of_extrapolated_rates(tmp_path):
-    """An IDA of two objects under sine records (horizontal): the table's P(OT) at uplift is
-    the fitted lognormal at g tan(alpha); a hazard curve tabulated only far above the
-    capacities puts most of each rate in its extrapolated lower tail, and the page warns."""
+    """An IDA of two objects under sine records (horizontal): the fragility is cut at g
+    tan(alpha) and the table's P(OT) just above it is the fitted lognormal there; a hazard
+    curve tabulated only far above the capacities puts most of each rate in its extrapolated
+    lower tail, and the page warns."""
     from scipy.stats import norm
     from test_objects import _sine_record
 
@@ -392,15 +393,15 @@ def test_the_risk_section_says_the_jump_at_uplift_and_warns_of_extrapolated_rate
     ds = incremental_dynamic_analysis(recs, objects, scan=0, step=0.05, tolerance=0.01)
     narrow = risk.HazardCurve.power_law(1e-4, 2.5, im="pga", units="g", levels=[5.0, 8.0])
     text = _text(record_report(ds, tmp_path / "r", n_boot=5, hazard=narrow))
-    assert "P(OT) jumps at the uplift PGA from 0" in text
+    assert "P(OT) jumps there from 0 to the lognormal" in text
     assert "comes from beyond the hazard curve" in text
     table = pd.read_csv(tmp_path / "r" / "annual_overturning.csv", index_col=0)
     for name, block in objects.items():
         row = table.loc[name]
         x_u = G * math.tan(block.slenderness) / G_UNIT
         expected = norm.cdf(np.log(x_u / row["median [g]"]) / row["beta"])
-        assert row["P(OT) at uplift"] == pytest.approx(expected, rel=1e-9)
-        assert row["fragility 0 below uplift"] == "yes"
+        assert row["P(OT) just above it"] == pytest.approx(expected, rel=1e-9)
+        assert row["fragility 0 below [g]"] == pytest.approx(x_u, rel=1e-12)
         assert row["share beyond the curve's levels"] > 0.1
     wide = risk.HazardCurve.power_law(1e-4, 2.5, im="pga", units="g", levels=[0.01, 9.0])
     text = _text(record_report(ds, tmp_path / "w", n_boot=5, hazard=wide))

@@ -395,6 +395,14 @@ def test_levels_beyond_any_ground_motion_are_refused_naming_units(im, levels, un
     assert curve.levels[-1] == levels[-1]
 
 
+def test_a_default_power_law_converts_to_every_unit_of_its_measure():
+    """Its levels end at 10 g, the limit itself: in any unit it stays readable."""
+    curve = HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
+    for units in ("m/s^2", "cm/s^2", "gal", "g"):
+        again = curve.to_units(units).to_units("g")
+        np.testing.assert_allclose(again.levels, curve.levels, rtol=1e-12)
+
+
 def test_an_openquake_curve_in_other_units_than_openquake_writes_is_refused(tmp_path):
     with pytest.raises(ValueError, match=r"^units: OpenQuake writes the levels of PGA in g"):
         HazardCurve.from_csv(DATA / "site_pga_openquake.csv", units="m/s^2")

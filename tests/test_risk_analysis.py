@@ -208,10 +208,12 @@ def _truncated_cornell(theta, beta, x_u):
 
 
 def _two_objects(vertical):
-    """A: capacities about 0.5 g with beta 1 and uplift at 0.45 g; B: about 0.45 g with beta
-    0.3 and uplift at 0.05 g. The whole lognormal ranks A first (its wide lower tail); with
-    the fragility 0 below uplift, B."""
-    cap = np.column_stack([_lognormal(0.5, 1.0, 300, 21), _lognormal(0.45, 0.3, 300, 22)])
+    """A: capacities 0.45 exp(2 |Z|) g, all above its uplift at 0.45 g but spread so wide that
+    the lognormal fitted to them (beta about 1.1) puts much of its mass below 0.45 g; B:
+    about 0.6 g with beta 0.3, uplift at 0.05 g. The whole lognormal ranks A first (its wide
+    lower tail); with the fragility 0 below uplift, B."""
+    z = np.random.default_rng(21).standard_normal(300)
+    cap = np.column_stack([0.45 * np.exp(2.0 * np.abs(z)), _lognormal(0.6, 0.3, 300, 22)])
     ds = _ida(cap, names=["A", "B"])
     ds["uplift_acceleration"] = ("structure", np.array([0.45, 0.05]) * G_UNIT)
     ds["vertical_component"] = ("record", np.arange(300) == 7 if vertical else np.zeros(300, bool))
@@ -266,3 +268,61 @@ def test_record_designs_say_which_records_have_a_vertical_component():
     np.testing.assert_array_equal(ds["vertical_component"].values, [False, True])
     ds = rd.cloud([h], {"block": Block(1.0, 0.2)})
     np.testing.assert_array_equal(ds["vertical_component"].values, [False])
+
+
+def test_the_cut_is_where_the_simulated_block_lifts_when_that_is_lower():
+    """An arch's equivalent block (what a design simulates) lifts off at g tan(theta_cr),
+    below the arch's own g lambda: nothing overturns below the lower of the two, so the cut
+    is there; the IDA's capacities of a real arch all lie above it."""
+    from test_objects import _sine_record
+
+    from rockstudy.constants import G
+    from rockstudy.structures import Arch, uplift_acceleration
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+
+    arch = Arch(np.pi, 0.15, 1.0, 0.9)
+    block_lifts = G * np.tan(arch.equivalent_block().slenderness) / G_UNIT  # [g]
+    own = uplift_acceleration(arch) / G_UNIT
+    assert block_lifts < own * 0.9  # (an arch: 14 % lower)
+    recs = [_sine_record(tp) for tp in (2.0, 3.0, 4.0)]
+    ida = incremental_dynamic_analysis(recs, {"arch": arch}, scan=0, step=0.05, tolerance=0.01)
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(ida, hazard, n_boot=0)
+    row = out.isel(structure=0)
+    assert bool(row["truncated_at_uplift"]) and not bool(row["overturned_below_uplift"])
+    assert float(row["cut_level"]) == pytest.approx(block_lifts, rel=1e-12)
+    assert float(row["uplift"]) == pytest.approx(own, rel=1e-12)
+    capacities = ida["capacity"].values.ravel() / G_UNIT
+    assert np.all(capacities[np.isfinite(capacities)] >= block_lifts)
+    assert str(row["status"].values) == "ok"  # all three records overturned it
+    t, b = float(row["theta"]), float(row["beta"])
+    expected = _truncated_cornell(t, b, block_lifts)
+    assert float(row["annual_rate"]) == pytest.approx(expected, rel=1e-9)
+
+
+def test_an_overturning_below_the_cut_refuses_the_cut():
+    """Data that the physics forbids (an overturning below uplift under horizontal records):
+    the fragility is not cut, and the object is marked."""
+    ds = _two_objects(False)
+    cap = ds["capacity_scale"].values.copy()
+    cap[3, 0] = 0.3  # below A's uplift at 0.45 g
+    ds["capacity_scale"] = (("record", "structure"), cap)
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    out = object_risk(ds, hazard, n_boot=0)
+    a, b = out.sel(structure="A"), out.sel(structure="B")
+    assert bool(a["overturned_below_uplift"]) and not bool(a["truncated_at_uplift"])
+    assert float(a["annual_rate"]) == float(a["annual_rate_lognormal"])
+    assert bool(b["truncated_at_uplift"]) and not bool(b["overturned_below_uplift"])
+
+
+def test_a_pgv_hazard_is_not_cut():
+    """PGV has no uplift level: the whole lognormal, whatever the records."""
+    ds = _two_objects(False)
+    ds["pgv"] = ("record", np.full(ds.sizes["record"], 0.5))  # capacities in m/s: 0.5 x scale
+    hazard = risk.HazardCurve.power_law(1e-4, 2.0, im="pgv", units="m/s")
+    out = object_risk(ds, hazard, n_boot=0)
+    assert not out["truncated_at_uplift"].values.any()
+    assert np.all(np.isnan(out["cut_level"].values))
+    np.testing.assert_array_equal(out["annual_rate"], out["annual_rate_lognormal"])
+    t, b = out["theta"].values, out["beta"].values
+    np.testing.assert_allclose(out["annual_rate"], 1e-4 * t**-2.0 * np.exp(2.0 * b**2), rtol=1e-9)

@@ -52,6 +52,7 @@ import numpy as np
 import xarray as xr
 
 from ... import risk
+from ...constants import G
 from . import record_fragility as rf
 from .fragility_fit import (
     NO_MAXIMUM,
@@ -86,7 +87,8 @@ def _check_hazard(ds, hazard):
 
 def _ida_fitter(ds, im, period):
     """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
-    level per object, no_maximum(j) -> None) of an IDA, in quoted units."""
+    level per object, no_maximum(j) -> None, lowest capacity per object) of an IDA, in quoted
+    units."""
     cap, top, cens, ok = rf.ida_arrays(ds, im, period)
 
     def fit(j, rows):
@@ -100,14 +102,15 @@ def _ida_fitter(ds, im, period):
 
     with np.errstate(invalid="ignore"):
         lowest = np.nanmin(np.where(ok & cens, top, np.nan), axis=0, initial=np.inf)
-    return fit, count, lowest, lambda j: None
+        first = np.nanmin(np.where(ok & ~cens, cap, np.nan), axis=0, initial=np.inf)
+    return fit, count, lowest, lambda j: None, first
 
 
 def _stripe_fitter(ds, im, period):
     """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points, a separated
     resample at its limit); the third item is the lowest intensity simulated per object, the
     fourth the kind of :data:`.fragility_fit.NO_MAXIMUM` of all its points (None if they
-    have a fit)."""
+    have a fit), the fifth the lowest intensity at which it overturned."""
     x, y, ok = rf.stripe_arrays(ds, im, period)
     y = y.astype(bool)
     j_axis = ds["overturned"].dims.index("structure")
@@ -131,7 +134,9 @@ def _stripe_fitter(ds, im, period):
         kind = separation(x[:, j][kk], y[:, j][kk], np.ones(int(kk.sum())))[0]
         return kind if kind in NO_MAXIMUM else None
 
-    return fit, count, lowest, no_maximum
+    hit = np.where(ok & y, x, np.nan).reshape(x.shape[0], x.shape[1], -1)
+    first = np.nanmin(hit, axis=(0, 2), initial=np.inf)
+    return fit, count, lowest, no_maximum, first
 
 
 def _uplift(ds, hazard):
@@ -180,16 +185,35 @@ def _rate(theta, beta, hazard, unit, cut=None):
     return risk.annual_rate(theta, beta, hazard, units=unit, threshold=cut)
 
 
-def _cuts(ds, hazard, uplift):
-    """Where each object's fragility is exactly 0 below its uplift PGA (in the hazard's units;
-    NaN: not truncated): for a PGA hazard, when no record of the design has a vertical
-    component (``vertical_component`` on ``record``; a design that does not say is not
-    truncated). Below g tan(alpha) of a block, g lambda of another structure (eq. 10 of
-    [003]), the ground never lifts it, so it cannot overturn: P(OT | PGA < a_up) = 0. A
-    vertical component can lift it under a lower PGA."""
-    horizontal = "vertical_component" in ds and not bool(ds["vertical_component"].any())
-    exact = hazard.im == "pga" and horizontal
-    return np.where(exact & np.isfinite(uplift) & (uplift > 0), uplift, np.nan)
+def cut_levels(ds, im, units, uplift):
+    """Where each object's fragility is exactly 0, in the hazard's units (NaN: nowhere): for
+    a PGA hazard when no record of the design has a vertical component
+    (:func:`horizontal`), below the lower of its uplift PGA (g tan(alpha) of a block, g lambda
+    of another structure, eq. 10 of [003]) and the g tan(theta_cr) at which the equivalent
+    block that the design simulates lifts off (lower for an arch): below both the ground
+    lifts neither, so P(OT | PGA) = 0. ``uplift`` (the structures' own uplift PGA) and the
+    result are in ``units``."""
+    if not (im == "pga" and horizontal(ds)):
+        return np.full(ds.sizes["structure"], np.nan)
+    level = uplift
+    if "critical_rotation" in ds:
+        lifts = G * np.tan(ds["critical_rotation"].transpose("structure").values.astype(float))
+        level = np.fmin(uplift, lifts / risk.UNIT_FACTORS[units][0])
+    return np.where(np.isfinite(level) & (level > 0), level, np.nan)
+
+
+def cut_refused(level, first) -> np.ndarray:
+    """True where an overturning was seen at an intensity below the cut ``level`` (beyond
+    the round-off of the scales that produced it)."""
+    with np.errstate(invalid="ignore"):
+        return np.asarray(first < level * (1.0 - 1e-9))
+
+
+def horizontal(ds) -> bool:
+    """True when the design says that none of its records has a vertical component
+    (``vertical_component`` on ``record``): then nothing lifts a structure, or overturns it,
+    below its uplift PGA. A design that does not say is not taken as horizontal."""
+    return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
 def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
@@ -213,7 +237,7 @@ def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning,
     """The point estimate, the bootstrap rates and the status of object ``j`` (its fragility
     0 below ``cut``, in ``unit``; None: the whole lognormal); and the rate of the whole
     lognormal."""
-    fit, count, _, no_maximum = fitter
+    fit, count, _, no_maximum, _ = fitter
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
     n_over = count(j, every)
@@ -277,11 +301,15 @@ def object_risk(
         ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
         ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
         PGA, g tan(alpha) of a block and g lambda of another structure, eq. 10 of [003], in
-        ``hazard.units``), ``truncated_at_uplift`` (True where the fragility is 0 below the
-        uplift PGA: a PGA hazard and no record with a vertical component (the design's
-        ``vertical_component``), where P(OT | PGA < uplift) = 0 exactly; ``annual_rate``, its
-        band and the probabilities are then those of the truncated fragility,
-        :func:`rockstudy.risk.annual_rate` with ``threshold``), ``annual_rate_lognormal``
+        ``hazard.units``), ``truncated_at_uplift`` (True where the fragility is 0 below
+        ``cut_level``: a PGA hazard and no record with a vertical component (the design's
+        ``vertical_component``), where P(OT | PGA) = 0 exactly below the lower of the uplift
+        PGA and the g tan(theta_cr) at which the simulated equivalent block lifts off
+        (:func:`cut_levels`); ``annual_rate``, its band and the probabilities are then those
+        of the cut fragility, :func:`rockstudy.risk.annual_rate` with ``threshold``),
+        ``cut_level`` (NaN where not cut), ``overturned_below_uplift`` (True where a
+        simulation overturned the object below that level, which the model forbids: then it
+        is not cut), ``annual_rate_lognormal``
         (the rate of the whole lognormal, Cornell et al.'s integral) and
         ``share_below_uplift`` (the share of ``annual_rate_lognormal`` from PGA below the
         uplift PGA: what the lognormal's lower tail adds, not what a simulation saw); and on
@@ -303,7 +331,13 @@ def object_risk(
     rng = np.random.default_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
     to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
-    cuts = _cuts(ds, hazard, _uplift(ds, hazard)) / to_hazard  # in the fragility's unit
+    uplift = _uplift(ds, hazard)
+    level = cut_levels(ds, hazard.im, hazard.units, uplift)
+    # an overturning seen below that level (which the physics forbids): the data and the cut
+    # disagree, and the fragility is not cut
+    refused = cut_refused(level, fitter[4] * to_hazard)
+    cut = np.where(refused, np.nan, level)
+    cuts = cut / to_hazard  # in the fragility's unit
     rows = [
         _one_object(
             j,
@@ -319,7 +353,8 @@ def object_risk(
         for j in range(ds.sizes["structure"])
     ]
     attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
-    return _risk_dataset(ds, rows, fitter[2] * to_hazard, hazard, years, to_hazard, attrs)
+    levels = (uplift, cut, refused)
+    return _risk_dataset(ds, rows, fitter[2] * to_hazard, hazard, years, to_hazard, attrs, levels)
 
 
 def _bands(boot, conf_level):
@@ -343,10 +378,10 @@ def _bounds(status, lowest, hazard, ida):
     return upper, lower
 
 
-def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
-    """The Dataset of :func:`object_risk` from the objects' rows, ranked."""
-    uplift = _uplift(ds, hazard)
-    cut = _cuts(ds, hazard, uplift)
+def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs, levels):
+    """The Dataset of :func:`object_risk` from the objects' rows, ranked; ``levels`` are the
+    objects' uplift and cut intensities in the hazard's units and where a cut was refused."""
+    uplift, cut, refused = levels
     theta, beta, n_over, status, rate, boot, whole = (list(c) for c in zip(*rows, strict=True))
     theta, beta, rate, whole = (np.array(v, float) for v in (theta, beta, rate, whole))
     boot = np.array(boot, float).reshape(len(rows), -1)
@@ -385,6 +420,8 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs):
         "boot_valid": valid,
         "uplift": uplift,
         "truncated_at_uplift": np.isfinite(cut),
+        "cut_level": cut,
+        "overturned_below_uplift": refused,
         "annual_rate_lognormal": whole,
         "share_below_uplift": np.array(
             [

@@ -21,6 +21,7 @@ import xarray as xr
 from ...constants import STANDARD_GRAVITY
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
+from ..analysis.risk import cut_levels, horizontal
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from ._page import _log_ticks, _mpl_text, _names, _plt, separation_note, shown_separation
@@ -283,7 +284,7 @@ def object_fragility(page, ctx):
             "; under these horizontal records nothing can overturn below it, so the fragility "
             "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "
             "leave out)"
-            if _horizontal(ctx)
+            if horizontal(ctx.ds)
             else ""
         ),
     )
@@ -324,7 +325,8 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
         return False
     grid = np.geomspace(low / 1.2, high * 1.2, 200)
     curve = fragility_curve(t, grid)
-    cut = im == "pga" and _horizontal(ctx)  # nothing overturns below uplift
+    # nothing overturns below the cut (uplift, or where the simulated block lifts if lower)
+    cut = cut_levels(ctx.ds, im, ctx.units, up) if up is not None else np.full(len(names), np.nan)
     shade = 0.15 if curve.sizes["group"] <= 3 else 0.07  # many bands overlap
     drawn = 0
     for g in curve.group.values:
@@ -332,8 +334,9 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
         if not np.isfinite(c.probability.values).any():
             continue
         drawn += 1
-        x_u = up[names.index(str(g))] if up is not None else np.nan
-        above = grid >= x_u if cut and np.isfinite(x_u) else np.ones(grid.size, bool)
+        j = names.index(str(g))
+        x_u = up[j] if up is not None else np.nan
+        above = grid >= cut[j] if np.isfinite(cut[j]) else np.ones(grid.size, bool)
         p = np.where(above, c.probability, 0.0)
         (line,) = ax.plot(grid, p, "-", label=ctx.text(str(g)))
         if not above.all():  # the fitted lognormal's tail, where the object cannot rock
@@ -351,13 +354,6 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
     ax.tick_params(labelsize=FONT)
     ax.legend(fontsize=FONT, loc="lower right")  # (an S-curve leaves that corner empty)
     return True
-
-
-def _horizontal(ctx) -> bool:
-    """True when no record of the design has a vertical component (the design says so): then
-    a PGA below an object's uplift level cannot lift it, and it cannot overturn there."""
-    ds = ctx.ds
-    return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
 # ------------------------------------------------------------------------------ capacity
@@ -563,7 +559,8 @@ def _ida_scenes(ctx) -> str:
     span = f", here PGA {pga.min():.3g} to {pga.max():.3g} {ctx.units}" if pga.size else ""
     return (
         " (IDA: each scene is a record at the highest scale simulated below the object's first "
-        f"overturning{span}: the strongest shaking each object was seen to stand)"
+        "overturning, or the highest it stood at where it never overturned"
+        f"{span}: the strongest shaking each object was seen to stand)"
     )
 
 

@@ -89,7 +89,7 @@ def _risk_table(out) -> pd.DataFrame:
     unit, y = out.attrs["units"], f"{out.attrs['years']:g}"
     beyond = _share_beyond(out)
     with np.errstate(invalid="ignore", divide="ignore"):
-        at_uplift = special.ndtr(np.log(out["uplift"] / out["theta"]) / out["beta"]).values
+        at_cut = special.ndtr(np.log(out["cut_level"] / out["theta"]) / out["beta"]).values
     counts = zip(out["n_overturning"].values, out["n_records"].values, strict=True)
     return pd.DataFrame(
         {
@@ -106,12 +106,8 @@ def _risk_table(out) -> pd.DataFrame:
             f"P({y} yr), 95 %": out["probability_hi"].values,
             "share beyond the curve's levels": beyond,
             f"uplift [{unit}]": out["uplift"].values,
-            "fragility 0 below uplift": np.where(
-                out["truncated_at_uplift"].values,
-                "yes",
-                np.where(np.isfinite(out["uplift"].values), "no", None),
-            ),
-            "P(OT) at uplift": at_uplift,
+            f"fragility 0 below [{unit}]": out["cut_level"].values,
+            "P(OT) just above it": at_cut,
             "lambda_OT, whole lognormal [1/yr]": out["annual_rate_lognormal"].values,
             "share below uplift": out["share_below_uplift"].values,
             "lambda_OT at most [1/yr]": out["rate_upper_bound"].values,
@@ -150,15 +146,25 @@ def _risk(page, ds, hazard, years, im_label):
         page.text(
             "Below its uplift PGA (g tan alpha of a block, g lambda of another structure) an "
             "object cannot leave rest, so under these horizontal records (no vertical "
-            "component) it cannot overturn there: its fragility is 0 below the uplift PGA and "
-            "the lognormal fitted to all its records above it (the median and beta are that "
-            "fit's, not refitted for the cut), so P(OT) jumps at the uplift PGA from 0 to the "
-            "lognormal's value there (column 'P(OT) at uplift'). lambda_OT, its band, P and "
-            "the ranking are those of this fragility. 'lambda_OT, whole lognormal' is Cornell "
-            "et al.'s integral of the lognormal alone, and 'share below uplift' the part of it "
-            "from below the uplift PGA, which the cut leaves out: the lognormal's lower tail, "
-            "not a simulated overturning. A large jump says the lognormal fits these records "
-            "poorly near uplift."
+            "component) it cannot overturn there. Its fragility is therefore 0 below that PGA "
+            "(or below the lower PGA at which the equivalent block the design simulates lifts "
+            "off, g tan theta_cr: an arch's; column 'fragility 0 below') and the lognormal "
+            "fitted to all its records above it (the median and beta are that fit's, not "
+            "refitted for the cut), so P(OT) jumps there from 0 to the lognormal's value "
+            "(column 'P(OT) just above it'). lambda_OT, its band, P and the ranking are those "
+            "of this fragility. 'lambda_OT, whole lognormal' is Cornell et al.'s integral of "
+            "the lognormal alone, and 'share below uplift' the part of it from below the uplift "
+            "PGA: the lognormal's lower tail, not a simulated overturning. A large jump says the "
+            "lognormal fits these records poorly near uplift."
+        )
+    below = out["overturned_below_uplift"].values
+    if below.any():
+        names = ", ".join(str(n) for n in out["structure"].values[below])
+        page.warning(
+            f"{names} overturned in the simulations at a PGA below the level at which the "
+            "ground can lift it under horizontal records, which the block model forbids: its "
+            "fragility is not cut there (the whole lognormal is integrated); check the design's "
+            "records and structures."
         )
     beyond = _share_beyond(out)
     wide = np.flatnonzero(beyond > EXTRAPOLATED_SHARE)
@@ -172,7 +178,9 @@ def _risk(page, ds, hazard, years, im_label):
         )
     table = _risk_table(out)
     optional = [c for c in table if "at most" in c or "at least" in c or "uplift" in c]
-    terms = [c for c in table if "uplift" in c or "whole" in c or "beyond" in c]
+    optional += [c for c in table if "below" in c or "just above" in c]
+    terms = [c for c in table if "uplift" in c or "whole" in c or "beyond" in c or "below" in c]
+    terms += [c for c in table if "just above" in c]
     page.table(
         table,
         "annual_overturning",

@@ -1396,9 +1396,13 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
             found = [file_problem] + [x for x in found if not x.startswith("structure.objects")]
         if hazard_problem:
             found = [hazard_problem] + [x for x in found if not x.startswith("hazard.")]
+            if found == [hazard_problem]:  # the rest is valid: its own checks (motion.units)
+                found += _problems_without_hazard(data, base_dir)
         raise StudyError(source, found + _motion_problems(data, base_dir)) from None
-    if file_problem or hazard_problem:
-        raise StudyError(source, [p for p in (file_problem, hazard_problem) if p])
+    if file_problem or hazard_problem:  # with the rest's problems (a bad motion.units too)
+        found = [p for p in (file_problem, hazard_problem) if p]
+        rest = [x for x in _problems_beside(study, base_dir) if not x.startswith("hazard")]
+        raise StudyError(source, found + [x for x in rest if x not in found])
 
     if study.design is not None and "chunk_size" in data:
         raise StudyError(
@@ -1410,6 +1414,26 @@ def validate_text(text: str, source: str = "<study>", base_dir=None) -> Study:
     study._text = text
     study._notes = notes(study, base_dir)
     return study
+
+
+def _problems_without_hazard(data, base_dir) -> list[str]:
+    """The problems of a study whose hazard file could not be read, without its ``[hazard]``
+    (so that a bad ``motion.units`` is reported beside a bad ``hazard.units``)."""
+    rest = {k: v for k, v in data.items() if k != "hazard"}
+    try:
+        study = Study.model_validate(rest)
+    except ValidationError:
+        return []
+    return [x for x in _problems_beside(study, base_dir) if not x.startswith("hazard")]
+
+
+def _problems_beside(study, base_dir) -> list[str]:
+    """:func:`problems` of a study whose objects or hazard file could not be read (what they
+    leave may be checked or may fail on their absence: then nothing more is said)."""
+    try:
+        return problems(study, base_dir)
+    except Exception:  # noqa: BLE001 - the file's own problem is already reported
+        return []
 
 
 def _motion_problems(data, base_dir) -> list[str]:
