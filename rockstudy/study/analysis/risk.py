@@ -160,16 +160,14 @@ def _uplift(ds, hazard):
 
 def share_below(theta, beta, hazard, level, units=None) -> float:
     """The share of lambda_OT (:func:`rockstudy.risk.annual_rate`) that comes from intensities
-    below ``level`` (in the hazard's units): the deaggregation of the curve with ``level``
-    inserted among its levels (at its interpolated rate, which leaves the curve unchanged).
-    NaN without a rate or a level."""
+    below ``level`` (in the hazard's units): what setting the fragility to 0 below ``level``
+    takes away (``threshold``). NaN without a rate or a level."""
     if not (np.isfinite(level) and level > 0 and np.isfinite(theta) and np.isfinite(beta)):
         return np.nan
-    x = np.union1d(hazard.levels, [level])
-    curve = risk.HazardCurve(hazard.im, x, hazard.rate(x), hazard.units, hazard.period)
-    _, upper, parts = risk.rate_deaggregation(theta, beta, curve, units)
-    total = parts.sum()
-    return float(parts[upper <= level].sum() / total) if total > 0 else np.nan
+    whole = risk.annual_rate(theta, beta, hazard, units)
+    factor = risk.UNIT_FACTORS[hazard.units][0] / risk.UNIT_FACTORS[units or hazard.units][0]
+    above = risk.annual_rate(theta, beta, hazard, units, threshold=level * factor)
+    return float(1.0 - above / whole) if whole > 0 else np.nan
 
 
 def _rate(theta, beta, hazard, unit, cut=None):

@@ -166,7 +166,8 @@ def _risk(page, ds, hazard, years, im_label):
             "fragility is not cut there (the whole lognormal is integrated); check the design's "
             "records and structures."
         )
-    beyond = _share_beyond(out)
+    table = _risk_table(out)
+    beyond = table["share beyond the curve's levels"].to_numpy()
     wide = np.flatnonzero(beyond > EXTRAPOLATED_SHARE)
     if wide.size:
         names = ", ".join(str(out["structure"].values[j]) for j in wide)
@@ -176,7 +177,6 @@ def _risk(page, ds, hazard, years, im_label):
             "end interval (column 'share beyond the curve's levels'): extend the curve (or "
             "check its units)."
         )
-    table = _risk_table(out)
     optional = [c for c in table if "at most" in c or "at least" in c or "uplift" in c]
     optional += [c for c in table if "below" in c or "just above" in c]
     terms = [c for c in table if "uplift" in c or "whole" in c or "beyond" in c or "below" in c]
