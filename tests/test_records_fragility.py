@@ -416,3 +416,16 @@ def test_capacities_that_share_a_record_are_not_counted_as_independent():
         assert r["p_band"] == "record_bootstrap"
         hits += r["theta_lo"] <= 0.5 * 1.01 <= r["theta_hi"]
     assert hits / runs >= 0.8
+
+
+def test_ida_capacities_all_equal_are_flagged_not_given_a_zero_width_band():
+    """Five records with one capacity (one record five times): beta = 0 is the MLE, but it
+    measures no spread; the fit warns and gives no interval instead of theta_lo = theta_hi."""
+    pga = np.full(5, 2.0)
+    ds = _ida_dataset((np.full(5, 0.5) * G_UNIT / pga)[:, None], pga, pga / 10, [1.0], [2.7])
+    with pytest.warns(UserWarning, match="all 0.5 g"):
+        t = rf.ida_fragility(ds)
+    row = t.loc["all"]
+    assert row["theta"] == pytest.approx(0.5, rel=1e-12) and row["beta"] == 0.0
+    assert np.isnan([row["theta_lo"], row["theta_hi"], row["beta_lo"], row["beta_hi"]]).all()
+    assert row["p_band"] == "none"

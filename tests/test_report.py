@@ -250,3 +250,35 @@ def test_median_in_g_reads_not_reached_where_the_median_is(tmp_path):
     in_g = shown["fragility"]["median capacity [g] (a_g only)"].tolist()
     assert in_g[0] == pytest.approx(5.0 / G_UNIT, rel=1e-15)
     assert in_g[1] == NOT_REACHED
+
+
+@pytest.mark.parametrize("kind, drawn", [("block", True), ("rocking_wall", False)])
+def test_overturning_map_closed_forms_follow_the_simulated_block(tmp_path, kind, drawn):
+    """The closed-form boundaries of [000] Fig. 4 hold for a slender block: they are drawn for
+    blocks of alpha <= 0.3, not for walls of the same slenderness, whose equivalent block
+    rocks on theta_cr = 2 alpha up to 0.6 (eq. 23 of [003])."""
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rockstudy.structures import RockingWall
+    from rockstudy.study.report import sampled as report
+
+    rng = np.random.default_rng(0)
+    alpha = rng.uniform(0.05, 0.3, 200)
+    theta_cr = alpha if kind == "block" else RockingWall.equivalent_parameters(1.0, alpha)[1]
+    ds = xr.Dataset(
+        {
+            "omega": ("sample", rng.uniform(1.0, 10.0, 200)),
+            "amplitude_ratio": ("sample", rng.uniform(1.0, 5.0, 200)),
+            "overturned": ("sample", (rng.uniform(size=200) < 0.3).astype(np.int8)),
+            "slenderness": ("sample", alpha),
+            "critical_rotation": ("sample", theta_cr),
+            "restitution": ("sample", np.full(200, 0.9)),
+        }
+    )
+    page = report._Page(tmp_path)
+    report._overturning_map(page, ds, SimpleNamespace(motion=SimpleNamespace(shape="sine")))
+    text = "".join(page.parts)
+    assert ("No closed-form boundary drawn" in text) is not drawn
+    assert ("Lines: the closed-form boundaries" in text) is drawn

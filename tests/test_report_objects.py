@@ -345,10 +345,11 @@ def test_an_ida_friction_warning_says_which_scenes_and_a_lift_off_reads_in_words
     assert float(table.loc[f"Stele / {rec.name}", column]) > 0.05
 
 
-def test_the_pga_fragility_drawn_is_zero_below_uplift_under_horizontal_records(records):
-    """Drawn solid: 0 below each object's uplift PGA g tan(alpha) (nothing can rock there)
-    and the fitted lognormal Phi(ln(x / theta) / beta) above it; with a vertical component
-    in the design, the whole lognormal."""
+@pytest.mark.parametrize("im", ["pga", "pga_ratio"])
+def test_the_pga_fragility_drawn_is_zero_below_uplift_under_horizontal_records(records, im):
+    """Drawn solid: 0 below each object's uplift PGA g tan(alpha) (1 in PGA / a_up: nothing
+    can rock there) and the fitted lognormal Phi(ln(x / theta) / beta) above it; with a
+    vertical component in the design, the whole lognormal."""
     from scipy.stats import norm
 
     from rockstudy.study.report import objects as ro
@@ -361,16 +362,16 @@ def test_the_pga_fragility_drawn_is_zero_below_uplift_under_horizontal_records(r
         ds["vertical_component"] = ("record", np.full(ds.sizes["record"], vertical))
         ctx = ReportContext(ds, n_boot=0)
         ctx.im_label = im_label
-        t = ro._object_fit(ctx, "pga", None)  # two records: separated, so a fit is given
+        t = ro._object_fit(ctx, im, None)  # two records: separated, so a fit is given
         t["theta"], t["beta"], t["p_band"] = [0.5, 0.8], [0.6, 0.4], "none"
         t[["var_ln_theta", "var_ln_beta", "cov_ln_theta_ln_beta"]] = 0.0
         fig, ax = _plt().subplots()
-        assert ro._plot_objects(ax, ctx, t, "pga", None)
+        assert ro._plot_objects(ax, ctx, t, im, None)
         solid = [ln for ln in ax.lines if ln.get_linestyle() == "-"]
         for name, line in zip(t.index, solid, strict=True):
             x, y = line.get_xdata(), line.get_ydata()
             fit = norm.cdf(np.log(x / t.loc[name, "theta"]) / t.loc[name, "beta"])
-            x_u = G * math.tan(OBJECTS[name].slenderness) / G_UNIT
+            x_u = G * math.tan(OBJECTS[name].slenderness) / G_UNIT if im == "pga" else 1.0
             expected = fit if vertical else np.where(x >= x_u, fit, 0.0)
             np.testing.assert_allclose(y, expected, rtol=1e-9, atol=1e-15)
             assert vertical or (x < x_u).any()

@@ -461,3 +461,17 @@ def test_a_scaled_record_within_range_is_accepted(tmp_path):
     """Not a refusal too many: a PGA target of 1e6 m/s^2 (about 1e5 g) is taken."""
     rec = write_csv(tmp_path / "r.csv", [0.0, 0.01, 0.02, 0.03], [0.0, 0.1, -0.1, 0.0])
     validate_text(record_study([rec], 'scale_to = { im = "pga", value = 1e6 }'))
+
+
+def test_replicates_of_another_structure_kind_name_the_kind():
+    """Replicates compare blocks (R, alpha) at one group point: a wall with its restitution
+    given is refused for its kind, not told that its restitution is Housner's."""
+    text = (Path(__file__).resolve().parents[1] / "studies" / "self_similarity_61.toml").read_text()
+    wall = text.replace('kind = "block"', 'kind = "rocking_wall"').replace(
+        "high = 0.35 }", "high = 0.3 }"
+    )
+    message = refused(wall)
+    assert "sampler.replicates" in message and '"rocking_wall"' in message, message
+    assert "Housner" not in message
+    housner = text.replace('restitution = { dist = "uniform", low = 0.8, high = 0.96 }\n', "")
+    assert "Housner" in refused(housner)

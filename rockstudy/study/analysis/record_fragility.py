@@ -325,6 +325,17 @@ def _exact_intervals(theta, beta, n, conf_level):
     return (theta * np.exp(-half), theta * np.exp(half)), tuple(beta * np.sqrt(n / chi))
 
 
+def _warn_equal_capacities(label, theta, n, unit):
+    """Warn that the ``n`` capacities of group ``label`` are all ``theta``: beta = 0."""
+    warnings.warn(
+        f"ida_fragility: the {n} capacities of group {label!r} are all {theta:.6g} {unit}: "
+        "beta = 0 is a step, not a record-to-record dispersion (the same record more than "
+        "once in the suite?); its intervals are NaN",
+        UserWarning,
+        stacklevel=3,
+    )
+
+
 def ida_fragility(
     ds: xr.Dataset,
     im: str | None = None,
@@ -367,7 +378,10 @@ def ida_fragility(
         cov = capacities_covariance(c[keep & ~cens], t[keep & cens], theta, beta)
         n_unc = int((keep & ~cens).sum())
         pooled = int(mask.sum()) > 1  # several structures share each record
-        if not cens[keep].any() and n_unc >= 2 and beta > 0 and not pooled:
+        if n_unc >= 2 and beta == 0.0:  # every capacity the same: no spread to fit or band
+            band, method = ((np.nan, np.nan), (np.nan, np.nan)), "none"
+            _warn_equal_capacities(label, theta, n_unc, unit)
+        elif not cens[keep].any() and n_unc >= 2 and beta > 0 and not pooled:
             band, method = _exact_intervals(theta, beta, n_unc, conf_level), "noncentral_t"
         elif not np.isfinite(beta):
             band, method = ((theta, theta), (np.nan, np.nan)), "none"

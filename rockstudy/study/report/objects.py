@@ -313,6 +313,17 @@ def object_fragility(page, ctx):
     page.table(shown, "object_fragility", "Fragility of each object, by name (90 % bands)")
 
 
+def _cut(ctx, im) -> np.ndarray:
+    """Where each object's fragility is 0 (:func:`cut_levels`: nothing overturns below its
+    uplift, or below where the simulated block lifts if lower), in ``im``: PGA, or PGA / a_up;
+    NaN for another measure or where there is no cut."""
+    if im not in ("pga", "pga_ratio"):
+        return np.full(ctx.ds.sizes["structure"], np.nan)
+    up = _uplift(ctx, "pga")
+    level = cut_levels(ctx.ds, "pga", ctx.units, up)
+    return level if im == "pga" else level / up
+
+
 def _plot_objects(ax, ctx, t, im, period) -> bool:
     """Each object's fitted curve and band on ``ax``; False (nothing drawn) when no fit is
     defined."""
@@ -325,8 +336,7 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
         return False
     grid = np.geomspace(low / 1.2, high * 1.2, 200)
     curve = fragility_curve(t, grid)
-    # nothing overturns below the cut (uplift, or where the simulated block lifts if lower)
-    cut = cut_levels(ctx.ds, im, ctx.units, up) if up is not None else np.full(len(names), np.nan)
+    cut = _cut(ctx, im)
     shade = 0.15 if curve.sizes["group"] <= 3 else 0.07  # many bands overlap
     drawn = 0
     for g in curve.group.values:

@@ -495,8 +495,7 @@ def _overturning_map(page, ds, study):
     ax.scatter(w[over], a[over], s=3, c="C3", alpha=0.4, lw=0, label="overturned")
     applies = (
         getattr(study.motion, "shape", None) == "sine"
-        and "slenderness" in d
-        and float(d["slenderness"].max()) <= SLENDER_LIMIT
+        and float(d["critical_rotation"].max()) <= SLENDER_LIMIT  # of the block simulated
     )
     if applies:
         eta = float(np.median(d["restitution"].values)) if "restitution" in d else 1.0
@@ -521,7 +520,7 @@ def _overturning_map(page, ds, study):
     else:
         note = (
             "No closed-form boundary drawn: those of [000] Fig. 4 hold for a sine pulse on a "
-            f"slender block (alpha <= {SLENDER_LIMIT}) only."
+            f"slender block (theta_cr <= {SLENDER_LIMIT}, of the block simulated) only."
         )
     ax.set(
         xscale="log",

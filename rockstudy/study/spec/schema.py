@@ -1027,7 +1027,13 @@ class Study(_Model):
                     "replicates need a pulse given by its groups: amplitude_ratio "
                     "or amplitude_a, and frequency_ratio",
                 )
-            if st.kind != "block" or st.restitution == "housner":
+            if st.kind != "block":  # the self-similarity report reads a block's (R, alpha)
+                raise FieldError(
+                    "sampler.replicates",
+                    f'replicates need structure.kind = "block" (got "{st.kind}"): the '
+                    "self-similarity section compares blocks (R, alpha) at one group point",
+                )
+            if st.restitution == "housner":
                 raise FieldError(
                     "sampler.replicates",
                     "replicates need a block with a given restitution (Housner's "
