@@ -475,3 +475,28 @@ def test_replicates_of_another_structure_kind_name_the_kind():
     assert "Housner" not in message
     housner = text.replace('restitution = { dist = "uniform", low = 0.8, high = 0.96 }\n', "")
     assert "Housner" in refused(housner)
+
+
+@pytest.mark.parametrize(
+    "old, new, line",
+    [
+        ("rtol = 1e-8", "rtoll = 1e-8", "run.rtoll: is not a setting here; did you mean 'rtol'?"),
+        ("seed = ", "chunksize = 9\nseed = ", "chunksize: is not a setting here; did you mean "),
+        ("[sampler]", "[sampler]\nreplicate = 2", "did you mean 'replicates'?"),
+    ],
+)
+def test_a_misspelt_setting_is_named_with_the_settings_it_resembles(old, new, line):
+    """A typo names the field and the settings of its own table that it resembles."""
+    assert old in PULSE
+    assert line in refused(PULSE.replace(old, new, 1))
+
+
+def test_a_misspelt_setting_of_a_kind_or_an_object_resembles_that_kinds_settings():
+    """Inside a table chosen by its kind (the structure), and inside an object of a list."""
+    quick = (Path(__file__).resolve().parents[1] / "studies" / "quickstart.toml").read_text()
+    message = refused(quick.replace("slenderness = {", "slendernes = {"))
+    assert "structure.slendernes: is not a setting here; did you mean 'slenderness'?" in message
+    museum = (Path(__file__).resolve().parents[1] / "studies" / "museum.toml").read_text()
+    message = refused(museum.replace("width = 0.50", "widht = 0.50", 1))
+    assert ".widht: is not a setting here; did you mean 'width'?" in message
+    assert "'rtol'" not in refused(quick.replace("seed = 2026", "seed = 2026\nzzz = 1"))

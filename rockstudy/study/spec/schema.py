@@ -38,6 +38,7 @@ Example (``studies/quickstart.toml``)::
 from __future__ import annotations
 
 import csv
+import difflib
 import hashlib
 import io
 import json
@@ -1265,6 +1266,30 @@ _MUST_BE = {
 }
 
 
+def _settings_at(loc) -> list[str]:
+    """The settings of the table at the pydantic location ``loc`` (a union's tags included),
+    read from the JSON schema of study files; [] where the path cannot be followed."""
+    schema = json_schema()
+
+    def resolve(node):
+        while "$ref" in node:
+            node = schema["$defs"][node["$ref"].rsplit("/", 1)[-1]]
+        return node
+
+    node = resolve(schema)
+    for key in loc:
+        if key in node.get("properties", {}):
+            node = resolve(node["properties"][key])
+        elif key in node.get("discriminator", {}).get("mapping", {}):
+            node = resolve({"$ref": node["discriminator"]["mapping"][key]})
+        elif isinstance(key, int) and "items" in node:
+            node = resolve(node["items"])
+        else:
+            return []
+    tables = [resolve(n) for n in node.get("oneOf", node.get("anyOf", [node]))]
+    return sorted({name for t in tables for name in t.get("properties", {})})
+
+
 def _sentence(e: dict, keys: list) -> str:
     """One plain sentence for one pydantic error (``keys`` may be extended)."""
     kind, ctx, value = e["type"], e.get("ctx", {}), e.get("input")
@@ -1275,6 +1300,9 @@ def _sentence(e: dict, keys: list) -> str:
             return 'is required (unless [structure] kind = "objects")'
         return "is required"
     if kind == "extra_forbidden":
+        close = difflib.get_close_matches(str(e["loc"][-1]), _settings_at(e["loc"][:-1]), 3)
+        if close:
+            return f"is not a setting here; did you mean {' or '.join(map(repr, close))}?"
         return "is not a setting here (a typo?); `rockstudy schema` lists the settings"
     if kind in _MUST_BE:
         return f"must be {_MUST_BE[kind]}, got {got}"
