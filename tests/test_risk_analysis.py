@@ -146,6 +146,16 @@ def test_stripes_overturned_everywhere_give_a_lower_bound():
     assert str(out["status"].values[0]) == "all"
     assert float(out["rate_lower_bound"].values[0]) == pytest.approx(K0 * 0.2**-K, rel=1e-9)
     assert np.isnan(out["annual_rate"].values[0])
+    assert np.isnan(out["rate_upper_bound"].values[0])  # a design that does not say horizontal
+    # horizontal records and an uplift PGA of 0.1 g: nothing overturns below it, P(OT) <= 1
+    # above, so lambda(0.1 g) >= lambda_OT >= lambda(0.2 g)
+    cut = ds.assign(
+        vertical_component=("record", np.zeros(n_rec, bool)),
+        uplift_acceleration=("structure", [0.1 * G_UNIT]),
+    )
+    out = object_risk(cut, hazard, n_boot=10)
+    assert float(out["rate_upper_bound"].values[0]) == pytest.approx(K0 * 0.1**-K, rel=1e-9)
+    assert float(out["rate_lower_bound"].values[0]) == pytest.approx(K0 * 0.2**-K, rel=1e-9)
 
 
 def test_a_hazard_the_design_cannot_express_is_refused():

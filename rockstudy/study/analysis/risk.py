@@ -23,7 +23,8 @@ What the records cannot say is marked, not invented (``status``):
   empirical capacity distribution is below lambda(x_c);
 - ``"all"``: (stripes, clouds) the object overturned at every point: no fit; the rate of
   exceeding the lowest intensity simulated, ``rate_lower_bound``, is what it is at least,
-  as far as the points say;
+  as far as the points say; where the fragility is cut (nothing overturns below the uplift
+  PGA), the rate of exceeding the cut, ``rate_upper_bound``, is what it is at most;
 - ``"separated"``: (stripes, clouds) every point at which the object overturned lies at or
   above every point at which it stood (:func:`.fragility_fit.separation`): the likelihood
   has no maximum, the data bound the median but not the dispersion beta, and lambda_OT of a
@@ -296,7 +297,8 @@ def object_risk(
         ``n_records``, ``n_overturning`` (records under which it overturned), ``status``
         (:data:`STATUSES`), ``annual_rate`` [1/yr] with ``annual_rate_lo``/``_hi`` (the band),
         ``probability`` in ``years`` with ``probability_lo``/``_hi``, ``return_period`` [yr],
-        ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, NaN elsewhere),
+        ``rate_upper_bound`` / ``rate_lower_bound`` (``"none"`` / ``"all"``, and
+        ``rate_upper_bound`` of an ``"all"`` whose fragility is cut; NaN elsewhere),
         ``boot_valid`` (resamples that gave a rate), ``uplift`` (for a PGA hazard: the uplift
         PGA, g tan(alpha) of a block and g lambda of another structure, eq. 10 of [003], in
         ``hazard.units``), ``truncated_at_uplift`` (True where the fragility is 0 below
@@ -367,12 +369,19 @@ def _bands(boot, conf_level):
     return lo, hi, valid
 
 
-def _bounds(status, lowest, hazard, ida):
-    """``rate_upper_bound`` (an IDA's "none") and ``rate_lower_bound`` (stripes' "all")."""
+def _bounds(status, lowest, hazard, ida, cut):
+    """``rate_upper_bound`` (an IDA's "none"; stripes' "all" where the fragility is cut: P(OT)
+    <= 1 from the cut on and 0 below it, so lambda_OT <= lambda(cut)) and ``rate_lower_bound``
+    (stripes' "all")."""
     at = hazard.rate(np.where(np.isfinite(lowest) & (lowest > 0), lowest, 1.0))
     ok = np.isfinite(lowest) & (lowest > 0)
-    upper = np.where(ida & (status == "none") & ok, at, np.nan)
-    lower = np.where(~ida & (status == "all") & ok, at, np.nan)
+    cut_ok = np.isfinite(cut) & (cut > 0)
+    at_cut = hazard.rate(np.where(cut_ok, cut, 1.0))
+    everywhere = ~ida & (status == "all")
+    upper = np.where(
+        ida & (status == "none") & ok, at, np.where(everywhere & cut_ok, at_cut, np.nan)
+    )
+    lower = np.where(everywhere & ok, at, np.nan)
     return upper, lower
 
 
@@ -399,7 +408,7 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs, levels):
         )[2]
     parts = np.where(fitted[:, None], parts, np.nan)
     status = np.array(status, dtype=object)
-    upper, lower = _bounds(status, lowest, hazard, attrs["design"] == "ida")
+    upper, lower = _bounds(status, lowest, hazard, attrs["design"] == "ida", cut)
     v = {
         "theta": np.where(np.isfinite(theta), theta * to_hazard, theta),
         "beta": beta,

@@ -135,7 +135,9 @@ def _risk(page, ds, hazard, years, im_label):
     page.text(
         "Status 'ok': at least 5 records overturned the object; 'few': fewer; "
         "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
-        "'all': it overturned at every point (stripes give a lower bound); 'separated': "
+        "'all': it overturned at every point (stripes give a lower bound, and under "
+        "horizontal records an upper bound: the rate of exceeding the PGA below which its "
+        "fragility is 0); 'separated': "
         "every point at which it overturned lies at or above every point at which it stood, "
         "so the fragility's dispersion cannot be estimated and no rate is given (a step "
         "function would be a guess, not an estimate); 'no rise': the points at which it "
