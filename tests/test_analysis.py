@@ -298,3 +298,42 @@ def test_fragility_bad_arguments_are_named():
         analysis.fragility(ds, "pga")
     with pytest.raises(ValueError, match="table: not a fragility table"):
         analysis.fragility_curve(ds.to_dataframe(), [1.0])
+
+
+def _rocking_with_falls(n=4000, seed=3):
+    """Samples whose survivors' peak rotation ratio depends on the amplitude alone, and whose
+    overturned samples carry the fall rotation pi/2 over alpha (the cube's convention): any
+    index of alpha on the ratio comes from the falls."""
+    rng = np.random.default_rng(seed)
+    alpha, amp = rng.uniform(0.05, 0.3, n), rng.uniform(1.0, 5.0, n)
+    over = (amp > 2.0).astype(np.int8)  # all but the weakest pulses overturn
+    ratio = np.where(over == 1, 0.5 * np.pi / alpha, 0.1 * amp)
+    return xr.Dataset(
+        {
+            "slenderness": ("sample", alpha),
+            "amplitude_ratio": ("sample", amp),
+            "overturned": ("sample", over),
+            "max_rotation_ratio": ("sample", ratio),
+        }
+    )
+
+
+def test_first_order_of_a_rotation_warns_when_the_falls_are_in_it():
+    """On every sample the falls give alpha a large index, and the call warns; on the
+    survivors (as the report computes it) alpha has none and amplitude has it all."""
+    ds = _rocking_with_falls()
+    names = ["slenderness", "amplitude_ratio"]
+    with pytest.warns(UserWarning, match="fall rotation"):
+        mixed = analysis.first_order_given_data(ds, "max_rotation_ratio", names)
+    assert mixed.loc["slenderness", "S1"] > 0.3
+    survivors = ds.where(ds.overturned == 0, drop=True)
+    clean = analysis.first_order_given_data(survivors, "max_rotation_ratio", names)
+    assert clean.loc["slenderness", "S1"] < 0.05 and clean.loc["amplitude_ratio", "S1"] > 0.9
+
+
+def test_sobol_of_a_rotation_with_falls_warns():
+    ds, names = ishigami_cube(n=2**8)
+    over = (np.arange(ds.sizes["sample"]) % 5 == 0).astype(np.int8)
+    ds = ds.assign(overturned=("sample", over), max_rotation_ratio=ds["y"])
+    with pytest.warns(UserWarning, match="mix overturning with the rocking amplitude"):
+        analysis.sobol_indices(ds, "max_rotation_ratio", num_resamples=10)

@@ -282,3 +282,25 @@ def test_overturning_map_closed_forms_follow_the_simulated_block(tmp_path, kind,
     text = "".join(page.parts)
     assert ("No closed-form boundary drawn" in text) is not drawn
     assert ("Lines: the closed-form boundaries" in text) is drawn
+
+
+def test_the_reports_first_order_indices_of_the_rotation_leave_out_the_falls(tmp_path):
+    """The survivors' peak rotation ratio depends on the amplitude alone; the falls carry pi /
+    (2 alpha). The report's index of alpha on the ratio is that of the survivors (near 0),
+    not the one the falls make (large)."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+    from test_analysis import _rocking_with_falls
+
+    from rockstudy.study.report import sampled as report
+
+    ds = _rocking_with_falls()
+    study = SimpleNamespace(parameters=lambda: {"slenderness": None, "amplitude_ratio": None})
+    page = report._Page(tmp_path)
+    report._first_order(page, ds, study)
+    t = pd.read_csv(tmp_path / "first_order.csv")
+    ratio = t[(t["on"] == "inputs") & t["output"].str.contains("rotation")]
+    s1 = dict(zip(ratio["variable"], ratio["S1"], strict=True))
+    assert s1[report._label("slenderness")] < 0.05
+    assert s1[report._label("amplitude_ratio")] > 0.9

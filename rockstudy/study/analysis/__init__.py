@@ -8,6 +8,7 @@ object's fragility and a site's hazard curve into its annual rate of overturning
 """
 
 from .sampled import (
+    ROTATION_OUTPUTS,
     UnexplainedShare,
     collapse_metric,
     first_order_given_data,
@@ -20,6 +21,7 @@ from .sampled import (
 )
 
 __all__ = [
+    "ROTATION_OUTPUTS",
     "UnexplainedShare",
     "collapse_metric",
     "first_order_given_data",

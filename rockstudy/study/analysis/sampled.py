@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import warnings
 from itertools import combinations_with_replacement
 from typing import Literal, NamedTuple
 
@@ -62,6 +63,30 @@ def _values(ds, output, failed: FailedPolicy):
     return y, bad
 
 
+#: Outputs whose value for an overturned sample is a convention (the fall rotation pi/2, over
+#: theta_cr for the ratio), not a rocking amplitude.
+ROTATION_OUTPUTS = ("max_rotation", "max_rotation_ratio")
+
+
+def warn_if_rotation_of_overturned(ds, output, who) -> None:
+    """Warn when ``output`` is a peak rotation and some samples of ``ds`` overturned: their
+    value is the fall rotation (pi/2, pi/(2 theta_cr) as a ratio), so indices of it on the
+    whole design mix overturning with the rocking amplitude."""
+    if output not in ROTATION_OUTPUTS or "overturned" not in ds:
+        return
+    n = int((ds["overturned"].values == 1).sum())
+    if n:
+        warnings.warn(
+            f"{who}: {n} of {ds.sizes['sample']} samples overturned, and their {output} is the "
+            "fall rotation pi/2 (over theta_cr for the ratio), which depends on theta_cr alone: "
+            f"indices of {output} mix overturning with the rocking amplitude. Analyse "
+            "'overturned' for overturning, and the survivors' rotation with "
+            "first_order_given_data on ds.where(ds.overturned == 0, drop=True)",
+            UserWarning,
+            stacklevel=3,
+        )
+
+
 def sobol_indices(
     ds: xr.Dataset,
     output: str,
@@ -95,6 +120,7 @@ def sobol_indices(
     d = len(names)
     block = 2 * d + 2 if second_order else d + 2
     y, bad = _values(ds, output, failed)
+    warn_if_rotation_of_overturned(ds, output, "sobol_indices")
     if y.size % block:
         raise ValueError(f"{y.size} samples is not a whole number of Saltelli blocks of {block}")
     if failed == "drop" and bad.any():
@@ -147,6 +173,7 @@ def first_order_given_data(
     from SALib.analyze import rbd_fast
 
     y, bad = _values(ds, output, failed)
+    warn_if_rotation_of_overturned(ds, output, "first_order_given_data")
     x = np.column_stack([np.asarray(ds[v].values, float) for v in variables])
     keep = ~bad & np.all(np.isfinite(x), axis=1)
     x, y = x[keep], y[keep]
