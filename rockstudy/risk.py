@@ -23,6 +23,7 @@ from scipy.special import log_ndtr, ndtr
 
 from .constants import STANDARD_GRAVITY
 from .motions import measures
+from .motions.records import IMPOSSIBLE_PGA
 
 #: Units a hazard curve's levels may be given in: name -> (factor to SI, SI unit). An IM's SI
 #: unit is that of the registry (:mod:`rockstudy.motions.measures`); its levels may be in any
@@ -273,7 +274,7 @@ class HazardCurve:
 
 #: Levels no ground motion reaches, in SI (the largest PGA recorded is about 4 g, the largest
 #: PGV about 4 m/s): a hazard curve beyond them has its levels in other units than declared.
-IMPOSSIBLE_LEVELS = {"pga": 10.0 * STANDARD_GRAVITY, "sa": 30.0 * STANDARD_GRAVITY, "pgv": 10.0}
+IMPOSSIBLE_LEVELS = {"pga": IMPOSSIBLE_PGA, "sa": 30.0 * STANDARD_GRAVITY, "pgv": 10.0}
 
 
 def _check_plausible(im, levels, units) -> None:

@@ -277,3 +277,45 @@ def test_validate_refuses_a_study_whose_glob_finds_a_special_file(tmp_path, kind
         validate_text(text, base_dir=tmp_path)
     message = str(err.value)
     assert "motion.files" in message and str(bad) in message and WHAT[kind] in message, message
+
+
+@pytest.mark.parametrize("columns", [("time", "horizontal"), ("time", "horizontal", "vertical")])
+def test_a_text_record_in_cm_s2_read_as_g_is_refused_naming_units(tmp_path, columns):
+    """A record of 272 cm/s^2 read in the default units (g) would peak at 272 g: refused,
+    naming units; read in cm/s2 it is 2.72 m/s^2."""
+    t = np.arange(200) * 0.01
+    a = 272.0 * np.sin(2 * np.pi * t)  # cm/s^2
+    data = np.column_stack([t, a] + ([0.3 * a] if "vertical" in columns else []))
+    path = tmp_path / "cms2.txt"
+    np.savetxt(path, data)
+    with pytest.raises(
+        ValueError, match=r"units='g': its peak acceleration reads 272 g, beyond any ground motion"
+    ):
+        Record.from_csv(path, columns=columns)
+    rec = Record.from_csv(path, units="cm/s2", columns=columns)
+    assert np.max(np.abs(rec.acceleration)) == pytest.approx(2.72, rel=1e-3)
+    a10 = np.column_stack([t, 9.99 * np.sin(2 * np.pi * t)])  # 9.99 g: strong, but read
+    np.savetxt(path, a10)
+    assert np.max(np.abs(Record.from_csv(path).acceleration)) <= 10 * STANDARD_GRAVITY
+
+
+def test_a_suite_of_text_records_in_cm_s2_read_as_g_names_motion_units(tmp_path):
+    """In a study file the refusal names motion.units, not the files (which were read)."""
+    from rockstudy.study import StudyError, validate_text
+
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    t = np.arange(300) * 0.01
+    np.savetxt(folder / "a.txt", np.column_stack([t, 272.0 * np.sin(2 * np.pi * t)]))
+    study = (
+        'name = "s"\nseed = 1\n[sampler]\nkind = "lhs"\nn = 4\n[structure]\nkind = "block"\n'
+        'half_diagonal = { dist = "uniform", low = 0.5, high = 1.0 }\n'
+        'slenderness = { dist = "uniform", low = 0.15, high = 0.3 }\n'
+        '[motion]\nkind = "record"\nfiles = "recs"\nunits = "g"\n'
+        'scale_to = { im = "pga_ratio", value = { dist = "grid", values = [1.0, 2.0] } }\n'
+        '[design]\nkind = "stripes"\n'
+    )
+    with pytest.raises(StudyError) as err:
+        validate_text(study, base_dir=tmp_path)
+    assert "motion.units:" in str(err.value) and "272 g, beyond any ground motion" in str(err.value)
+    validate_text(study.replace('units = "g"', 'units = "cm/s2"'), base_dir=tmp_path)

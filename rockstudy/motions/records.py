@@ -24,6 +24,10 @@ MAX_RECORD_BYTES = 64 * 2**20
 #: Factor to m/s^2 of each acceleration unit; "g" is standard gravity (the PEER convention).
 _UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
 
+#: A PGA no ground motion reaches [m/s^2] (the largest recorded is about 4 g): a file that
+#: reads above it is in other units than those it was read in (cm/s^2 read as g: 100 times).
+IMPOSSIBLE_PGA = 10.0 * STANDARD_GRAVITY
+
 #: Methods of :meth:`Record.pulse`.
 PULSE_METHODS = {"wavelet": extract_wavelet_pulse, "mavroeidis": extract_pulse}
 
@@ -431,6 +435,7 @@ class Record(Motion):
             path,
             lambda: cls(col["horizontal"] * factor, **timing, name=path.stem, vertical=vert),
         )
+        _check_plausible_pga(path, record, units)
         if vertical is None:
             return record
         return record._with_vertical(
@@ -520,6 +525,27 @@ def _first_bad_line(lines, delimiter, skip_names=0, ncol=2) -> tuple:
         if len(values) != ncol:
             return i, len(values)
     return 0, 0
+
+
+class UnitsError(ValueError):
+    """A record file whose samples, read in the units given, are beyond any ground motion."""
+
+
+def _check_plausible_pga(path, record, units) -> None:
+    """A :class:`UnitsError` naming ``units`` where a component read from ``path`` in
+    ``units`` peaks beyond any ground motion (:data:`IMPOSSIBLE_PGA`)."""
+    for what, a in (("", record.acceleration), (" vertical", record.vertical)):
+        peak = 0.0 if a is None else float(np.max(np.abs(a)))
+        if peak > IMPOSSIBLE_PGA * (1.0 + 1e-9):
+            reads = f"{peak / _UNITS[units]:.4g} {units}"
+            if units != "g":
+                reads += f" = {peak / STANDARD_GRAVITY:.4g} g"
+            raise UnitsError(
+                f"{path}: units={units!r}: its{what} peak acceleration reads {reads}, beyond "
+                f"any ground motion (above {IMPOSSIBLE_PGA / STANDARD_GRAVITY:g} g): are the "
+                "samples in other units (cm/s^2 read as g)? give the units they are in "
+                '(units="cm/s2" or "m/s2")'
+            )
 
 
 def _build(path, make) -> Record:

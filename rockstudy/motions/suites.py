@@ -11,7 +11,7 @@ import glob
 import re
 from pathlib import Path
 
-from .records import Record, not_a_file
+from .records import Record, UnitsError, not_a_file
 
 #: Suffixes (case-insensitive) of the files read from a folder.
 RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
@@ -69,6 +69,9 @@ def _read(path: Path, units: str, field: str) -> Record:
         if path.suffix.lower() == ".at2":
             return Record.from_at2(path)
         return Record.from_csv(path, units=units)
+    except UnitsError as exc:  # the file is read; the units it was read in are wrong
+        units_field = f"{field.rpartition('.')[0]}.units".lstrip(".")
+        raise ValueError(f"{units_field}: {exc}") from exc
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise ValueError(f"{field}: cannot read the record file {str(path)!r}: {exc}") from exc
 
