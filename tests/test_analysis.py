@@ -337,3 +337,28 @@ def test_sobol_of_a_rotation_with_falls_warns():
     ds = ds.assign(overturned=("sample", over), max_rotation_ratio=ds["y"])
     with pytest.warns(UserWarning, match="mix overturning with the rocking amplitude"):
         analysis.sobol_indices(ds, "max_rotation_ratio", num_resamples=10)
+
+
+def test_lack_of_fit_holds_its_level_and_rejects_a_probability_that_levels_off():
+    """Outcomes drawn from a lognormal fragility: the Hosmer-Lemeshow p-value falls below
+    0.05 in about 5 % of the fits (its nominal level). Outcomes whose probability levels off
+    at 0.6 (a pulse too short to overturn the block whatever its strength) reject it."""
+    from scipy.stats import norm
+
+    rng = np.random.default_rng(8)
+    p_values = []
+    for _ in range(300):
+        im = np.exp(rng.uniform(np.log(0.1), np.log(10.0), 600))
+        over = (rng.uniform(size=im.size) < norm.cdf(np.log(im / 1.0) / 0.6)).astype(int)
+        t = analysis.fragility(
+            xr.Dataset({"im": ("sample", im), "o": ("sample", over)}), "im", outcome="o", n_boot=0
+        )
+        p_values.append(float(t["lack_of_fit_p"].iloc[0]))
+    assert 0.02 <= np.mean(np.array(p_values) < 0.05) <= 0.09
+    im = np.exp(rng.uniform(np.log(0.1), np.log(10.0), 600))
+    levels_off = 0.6 * norm.cdf(np.log(im / 0.5) / 0.3)
+    over = (rng.uniform(size=im.size) < levels_off).astype(int)
+    t = analysis.fragility(
+        xr.Dataset({"im": ("sample", im), "o": ("sample", over)}), "im", outcome="o", n_boot=0
+    )
+    assert float(t["lack_of_fit_p"].iloc[0]) < 1e-3

@@ -304,3 +304,46 @@ def test_the_reports_first_order_indices_of_the_rotation_leave_out_the_falls(tmp
     s1 = dict(zip(ratio["variable"], ratio["S1"], strict=True))
     assert s1[report._label("slenderness")] < 0.05
     assert s1[report._label("amplitude_ratio")] > 0.9
+
+
+def test_the_fragility_figure_draws_its_samples_and_warns_where_the_lognormal_misses(tmp_path):
+    """Each curve is drawn over its samples: the share overturned in eight equal-count bins of
+    the intensity, computed here with numpy. Outcomes whose probability levels off at 0.6 are
+    named in a warning; lognormal ones are not."""
+    from scipy.stats import norm
+
+    import xarray as xr
+
+    from rockstudy.study.report import sampled as report
+    from rockstudy.study.report._page import _plt
+
+    rng = np.random.default_rng(5)  # (the test rejects 1 % of lognormal data at 0.01)
+    n = 3000
+    size = rng.uniform(0.5, 3.0, n)
+    amp = np.exp(rng.uniform(np.log(0.5), np.log(20.0), n))
+    small = size < 1.5
+    p = np.where(small, 0.6 * norm.cdf(np.log(amp / 2.0) / 0.3), norm.cdf(np.log(amp / 4.0) / 0.5))
+    ds = xr.Dataset(
+        {
+            "half_diagonal": ("sample", size),
+            "abs_amplitude": ("sample", amp),
+            "period": ("sample", rng.uniform(0.5, 1.5, n)),
+            "overturned": ("sample", (rng.uniform(size=n) < p).astype(np.int8)),
+        }
+    )
+    page = report._Page(tmp_path)
+    fig, ax = _plt().subplots()
+    t = report._fragility_view(
+        page, ax, ds, np.array([0.5, 1.5, 3.0 + 1e-12]), "abs_amplitude", "period", "a_g"
+    )
+    third = report._middle_third(ds["period"].values)
+    markers = [ln for ln in ax.lines if ln.get_marker() == "o" and len(ln.get_xdata())]
+    for line, sel in zip(markers, (small & third, ~small & third), strict=True):
+        order = np.argsort(amp[sel], kind="stable")
+        groups = np.array_split(order, 8)
+        shares = [ds["overturned"].values[sel][g].mean() for g in groups]
+        np.testing.assert_allclose(line.get_ydata(), shares, rtol=1e-12)
+    report._lack_of_fit_warning(page, t)
+    text = "".join(page.parts)
+    assert "does not describe the samples of R 0.5 to 1.5 m" in text
+    assert "R 1.5 to 3 m" not in text

@@ -34,6 +34,7 @@ from .fragility_fit import (
     fit_binomial,
     fit_binomial_limit,
     fragility_row,
+    lack_of_fit,
     no_maximum_row,
     percentile_intervals,
     probability_band,
@@ -240,7 +241,10 @@ def fragility(
         ``im_min``-``im_max`` of the group, two flags: ``theta_in_range`` (the median lies
         within the observed intensities) and ``band_in_range`` (so does its whole band), and
         the covariance of (ln theta, ln beta) from which :func:`fragility_curve` forms the
-        pointwise band of P over both parameters (``p_band`` "likelihood").
+        pointwise band of P over both parameters (``p_band`` "likelihood"), and
+        ``lack_of_fit_p``, the p-value of the Hosmer-Lemeshow test of the fitted lognormal on
+        the samples (:func:`~rockstudy.study.analysis.fragility_fit.lack_of_fit`): below
+        0.01 the lognormal shape does not describe them (NaN without a fit).
         A median outside the data is an extrapolation of the lognormal shape, not a
         measurement: read it as "not reached within the sampled range" (or "below it").
         A group whose outcome never changes has no fit: its ``theta`` and band are ``inf``
@@ -309,7 +313,9 @@ def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
         band = percentile_intervals(boot, conf_level)
     else:
         band = wald_intervals(theta, beta, cov, conf_level)
-    return fragility_row(name, theta, beta, band, z.size, x, by, cov, "likelihood", conf_level)
+    row = fragility_row(name, theta, beta, band, z.size, x, by, cov, "likelihood", conf_level)
+    row["lack_of_fit_p"] = lack_of_fit(x, z, theta, beta)[2]
+    return row
 
 
 def fragility_curve(table: pd.DataFrame, im) -> xr.Dataset:

@@ -21,7 +21,7 @@ import pandas as pd
 from ...constants import STANDARD_GRAVITY, G
 from ...motions import measures
 from ..analysis import sampled as analysis
-from ..analysis.fragility_fit import BAND_COLUMNS
+from ..analysis.fragility_fit import BAND_COLUMNS, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
 from ..spec.schema import SAMPLER_LAYOUTS
@@ -155,9 +155,11 @@ def _fragility(page, ds, study=None):
         "the median and beta) by "
         "block size: in dimensional terms the sizes spread apart, in the groups they "
         "collapse (to the extent the groups make the response self-similar); dashed: the "
-        "median lies outside the sampled intensities; a_up is the uplift acceleration (g tan "
-        "alpha for a block)",
+        "median lies outside the sampled intensities; markers: the share of the samples that "
+        "overturned in eight bins of equal count along the intensity, the data each curve is "
+        "fitted to; a_up is the uplift acceleration (g tan alpha for a block)",
     )
+    _lack_of_fit_warning(page, pd.concat(tables))
     _fragility_table(page, pd.concat(tables))
     _fragility_spread(page, tables)
 
@@ -174,18 +176,53 @@ def _fragility_view(page, ax, d, bins, im, band, label):
         page.text(f"Fragility against {im}: {err}")
         return None
     # the groups by readable names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
-    t.index = [
-        f"R {lo:.3g} to {hi:.3g} m"
-        for lo, hi in (map(float, g.split("-")) for g in t.index.astype(str))
-    ]
+    edges = [tuple(map(float, g.split("-"))) for g in t.index.astype(str)]
+    t.index = [f"R {lo:.3g} to {hi:.3g} m" for lo, hi in edges]
     t.index.name = "block size"
     t.insert(0, "intensity", im)
     t.insert(1, "band", band)
     grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
     separation_note(page, t, f"Fragility against {im}")
     if draw_fits(ax, grid, analysis.fragility_curve(t, grid), t, _plain_log_ticks):
+        _draw_observed(ax, sub, im, edges)
         ax.set(xlabel=label, ylabel="probability of overturning")
     return t
+
+
+def _draw_observed(ax, sub, im, edges):
+    """The samples each curve was fitted to, as the share overturned in 8 equal-count bins of
+    the intensity (markers in the curve's colour, :func:`fragility_fit.binned_outcomes`)."""
+    size = sub["half_diagonal"].values
+    for k, (lo, hi) in enumerate(edges):
+        sel = np.flatnonzero((size >= lo) & (size < hi))
+        x = np.abs(sub[im].values[sel])
+        at, share, _ = binned_outcomes(x, sub["overturned"].values[sel] == 1)
+        ax.plot(at, share, "o", ms=4, color=f"C{k}", mec="k", mew=0.4)
+    ax.plot([], [], "o", ms=4, color="0.6", mec="k", mew=0.4, label="samples, binned")
+    ax.legend(fontsize=8)
+
+
+#: p-value of the lack-of-fit test below which the page says a lognormal curve misses its data
+LACK_OF_FIT_LEVEL = 0.01
+
+
+def _lack_of_fit_warning(page, fit):
+    """A warning naming the curves whose lognormal shape the samples reject (Hosmer-Lemeshow
+    p below :data:`LACK_OF_FIT_LEVEL`)."""
+    bad = fit[fit["lack_of_fit_p"] < LACK_OF_FIT_LEVEL]
+    if bad.empty:
+        return
+    names = ", ".join(
+        f"{g} against {_SHORT.get(r['intensity'], r['intensity'])} (p = {r['lack_of_fit_p']:.2g})"
+        for g, r in bad.iterrows()
+    )
+    page.warning(
+        f"The lognormal shape does not describe the samples of {names}: the Hosmer-Lemeshow "
+        f"test rejects it at the {LACK_OF_FIT_LEVEL:g} level. Under pulses the probability of "
+        "overturning need not rise to 1 with the amplitude (a short pulse topples a block "
+        "only within a window of amplitudes); read those curves' medians and beta as a summary "
+        "and the markers as the data."
+    )
 
 
 def _fragility_table(page, fit):
