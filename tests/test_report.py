@@ -310,9 +310,8 @@ def test_the_fragility_figure_draws_its_samples_and_warns_where_the_lognormal_mi
     """Each curve is drawn over its samples: the share overturned in eight equal-count bins of
     the intensity, computed here with numpy. Outcomes whose probability levels off at 0.6 are
     named in a warning; lognormal ones are not."""
-    from scipy.stats import norm
-
     import xarray as xr
+    from scipy.stats import norm
 
     from rockstudy.study.report import sampled as report
     from rockstudy.study.report._page import _plt
