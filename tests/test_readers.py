@@ -319,3 +319,28 @@ def test_a_suite_of_text_records_in_cm_s2_read_as_g_names_motion_units(tmp_path)
         validate_text(study, base_dir=tmp_path)
     assert "motion.units:" in str(err.value) and "272 g, beyond any ground motion" in str(err.value)
     validate_text(study.replace('units = "g"', 'units = "cm/s2"'), base_dir=tmp_path)
+
+
+def test_at2_trailer_fortran_exponents_and_text_among_the_samples(tmp_path):
+    """A text line after the samples (END OF DATA) is a trailer, not values; Fortran D
+    exponents are numbers; text among the samples is refused naming its line."""
+    path = write_at2(tmp_path / "end.AT2", NGA_HEADERS["plain"])
+    path.write_text(path.read_text() + "END OF DATA\n")
+    check(Record.from_at2(path), VALUES_G, 0.005)
+    fortran_d = write_at2(tmp_path / "d.AT2", NGA_HEADERS["plain"])
+    text = fortran_d.read_text().splitlines()
+    samples = [" ".join(f"{float(v):.7E}".replace("E", "D") for v in r.split()) for r in text[4:]]
+    fortran_d.write_text("\n".join(text[:4] + samples) + "\n")
+    np.testing.assert_allclose(
+        Record.from_at2(fortran_d).acceleration, VALUES_G * STANDARD_GRAVITY, rtol=1e-7
+    )
+    among = write_at2(tmp_path / "among.AT2", NGA_HEADERS["plain"])
+    lines = among.read_text().splitlines()
+    lines.insert(6, "  some text 1.0")
+    among.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"among.AT2: line 7 holds text where the samples"):
+        Record.from_at2(among)
+    extra = write_at2(tmp_path / "extra.AT2", NGA_HEADERS["plain"])
+    extra.write_text(extra.read_text() + "END OF DATA 2\n")  # a number in it: not a trailer
+    with pytest.raises(ValueError, match="line"):
+        Record.from_at2(extra)

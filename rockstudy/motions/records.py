@@ -352,13 +352,7 @@ class Record(Motion):
             raise ValueError(f"{path}: line 4 does not give NPTS and DT") from None
         if "UNITS OF G" not in lines[2].upper():
             raise ValueError(f"{path}: line 3 must state 'UNITS OF G'")
-        tokens = " ".join(lines[4:]).split()
-        if len(tokens) != npts:
-            raise ValueError(f"{path}: header says NPTS={npts} but {len(tokens)} values follow")
-        try:
-            values = np.array(tokens, dtype=float)
-        except ValueError:
-            raise ValueError(f"{path}: the values after line 4 are not all numbers") from None
+        values = _at2_values(path, lines, npts)
         record = _build(path, lambda: cls(values * STANDARD_GRAVITY, dt=dt, name=path.stem))
         return (
             record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
@@ -525,6 +519,44 @@ def _first_bad_line(lines, delimiter, skip_names=0, ncol=2) -> tuple:
         if len(values) != ncol:
             return i, len(values)
     return 0, 0
+
+
+#: A Fortran double-precision exponent (1.5D-03), which some processing writes for E.
+_FORTRAN_EXPONENT = re.compile(r"(?<=[0-9.])[Dd](?=[-+]?[0-9])")
+
+
+def _at2_values(path, lines, npts) -> np.ndarray:
+    """The ``npts`` samples after the header (line 5 on) of an ``.AT2`` file, in g: numbers
+    (Fortran ``D`` exponents read as ``E``), with a text line after the last of them (``END
+    OF DATA``) ignored; a ValueError naming the file and the line of anything else."""
+    rows = [_FORTRAN_EXPONENT.sub("E", line).split() for line in lines[4:]]
+    try:
+        values = np.array([t for row in rows for t in row], dtype=float)
+    except ValueError:
+        values = None
+    if values is not None and values.size == npts:
+        return values
+    numbers, at = [], None
+    for i, row in enumerate(rows, start=5):
+        for token in row:
+            try:
+                numbers.append(float(token))
+            except ValueError:
+                at = i
+                break
+        if at is not None:
+            break
+    trailer = at is not None and all(
+        not re.search(r"[0-9]", t) for row in rows[at - 5 :] for t in row
+    )
+    if at is not None and not (trailer and len(numbers) == npts):
+        raise ValueError(
+            f"{path}: line {at} holds text where the samples are expected (numbers only, "
+            f"after the 4 header lines)"
+        )
+    if len(numbers) != npts:
+        raise ValueError(f"{path}: header says NPTS={npts} but {len(numbers)} values follow")
+    return np.array(numbers)
 
 
 class UnitsError(ValueError):
