@@ -500,3 +500,30 @@ def test_a_misspelt_setting_of_a_kind_or_an_object_resembles_that_kinds_settings
     message = refused(museum.replace("width = 0.50", "widht = 0.50", 1))
     assert ".widht: is not a setting here; did you mean 'width'?" in message
     assert "'rtol'" not in refused(quick.replace("seed = 2026", "seed = 2026\nzzz = 1"))
+
+
+def test_every_range_problem_of_a_structure_is_named_at_once():
+    """A negative half-diagonal does not hide a slenderness beyond pi/2 (one run, all named)."""
+    quick = (Path(__file__).resolve().parents[1] / "studies" / "quickstart.toml").read_text()
+    bad = quick.replace("low = 0.5, high = 3.0", "low = -0.5, high = 3.0").replace(
+        "low = 0.1, high = 0.3", "low = 0.1, high = 1.7"
+    )
+    message = refused(bad)
+    assert "structure.half_diagonal: the distribution must only give values > 0" in message
+    assert "structure.slenderness: the distribution must only give values in (0, pi/2)" in message
+
+
+def test_a_record_that_does_not_read_is_named_beside_an_objects_problem(tmp_path):
+    """A NaN in a record file is reported in the same run as a negative width of an object."""
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    t = np.arange(300) * 0.01
+    a = 0.3 * np.sin(2 * np.pi * t)
+    a[50] = np.nan
+    np.savetxt(folder / "a.txt", np.column_stack([t, a]))
+    np.savetxt(folder / "b.txt", np.column_stack([t, 0.2 * np.sin(3 * np.pi * t)]))
+    museum = (Path(__file__).resolve().parents[1] / "studies" / "museum.toml").read_text()
+    museum = museum.split("[hazard]")[0].replace('"../data/records/*_H.AT2"', '"recs"')
+    message = refused(museum.replace("width = 0.50", "width = -0.50", 1), base_dir=tmp_path)
+    assert ".width: " in message and "got -0.5" in message
+    assert "a.txt" in message and "NaN" in message

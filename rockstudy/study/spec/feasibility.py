@@ -258,16 +258,30 @@ def _units_problem(motion, pairs) -> list[str]:
     return [f"motion.units: {refusal}"] if refusal else []
 
 
+def _read_each(motion, pairs):
+    """(field, file, record, problem) of each of ``pairs`` read in ``motion.units``: the
+    record and None, or None and why it does not read (naming its field and file)."""
+    for field, h, v in pairs:
+        vfield = field.replace("files", "vertical") if isinstance(motion.vertical, list) else field
+        try:
+            yield field, h, read_pair(h, v, motion.units, field, vfield), None
+        except (OSError, ValueError) as exc:
+            yield field, h, None, (_reason(exc, h) if isinstance(exc, OSError) else str(exc))
+
+
+def read_problems(motion, pairs) -> list[str]:
+    """Each record of ``pairs`` that does not read in ``motion.units`` (a NaN, a bad header,
+    units that make its peak impossible), each naming its field and file."""
+    return [problem for *_, problem in _read_each(motion, pairs) if problem]
+
+
 def _record_problems(study, pairs) -> list[str]:
     """Every record must read, fit the step limit and, if it is scaled to a target, have a
     non-zero measure to scale (each problem names the field and the file)."""
-    mo, max_steps, found = study.motion, study.run.max_steps, []
-    for field, h, v in pairs:
-        vfield = field.replace("files", "vertical") if isinstance(mo.vertical, list) else field
-        try:
-            rec = read_pair(h, v, mo.units, field, vfield)
-        except (OSError, ValueError) as exc:
-            found.append(_reason(exc, h) if isinstance(exc, OSError) else str(exc))
+    max_steps, found = study.run.max_steps, []
+    for field, h, rec, problem in _read_each(study.motion, pairs):
+        if problem:
+            found.append(problem)
             continue
         if rec.acceleration.size > max_steps:
             found.append(_too_long(field, rec.acceleration.size, max_steps))

@@ -80,7 +80,7 @@ from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
 from .ida_options import IdaOptionError, IdaOptions
-from .structures import KINDS, FieldError, check_object, object_fields
+from .structures import KINDS, FieldError, FieldErrors, check_all, check_object, object_fields
 
 
 def _param_tag(value):
@@ -126,11 +126,18 @@ def _sampled_geometry(spec):
     """The half-diagonal and slenderness of a sampled kind within the ranges of its registry
     entry (:data:`.structures.KINDS`)."""
     kind = KINDS[spec.kind]
-    _check_positive("half_diagonal", spec.half_diagonal)
-    _span("half_diagonal", spec.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
     top, label = kind.slenderness_top, kind.fields["slenderness"].label
-    _within("slenderness", spec.slenderness, 0.0, top, label.replace(f"[{MIN_SLENDERNESS:g}", "(0"))
-    _span("slenderness", spec.slenderness, MIN_SLENDERNESS, top, label)
+    open_label = label.replace(f"[{MIN_SLENDERNESS:g}", "(0")
+
+    def radius():
+        _check_positive("half_diagonal", spec.half_diagonal)
+        _span("half_diagonal", spec.half_diagonal, *HALF_DIAGONAL_RANGE, _R_LABEL)
+
+    def slenderness():
+        _within("slenderness", spec.slenderness, 0.0, top, open_label)
+        _span("slenderness", spec.slenderness, MIN_SLENDERNESS, top, label)
+
+    check_all(radius, slenderness)
 
 
 class BlockSpec(_Model):
@@ -143,20 +150,23 @@ class BlockSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _sampled_geometry(self)
+        check_all(lambda: _sampled_geometry(self), self._restitution)
+        return self
+
+    def _restitution(self):
         if self.restitution != "housner":
             _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
-        else:  # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
-            top = _largest(self.slenderness)
-            if not top < HOUSNER_MAX_SLENDERNESS:
-                raise FieldError(
-                    "slenderness",
-                    "Housner's restitution eta = 1 - 1.5 sin^2(alpha) (eq. 2.4 of [000]), "
-                    "derived from it, must lie in (0, 1], which needs slenderness < "
-                    f"{HOUSNER_MAX_SLENDERNESS:.4f} rad; slenderness reaches {top:g} rad. "
-                    "Narrow slenderness or give restitution",
-                )
-        return self
+            return
+        # the derived eta = 1 - 1.5 sin^2(alpha), eq. (2.4) of [000], must be in (0, 1]
+        top = _largest(self.slenderness)
+        if not top < HOUSNER_MAX_SLENDERNESS:
+            raise FieldError(
+                "slenderness",
+                "Housner's restitution eta = 1 - 1.5 sin^2(alpha) (eq. 2.4 of [000]), "
+                "derived from it, must lie in (0, 1], which needs slenderness < "
+                f"{HOUSNER_MAX_SLENDERNESS:.4f} rad; slenderness reaches {top:g} rad. "
+                "Narrow slenderness or give restitution",
+            )
 
 
 class WallSpec(_Model):
@@ -171,8 +181,10 @@ class WallSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _sampled_geometry(self)
-        _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
+        check_all(
+            lambda: _sampled_geometry(self),
+            lambda: _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]"),
+        )
         return self
 
 
@@ -186,12 +198,19 @@ class EquivalentBlockSpec(_Model):
 
     @model_validator(mode="after")
     def _ranges(self):
-        _check_positive("frequency_parameter", self.frequency_parameter)
         lo, hi = FREQUENCY_PARAMETER_RANGE
-        _span("frequency_parameter", self.frequency_parameter, lo, hi, f"[{lo:g}, {hi:g}] rad/s")
-        _within("critical_rotation", self.critical_rotation, 0.0, math.pi / 2, "(0, pi/2) rad")
-        _span("critical_rotation", self.critical_rotation, MIN_SLENDERNESS, 2, _ALPHA_LABEL)
-        _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]")
+        p, theta = self.frequency_parameter, self.critical_rotation
+        check_all(
+            lambda: (
+                _check_positive("frequency_parameter", p),
+                _span("frequency_parameter", p, lo, hi, f"[{lo:g}, {hi:g}] rad/s"),
+            ),
+            lambda: (
+                _within("critical_rotation", theta, 0.0, math.pi / 2, "(0, pi/2) rad"),
+                _span("critical_rotation", theta, MIN_SLENDERNESS, 2, _ALPHA_LABEL),
+            ),
+            lambda: _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]"),
+        )
         return self
 
 
@@ -1338,9 +1357,20 @@ def _object_name(data, keys) -> str:
     return ""
 
 
+def _expanded(errors):
+    """pydantic's errors, with each :class:`FieldErrors` split into one error per field."""
+    for e in errors:
+        error = e.get("ctx", {}).get("error")
+        if e["type"] == "value_error" and isinstance(error, FieldErrors):
+            for one in error.errors:
+                yield {**e, "ctx": {**e["ctx"], "error": one}}
+        else:
+            yield e
+
+
 def _format_errors(err: ValidationError, data) -> list[str]:
     lines = []
-    for e in err.errors():
+    for e in _expanded(err.errors()):
         loc = e["loc"][:-1] if e["type"] == "missing" else e["loc"]
         keys = _path(data, loc)
         message = _sentence(e, keys)
@@ -1481,13 +1511,17 @@ def _motion_problems(data, base_dir) -> list[str]:
         spec = RecordSpec.model_validate(files)
     except ValidationError:
         return []  # reported by the whole study's validation
-    from .feasibility import record_pairs
+    from .feasibility import read_problems, record_pairs
 
     try:
-        record_pairs(spec, base_dir)
+        pairs = record_pairs(spec, base_dir)
     except ValueError as exc:
         return [str(exc)]
-    return []
+    try:  # and the records themselves, in the study's units if those are valid
+        spec = RecordSpec.model_validate({**files, "units": motion.get("units", "g")})
+    except ValidationError:
+        return []
+    return read_problems(spec, pairs)
 
 
 #: Columns of an objects CSV file (``[structure] kind = "objects"``, ``file = ...``).

@@ -48,6 +48,31 @@ class FieldError(ValueError):
         super().__init__(message)
 
 
+class FieldErrors(ValueError):
+    """Several :class:`FieldError` of one table, raised together (:func:`check_all`)."""
+
+    def __init__(self, errors):
+        self.errors = list(errors)
+        super().__init__("; ".join(f"{e.field}: {e}" for e in self.errors))
+
+
+def check_all(*checks) -> None:
+    """Run every check (a callable without arguments) of one table, and raise what they
+    found together: so a study file's problems are all named at once, not one per run."""
+    errors = []
+    for check in checks:
+        try:
+            check()
+        except FieldErrors as exc:
+            errors.extend(exc.errors)
+        except FieldError as exc:
+            errors.append(exc)
+    if len(errors) == 1:
+        raise errors[0]
+    if errors:
+        raise FieldErrors(errors)
+
+
 @dataclass(frozen=True)
 class FieldRange:
     """The values a field of an object takes: ``low < value < high`` (``<=`` at an end marked
