@@ -477,9 +477,10 @@ def simulate(
     if friction is not None:
         friction = _validate.positive("friction", friction)
         if not block:
+            name = type(structure).__name__
             raise ValueError(
-                "friction: the friction demand is computed for a Block, not for a "
-                f"{type(structure).__name__}"
+                "friction: the friction demand is computed for a Block, not for "
+                f"{'an' if name[0] in 'AEIOU' else 'a'} {name}"
             )
     run_args = (motion, method, rtol, t_max, int(max_steps), x0, l)
     if hasattr(structure, "mechanism"):

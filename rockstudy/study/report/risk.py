@@ -117,6 +117,21 @@ def _risk_table(out) -> pd.DataFrame:
     )
 
 
+#: What each status of the risk table means.
+_STATUS_NOTE = (
+    "Status 'ok': at least 5 records overturned the object; 'few': fewer; "
+    "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
+    "'all': it overturned at every point (stripes give a lower bound, and under "
+    "horizontal records an upper bound: the rate of exceeding the PGA below which its "
+    "fragility is 0); 'separated': "
+    "every point at which it overturned lies at or above every point at which it stood, "
+    "so the fragility's dispersion cannot be estimated and no rate is given (a step "
+    "function would be a guess, not an estimate); 'no rise': the points at which it "
+    "overturned do not lie higher in the intensity than those at which it stood, so no "
+    "increasing fragility fits them and no rate is given."
+)
+
+
 def _risk(page, ds, hazard, years, im_label):
     """Per object: lambda_OT and P(``years``) with their 90 % bands by resampling records,
     ranked, and the deaggregation figure (:func:`~rockstudy.study.analysis.risk.object_risk`)."""
@@ -132,18 +147,7 @@ def _risk(page, ds, hazard, years, im_label):
         f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
         "and integrated again."
     )
-    page.text(
-        "Status 'ok': at least 5 records overturned the object; 'few': fewer; "
-        "'none': it never overturned, so no rate is estimable (an IDA gives an upper bound); "
-        "'all': it overturned at every point (stripes give a lower bound, and under "
-        "horizontal records an upper bound: the rate of exceeding the PGA below which its "
-        "fragility is 0); 'separated': "
-        "every point at which it overturned lies at or above every point at which it stood, "
-        "so the fragility's dispersion cannot be estimated and no rate is given (a step "
-        "function would be a guess, not an estimate); 'no rise': the points at which it "
-        "overturned do not lie higher in the intensity than those at which it stood, so no "
-        "increasing fragility fits them and no rate is given."
-    )
+    page.text(_STATUS_NOTE)
     if out["truncated_at_uplift"].values.any():
         page.text(
             "Below its uplift PGA (g tan alpha of a block, g lambda of another structure) an "
