@@ -70,9 +70,12 @@ class Record(Motion):
     acceleration : array_like
         Ground acceleration samples [m/s^2]; finite everywhere.
     dt : float, optional
-        Uniform time step [s]. Give either ``dt`` or ``time``.
+        Uniform time step [s]. Give either ``dt`` or ``time``. For a record given by ``time``
+        it is set to the median of its steps, a summary: unequal steps are kept, and the
+        motion and its measures use the times themselves.
     time : array_like, optional
-        Strictly increasing sample times [s]; shifted so that the first sample is at t = 0.
+        Strictly increasing sample times [s]; shifted so that the first sample is at t = 0
+        (a file whose times start at 1 s starts its motion at 0).
     name : str
         A label for plots and results.
     vertical : array_like, optional
