@@ -374,10 +374,11 @@ def trig_batch(p, alpha, eta, mp):
 
 def _phase_state(row, sig, p, alpha, W, phase):
     """theta [rad] and theta_dot [rad/s] at sigma = tau - tau0 in a logged phase (eq. 3.4 of
-    [000], the closed form of the module docstring)."""
+    [000], the closed form of the module docstring); ``row`` may hold a column of phases, one
+    per value of ``sig``."""
     tau0, _, A, B, s, q, _ = row
     c = q / (1.0 + W * W)
-    x = (W * tau0 + phase if q != 0.0 else 0.0) + W * sig
+    x = np.where(q != 0.0, W * tau0 + phase, 0.0) + W * sig
     em, ep = np.exp(-sig), np.exp(sig)
     return alpha * s + c * np.sin(x) + A * em + B * ep, p * (c * W * np.cos(x) - A * em + B * ep)
 
@@ -392,23 +393,29 @@ def phase_history(rec, p, alpha, omega, phase, x0=(0.0, 0.0), points_per_unit=40
     """Evaluate a phase log on a dense grid: (t [s], theta [rad], theta_dot [rad/s], impacts [s]).
 
     Each phase is sampled at ``points_per_unit`` points per unit of tau = p t (at least 8), and
-    at both ends, so impacts appear twice (before and after the jump of theta_dot).
+    at both ends, so impacts appear twice (before and after the jump of theta_dot). All phases
+    are evaluated in one pass of array operations (a loop over a hundred phases cost 7 ms).
     """
-    ts, ths, oms = [np.zeros(1)], [np.full(1, x0[0])], [np.full(1, x0[1])]
-    W = omega / p
     phases = _phases(rec)
-    for row in phases:
-        tau0, tau1 = row[0], row[1]
-        m = max(8, int(np.ceil((tau1 - tau0) * points_per_unit)))
-        sig = np.linspace(0.0, tau1 - tau0, m + 1)
-        th, om = _phase_state(row, sig, p, alpha, W, phase)
-        if row[6] == ROW_IMPACT:  # the closed form at the located impact: 0 up to rounding
-            th[-1] = 0.0
-        ts.append((tau0 + sig) / p)
-        ths.append(th)
-        oms.append(om)
+    tau0, tau1 = phases[:, 0], phases[:, 1]
+    m = np.maximum(8, np.ceil((tau1 - tau0) * points_per_unit).astype(np.int64))
+    owner = np.repeat(np.arange(phases.shape[0]), m + 1)  # the phase of each point
+    first = np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)
+    k = np.arange(owner.size) - first  # the point's index within its phase: 0 .. m
+    span = tau1 - tau0
+    sig = k * (span / m)[owner]  # as np.linspace(0, span, m + 1), its end exactly at span
+    ends = first + m[owner] == np.arange(owner.size)
+    sig[ends] = span[owner][ends]
+    th, om = _phase_state(phases[owner].T, sig, p, alpha, omega / p, phase)
+    th[ends & (phases[owner, 6] == ROW_IMPACT)] = 0.0  # the closed form at the located impact
+    t = (tau0[owner] + sig) / p
     impacts = phases[phases[:, 6] == ROW_IMPACT, 1] / p
-    return np.concatenate(ts), np.concatenate(ths), np.concatenate(oms), impacts
+    return (
+        np.concatenate([[0.0], t]),
+        np.concatenate([[x0[0]], th]),
+        np.concatenate([[x0[1]], om]),
+        impacts,
+    )
 
 
 def phase_peaks(rec, p):
