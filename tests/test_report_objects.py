@@ -443,3 +443,25 @@ def test_the_rate_without_records_outside_the_model_is_refitted_without_them(tmp
         x_u = G * math.tan(objects[name].slenderness) / G_UNIT
         expected = risk.annual_rate(np.exp(mu_ln), beta, hazard, threshold=x_u)
         assert row["lambda_OT without them [1/yr]"] == pytest.approx(expected, rel=1e-9)
+
+
+def test_objects_whose_capacities_do_not_look_lognormal_are_named_in_a_warning(tmp_path):
+    """The warning names (escaped) the objects whose capacities the Shapiro-Wilk test rejects
+    at 0.01, and only those."""
+    from types import SimpleNamespace
+
+    from rockstudy.study.report import objects as ro
+    from rockstudy.study.report._page import _Page
+
+    table = pd.DataFrame(
+        {"intensity": ["PGA [g]"] * 3, "lack_of_fit_p": [0.2, 0.004, np.nan]},
+        index=pd.Index(["Kouros", "<Urn & lid>", "Stele"], name="object"),
+    )
+    page = _Page(tmp_path)
+    ro._capacities_not_lognormal(page, SimpleNamespace(), table)
+    text = "".join(page.parts)
+    assert "&lt;Urn &amp; lid&gt; in PGA [g] (p = 0.004)" in text
+    assert "Kouros" not in text and "Stele" not in text
+    quiet = _Page(tmp_path)
+    ro._capacities_not_lognormal(quiet, SimpleNamespace(), table.iloc[[0, 2]])
+    assert not quiet.parts

@@ -363,7 +363,10 @@ def ida_fragility(
     ``survives_above_capacity`` in the dataset).
 
     Parameters and returns as in :func:`stripe_fragility` (``n`` counts capacities, censored
-    ones included; ``im_min``/``im_max`` span capacities and censoring levels).
+    ones included; ``im_min``/``im_max`` span capacities and censoring levels), with
+    ``lack_of_fit_p``: the p-value of the Shapiro-Wilk test of ln(capacity)
+    (:func:`capacities_lack_of_fit`) for a group of one structure without censored
+    capacities, NaN otherwise; below 0.01 the capacities do not look lognormal.
     """
     conf_level, n_boot = _check(ds, "ida", conf_level, n_boot)
     im, period = _measure(ds, im, period)
@@ -412,10 +415,19 @@ def ida_fragility(
                     stacklevel=2,
                 )
         x = np.where(cens, t, c)[keep]
-        rows.append(
-            _row(label, theta, beta, band, keep.sum(), x, unit, by, cov, method, conf_level)
-        )
+        row = _row(label, theta, beta, band, keep.sum(), x, unit, by, cov, method, conf_level)
+        complete = not pooled and not cens[keep].any() and beta > 0
+        row["lack_of_fit_p"] = capacities_lack_of_fit(c[keep & ~cens]) if complete else np.nan
+        rows.append(row)
     return pd.DataFrame(rows).set_index(by or "group")
+
+
+def capacities_lack_of_fit(capacities) -> float:
+    """p-value of the Shapiro-Wilk test of normality of ln(capacity) (Shapiro & Wilk 1965,
+    scipy.stats.shapiro): whether the capacities of one structure under a suite look
+    lognormal at all (its level is exact with both parameters estimated); NaN below 3."""
+    c = np.asarray(capacities, float)
+    return float(stats.shapiro(np.log(c)).pvalue) if c.size >= 3 else np.nan
 
 
 def _specs(ds, candidates):

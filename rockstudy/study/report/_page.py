@@ -257,5 +257,5 @@ _FRAGILITY_NAMES = {
     "separated": "outcomes separated (no fit)",
     "no_rise": "no rise with the intensity (no fit)",
     "band": "subset of the samples",
-    "lack_of_fit_p": "lognormal vs samples, p (Hosmer-Lemeshow)",
+    "lack_of_fit_p": "lognormal vs data, p (lack of fit)",
 }

@@ -290,7 +290,7 @@ def object_fragility(page, ctx):
     )
     table = pd.concat(tables)
     cols = ["intensity", "theta", "theta_lo", "theta_hi", "beta", "n", "theta_in_range"]
-    cols += ["separated", "no_rise"]
+    cols += ["separated", "no_rise"] + (["lack_of_fit_p"] if "lack_of_fit_p" in table else [])
     shown = table[cols].rename(
         columns={
             "theta": "median capacity",
@@ -301,6 +301,7 @@ def object_fragility(page, ctx):
             "theta_in_range": "median within the data",
             "separated": "outcomes separated (no fit)",
             "no_rise": "no rise with the intensity (no fit)",
+            "lack_of_fit_p": "lognormal vs capacities, p (Shapiro-Wilk)",
         }
     )
     for col in ("median capacity", "median, lower", "median, upper"):
@@ -311,6 +312,26 @@ def object_fragility(page, ctx):
     names = list(map(str, ctx.ds["structure"].values))
     shown.insert(1, f"uplift level, PGA [{ctx.units}]", [up[names.index(n)] for n in table.index])
     page.table(shown, "object_fragility", "Fragility of each object, by name (90 % bands)")
+    _capacities_not_lognormal(page, ctx, table)
+
+
+def _capacities_not_lognormal(page, ctx, table):
+    """A warning naming the objects whose IDA capacities do not look lognormal (Shapiro-Wilk
+    p of ln capacity below 0.01, :func:`rf.capacities_lack_of_fit`)."""
+    if "lack_of_fit_p" not in table:
+        return
+    bad = table[table["lack_of_fit_p"] < 0.01]
+    if bad.empty:
+        return
+    names = ", ".join(
+        f"{o} in {r['intensity']} (p = {r['lack_of_fit_p']:.2g})" for o, r in bad.iterrows()
+    )
+    page.warning(
+        f"The capacities of {names} do not look lognormal (Shapiro-Wilk test of their "
+        "logarithms at the 0.01 level): the records may fall in families that topple the "
+        "object at distant levels. Read those medians and betas as a summary, and the IDA "
+        "curves as the data."
+    )
 
 
 def _cut(ctx, im) -> np.ndarray:
