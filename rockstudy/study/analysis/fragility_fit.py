@@ -359,6 +359,11 @@ def _cells(outcome, prob, n_groups):
     return np.array(cells)
 
 
+#: p-value of a lack-of-fit test (:func:`lack_of_fit`, and the Shapiro-Wilk test of IDA
+#: capacities) below which the reports say a lognormal fragility misses its data.
+LACK_OF_FIT_LEVEL = 0.01
+
+
 def lack_of_fit(im, outcome, theta, beta, n_groups=20) -> tuple[float, int, float]:
     """Hosmer-Lemeshow test of a lognormal fragility fitted to Bernoulli outcomes.
 

@@ -261,6 +261,25 @@ def fragility(
         with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for name, (x, z) in fragility_samples(ds, intensity, outcome, by, bins, failed).items():
+        if z.size >= 10:
+            rows.append(_bernoulli_row(name, x, z, by, n_boot, conf_level, rng))
+    if not rows:
+        raise ValueError(
+            f"no group has 10 samples with a finite, positive {intensity!r}: "
+            "no fragility curve can be fitted"
+        )
+    return pd.DataFrame(rows).set_index(by or "group")
+
+
+def fragility_samples(
+    ds, intensity, outcome="overturned", by=None, bins=None, failed: FailedPolicy = "drop"
+) -> dict:
+    """The samples :func:`fragility` fits, by group (its index labels): for each, the
+    intensities and outcomes of the samples with a finite, positive intensity (and, with
+    ``failed="drop"``, not failed)."""
     check_variables(ds, intensity=intensity, outcome=outcome, by=by)
     if bins is not None and by is None:
         raise ValueError("bins: bins the variable given as by=; give by= too, or no bins")
@@ -277,18 +296,7 @@ def fragility(
             }
         else:
             groups = {v: keep & (g == v) for v in np.unique(g[keep])}
-    rng = np.random.default_rng(seed)
-    rows = []
-    for name, sel in groups.items():
-        x, z = im[sel], y[sel]
-        if z.size >= 10:
-            rows.append(_bernoulli_row(name, x, z, by, n_boot, conf_level, rng))
-    if not rows:
-        raise ValueError(
-            f"no group has 10 samples with a finite, positive {intensity!r}: "
-            "no fragility curve can be fitted"
-        )
-    return pd.DataFrame(rows).set_index(by or "group")
+    return {name: (im[sel], y[sel]) for name, sel in groups.items()}
 
 
 def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):

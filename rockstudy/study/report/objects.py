@@ -21,6 +21,7 @@ import xarray as xr
 from ...constants import STANDARD_GRAVITY
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
+from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL
 from ..analysis.risk import cut_levels, horizontal
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
@@ -317,10 +318,10 @@ def object_fragility(page, ctx):
 
 def _capacities_not_lognormal(page, ctx, table):
     """A warning naming the objects whose IDA capacities do not look lognormal (Shapiro-Wilk
-    p of ln capacity below 0.01, :func:`rf.capacities_lack_of_fit`)."""
+    p of ln capacity below :data:`LACK_OF_FIT_LEVEL`, :func:`rf.capacities_lack_of_fit`)."""
     if "lack_of_fit_p" not in table:
         return
-    bad = table[table["lack_of_fit_p"] < 0.01]
+    bad = table[table["lack_of_fit_p"] < LACK_OF_FIT_LEVEL]
     if bad.empty:
         return
     names = ", ".join(
@@ -328,9 +329,9 @@ def _capacities_not_lognormal(page, ctx, table):
     )
     page.warning(
         f"The capacities of {names} do not look lognormal (Shapiro-Wilk test of their "
-        "logarithms at the 0.01 level): the records may fall in families that topple the "
-        "object at distant levels. Read those medians and betas as a summary, and the IDA "
-        "curves as the data."
+        f"logarithms at the {LACK_OF_FIT_LEVEL:g} level): the records may fall in families "
+        "that topple the object at distant levels. Read those medians and betas as a summary, "
+        "and the IDA curves as the data."
     )
 
 

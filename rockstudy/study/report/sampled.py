@@ -21,7 +21,7 @@ import pandas as pd
 from ...constants import STANDARD_GRAVITY, G
 from ...motions import measures
 from ..analysis import sampled as analysis
-from ..analysis.fragility_fit import BAND_COLUMNS, binned_outcomes
+from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
 from ..spec.schema import SAMPLER_LAYOUTS
@@ -175,35 +175,34 @@ def _fragility_view(page, ax, d, bins, im, band, label):
     except ValueError as err:  # no block size saw both outcomes
         page.text(f"Fragility against {im}: {err}")
         return None
-    # the groups by readable names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
-    edges = [tuple(map(float, g.split("-"))) for g in t.index.astype(str)]
-    t.index = [f"R {lo:.3g} to {hi:.3g} m" for lo, hi in edges]
+    # the samples of each fit, by its label, for the markers; then the groups by readable
+    # names: "R 0.5 to 1.33 m" (analysis labels them by bins, "%g")
+    fitted = analysis.fragility_samples(sub, im, by="half_diagonal", bins=bins)
+    samples = [fitted[g] for g in t.index]
+    t.index = [
+        f"R {lo:.3g} to {hi:.3g} m"
+        for lo, hi in (map(float, g.split("-")) for g in t.index.astype(str))
+    ]
     t.index.name = "block size"
     t.insert(0, "intensity", im)
     t.insert(1, "band", band)
     grid = np.geomspace(float(sub[im].min()), float(sub[im].max()), 200)
     separation_note(page, t, f"Fragility against {im}")
     if draw_fits(ax, grid, analysis.fragility_curve(t, grid), t, _plain_log_ticks):
-        _draw_observed(ax, sub, im, edges)
+        _draw_observed(ax, samples)
         ax.set(xlabel=label, ylabel="probability of overturning")
     return t
 
 
-def _draw_observed(ax, sub, im, edges):
-    """The samples each curve was fitted to, as the share overturned in 8 equal-count bins of
-    the intensity (markers in the curve's colour, :func:`fragility_fit.binned_outcomes`)."""
-    size = sub["half_diagonal"].values
-    for k, (lo, hi) in enumerate(edges):
-        sel = np.flatnonzero((size >= lo) & (size < hi))
-        x = np.abs(sub[im].values[sel])
-        at, share, _ = binned_outcomes(x, sub["overturned"].values[sel] == 1)
+def _draw_observed(ax, samples):
+    """The samples each curve was fitted to (``samples``: its (intensities, outcomes), in the
+    table's order), as the share overturned in 8 equal-count bins of the intensity (markers
+    in the curve's colour, :func:`fragility_fit.binned_outcomes`)."""
+    for k, (x, z) in enumerate(samples):
+        at, share, _ = binned_outcomes(x, z == 1)
         ax.plot(at, share, "o", ms=4, color=f"C{k}", mec="k", mew=0.4)
     ax.plot([], [], "o", ms=4, color="0.6", mec="k", mew=0.4, label="samples, binned")
     ax.legend(fontsize=8)
-
-
-#: p-value of the lack-of-fit test below which the page says a lognormal curve misses its data
-LACK_OF_FIT_LEVEL = 0.01
 
 
 def _lack_of_fit_warning(page, fit):

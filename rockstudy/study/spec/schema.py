@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import csv
 import difflib
+import functools
 import hashlib
 import io
 import json
@@ -200,15 +201,18 @@ class EquivalentBlockSpec(_Model):
     def _ranges(self):
         lo, hi = FREQUENCY_PARAMETER_RANGE
         p, theta = self.frequency_parameter, self.critical_rotation
+
+        def frequency():
+            _check_positive("frequency_parameter", p)
+            _span("frequency_parameter", p, lo, hi, f"[{lo:g}, {hi:g}] rad/s")
+
+        def rotation():
+            _within("critical_rotation", theta, 0.0, math.pi / 2, "(0, pi/2) rad")
+            _span("critical_rotation", theta, MIN_SLENDERNESS, 2, _ALPHA_LABEL)
+
         check_all(
-            lambda: (
-                _check_positive("frequency_parameter", p),
-                _span("frequency_parameter", p, lo, hi, f"[{lo:g}, {hi:g}] rad/s"),
-            ),
-            lambda: (
-                _within("critical_rotation", theta, 0.0, math.pi / 2, "(0, pi/2) rad"),
-                _span("critical_rotation", theta, MIN_SLENDERNESS, 2, _ALPHA_LABEL),
-            ),
+            frequency,
+            rotation,
             lambda: _within("restitution", self.restitution, 0.0, 1.0 + 1e-15, "(0, 1]"),
         )
         return self
@@ -1285,10 +1289,16 @@ _MUST_BE = {
 }
 
 
+@functools.cache
+def _schema() -> dict:
+    """The JSON schema of study files, made once (it is fixed when the module is imported)."""
+    return json_schema()
+
+
 def _settings_at(loc) -> list[str]:
     """The settings of the table at the pydantic location ``loc`` (a union's tags included),
     read from the JSON schema of study files; [] where the path cannot be followed."""
-    schema = json_schema()
+    schema = _schema()
 
     def resolve(node):
         while "$ref" in node:
