@@ -305,6 +305,8 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
 def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
     """Copy a one-record design Dataset into the rows ``rows`` of ``result``."""
     for name, (*_, extra) in outs.items():
+        if extra is not None and width[extra] == 0:  # no periods asked: nothing to copy
+            continue
         src = "status" if name == "kernel_status" else name
         var = ds[src].isel(record=0) if "record" in ds[src].dims else ds[src]
         if "structure" in var.dims:
@@ -352,7 +354,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         else:
             out[new] = (("record", "structure", "level"), values, var.attrs)
     coords = {
-        "record": np.arange(n_rec),
+        "record": rd.record_labels(names),
         "structure": (
             np.array(json.loads(cube.attrs["structure_names"]), dtype=object)
             if "structure_names" in cube.attrs

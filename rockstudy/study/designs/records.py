@@ -204,7 +204,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     ims = [r.intensity_measures(periods=periods, damping=damping) for r in records]
     pulses = [r.pulse() for r in records]
     data = {k: ("record", np.array([m[k] for m in ims], float)) for k in _ms.listed(False)}
-    for k in _ms.listed(True):
+    for k in _ms.listed(True) if len(periods) else ():  # (netCDF-3 reads no empty inner axis)
         data[k] = (
             ("record", "period"),
             np.array([m[k] for m in ims], float).reshape(len(ims), len(periods)),
@@ -221,7 +221,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     ds = xr.Dataset(
         data,
         coords={
-            "record": np.arange(len(records)),
+            "record": record_labels([r.name for r in records]),
             "structure": np.arange(structures["critical_rotation"].size)
             if names is None
             else np.array(names, dtype=object),
@@ -247,6 +247,19 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
         if k in ds:
             ds[k].attrs["units"] = unit
     return ds
+
+
+def record_labels(names) -> np.ndarray:
+    """The ``record`` coordinate: each record's name, with ``#2``, ``#3`` ... after a name that
+    is already taken (a suite may hold one record twice, or several unnamed ones)."""
+    seen: dict[str, int] = {}
+    labels = []
+    for name in map(str, names):
+        seen[name] = seen.get(name, 0) + 1
+        labels.append(name if seen[name] == 1 else f"{name}#{seen[name]}")
+    if len(set(labels)) < len(labels):  # a given name that reads like a numbered one
+        labels = [f"{k}: {x}" for k, x in enumerate(map(str, names))]
+    return np.array(labels, dtype=object)
 
 
 def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None):
@@ -442,6 +455,16 @@ def multiple_stripes(
 # ------------------------------------------------------------------------------ IDA
 
 
+def cf_flags(meanings: dict) -> dict:
+    """CF attributes of a flag variable: ``flag_values`` and ``flag_meanings``, one
+    space-separated string of words (spaces within a meaning become underscores), as netCDF
+    writers need."""
+    return {
+        "flag_values": np.array(list(meanings), np.int64),
+        "flag_meanings": " ".join(m.replace(" ", "_") for m in meanings.values()),
+    }
+
+
 #: ``censored_reason`` of a capacity (CF flag values and meanings).
 CENSORED_REASONS = {0: "not censored", 1: "standing at max_pga_ratio", 2: "free fall above"}
 #: ``step_kind`` of a simulated point of an IDA curve.
@@ -551,9 +574,7 @@ def incremental_dynamic_analysis(
             "long_name": f"overturning {im} (first overturning level)",
         },
     )
-    ds["censored_reason"].attrs.update(
-        flag_values=list(CENSORED_REASONS), flag_meanings=list(CENSORED_REASONS.values())
-    )
+    ds["censored_reason"].attrs.update(cf_flags(CENSORED_REASONS))
     ds.attrs.update(
         design="ida",
         **options.attrs(),

@@ -623,11 +623,11 @@ def friction_check(page, ctx):
         )
         table["scenes outside the model (demand > mu or lift-off)"] = flags.sum(rest).astype(int)
     frame = xr.Dataset(table).to_dataframe(dim_order=list(by))[list(table)]
-    names = ctx.record_names()
+    names = dict(zip(map(str, ds["record"].values), ctx.record_names(), strict=True))
     if ctx.objects:
-        frame.index = [f"{o} / {names[int(r)]}" for o, r in frame.index]
+        frame.index = [f"{o} / {names[str(r)]}" for o, r in frame.index]
     else:
-        frame.index = [names[int(r)] for r in frame.index]
+        frame.index = [names[str(r)] for r in frame.index]
     frame.index.name = "object / record" if ctx.objects else "record"
     top = frame["largest finite friction demand |F_h / F_v| [-]"]
     frame["largest finite friction demand |F_h / F_v| [-]"] = [  # no finite demand: F_v < 0
