@@ -17,6 +17,11 @@ PYTHON = [code for lang, code in BLOCKS if lang == "python"]
 TOML = [code for lang, code in BLOCKS if lang == "toml"]
 
 
+def test_readme_is_a_front_door():
+    """The README stays short enough to read at once; the rest lives in the docs site."""
+    assert len(README.splitlines()) <= 250
+
+
 def test_readme_has_runnable_blocks():
     assert PYTHON, "the README shows no Python example"
     assert "../shared" not in README, "the README points outside the repository"
