@@ -465,3 +465,30 @@ def test_objects_whose_capacities_do_not_look_lognormal_are_named_in_a_warning(t
     quiet = _Page(tmp_path)
     ro._capacities_not_lognormal(quiet, SimpleNamespace(), table.iloc[[0, 2]])
     assert not quiet.parts
+
+
+def test_the_risk_section_resamples_as_often_as_the_report_is_told(tmp_path):
+    """``record_report(n_boot=...)`` reaches the annual rates: without resampling the risk
+    table has no band, with it every band brackets its rate, and the page says how many
+    resamples made it."""
+    from test_objects import _sine_record
+
+    from rockstudy import risk
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+
+    recs = [_sine_record(tp) for tp in (0.6, 0.9, 1.2, 1.5, 2.0, 2.5)]
+    objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
+    ds = incremental_dynamic_analysis(recs, objects, scan=0, step=0.05, tolerance=0.01)
+    hazard = risk.HazardCurve.power_law(1e-4, 2.5, im="pga", units="g")
+    bands = []
+    for n_boot in (0, 12):
+        text = _text(record_report(ds, tmp_path / f"r{n_boot}", n_boot=n_boot, hazard=hazard))
+        table = pd.read_csv(tmp_path / f"r{n_boot}" / "annual_overturning.csv", index_col=0)
+        rate = table["lambda_OT [1/yr]"]
+        low, high = table["lambda_OT, 5 %"], table["lambda_OT, 95 %"]
+        bands.append((rate, low, high))
+        assert (f"from {n_boot} resamples of the records" in text) == (n_boot > 0)
+    rate, low, high = bands[0]
+    assert low.isna().all() and high.isna().all()
+    rate, low, high = bands[1]
+    assert np.isfinite(rate).all() and ((low <= rate) & (rate <= high)).all()

@@ -48,6 +48,10 @@ from ..._warnings import SeparationWarning
 
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: how the pointwise band of P(x) of a fitted row is formed (see the module docstring).
+#: Resamples (of records, or of samples) behind every bootstrapped band, unless a call gives
+#: ``n_boot``: the fitting functions, the reports and the risk integral share it.
+N_BOOT = 200
+
 BAND_METHODS = ("likelihood", "record_bootstrap", "noncentral_t", "none")
 
 

@@ -30,6 +30,7 @@ from scipy import stats
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from .fragility_fit import (
+    N_BOOT,
     NO_MAXIMUM,
     binomial_covariance,
     capacities_covariance,
@@ -228,7 +229,7 @@ def stripe_fragility(
     period=None,
     by=None,
     bins=None,
-    n_boot: int = 200,
+    n_boot: int = N_BOOT,
     conf_level: float = 0.9,
     seed: int = 0,
 ) -> pd.DataFrame:
@@ -343,7 +344,7 @@ def ida_fragility(
     by=None,
     bins=None,
     conf_level: float = 0.9,
-    n_boot: int = 200,
+    n_boot: int = N_BOOT,
     seed: int = 0,
 ) -> pd.DataFrame:
     """Lognormal fit of IDA capacities (first overturning levels) in any stored measure.
@@ -456,7 +457,7 @@ def _specs(ds, candidates):
 
 
 def im_efficiency(
-    ds: xr.Dataset, candidates=None, by=None, bins=None, n_boot: int = 100, **kw
+    ds: xr.Dataset, candidates=None, by=None, bins=None, n_boot: int = N_BOOT, **kw
 ) -> pd.DataFrame:
     """Which intensity measure predicts overturning best: the dispersion of each, per power.
 

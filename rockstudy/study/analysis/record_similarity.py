@@ -25,7 +25,7 @@ import pandas as pd
 import xarray as xr
 
 from ...motions import measures
-from .fragility_fit import NO_MAXIMUM, fit_binomial_limit, separation
+from .fragility_fit import N_BOOT, NO_MAXIMUM, fit_binomial_limit, separation
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
@@ -152,7 +152,7 @@ def size_class_medians(
     period=None,
     size_bins=3,
     frequency_bins=None,
-    n_boot: int = 200,
+    n_boot: int = N_BOOT,
     conf_level: float = 0.9,
     seed: int = 0,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:

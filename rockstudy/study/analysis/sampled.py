@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
+    N_BOOT,
     NO_MAXIMUM,
     binomial_covariance,
     check_conf_level,
@@ -209,7 +210,7 @@ def fragility(
     outcome: str = "overturned",
     by=None,
     bins=None,
-    n_boot: int = 200,
+    n_boot: int = N_BOOT,
     conf_level: float = 0.9,
     seed: int = 0,
     failed: FailedPolicy = "drop",

@@ -21,7 +21,7 @@ import xarray as xr
 from ...constants import STANDARD_GRAVITY
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
-from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL
+from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL, N_BOOT
 from ..analysis.risk import cut_levels, horizontal
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
@@ -54,7 +54,7 @@ class ReportContext:
     and the answers several sections share (computed once)."""
 
     ds: xr.Dataset
-    n_boot: int = 50
+    n_boot: int = N_BOOT
     compare: xr.Dataset | None = None
     units: str = "g"
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR

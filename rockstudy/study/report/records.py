@@ -21,7 +21,7 @@ from ...constants import G
 from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
-from ..analysis.fragility_fit import BAND_COLUMNS
+from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from . import objects as ro
@@ -619,7 +619,7 @@ def record_report(
     out,
     title: str = "Record design",
     description: str = "",
-    n_boot: int = 50,
+    n_boot: int = N_BOOT,
     appendix=None,
     compare: xr.Dataset | None = None,
     units: str = "g",
@@ -648,7 +648,10 @@ def record_report(
     title, description : str
         Shown (escaped) at the top of the page.
     n_boot : int
-        Resamples of the records for the bootstrapped bands.
+        Resamples of the records behind every band of the page: the fragilities', the
+        efficiency table's and the annual rates' (default
+        :data:`~rockstudy.study.analysis.fragility_fit.N_BOOT`); 0 gives the fits' Wald
+        intervals and rates without bands.
     appendix : callable, optional
         Called with the page last, to add sections (a study's report adds its study file).
     compare : xarray.Dataset, optional

@@ -18,7 +18,7 @@ def section(page, ctx):
     if ctx.hazard is None:
         return
     page.heading("Annual probability of overturning")
-    out = _risk(page, ctx.ds, ctx.hazard, ctx.years, ctx.im_label)
+    out = _risk(page, ctx.ds, ctx.hazard, ctx.years, ctx.im_label, ctx.n_boot)
     if out is not None and ctx.friction is not None and "friction_demand" in ctx.ds:
         _without_outside_scenes(page, ctx, out)
 
@@ -65,8 +65,6 @@ def _without_outside_scenes(page, ctx, out):
     )
 
 
-#: Resamples of the records for the bands of the annual rates (:func:`_risk`).
-RISK_RESAMPLES = 200
 #: Most objects drawn in the deaggregation figure (the highest rates; all are in its CSV).
 MAX_DEAGGREGATION_LINES = 10
 
@@ -132,20 +130,25 @@ _STATUS_NOTE = (
 )
 
 
-def _risk(page, ds, hazard, years, im_label):
-    """Per object: lambda_OT and P(``years``) with their 90 % bands by resampling records,
+def _risk(page, ds, hazard, years, im_label, n_boot):
+    """Per object: lambda_OT and P(``years``) with their 90 % bands by ``n_boot`` resamples of
+    the records (none when 0),
     ranked, and the deaggregation figure (:func:`~rockstudy.study.analysis.risk.object_risk`)."""
     try:
-        out = object_risk(ds, hazard, years=years, n_boot=RISK_RESAMPLES)
+        out = object_risk(ds, hazard, years=years, n_boot=n_boot)
     except ValueError as err:
         page.text(f"No annual rates: {err}")
         return None
     page.text(
         f"Hazard: the {hazard.describe()}, from {out.attrs['hazard_source'] or 'the study'}. "
         f"Each object's lognormal fragility in {im_label(hazard.im, hazard.period)} is "
-        "integrated against it (Cornell et al. 2002); the 90 % bands come from "
-        f"{RISK_RESAMPLES} resamples of the records (with replacement, seed 0), each refitted "
-        "and integrated again."
+        "integrated against it (Cornell et al. 2002); "
+        + (
+            f"the 90 % bands come from {n_boot} resamples of the records (with replacement, "
+            "seed 0), each refitted and integrated again."
+            if n_boot
+            else "no bands (no resampling asked)."
+        )
     )
     page.text(_STATUS_NOTE)
     if out["truncated_at_uplift"].values.any():
