@@ -27,6 +27,7 @@ from ._warnings import (
     LinearizationWarning,
     LooseToleranceWarning,
     SeparationWarning,
+    UnitsWarning,
     UpliftWarning,
 )
 
@@ -67,6 +68,7 @@ __all__ = [
     "IncompleteReferenceWarning",
     "RockingResult",
     "SeparationWarning",
+    "UnitsWarning",
     "UpliftWarning",
     "StepLimitError",
     "closedform",

@@ -51,3 +51,8 @@ class SeparationWarning(AccuracyWarning):
 class UpliftWarning(AccuracyWarning):
     """A result's uplift level is not the structure's own: a cube written before the design
     carried each structure's uplift acceleration (g lambda, eq. 10 of [003])."""
+
+
+class UnitsWarning(AccuracyWarning):
+    """An input read in the units given lies where real inputs seldom do (a record weaker than
+    accelerographs trigger at): the units may be wrong, and every result with them."""

@@ -9,12 +9,15 @@ comments, and a first row of column names.
 """
 
 import re
+import warnings
 
 import numpy as np
 import pytest
 
+import rockstudy as rs
 from rockstudy.constants import STANDARD_GRAVITY
 from rockstudy.motions import Record
+from rockstudy.motions.records import UnitsError
 
 VALUES_G = np.array(
     [0.01717907, 0.01723899, -0.0004393325, 0.0, -0.1250000, 0.3490000, -0.2, 0.0001096612]
@@ -144,7 +147,8 @@ def test_two_column_units(tmp_path):
     path = tmp_path / "rec.txt"
     path.write_text("".join(f"{t} {a}\n" for t, a in zip(TIMES, ACC, strict=True)))
     np.testing.assert_allclose(Record.from_csv(path, units="m/s2").acceleration, ACC)
-    np.testing.assert_allclose(Record.from_csv(path, units="cm/s2").acceleration, ACC / 100)
+    path.write_text("".join(f"{t} {100 * a}\n" for t, a in zip(TIMES, ACC, strict=True)))
+    np.testing.assert_allclose(Record.from_csv(path, units="cm/s2").acceleration, ACC)
     with pytest.raises(ValueError, match="units"):
         Record.from_csv(path, units="gal")
 
@@ -319,6 +323,47 @@ def test_a_suite_of_text_records_in_cm_s2_read_as_g_names_motion_units(tmp_path)
         validate_text(study, base_dir=tmp_path)
     assert "motion.units:" in str(err.value) and "272 g, beyond any ground motion" in str(err.value)
     validate_text(study.replace('units = "g"', 'units = "cm/s2"'), base_dir=tmp_path)
+
+
+@pytest.mark.parametrize("columns", [("time", "horizontal"), ("time", "horizontal", "vertical")])
+def test_a_text_record_in_g_read_as_cm_s2_is_refused_naming_units(tmp_path, columns):
+    """El Centro's 0.35 g read as cm/s^2 would peak at 0.0036 m/s^2 (0.00036 g), weaker than
+    any strong-motion record and than the uplift of any block: refused, naming units; a
+    record that reads between 0.0005 g and 0.005 g is read with a UnitsWarning; in g it is
+    3.4 m/s^2 and read without a word."""
+    t = np.arange(300) * 0.01
+    a = 0.349 * np.sin(2 * np.pi * t)  # g
+    data = np.column_stack([t, a] + ([0.5 * a] if "vertical" in columns else []))
+    path = tmp_path / "in_g.txt"
+    np.savetxt(path, data)
+    with pytest.raises(UnitsError, match=r"units='cm/s2': its peak acceleration reads 0.349 cm/s2"):
+        Record.from_csv(path, units="cm/s2", columns=columns)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rec = Record.from_csv(path, units="g", columns=columns)
+    assert np.max(np.abs(rec.acceleration)) == pytest.approx(0.349 * STANDARD_GRAVITY, rel=1e-3)
+    weak = np.column_stack([t, 2.0 * np.sin(2 * np.pi * t)])  # 2 cm/s^2 = 0.002 g
+    np.savetxt(path, weak)
+    with pytest.warns(rs.UnitsWarning, match="units='cm/s2'"):
+        rec = Record.from_csv(path, units="cm/s2")
+    assert np.max(np.abs(rec.acceleration)) == pytest.approx(0.02, rel=1e-3)
+
+
+def test_a_suite_of_text_records_in_g_read_as_cm_s2_names_motion_units(tmp_path):
+    """validate refuses the weak reading as a problem of motion.units."""
+    from rockstudy.study import StudyError, validate_text
+
+    t = np.arange(300) * 0.01
+    np.savetxt(tmp_path / "a.txt", np.column_stack([t, 0.349 * np.sin(2 * np.pi * t)]))
+    study = (
+        'name = "s"\nseed = 1\n[structure]\nkind = "objects"\n'
+        'objects = [{ name = "A", width = 0.4, height = 1.6 }]\n'
+        '[motion]\nkind = "record"\nfiles = "a.txt"\nunits = "cm/s2"\n[design]\nkind = "cloud"\n'
+    )
+    with pytest.raises(StudyError) as err:
+        validate_text(study, base_dir=tmp_path)
+    assert "motion.units:" in str(err.value) and "below any strong-motion record" in str(err.value)
+    validate_text(study.replace('units = "cm/s2"', 'units = "g"'), base_dir=tmp_path)
 
 
 def test_at2_trailer_fortran_exponents_and_text_among_the_samples(tmp_path):

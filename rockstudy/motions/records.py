@@ -6,12 +6,14 @@ import math
 import os
 import re
 import stat
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .. import _validate
+from .._warnings import UnitsWarning
 from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity, measures
 from .base import Motion
@@ -27,6 +29,16 @@ _UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s
 #: A PGA no ground motion reaches [m/s^2] (the largest recorded is about 4 g): a file that
 #: reads above it is in other units than those it was read in (cm/s^2 read as g: 100 times).
 IMPOSSIBLE_PGA = 10.0 * STANDARD_GRAVITY
+
+#: The weakest PGA of a strong-motion record read from a file [m/s^2]: accelerographs trigger
+#: near 0.005 g and no block rocks below g tan(alpha), so a record that reads below 0.0005 g is
+#: in other units than those it was read in (a file in g read as cm/s^2 reads 100 times low:
+#: El Centro 1940's 0.35 g would read 0.00036 g).
+WEAKEST_PGA = 5e-4 * STANDARD_GRAVITY
+
+#: A PGA below which a record read from a file is warned of [m/s^2] (:class:`UnitsWarning`):
+#: weaker than the trigger level of most accelerographs, so possibly in other units.
+WEAK_PGA = 5e-3 * STANDARD_GRAVITY
 
 #: Methods of :meth:`Record.pulse`.
 PULSE_METHODS = {"wavelet": extract_wavelet_pulse, "mavroeidis": extract_pulse}
@@ -566,17 +578,39 @@ class UnitsError(ValueError):
     """A record file whose samples, read in the units given, are beyond any ground motion."""
 
 
+def _reads(peak, units) -> str:
+    """A peak acceleration [m/s^2] as the file's numbers read it, and in g."""
+    out = f"{peak / _UNITS[units]:.4g} {units}"
+    return out if units == "g" else f"{out} = {peak / STANDARD_GRAVITY:.4g} g"
+
+
 def _check_plausible_pga(path, record, units) -> None:
     """A :class:`UnitsError` naming ``units`` where a component read from ``path`` in
-    ``units`` peaks beyond any ground motion (:data:`IMPOSSIBLE_PGA`)."""
+    ``units`` peaks beyond any ground motion (:data:`IMPOSSIBLE_PGA`), or where the horizontal
+    one peaks below any strong-motion record (:data:`WEAKEST_PGA`); a :class:`UnitsWarning`
+    below :data:`WEAK_PGA`."""
+    peak = float(np.max(np.abs(record.acceleration)))
+    if 0.0 < peak < WEAKEST_PGA:
+        raise UnitsError(
+            f"{path}: units={units!r}: its peak acceleration reads {_reads(peak, units)}, "
+            f"below any strong-motion record (under {WEAKEST_PGA / STANDARD_GRAVITY:g} g; "
+            "accelerographs trigger near 0.005 g): are the samples in other units (g read as "
+            'cm/s^2)? give the units they are in (units="g" or "m/s2")'
+        )
+    if 0.0 < peak < WEAK_PGA:
+        warnings.warn(
+            f"{path}: units={units!r}: its peak acceleration reads {_reads(peak, units)}, "
+            f"weaker than most accelerographs record (under {WEAK_PGA / STANDARD_GRAVITY:g} "
+            "g): check that the samples are in these units",
+            UnitsWarning,
+            stacklevel=3,
+        )
     for what, a in (("", record.acceleration), (" vertical", record.vertical)):
         peak = 0.0 if a is None else float(np.max(np.abs(a)))
         if peak > IMPOSSIBLE_PGA * (1.0 + 1e-9):
-            reads = f"{peak / _UNITS[units]:.4g} {units}"
-            if units != "g":
-                reads += f" = {peak / STANDARD_GRAVITY:.4g} g"
             raise UnitsError(
-                f"{path}: units={units!r}: its{what} peak acceleration reads {reads}, beyond "
+                f"{path}: units={units!r}: its{what} peak acceleration reads "
+                f"{_reads(peak, units)}, beyond "
                 f"any ground motion (above {IMPOSSIBLE_PGA / STANDARD_GRAVITY:g} g): are the "
                 "samples in other units (cm/s^2 read as g)? give the units they are in "
                 '(units="cm/s2" or "m/s2")'
