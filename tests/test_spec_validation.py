@@ -527,3 +527,31 @@ def test_a_record_that_does_not_read_is_named_beside_an_objects_problem(tmp_path
     message = refused(museum.replace("width = 0.50", "width = -0.50", 1), base_dir=tmp_path)
     assert ".width: " in message and "got -0.5" in message
     assert "a.txt" in message and "NaN" in message
+
+
+def test_the_stored_study_of_an_ida_shows_every_option_it_runs_with(tmp_path):
+    """An IDA study that leaves its options out is stored with the values it runs with (the
+    defaults documented for ``[design]``: step 0.01, tolerance 0.001, max_pga_ratio 30,
+    scan 24, im pga), and the normalized study validates to itself."""
+    import json
+
+    records = Path(__file__).resolve().parents[1] / "data" / "records"
+    text = (
+        'name = "ida"\nseed = 1\n[structure]\nkind = "objects"\n'
+        'objects = [{ name = "A", width = 0.4, height = 1.6 }]\n'
+        f'[motion]\nkind = "record"\nfiles = "{records}/*_H.AT2"\n[design]\nkind = "ida"\n'
+    )
+    study = validate_text(text)
+    design = json.loads(study.normalized())["design"]
+    assert {k: design[k] for k in ("im", "step", "tolerance", "max_pga_ratio", "scan")} == {
+        "im": "pga",
+        "step": 0.01,
+        "tolerance": 0.001,
+        "max_pga_ratio": 30.0,
+        "scan": 24,
+    }
+    again = Study.model_validate(json.loads(study.normalized()))
+    assert again.normalized() == study.normalized()
+    given = validate_text(text + "step = 0.05\nscan = 0\n")
+    design = json.loads(given.normalized())["design"]
+    assert design["step"] == 0.05 and design["scan"] == 0 and design["tolerance"] == 0.001

@@ -637,9 +637,11 @@ class DesignSpec(_Model):
             return self
         _check_period(self.im or "pga", self.period, "period")
         try:
-            self.ida()
+            options = self.ida()
         except IdaOptionError as exc:
             raise FieldError(exc.option, str(exc).partition(" ")[2]) from None
+        for name in ida:  # the stored study shows every option the run used
+            object.__setattr__(self, name, getattr(options, name))
         return self
 
     def ida(self) -> IdaOptions:
