@@ -16,7 +16,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from ._warnings import (
+from .warnings import (
     AccuracyWarning,
     ClosedFormValidityWarning,
     ComplexAccuracyWarning,
@@ -49,6 +49,7 @@ _LAZY = {
     "motions": (".motions", None),
     "risk": (".risk", None),
     "similarity": (".similarity", None),
+    "UnitsError": (".motions.records", "UnitsError"),
     "structures": (".structures", None),
     # the study layer (xarray, dask, pydantic, scipy): on first use of ``rockstudy.study``,
     # which also registers the ``ds.rocking`` accessor of xarray Datasets
@@ -71,6 +72,7 @@ __all__ = [
     "UnitsWarning",
     "UpliftWarning",
     "StepLimitError",
+    "UnitsError",
     "closedform",
     "motions",
     "risk",
@@ -78,6 +80,7 @@ __all__ = [
     "simulate",
     "simulate_batch",
     "structures",
+    "warnings",
     "__version__",
 ]
 

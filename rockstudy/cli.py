@@ -12,6 +12,8 @@ from pathlib import Path
 
 from . import __version__
 
+__all__ = ["main"]
+
 
 def _simulate(args) -> int:
     from . import Block, StepLimitError, simulate

@@ -15,6 +15,8 @@ The two differ by 3.4e-4 (relative). Keeping the physics at 9.81 keeps every ker
 it was; converting units with 9.80665 keeps a PEER record's own velocity and displacement.
 """
 
+__all__ = ["FALL_ROTATION", "G", "STANDARD_GRAVITY"]
+
 #: Gravity of the physics [m/s^2]: p = sqrt(3 g / 4 R), uplift at g tan(alpha), Arias' pi / 2g.
 G = 9.81
 

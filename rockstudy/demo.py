@@ -15,6 +15,8 @@ from .dynamics import simulate
 from .motions import SinePulse
 from .structures import Block
 
+__all__ = ["run"]
+
 
 def run(out_dir="results/demo") -> dict:
     """Rock a 2 m tall, 0.5 m wide block through a sine pulse with each method.

@@ -35,6 +35,20 @@ from .constants import G
 from .dynamics import simulate, simulate_batch
 from .structures import Block
 
+__all__ = [
+    "fig003_14",
+    "fig003_arch",
+    "fig003_frame",
+    "fig003_wall",
+    "fig04",
+    "fig06",
+    "fig08",
+    "fig10",
+    "fig11",
+    "fig13",
+    "make_all",
+]
+
 _MODE_COLORS = ["#dddddd", "#9ecae1", "#c7e9c0", "#fdae6b", "#e6550d"]
 
 

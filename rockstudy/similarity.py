@@ -29,6 +29,19 @@ from .motions.records import Record
 from .structures.block import Block, block_parameters
 from .structures.block import uplift_acceleration as _uplift_acceleration
 
+__all__ = [
+    "LAWS",
+    "Law",
+    "block_for",
+    "from_groups",
+    "groups",
+    "pulse_for",
+    "record_groups",
+    "rotation_scale",
+    "to_groups",
+    "uplift_acceleration",
+]
+
 Law = Literal["4.10", "4.11", "5.3", "6.1"]
 LAWS = ("4.10", "4.11", "5.3", "6.1")
 

@@ -21,6 +21,7 @@ LAYER = {
     "_validate": 0,
     "_roots": 0,  # the one Newton-bisection root finder, shared from motions up to closedform
     "_warnings": 0,
+    "warnings": 0,
     "_numba_cache": 0,  # numba's cache saves made safe between processes
     "data": 0,
     "motions": 1,

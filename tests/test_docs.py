@@ -134,7 +134,7 @@ def test_every_page_renders_and_every_gallery_image_loads(site, tmp_path):
     import rockstudy
 
     for name in rockstudy.__all__:
-        modules = ("closedform", "motions", "risk", "similarity", "structures")
+        modules = ("closedform", "motions", "risk", "similarity", "structures", "warnings")
         if name.startswith("__") or name in modules:
             continue
         assert (site / "generated" / f"rockstudy.{name}.html").is_file(), name

@@ -10,12 +10,19 @@ from .analysis.record_fragility import ida_fragility, im_efficiency, stripe_frag
 from .analysis.risk import object_risk
 from .designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
 from .designs.sampling import make_design, salib_problem
-from .running.runner import RunReport, run_study
-from .running.store import export_netcdf, open_result
+from .running.runner import FailedSamplesError, RunReport, SchedulerError, run_study
+from .running.store import StoreError, export_netcdf, open_result
+from .spec.ida_options import IdaOptionError
 from .spec.schema import Study, StudyError, json_schema, load_study, validate_text
+from .spec.structures import FieldError
 
 __all__ = [
+    "FailedSamplesError",
+    "FieldError",
+    "IdaOptionError",
     "RockingAccessor",
+    "SchedulerError",
+    "StoreError",
     "RunReport",
     "cloud",
     "ida_fragility",

@@ -14,3 +14,5 @@ This layer sits above the physics packages (``dynamics``, ``closedform``, ``simi
 The modules are imported on demand (``from rockstudy.verification.validity import
 validity_map``) so that ``import rockstudy`` does not pay for them.
 """
+
+__all__: list[str] = []  # the modules are imported by name

@@ -5,3 +5,5 @@
 Python (cloud, multiple stripes, incremental dynamic analysis); ``record_rows`` lays a study
 file's record design out as rows of the result cube, and folds the rows back.
 """
+
+__all__: list[str] = []  # the modules are imported by name

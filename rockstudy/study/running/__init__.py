@@ -4,3 +4,5 @@
 is the function each task runs on a chunk of rows; ``store`` writes, resumes, verifies and
 opens the cube; ``_warmup`` compiles the numba kernels before the workers need them.
 """
+
+__all__: list[str] = []  # the modules are imported by name
