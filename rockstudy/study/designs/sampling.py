@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
-from scipy.stats import qmc
 
 from ...constants import G
 from ...structures.block import restitution_housner, uplift_acceleration_block
+from ..spec.samplers import SAMPLERS
 from ..spec.schema import Study
 from ..spec.structures import KINDS
 
@@ -49,48 +49,15 @@ VARIABLES = {
 }
 
 
-def salib_problem(study: Study) -> dict:
-    """The SALib problem of a study: its distributed parameters on the unit hypercube."""
-    names = list(study.parameters())
-    return {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
-
-
-def _monte_carlo(study: Study, d: int) -> np.ndarray:
-    """Plain Monte Carlo: independent uniform points from the study's root seed."""
-    return np.random.default_rng(np.random.SeedSequence(study.seed)).random((study.sampler.n, d))
-
-
-def _latin_hypercube(study: Study, d: int) -> np.ndarray:
-    """A scrambled Latin hypercube (``scipy.stats.qmc``) from the study's root seed."""
-    rng = np.random.default_rng(np.random.SeedSequence(study.seed))
-    return qmc.LatinHypercube(d=d, seed=rng).random(study.sampler.n)
-
-
-def _saltelli(study: Study, d: int) -> np.ndarray:
-    """Scrambled Sobol' points in SALib's Saltelli layout (N (D + 2) rows, or N (2 D + 2)
-    with second-order indices)."""
-    from SALib.sample import sobol
-
-    s = study.sampler
-    x = sobol.sample(
-        salib_problem(study), s.n, calc_second_order=s.second_order, scramble=True, seed=study.seed
-    )
-    return np.clip(x, 0.0, np.nextafter(1.0, 0.0))
-
-
-#: Sampler kind -> its points in [0, 1)^D: (study, D) -> array (rows = samples). The grid
-#: sampler takes each distribution's own points instead (:func:`_inputs`).
-UNIT_SAMPLERS = {"monte_carlo": _monte_carlo, "lhs": _latin_hypercube, "sobol": _saltelli}
-
-
 def unit_samples(study: Study) -> np.ndarray:
-    """Points in [0, 1)^D of the study's sampler (rows = samples)."""
+    """Points in [0, 1)^D of the study's sampler (rows = samples), from the registry
+    :data:`rockstudy.study.spec.samplers.SAMPLERS`."""
     kind = study.sampler.kind
-    if kind not in UNIT_SAMPLERS:
-        raise ValueError(
-            f"unit samples do not apply to sampler {kind!r}; they do to {', '.join(UNIT_SAMPLERS)}"
-        )
-    return UNIT_SAMPLERS[kind](study, len(study.parameters()))
+    points = SAMPLERS[kind].points
+    if points is None:
+        with_points = ", ".join(k for k, s in SAMPLERS.items() if s.points is not None)
+        raise ValueError(f"unit samples do not apply to sampler {kind!r}; they do to {with_points}")
+    return points(study, len(study.parameters()))
 
 
 def _inputs(study: Study) -> tuple[dict, dict]:

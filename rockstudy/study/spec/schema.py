@@ -81,6 +81,7 @@ from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
 from .ida_options import IdaOptionError, IdaOptions
+from .samplers import SAMPLERS, kinds_laid_out
 from .structures import KINDS, FieldError, FieldErrors, check_all, check_object, object_fields
 
 
@@ -682,36 +683,34 @@ class StochasticSpec(_Model):
         return int(round(self.duration / self.dt)) + 1
 
 
-#: Sampler kind -> its layout: ``"random"`` (n independent draws: replicated group points
-#: allowed, and a ``[design]`` may draw its structures with it), ``"saltelli"`` (Sobol' points
-#: in SALib's Saltelli layout, n = 2^k) or ``"grid"`` (each parameter's own points). A new
-#: sampler is one entry here and its points in
-#: :data:`rockstudy.study.designs.sampling.UNIT_SAMPLERS`.
-SAMPLER_LAYOUTS = {"monte_carlo": "random", "lhs": "random", "sobol": "saltelli", "grid": "grid"}
+#: Sampler kind -> its layout (:data:`.samplers.LAYOUTS`), read from the one registry
+#: :data:`.samplers.SAMPLERS`.
+SAMPLER_LAYOUTS = {kind: s.layout for kind, s in SAMPLERS.items()}
 
 
 def samplers_laid_out(*layouts) -> list[str]:
-    """The sampler kinds of the given layouts, in the order of :data:`SAMPLER_LAYOUTS`."""
-    return [kind for kind, layout in SAMPLER_LAYOUTS.items() if layout in layouts]
+    """The sampler kinds of the given layouts, in the order of :data:`.samplers.SAMPLERS`."""
+    return kinds_laid_out(*layouts)
 
 
 class SamplerSpec(_Model):
     """Monte Carlo, Latin hypercube, Sobol' (Saltelli layout, n = 2^k) or a full grid."""
 
-    kind: Literal[tuple(SAMPLER_LAYOUTS)]
+    kind: Literal[tuple(SAMPLERS)]
     n: int | None = Field(default=None, ge=1, le=2**53)
     second_order: bool = False
     replicates: int = Field(default=1, ge=1, le=10**6)
 
     @model_validator(mode="after")
     def _n(self):
-        if self.kind == "grid":
+        sampler = SAMPLERS[self.kind]
+        if not sampler.takes_n:
             if self.n is not None:
                 raise FieldError("n", "a grid takes its size from the grid parameters; remove n")
         elif self.n is None:
             raise FieldError("n", f"sampler {self.kind!r} needs n")
-        elif self.kind == "sobol" and self.n & (self.n - 1):
-            raise FieldError("n", f"sobol needs n = 2^k, got {self.n}")
+        elif sampler.n_rule is not None and sampler.n_rule(self.n):
+            raise FieldError("n", sampler.n_rule(self.n))
         if self.second_order and self.kind != "sobol":
             raise FieldError("second_order", "applies to the sobol sampler only")
         if self.replicates > 1 and SAMPLER_LAYOUTS[self.kind] != "random":
