@@ -10,8 +10,7 @@ import itertools
 import numpy as np
 import pytest
 
-from rockstudy.study import StudyError, make_design, validate_text
-from rockstudy.study import json_schema
+from rockstudy.study import StudyError, json_schema, make_design, validate_text
 from rockstudy.study.designs.sampling import unit_samples
 from rockstudy.study.spec.samplers import SAMPLERS, kinds_laid_out
 
