@@ -1,27 +1,35 @@
 """The result cube: a zarr store written chunk by chunk, with a ``status`` written last.
 
-The template (design, outputs filled with their fill values, ``status`` = 0 pending) is written
-first. Each finished chunk is written into its own region (zarr chunks are aligned with the
-study's chunks, so no two writers ever share a zarr chunk), outputs first and ``status`` last:
-a chunk whose status is not pending is complete. A killed run resumes from the pending chunks.
+The template (design, outputs filled with their fill values, ``status`` = 0 pending, every
+chunk file written) is written first. Each finished chunk is written into its own region (zarr
+chunks are aligned with the study's chunks, so no two writers ever share a zarr chunk) in three
+stages (:class:`ChunkWriter`): its outputs; the sha256 of every file of the chunk, ``status``
+included (encoded beforehand in a staging array), into ``.rockstudy-chunks/<k>``; and its
+``status`` file, moved in by one rename. A chunk whose status reads done and whose files match
+those sums is finished; one whose status reads pending is pending; anything else is damaged. A
+killed run resumes from the pending chunks.
 
 The store never destroys what it did not write. A run claims a folder only if it is new (or
 empty: nothing in it but, at most, a lock file), and writes a marker file ``.rockstudy`` into
 it first (the study's sha256, the sha256 of every input file, the package version, and whether
 the template is complete). Only that marker identifies a store: a lock file never does, and a
 store whose marker is lost is resumed only if its cube's own attributes pass the marker's
-checks. A run holds an exclusive lock (``.rockstudy.lock``, ``fcntl.flock``, naming its PID and
+checks. A marker is believed only where it agrees with the cube: the same study and input
+files as the cube's attributes, and no finished chunk if it says the template is unfinished.
+A run holds an exclusive lock (``.rockstudy.lock``, ``fcntl.flock``, naming its PID and
 host once the run is accepted) for its whole life: a second run on the same store is refused
 at once, and the lock of a killed run vanishes with its process, so ``--resume`` after SIGKILL
-just works. The template records the sha256 of ``.zmetadata`` and of the design's files, and
-each finished chunk those of its outputs (``.rockstudy-chunks/``): on resume a chunk marked
-done whose files are missing or differ is computed again, and a reader
-(:func:`open_result`, :func:`verify_cube`) refuses a cube whose files differ.
+just works. The template records the sha256 of ``.zmetadata`` and of the design's files; every
+other metadata file must read as its copy in ``.zmetadata``. On resume a chunk marked done
+whose files are missing or differ is computed again and metadata files are restored from
+``.zmetadata``; a reader (:func:`open_result`, :func:`verify_cube`) refuses a cube whose files
+differ.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import importlib.metadata
 import json
@@ -150,9 +158,7 @@ def write_marker(path, **fields) -> None:
     """Write (or update) the marker atomically: a temporary file renamed over it."""
     marker = Path(path) / MARKER
     data = {**(read_marker(path) or {}), **fields}
-    tmp = marker.with_name(MARKER + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    os.replace(tmp, marker)
+    _write_json(marker, data)
 
 
 def _cube_attrs(path) -> dict | None:
@@ -307,10 +313,12 @@ def claim(path, study: Study, inputs: dict, resume: bool) -> tuple[StoreLock, bo
             f"{path} holds a rockstudy store: continue it with --resume, or choose a new --out"
         )
     _check_same(path, marker, study.sha256(), inputs)  # read only: nothing is touched yet
+    _check_marker_agrees(path, marker)
     lock.acquire()
     try:
         marker = _marker_or_legacy(path)  # again, under the lock
         _check_same(path, marker, study.sha256(), inputs)
+        _check_marker_agrees(path, marker)
         complete = bool(marker.get("template_complete"))
         if complete:
             _check_metadata(path)
@@ -383,13 +391,16 @@ def _check_metadata(path) -> None:
         "If the arrays' own metadata are intact, rebuild it with python -c \"import zarr; "
         f"zarr.consolidate_metadata('{path}', zarr_format=2)\" and --resume again"
     )
-    try:
-        want = json.loads((path / CHECKSUMS / TEMPLATE_SUMS).read_text())[".zmetadata"]
-    except (OSError, ValueError, KeyError, TypeError):
-        want = None  # a store written before these sums: what opens is all that is checked
+    sums = read_template_sums(path)
+    if sums is None:  # written with the template, before its marker said it was complete
+        raise StoreError(
+            f"{path}: the sums of its metadata and design ({CHECKSUMS}/{TEMPLATE_SUMS}) are "
+            "missing or unreadable, so the cube cannot be checked; nothing was changed. Run "
+            "the study into a new --out"
+        )
     try:
         json.loads((path / ".zmetadata").read_text())["metadata"]
-        if want is not None and file_sha256(path / ".zmetadata") != want:
+        if file_sha256(path / ".zmetadata") != sums["files"].get(".zmetadata"):
             advice = "The cube cannot be trusted: run the study into a new --out"
             raise ValueError("it differs from the file written: its sha256 changed")
         group = zarr.open_group(str(path), mode="r", zarr_format=2, use_consolidated=True)
@@ -488,7 +499,14 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         if var.dims[:1] == ("sample",)
     }
     with dask.config.set(scheduler="threads"), _quiet_about_our_files():
-        ds.to_zarr(Path(path), mode="a", encoding=chunks, zarr_format=2, consolidated=False)
+        ds.to_zarr(  # every chunk file is written (status included): a lost one is known
+            Path(path),
+            mode="a",
+            encoding=chunks,
+            zarr_format=2,
+            consolidated=False,
+            write_empty_chunks=True,
+        )
         group = zarr.open_group(str(path), mode="r+", zarr_format=2)
         error = group.create_array("error", shape=(n,), chunks=(size,), dtype=str, fill_value="")
         error.attrs.update(  # variable-length: messages are stored whole
@@ -571,13 +589,18 @@ def stop_zarr_io(timeout: float = 60.0) -> None:
 
 
 class ChunkWriter:
-    """Writes finished chunks straight into the zarr arrays of a cube: the outputs, their
-    checksums, and ``status`` last.
+    """Writes finished chunks into the zarr arrays of a cube in three stages (:attr:`STAGES`):
+    the outputs, then their checksums with that of the chunk's ``status``, then ``status``.
 
     The arrays were created by :func:`create_store` with the study's chunks, so each chunk
-    write touches its own zarr chunks only. The sha256 of every file of the chunk goes to
-    ``.rockstudy-chunks/<k>``: a resume trusts a chunk only if its files still match.
+    write touches its own zarr chunks only. ``status`` is encoded first into a staging copy of
+    its array (``.rockstudy-chunks/staging``), so that its sha256 is known before it is
+    written: the checksums (``.rockstudy-chunks/<k>``) cover every file of the chunk, status
+    included, and the status file then moves into the cube in one rename. A kill at any stage
+    leaves the chunk pending (its status still reads 0) or finished and covered.
     """
+
+    STAGES = ("outputs", "checksums", "status")
 
     def __init__(self, path):
         import zarr
@@ -585,45 +608,73 @@ class ChunkWriter:
         self.path = Path(path)
         self.group = zarr.open_group(str(path), mode="r+", zarr_format=2)
         self.size = self.group["status"].chunks[0]
-        (self.path / CHECKSUMS).mkdir(exist_ok=True)
+        self.staging = _staging_array(self.path)
 
     def write(self, start: int, stop: int, result: dict) -> None:
+        """Write the chunk ``[start, stop)`` whole: every stage of :meth:`stages`."""
+        for stage in self.stages(start, stop, result):
+            stage()
+
+    def stages(self, start: int, stop: int, result: dict) -> list:
+        """The writes of the chunk ``[start, stop)``, in order (one callable per stage)."""
         import zarr
 
-        # every chunk file is written, even one equal to the fill value: a done chunk whose
-        # file is missing is then known to be lost (see chunks_to_compute)
-        with zarr.config.set({"array.write_empty_chunks": True}):
-            names = [name for name in result if name != "status"]
-            for name in names:
-                self.group[name][start:stop] = result[name]
-            k = start // self.size
+        k = start // self.size
+        names = [name for name in result if name != "status"]
+        status_file = self.staging.path / str(k)
+
+        def outputs():
+            # every chunk file is written, even one equal to the fill value: a done chunk
+            # whose file is missing is then known to be lost (see chunks_to_compute)
+            with zarr.config.set({"array.write_empty_chunks": True}):
+                for name in names:
+                    self.group[name][start:stop] = result[name]
+
+        def checksums():
+            with zarr.config.set({"array.write_empty_chunks": True}):
+                self.staging.array[start:stop] = result["status"]
             sums = {
                 name: file_sha256(self.path / name / _chunk_file(self.group, name, k))
                 for name in names
                 if self.group[name].size  # an array of no values has no chunk files
             }
-            target = self.path / CHECKSUMS / str(k)
-            tmp = target.with_name(f"{k}.tmp")
-            tmp.write_text(json.dumps(sums))
-            os.replace(tmp, target)
-            self.group["status"][start:stop] = result["status"]
+            sums["status"] = file_sha256(status_file)
+            _write_json(self.path / CHECKSUMS / str(k), sums)
+
+        def status():
+            os.replace(status_file, self.path / "status" / str(k))
+
+        return [outputs, checksums, status]
 
 
-def _chunk_intact(path, group, names, k) -> bool:
-    """Whether chunk ``k`` of every variable in ``names`` still has the checksum it was
-    written with."""
-    try:
-        sums = json.loads((path / CHECKSUMS / str(k)).read_text())
-        return all(
-            file_sha256(path / name / _chunk_file(group, name, k)) == sums[name]
-            for name in names
-            if group[name].size
-        )
-    except (OSError, ValueError, KeyError, TypeError):
-        return False
+@dataclasses.dataclass
+class _Staging:
+    path: Path
+    array: object
+
+
+def _staging_array(path) -> _Staging:
+    """An empty copy of the cube's ``status`` array (its metadata from ``.zmetadata``), in
+    which a chunk's status is encoded before it moves into the cube."""
+    import zarr
+
+    folder = Path(path) / CHECKSUMS / "staging"
+    folder.mkdir(parents=True, exist_ok=True)
+    _write_json(folder / ".zarray", _consolidated(path)["status/.zarray"])
+    return _Staging(folder, zarr.open_array(str(folder), mode="r+", zarr_format=2))
+
+
+def _write_json(target, data) -> None:
+    """Write ``data`` as JSON into ``target`` atomically (a temporary file renamed over it)."""
+    target = Path(target)
+    tmp = target.with_name(target.name + ".tmp")
+    tmp.write_text(json.dumps(data))
+    os.replace(tmp, target)
 
 
 TEMPLATE_SUMS = "template"  # in CHECKSUMS: the sha256 of .zmetadata and of the design's files
+_METADATA = (".zarray", ".zattrs", ".zgroup")  # the files of zarr v2 metadata
+_MARKER_VARIABLE = f"{MARKER} (the store's marker)"
 
 
 def _files_of(path, name) -> list[Path]:
@@ -632,19 +683,78 @@ def _files_of(path, name) -> list[Path]:
     return sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith("."))
 
 
+def _arrays(meta) -> dict:
+    """The arrays of a cube's consolidated metadata: name -> its ``.zarray``."""
+    return {key.split("/")[0]: value for key, value in meta.items() if key.endswith("/.zarray")}
+
+
 def write_template_sums(path, names) -> None:
     """Record the sha256 of the consolidated metadata and of every chunk file of the design
-    variables ``names``: what a reader checks besides the finished chunks' own sums."""
+    variables ``names``, and the names of the result arrays (all the others), whose files each
+    finished chunk's checksums must cover."""
     path = Path(path)
-    sums = {".zmetadata": file_sha256(path / ".zmetadata")}
+    files = {".zmetadata": file_sha256(path / ".zmetadata")}
     for name in names:
         for file in _files_of(path, name):
-            sums[f"{name}/{file.name}"] = file_sha256(file)
+            files[f"{name}/{file.name}"] = file_sha256(file)
+    results = sorted(set(_arrays(_consolidated(path))) - set(names))
     (path / CHECKSUMS).mkdir(exist_ok=True)
-    target = path / CHECKSUMS / TEMPLATE_SUMS
-    tmp = target.with_name(TEMPLATE_SUMS + ".tmp")
-    tmp.write_text(json.dumps(sums))
-    os.replace(tmp, target)
+    _write_json(path / CHECKSUMS / TEMPLATE_SUMS, {"files": files, "results": results})
+
+
+def read_template_sums(path) -> dict | None:
+    """The sums written with the template (``files``: path -> sha256, ``results``: names), or
+    None if they are missing or unreadable."""
+    try:
+        sums = json.loads((Path(path) / CHECKSUMS / TEMPLATE_SUMS).read_text())
+        if isinstance(sums["files"], dict) and isinstance(sums["results"], list):
+            return sums
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    return None
+
+
+def _finished_ledgers(path) -> list[str]:
+    """The chunks that have checksums in ``.rockstudy-chunks`` (written only once the
+    template is complete)."""
+    folder = Path(path) / CHECKSUMS
+    return sorted(p.name for p in folder.iterdir() if p.name.isdigit()) if folder.is_dir() else []
+
+
+def _marker_disagreement(path, marker) -> str | None:
+    """What the marker says against the cube's own record (its attributes and checksums), or
+    None if they agree. A marker that says the template is unfinished agrees with a cube that
+    has finished no chunk: a run killed while writing its template leaves one."""
+    attrs = _cube_attrs(path)
+    if attrs is not None:
+        if attrs.get("study_sha256") != marker.get("study_sha256"):
+            return (
+                "names another study than its cube's own attributes (a marker copied from "
+                "another store?)"
+            )
+        try:
+            inputs = json.loads(attrs["inputs_sha256"])
+        except (KeyError, TypeError, ValueError):
+            inputs = marker.get("inputs_sha256")  # not recorded in the cube: nothing to compare
+        if inputs != marker.get("inputs_sha256"):
+            return "names other input files than its cube's own attributes"
+    finished = _finished_ledgers(path)
+    if not marker.get("template_complete") and finished:
+        return (
+            f"says its template was never completed, but the cube holds {len(finished)} "
+            "finished chunks"
+        )
+    return None
+
+
+def _check_marker_agrees(path, marker) -> None:
+    """Refuse (StoreError) a marker that disagrees with the cube: it is not believed."""
+    what = _marker_disagreement(path, marker)
+    if what is not None:
+        raise StoreError(
+            f"{path}: its marker {MARKER} {what}: it is not believed and nothing was changed. "
+            "Restore the store's own marker, or run into a new --out"
+        )
 
 
 class DamagedCube(StoreError):
@@ -656,14 +766,16 @@ class DamagedCube(StoreError):
         self.variable, self.chunk = variable, chunk
 
 
-def _damaged(path, what, variable, chunk=None, rows=None):
+_RECOMPUTE = "rockstudy run ... --resume computes it again"
+_RESTORE = "rockstudy run ... --resume restores it from the checked .zmetadata"
+_AFRESH = "run the study again into a new --out"
+
+
+def _damaged(path, what, variable, chunk=None, rows=None, advice=None):
     where = f"variable {variable!r}" + ("" if chunk is None else f", chunk {chunk}")
     where += "" if rows is None else f" (samples {rows[0]} to {rows[1] - 1})"
-    advice = (
-        "rockstudy run ... --resume computes it again"
-        if chunk is not None and variable != "status"
-        else "run the study again into a new --out"
-    )
+    if advice is None:
+        advice = _RECOMPUTE if chunk is not None else _AFRESH
     return DamagedCube(
         f"{path} is damaged: {where}: {what}; it is not read. {advice}", variable, chunk
     )
@@ -685,32 +797,113 @@ def _verify_template(path, sums) -> int:
     return len(sums)
 
 
-def _verify_chunk(path, ndim, k, rows) -> int:
-    """Check chunk ``k`` of every output (``ndim``: name -> its dimensions) against the sums
-    written with it; the count."""
+def _metadata_files(path) -> set[str]:
+    """The zarr metadata files of a cube (its own and each array's), relative to it."""
+    path = Path(path)
+    found = {name for name in _METADATA if (path / name).exists()}
+    for folder in path.iterdir():
+        if folder.is_dir() and not folder.name.startswith("."):
+            found.update(f"{folder.name}/{n}" for n in _METADATA if (folder / n).exists())
+    return found
+
+
+def _metadata_differences(path, meta) -> list[str]:
+    """The metadata files that are missing, differ from their copy in the consolidated
+    metadata ``meta`` (itself checked by its sha256), or are not in it."""
+    out = []
+    for key in sorted(set(meta) | _metadata_files(path)):
+        try:
+            same = json.loads((Path(path) / key).read_text()) == meta[key]
+        except (OSError, ValueError, KeyError):
+            same = False
+        if not same:
+            out.append(key)
+    return out
+
+
+def _check_array_metadata(path, meta) -> int:
+    """Raise DamagedCube naming the first metadata file that does not read as written; the
+    count checked."""
+    for key in _metadata_differences(path, meta):
+        variable = key.rpartition("/")[0] or f"{key} (the cube's own metadata)"
+        what = (
+            f"its metadata file {key} is missing or differs from its copy in .zmetadata"
+            if key in meta
+            else f"it holds a metadata file {key} that .zmetadata does not list"
+        )
+        raise _damaged(path, what, variable, advice=_RESTORE if key in meta else _AFRESH)
+    return len(meta)
+
+
+class _ChunkDamage(Exception):
+    """A chunk that is neither pending nor finished and covered: ``variable``, ``what``."""
+
+    def __init__(self, variable, what):
+        super().__init__(what)
+        self.variable, self.what = variable, what
+
+
+def _results_with_values(meta, names) -> dict:
+    """Of the result arrays ``names``, those that hold values: name -> its number of
+    dimensions (an array of no values has no chunk files)."""
+    arrays = _arrays(meta)
+    return {
+        name: len(arrays[name]["shape"])
+        for name in names
+        if name in arrays and all(arrays[name]["shape"])
+    }
+
+
+def _chunk_finished(path, results, k, status) -> bool:
+    """Whether chunk ``k`` is finished (True) or pending (False).
+
+    Finished: its status reads 1 or 2, and every file of it (each of ``results``, a dict name
+    -> number of dimensions, ``status`` included) has the sha256 in ``.rockstudy-chunks/<k>``.
+    Pending: its status reads 0 (its checksums, if any, are those of a write a kill stopped
+    before its status moved in). ``status`` is the chunk's decoded status (None if it does not
+    decode). Raises :class:`_ChunkDamage` for anything else.
+    """
+    path = Path(path)
+    if not (path / "status" / str(k)).is_file():
+        raise _ChunkDamage("status", "its file is missing (every chunk has one from the start)")
+    if status is None or not np.all(np.isin(status, (STATUS_PENDING, *DONE))):
+        raise _ChunkDamage("status", "it does not decode to 0, 1 or 2")
+    if np.all(status == STATUS_PENDING):
+        return False
+    if np.any(status == STATUS_PENDING):
+        raise _ChunkDamage("status", "it is partly pending, partly done")
     try:
-        sums = json.loads((Path(path) / CHECKSUMS / str(k)).read_text())
+        sums = json.loads((path / CHECKSUMS / str(k)).read_text())
         if not isinstance(sums, dict):
             raise ValueError
     except (OSError, ValueError):
-        raise _damaged(
-            path,
-            f"the checksums of a finished chunk ({CHECKSUMS}/{k}) are missing or unreadable",
+        raise _ChunkDamage(
             "status",
-            k,
-            rows,
+            f"it reads finished, but the checksums of its chunk ({CHECKSUMS}/{k}) are missing "
+            "or unreadable",
         ) from None
-    for name, want in sums.items():
+    for name, ndim in results.items():
         try:
-            file = str(k) + ".0" * (ndim[name] - 1)
-            same = file_sha256(Path(path) / name / file) == want
+            same = file_sha256(path / name / (str(k) + ".0" * (ndim - 1))) == sums[name]
         except (OSError, KeyError):
             same = False
         if not same:
-            raise _damaged(
-                path, "its file is missing or differs from the one written", name, k, rows
-            )
-    return len(sums)
+            raise _ChunkDamage(name, "its file is missing or differs from the one written")
+    return True
+
+
+def _status_chunks(status, bounds):
+    """The decoded status of each chunk (None where it does not decode), read at once where
+    the whole array decodes."""
+    try:
+        whole = status[:]
+    except Exception:  # noqa: BLE001 - chunk by chunk, to find the one that does not decode
+        whole = None
+    for a, b in bounds:
+        try:
+            yield status[a:b] if whole is None else whole[a:b]
+        except Exception:  # noqa: BLE001 - a status chunk that does not decode
+            yield None
 
 
 def written_by_run(path) -> bool:
@@ -727,14 +920,32 @@ def written_by_run(path) -> bool:
         return False
 
 
+def _check_template_state(path) -> None:
+    """Refuse a cube whose marker disagrees with it (DamagedCube), or whose run stopped before
+    its template was complete (StoreError: it holds nothing to verify)."""
+    marker = read_marker(path)
+    if marker is None:
+        return
+    what = _marker_disagreement(path, marker)
+    if what is not None:
+        raise _damaged(path, f"it {what}", _MARKER_VARIABLE)
+    if not marker.get("template_complete"):
+        raise StoreError(
+            f"{path}: its run stopped before its template was complete, so it holds no results "
+            f"yet: resume it (rockstudy run STUDY --out {path} --resume)"
+        )
+
+
 def verify_cube(path) -> dict:
     """Check a zarr cube written by a run against the sha256 recorded when it was written.
 
-    Checked: the consolidated metadata and the design's files (recorded with the template),
-    the ``status`` of every chunk (it must decode to 0, 1 or 2), and the files of every output
-    of each finished chunk. Returns ``{"chunks", "done", "files"}``; raises
-    :class:`DamagedCube` (a StoreError) naming the first damaged variable and chunk, or
-    StoreError for a folder that is not a cube a run wrote.
+    Checked: the marker against the cube's own attributes; the consolidated metadata and the
+    design's files (recorded with the template); every metadata file against its copy in the
+    consolidated metadata; and each chunk (see :func:`_chunk_finished`): pending, or finished
+    with every file of it, ``status`` included, as written. Returns ``{"chunks", "done",
+    "files"}``; raises :class:`DamagedCube` (a StoreError) naming the first damaged variable
+    and chunk, or StoreError for a folder that is not a cube a run finished writing the
+    template of.
     """
     import zarr
 
@@ -746,47 +957,43 @@ def verify_cube(path) -> dict:
             f"{path} was not written by rockstudy run (no marker, checksums or template "
             "attribute): it carries no checksums to verify"
         )
-    try:
-        sums = json.loads((path / CHECKSUMS / TEMPLATE_SUMS).read_text())
-    except (OSError, ValueError):
+    _check_template_state(path)
+    sums = read_template_sums(path)
+    if sums is None:
+        copied = not (path / MARKER).exists() and not (path / CHECKSUMS).exists()
         raise _damaged(
             path,
-            f"the sums of its metadata and design ({CHECKSUMS}/{TEMPLATE_SUMS}) are "
-            "missing or unreadable (a copy saved with to_zarr has none: open_result(..., "
-            "verify=False) reads it unchecked)",
+            f"the sums of its metadata and design ({CHECKSUMS}/{TEMPLATE_SUMS}) are missing or "
+            "unreadable"
+            + (
+                " (a copy saved with to_zarr has none: open_result(..., verify=False) reads "
+                "it unchecked)"
+                if copied
+                else ""
+            ),
             ".zmetadata (the cube's metadata)",
-        ) from None
-    files = _verify_template(path, sums)
+        )
+    files = _verify_template(path, sums["files"])
     try:
-        group = zarr.open_group(str(path), mode="r", zarr_format=2, use_consolidated=True)
-        status = group["status"]
-        size = status.chunks[0]
-        ndim = {
-            key.split("/")[0]: len(value["shape"])
-            for key, value in _consolidated(path).items()
-            if key.endswith("/.zarray")
-        }
+        meta = _consolidated(path)
+        files += _check_array_metadata(path, meta)
+        status = zarr.open_group(str(path), mode="r", zarr_format=2, use_consolidated=True)[
+            "status"
+        ]
+        bounds = chunk_bounds(status.shape[0], status.chunks[0])
+    except DamagedCube:
+        raise
     except Exception as exc:  # noqa: BLE001 - metadata that does not open: one line
         raise _damaged(path, f"it does not open ({type(exc).__name__})", "status") from None
-    bounds = chunk_bounds(status.shape[0], size)
-    try:
-        whole = status[:]  # one read; chunk by chunk only to find the one that does not decode
-    except Exception:  # noqa: BLE001
-        whole = None
+    results = _results_with_values(meta, sums["results"])
     done = 0
-    for k, rows in enumerate(bounds):
+    for k, (rows, values) in enumerate(zip(bounds, _status_chunks(status, bounds), strict=True)):
         try:
-            values = status[rows[0] : rows[1]] if whole is None else whole[rows[0] : rows[1]]
-        except Exception:  # noqa: BLE001 - a status chunk that does not decode
-            values = None
-        if values is None or not np.all(np.isin(values, (STATUS_PENDING, *DONE))):
-            raise _damaged(path, "it does not decode to 0, 1 or 2", "status", k, rows)
-        if np.all(values == STATUS_PENDING):
-            continue
-        if np.any(values == STATUS_PENDING):
-            raise _damaged(path, "it is partly pending, partly done", "status", k, rows)
-        files += _verify_chunk(path, ndim, k, rows)
-        done += 1
+            finished = _chunk_finished(path, results, k, values)
+        except _ChunkDamage as exc:
+            raise _damaged(path, exc.what, exc.variable, k, rows) from None
+        done += finished
+        files += len(results) if finished else 0
     return {"chunks": len(bounds), "done": done, "files": files}
 
 
@@ -800,26 +1007,30 @@ def _consolidated(path) -> dict:
 
 
 def _restore_metadata(path, meta) -> list[str]:
-    """Rewrite the per-array metadata files that are missing, from the consolidated copy."""
+    """Rewrite the metadata files that are missing or differ, from the consolidated copy
+    (checked by its sha256); StoreError for one the copy does not list."""
     restored = []
-    for key, value in meta.items():
+    for key in _metadata_differences(path, meta):
+        if key not in meta:
+            raise StoreError(
+                f"{path} holds a metadata file {key} that its .zmetadata does not list: "
+                "nothing was changed; move it away, or run into a new --out"
+            )
         target = Path(path) / key
-        if not target.exists():
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_text(json.dumps(value, indent=4))
-            restored.append(key)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _write_json(target, meta[key])
+        restored.append(key)
     return restored
 
 
 def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
     """The chunks a resume must compute: ``(pending, damaged)``.
 
-    A chunk marked done is trusted only if its status reads 1 or 2 and the files of every
-    per-sample output still have the sha256 recorded when they were written
-    (:class:`ChunkWriter`); otherwise its files are removed, it is marked pending again and
-    listed in ``damaged``. The
-    design variables are compared with ``design`` (made again from the study) and rewritten
-    where they differ. Metadata files missing beside the consolidated ``.zmetadata`` are
+    A chunk marked done is trusted only if every file of it, ``status`` included, still has
+    the sha256 recorded when it was written (see :func:`_chunk_finished`); otherwise its files
+    are removed, it is marked pending again and listed in ``damaged``. The design variables are
+    compared with ``design`` (made again from the study) and rewritten where they differ.
+    Metadata files that are missing or differ from the consolidated ``.zmetadata`` are
     restored from it.
     """
     import zarr
@@ -834,38 +1045,40 @@ def chunks_to_compute(path, design: xr.Dataset, size: int) -> tuple[list, list]:
         )
     _restore_metadata(path, meta)
     group = zarr.open_group(str(path), mode="r+", zarr_format=2)
-    for name in design.variables:
-        want = design[name].values
-        try:
-            same = np.array_equal(group[name][:], want, equal_nan=want.dtype.kind == "f")
-        except Exception:  # noqa: BLE001 - any unreadable design chunk is written again
-            same = False
-        if not same:
-            with zarr.config.set({"array.write_empty_chunks": True}):
+    with zarr.config.set({"array.write_empty_chunks": True}):
+        for name in design.variables:
+            want = design[name].values
+            try:
+                same = np.array_equal(group[name][:], want, equal_nan=want.dtype.kind == "f")
+            except Exception:  # noqa: BLE001 - any unreadable design chunk is written again
+                same = False
+            if not same:
                 group[name][:] = want
-    write_template_sums(path, design.variables)  # the design as it now reads
-    results = sorted(
-        key.split("/")[0]
-        for key in meta
-        if key.endswith("/.zarray") and key.split("/")[0] not in design.variables
-    )
-    outputs = [name for name in results if name != "status"]
-    pending, damaged = [], []
-    n = design.sizes["sample"]
-    for k, (a, b) in enumerate(chunk_bounds(n, size)):
-        try:
-            status = group["status"][a:b]
-        except Exception:  # noqa: BLE001 - a status chunk that does not decode: recompute
-            status = np.full(b - a, -1)
-        if np.all(status == STATUS_PENDING):
-            pending.append((a, b))
-        elif not (np.all(np.isin(status, DONE)) and _chunk_intact(path, group, outputs, k)):
-            damaged.append((a, b))
-            (path / CHECKSUMS / str(k)).unlink(missing_ok=True)
-            for name in results:  # never merged into: a damaged file may not decode
-                (path / name / _chunk_file(group, name, k)).unlink(missing_ok=True)
-            group["status"][a:b] = np.full(b - a, STATUS_PENDING, np.int8)
+        write_template_sums(path, design.variables)  # the design as it now reads
+        results = _results_with_values(meta, read_template_sums(path)["results"])
+        pending, damaged = [], []
+        bounds = chunk_bounds(design.sizes["sample"], size)
+        for k, (rows, status) in enumerate(
+            zip(bounds, _status_chunks(group["status"], bounds), strict=True)
+        ):
+            try:
+                finished = _chunk_finished(path, results, k, status)
+            except _ChunkDamage:
+                damaged.append(rows)
+                _reset_chunk(path, group, results, k, rows)
+                continue
+            if not finished:
+                pending.append(rows)
     return pending, damaged
+
+
+def _reset_chunk(path, group, results, k, rows) -> None:
+    """Remove the files of chunk ``k`` (never merged into: a damaged file may not decode) and
+    its checksums, and mark it pending."""
+    (path / CHECKSUMS / str(k)).unlink(missing_ok=True)
+    for name, ndim in results.items():
+        (path / name / (str(k) + ".0" * (ndim - 1))).unlink(missing_ok=True)
+    group["status"][rows[0] : rows[1]] = np.full(rows[1] - rows[0], STATUS_PENDING, np.int8)
 
 
 def open_result(path, verify: bool = True) -> xr.Dataset:
