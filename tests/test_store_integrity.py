@@ -180,6 +180,17 @@ def test_a_marker_of_another_study_of_the_same_shape_is_refused(finished, tmp_pa
     assert code == 1 and "marker" in one_line(err)
 
 
+def test_a_store_of_the_former_layout_is_not_resumed(finished, tmp_path):
+    """A store written before every chunk's checksums covered its status (no store_format in
+    its marker) is refused on resume, naming the format, and left as it was."""
+    study, src = finished
+    out = _copy(src, tmp_path)
+    marker = json.loads((out / ".rockstudy").read_text())
+    marker.pop("store_format")
+    (out / ".rockstudy").write_text(json.dumps(marker))
+    _refused_on_resume(study, out, ("store format 1", f"format {store.STORE_FORMAT}"))
+
+
 # ------------------------------------------------------------------ a kill at any stage
 
 

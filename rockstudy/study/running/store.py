@@ -78,6 +78,9 @@ def chunk_bounds(n: int, size: int) -> list[tuple[int, int]]:
     return [(i, min(i + size, n)) for i in range(0, n, size)]
 
 
+#: The layout of a store: 2 since every chunk's checksums cover its status and the arrays'
+#: metadata is checked against the consolidated copy. A store of another layout is not resumed.
+STORE_FORMAT = 2
 MARKER = ".rockstudy"  # written first into every folder a run creates: what it holds
 LOCK = ".rockstudy.lock"  # flock-ed by the run that writes the store, naming its PID and host
 CHECKSUMS = ".rockstudy-chunks"  # the sha256 of each finished chunk's files
@@ -201,6 +204,7 @@ def _legacy_marker(path, attrs) -> dict:
         "study_sha256": attrs["study_sha256"],
         "inputs_sha256": inputs,
         "rockstudy": version,
+        "store_format": attrs.get("store_format", 1),
         "template_complete": True,
     }
 
@@ -353,6 +357,7 @@ def _identity(study, inputs) -> dict:
         "study_sha256": study.sha256(),
         "inputs_sha256": inputs,
         "rockstudy": package_versions()["rockstudy"],
+        "store_format": STORE_FORMAT,
     }
 
 
@@ -372,6 +377,12 @@ def _check_same(path, marker, sha, inputs) -> None:
             f"{path}: input file(s) {', '.join(changed)} changed since this store was started; "
             "resuming would mix results of different inputs: restore them, or run into a new "
             "--out"
+        )
+    if marker.get("store_format", 1) != STORE_FORMAT:
+        raise StoreError(
+            f"{path} was written in store format {marker.get('store_format', 1)} by an earlier "
+            f"rockstudy; this one writes format {STORE_FORMAT} (every chunk's checksums cover its "
+            "status): run the study into a new --out"
         )
     version = package_versions()["rockstudy"]
     if marker.get("rockstudy") != version:
@@ -489,6 +500,7 @@ def create_store(path, design: xr.Dataset, study: Study, inputs: dict | None = N
         seed=study.seed,
         chunk_size=study.chunk_size,
         versions=json.dumps(package_versions()),
+        store_format=STORE_FORMAT,
         Conventions="CF-1.8",
         gravity=G,  # [m/s^2] the physics' g: p = sqrt(3 g / 4 R), uplift g tan(alpha)
         record_g_unit=STANDARD_GRAVITY,  # [m/s^2] the unit g of records read in g
