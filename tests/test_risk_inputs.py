@@ -235,6 +235,13 @@ def test_the_rate_of_a_level_outside_the_curve_s_domain_is_refused():
             POWER.rate(x)
     assert POWER.rate(0.3) == pytest.approx(2e-4 * 0.3**-2.3, rel=1e-12)
     assert POWER.rate(np.inf) == 0.0  # the limit of k0 x^-k
+    # 2e-4 (1e-300)^-2.3 = 2e686 /yr: beyond float64, refused without a warning first
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match="^x: the rate of exceeding 1e-300 g is beyond"):
+            POWER.rate(1e-300)
+        with pytest.raises(ValueError, match="^annual_rate: .*beyond floating point"):
+            annual_rate(0.3, 0.4, POWER, threshold=1e-300)
 
 
 # ------------------------------------------------------------------- what overflows
@@ -360,3 +367,21 @@ def test_contact_of_the_record_designs_is_true_or_false(contact):
     for call in calls:
         with pytest.raises(TypeError, match="^contact must be True or False"):
             call()
+
+
+@pytest.mark.parametrize("seed", [-1, "0", True, 1.0])
+def test_the_seed_of_every_bootstrap_is_a_whole_number(seed):
+    from rockstudy.study.analysis import record_fragility, sampled
+
+    samples = xr.Dataset(
+        {"im": ("sample", np.arange(1.0, 13.0)), "overturned": ("sample", np.arange(12) % 3 == 0)}
+    )
+    calls = (
+        lambda: record_fragility.ida_fragility(_ida(), n_boot=2, seed=seed),
+        lambda: sampled.fragility(samples, "im", n_boot=2, seed=seed),
+    )
+    for call in calls:
+        with pytest.raises(ValueError, match="^seed must be a whole number >= 0"):
+            call()
+    table = record_fragility.ida_fragility(_ida(), n_boot=2, seed=3)
+    assert np.isfinite(np.asarray(table["theta"], float)).all()

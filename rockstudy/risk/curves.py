@@ -150,13 +150,24 @@ class HazardCurve:
         bad = np.flatnonzero(~(x > 0.0))
         if bad.size:
             raise ValueError(f"x must be > 0, got {float(x.flat[bad[0]])!r}")
-        lx = np.log(x)
+        log_rate = self.log_rate(np.log(x))
+        over = np.flatnonzero(log_rate >= LOG_HUGE)
+        if over.size:
+            raise ValueError(
+                f"x: the rate of exceeding {float(x.flat[over[0]]):g} {self.units} is beyond "
+                "floating point: the curve's power law below its first level grows without "
+                "bound as x -> 0"
+            )
+        return np.exp(log_rate)
+
+    def log_rate(self, log_x):
+        """ln lambda at ln x = ``log_x`` (an array, -inf to inf): :meth:`rate` in logs, which
+        never overflows."""
         lev, lr = np.log(self.levels), np.log(self.rates)
         k = _slopes(lev, lr)
-        out = np.interp(lx, lev, lr)
-        out = np.where(lx < lev[0], lr[0] - k[0] * (lx - lev[0]), out)
-        out = np.where(lx > lev[-1], lr[-1] - k[-1] * (lx - lev[-1]), out)
-        return np.exp(out)
+        out = np.interp(log_x, lev, lr)
+        out = np.where(log_x < lev[0], lr[0] - k[0] * (log_x - lev[0]), out)
+        return np.where(log_x > lev[-1], lr[-1] - k[-1] * (log_x - lev[-1]), out)
 
     @classmethod
     def power_law(cls, k0, k, im="pga", units=None, period=None, levels=None) -> HazardCurve:

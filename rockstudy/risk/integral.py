@@ -269,7 +269,8 @@ def _contributions(mu, beta, hazard, cut):
         # level, the edge term there opens the next), and those below x_u give nothing
         holds = np.searchsorted(lev, cut, side="right")[..., None]
         on_level = np.take(np.append(-np.inf, lev), holds) == cut[..., None]
-        start = (hazard.rate(np.exp(cut)) * _fragility_at(cut, mu, beta))[..., None]
+        with np.errstate(over="ignore", invalid="ignore"):  # (refused below: :func:`_finite`)
+            start = (np.exp(hazard.log_rate(cut)) * _fragility_at(cut, mu, beta))[..., None]
         start = np.where(on_level, 0.0, start)
         np.put_along_axis(parts, holds, np.take_along_axis(parts, holds, -1) + start, -1)
         parts = np.where(np.append(lev, np.inf) <= cut[..., None], 0.0, parts)

@@ -72,6 +72,12 @@ def check_n_boot(n_boot) -> int:
     return _validate.count("n_boot", n_boot, 0, MAX_BOOT)
 
 
+def bootstrap_rng(seed) -> np.random.Generator:
+    """The random generator of a bootstrap, seeded by ``seed``: a whole number >= 0 (as a
+    study's), or a ValueError naming it."""
+    return np.random.default_rng(_validate.count("seed", seed, 0))
+
+
 # ------------------------------------------------------------------------------ fits
 
 

@@ -58,6 +58,7 @@ from ...constants import G
 from . import record_fragility as rf
 from .fragility_fit import (
     NO_MAXIMUM,
+    bootstrap_rng,
     check_conf_level,
     check_n_boot,
     fit_binomial_limit,
@@ -326,7 +327,6 @@ def object_risk(
         "years", years, 0.0, risk.MAX_YEARS, f"(0, {risk.MAX_YEARS:g}]", low_open=True
     )
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
-    seed = _validate.count("seed", seed, 0)
     min_overturning = _validate.count("min_overturning", min_overturning, 1)
     design = ds.attrs.get("design")
     if design not in ("ida", "stripes", "cloud"):
@@ -336,7 +336,7 @@ def object_risk(
     ida = design == "ida"
     fitter = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
     n_rec = ds.sizes["record"]
-    rng = np.random.default_rng(seed)
+    rng = bootstrap_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
     to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
     uplift = _uplift(ds, hazard)
@@ -360,7 +360,7 @@ def object_risk(
         )
         for j in range(ds.sizes["structure"])
     ]
-    attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": seed}
+    attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
     levels = (uplift, cut, refused)
     return _risk_dataset(ds, rows, fitter[2] * to_hazard, hazard, years, to_hazard, attrs, levels)
 
