@@ -118,24 +118,54 @@ def finite_array(name: str, values) -> np.ndarray:
     return arr
 
 
-def real_array(name: str, values, low=-math.inf, high=math.inf, label="") -> np.ndarray:
-    """``values`` as a float array of any shape, or a ValueError naming ``name``: not numbers
-    (strings, None, booleans), NaN, infinite, or outside [low, high] (``label`` says the
-    allowed range in the message)."""
+def numbers_array(name: str, values) -> np.ndarray:
+    """``values`` (a number or a nested sequence or array of numbers) as a float array of any
+    shape, or a :class:`NotANumberError` naming ``name``: a string (``"0.1"``), a boolean
+    (``True``, also one inside a list of floats, which numpy would take for 1.0), None or any
+    other object is not a number. NaN and infinities pass (the caller says its range)."""
     raw = _as_array(name, values)
-    if raw.size == 0:
-        raise ValueError(f"{name} must be a number or an array of numbers, got {_what(values)}")
-    if raw.dtype.kind not in "iuf":
+    boolean = raw.dtype.kind == "b" or (
+        isinstance(values, list | tuple)
+        and any(isinstance(v, bool | np.bool_) for v in np.asarray(values, dtype=object).flat)
+    )
+    if boolean or raw.dtype.kind not in "iuf":
         raise NotANumberError(
             f"{name} must be a number or an array of numbers, got {_what(values)}"
         )
-    arr = raw.astype(float)
+    return raw.astype(float)
+
+
+def real_array(name: str, values, low=-math.inf, high=math.inf, label="") -> np.ndarray:
+    """``values`` as a float array of any shape, or a ValueError naming ``name``: not numbers
+    (:func:`numbers_array`), NaN, infinite, or outside [low, high] (``label`` says the
+    allowed range in the message)."""
+    if _as_array(name, values).size == 0:
+        raise ValueError(f"{name} must be a number or an array of numbers, got {_what(values)}")
+    arr = numbers_array(name, values)
     bad = ~np.isfinite(arr) | (arr < low) | (arr > high)
     if bad.any():
         first = float(arr.flat[int(np.flatnonzero(bad)[0])])
         allowed = label or "finite numbers"
         raise ValueError(f"{name} must be {allowed}, got {first!r}")
     return arr
+
+
+def count(name: str, value, low: int = 0, high: int | None = None) -> int:
+    """``value`` as an int, or a ValueError naming ``name`` unless it is a whole number (an
+    integer type: not a float, a string or a boolean) in [low, high] (high None: no bound)."""
+    label = f">= {low}" if high is None else f"in [{low}, {high}]"
+    whole = isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_)
+    if not whole or value < low or (high is not None and value > high):
+        raise ValueError(f"{name} must be a whole number {label}, got {_what(value)}")
+    return int(value)
+
+
+def flag(name: str, value) -> bool:
+    """``value`` as a bool, or a TypeError naming ``name`` unless it is True or False (a
+    string such as ``"yes"`` or a number is not taken for one)."""
+    if not isinstance(value, bool | np.bool_):
+        raise TypeError(f"{name} must be True or False, got {_what(value)}")
+    return bool(value)
 
 
 def _as_array(name, values) -> np.ndarray:
@@ -161,11 +191,13 @@ def rtol(value: float) -> float:
     return in_range("rtol", value, RTOL_MIN, 1.0, f"[{RTOL_MIN:g}, 1)", high_open=True)
 
 
-def in_range(name, value, low, high, label, high_open=False) -> float:
-    """Return ``value`` as a float, or raise if it is outside [low, high] (or [low, high))."""
+def in_range(name, value, low, high, label, high_open=False, low_open=False) -> float:
+    """Return ``value`` as a float, or raise if it is outside [low, high] (an end marked open
+    excluded: ``high_open``, ``low_open``)."""
     value = number(name, value)
     above = value >= high if high_open else value > high
-    if not math.isfinite(value) or value < low or above:
+    below = value <= low if low_open else value < low
+    if not math.isfinite(value) or below or above:
         raise ValueError(f"{name} must lie in {label}, got {value!r}")
     return value
 

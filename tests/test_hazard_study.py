@@ -142,7 +142,7 @@ def test_a_file_in_other_units_or_of_another_measure_is_refused_naming_the_field
     assert _study(tmp_path, hazard.format("cm/s^2")).hazard.curve().units == "cm/s^2"
     (tmp_path / "g.csv").write_bytes((DATA / "hazard" / "site_pga.csv").read_bytes())
     text = _problems(tmp_path, '[hazard]\nkind = "file"\nfile = "g.csv"\nim = "pgv"\nunits = "m/s"')
-    assert text.startswith("hazard.im: g.csv names its level column 'pga_g', a pga curve"), text
+    assert text.startswith("hazard.im: g.csv, line 2: the level column's name says a pga curve")
     oq = DATA / "hazard" / "site_pga_openquake.csv"
     text = _problems(
         tmp_path, f'[hazard]\nkind = "file"\nfile = "{oq}"\nim = "pga"\nunits = "m/s^2"'
@@ -158,5 +158,5 @@ def test_a_bad_hazard_unit_does_not_hide_a_bad_motion_unit(tmp_path):
         'kind = "record"\n', 'kind = "record"\nunits = "m/s2"\n'
     )
     found = _problems(tmp_path, None, text)
-    assert "hazard.units: site_pga.csv names its level column 'pga_g'" in found, found
+    assert "hazard.units: site_pga.csv, line 2: the level column's name states it in g" in found
     assert "motion.units: 'm/s2' does not apply to .AT2 files" in found, found

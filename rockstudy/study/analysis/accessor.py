@@ -20,6 +20,7 @@ from functools import cached_property
 
 import xarray as xr
 
+from ... import _validate
 from ..designs.record_rows import design_dataset
 from ..spec.schema import Study
 from . import contact, record_fragility, record_similarity, risk, sampled
@@ -462,4 +463,4 @@ class RockingAccessor:
                     "friction coefficient"
                 )
             friction = mu
-        return contact.outside_model(self._ds, friction)
+        return contact.outside_model(self._ds, _validate.numbers_array("friction", friction))

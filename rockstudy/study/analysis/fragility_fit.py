@@ -44,6 +44,7 @@ import warnings
 import numpy as np
 from scipy import optimize, special, stats
 
+from ... import _validate
 from ..._warnings import SeparationWarning
 
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
@@ -64,11 +65,21 @@ def check_conf_level(conf_level) -> float:
     return float(conf_level)
 
 
+#: The most resamples of a bootstrap band: ten times the 1,000 or so that a percentile interval
+#: is usually formed from. Each resample refits every structure, so the bound keeps a call
+#: finite (1e9 resamples ran without end).
+MAX_BOOT = 10_000
+
+
 def check_n_boot(n_boot) -> int:
-    """``n_boot`` as a non-negative integer, or a ValueError naming it."""
-    if isinstance(n_boot, bool) or not isinstance(n_boot, numbers.Integral) or n_boot < 0:
-        raise ValueError(f"n_boot must be a non-negative integer, got {n_boot!r}")
-    return int(n_boot)
+    """``n_boot`` as an int in [0, :data:`MAX_BOOT`], or a ValueError naming it."""
+    return _validate.count("n_boot", n_boot, 0, MAX_BOOT)
+
+
+def bootstrap_rng(seed) -> np.random.Generator:
+    """The random generator of a bootstrap, seeded by ``seed``: a whole number >= 0 (as a
+    study's), or a ValueError naming it."""
+    return np.random.default_rng(_validate.count("seed", seed, 0))
 
 
 # ------------------------------------------------------------------------------ fits

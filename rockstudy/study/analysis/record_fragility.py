@@ -33,6 +33,7 @@ from .fragility_fit import (
     N_BOOT,
     NO_MAXIMUM,
     binomial_covariance,
+    bootstrap_rng,
     capacities_covariance,
     check_conf_level,
     check_n_boot,
@@ -281,7 +282,7 @@ def stripe_fragility(
         np.arange(ds.sizes["record"]).reshape((-1,) + (1,) * (x_all.ndim - 1)), x_all.shape
     )
     unit = quoted(im)[0]
-    rng = np.random.default_rng(seed)
+    rng = bootstrap_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
     for label, mask in _groups(ds, by, bins).items():
@@ -373,7 +374,7 @@ def ida_fragility(
     im, period = _measure(ds, im, period)
     cap, top, cens_all, ok = ida_arrays(ds, im, period)
     unit = quoted(im)[0]
-    rng = np.random.default_rng(seed)
+    rng = bootstrap_rng(seed)
     n_rec = ds.sizes["record"]
     rows = []
     for label, mask in _groups(ds, by, bins).items():

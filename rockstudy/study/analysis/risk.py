@@ -36,7 +36,8 @@ What the records cannot say is marked, not invented (``status``):
   higher in the intensity, on average, than those at which it stood: no increasing
   fragility fits them (the likelihood rises as beta -> infinity, a flat curve), and a rate
   from such a fit would be meaningless (infinite for a power-law hazard). No rate is given;
-- ``"no fit"``: the fit did not converge to a finite median and dispersion.
+- ``"no fit"``: the fit did not converge to a finite median and a dispersion of at most
+  :data:`rockstudy.risk.MAX_DISPERSION` (a wider one says nothing of the object).
 
 In the band, a resample whose points are separated enters at its limit
 (:func:`.fragility_fit.fit_binomial_limit`: a step at the middle of its gap, rate lambda at
@@ -52,11 +53,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ... import risk
+from ... import _validate, risk
 from ...constants import G
 from . import record_fragility as rf
 from .fragility_fit import (
     NO_MAXIMUM,
+    bootstrap_rng,
     check_conf_level,
     check_n_boot,
     fit_binomial_limit,
@@ -173,9 +175,9 @@ def share_below(theta, beta, hazard, level, units=None) -> float:
 
 def _rate(theta, beta, hazard, unit, cut=None):
     """lambda_OT of one fit, its fragility 0 below ``cut`` (in ``unit``; None: the whole
-    lognormal); 0 for a median not reached (theta inf), NaN without a fit or for a flat one
-    (beta inf, no rise)."""
-    if beta == np.inf:
+    lognormal); 0 for a median not reached (theta inf), NaN without a fit, for a flat one
+    (beta inf, no rise) or one wider than :data:`rockstudy.risk.MAX_DISPERSION`."""
+    if beta > risk.MAX_DISPERSION:  # (inf: no rise)
         return np.nan
     if theta == np.inf:
         return 0.0
@@ -222,7 +224,7 @@ def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
         return "all"
     if no_maximum is not None:
         return "no rise" if no_maximum == "no rise" else "separated"
-    if not (np.isfinite(theta) and theta > 0 and np.isfinite(beta)):
+    if not (np.isfinite(theta) and theta > 0 and 0 <= beta <= risk.MAX_DISPERSION):
         return "no fit" if n_over >= (2 if ida else 1) else "few"
     return "ok" if n_over >= min(min_overturning, n_rec) else "few"
 
@@ -275,19 +277,22 @@ def object_risk(
         stored period); its units may be any of :data:`rockstudy.risk.UNIT_FACTORS` of that
         IM (g, m/s^2, cm/s^2 for accelerations): the fragility is converted to them.
     years : float
-        The exposure time t [yr] of the probability 1 - exp(-lambda_OT t), > 0.
+        The exposure time t [yr] of the probability 1 - exp(-lambda_OT t), in (0, 1e6] (as a
+        study's ``[hazard] years``: :data:`rockstudy.risk.MAX_YEARS`).
     n_boot : int
         Resamples of the records (with replacement) for the band: each refits the
         fragility and integrates again; a resample in which the object never overturns
         counts as a rate of 0 (its fitted median is not reached), one without a fit (fewer
-        than two capacities) is left out (``boot_valid`` counts the rest). 0: no band.
+        than two capacities) is left out (``boot_valid`` counts the rest). 0: no band; at
+        most :data:`~rockstudy.study.analysis.fragility_fit.MAX_BOOT` (10,000).
     conf_level : float
         Level of the band, in (0, 1): the percentiles (1 -+ level) / 2 of the resampled rates.
     seed : int
-        Seed of the resampling (the same seed gives the same band).
+        Seed of the resampling (the same seed gives the same band), a whole number >= 0 (as
+        a study's).
     min_overturning : int
         Records under which an object must have overturned for ``status`` "ok" (fewer:
-        "few"; capped at the number of records).
+        "few"; capped at the number of records), a whole number >= 1.
 
     Returns
     -------
@@ -318,8 +323,11 @@ def object_risk(
         with the edges ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard,
         ``years``, ``n_boot``, ``conf_level`` and ``seed``.
     """
-    years = float(risk._positive("years", years))
+    years = _validate.in_range(
+        "years", years, 0.0, risk.MAX_YEARS, f"(0, {risk.MAX_YEARS:g}]", low_open=True
+    )
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
+    min_overturning = _validate.count("min_overturning", min_overturning, 1)
     design = ds.attrs.get("design")
     if design not in ("ida", "stripes", "cloud"):
         raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")
@@ -328,7 +336,7 @@ def object_risk(
     ida = design == "ida"
     fitter = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
     n_rec = ds.sizes["record"]
-    rng = np.random.default_rng(seed)
+    rng = bootstrap_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
     to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
     uplift = _uplift(ds, hazard)
@@ -347,7 +355,7 @@ def object_risk(
             hazard,
             unit,
             ida,
-            int(min_overturning),
+            min_overturning,
             cuts[j] if np.isfinite(cuts[j]) else None,
         )
         for j in range(ds.sizes["structure"])

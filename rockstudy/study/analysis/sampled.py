@@ -30,6 +30,7 @@ from .fragility_fit import (
     N_BOOT,
     NO_MAXIMUM,
     binomial_covariance,
+    bootstrap_rng,
     check_conf_level,
     check_n_boot,
     fit_binomial,
@@ -262,7 +263,7 @@ def fragility(
         with fewer than 10 samples are left out.
     """
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
-    rng = np.random.default_rng(seed)
+    rng = bootstrap_rng(seed)
     rows = []
     for name, (x, z) in fragility_samples(ds, intensity, outcome, by, bins, failed).items():
         if z.size >= 10:

@@ -25,6 +25,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from ... import _validate
 from ...constants import G
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
@@ -360,6 +361,7 @@ def cloud(
         whose vertical component reaches -g is not run (free fall): ``censored`` and
         ``status`` :data:`STATUS_FREE_FALL` on its points.
     """
+    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
     _, periods = _target("pga", None, periods)
@@ -421,6 +423,7 @@ def multiple_stripes(
         :data:`STATUS_FREE_FALL` (2), which the fragility fits leave out; the record's
         other points run.
     """
+    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
     period, periods = _target(im, period, periods)
@@ -555,6 +558,7 @@ def incremental_dynamic_analysis(
         (:data:`STEP_KINDS`): the IDA curves. Attributes: the options and ``n_simulations``.
     """
     options = IdaOptions(im, period, step, tolerance, max_pga_ratio, scan)
+    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
     period, periods = _target(im, period, periods)

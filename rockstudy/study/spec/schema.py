@@ -71,6 +71,7 @@ from ...constants import G
 from ...dynamics.methods import MAX_STEPS
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
+from ...risk import MAX_YEARS
 from ...structures.block import (
     FREQUENCY_PARAMETER_RANGE,
     HALF_DIAGONAL_RANGE,
@@ -794,7 +795,7 @@ class HazardSpec(_Model):
     im: Literal[HAZARD_MEASURES]
     units: str | None = None
     period: _Period | None = None
-    years: float = Field(default=50.0, gt=0, le=1e6)
+    years: float = Field(default=50.0, gt=0, le=MAX_YEARS)
     k0: float | None = Field(default=None, gt=0)
     k: float | None = Field(default=None, gt=0)
     file: str | None = None
@@ -831,7 +832,7 @@ class HazardSpec(_Model):
                 ),
                 "file" if self.kind == "file" else "im",
             )
-            raise FieldError(field, text) from None
+            raise FieldError(field, text.removeprefix(f"{field}: ")) from None
         return self
 
     def curve(self):
@@ -1606,8 +1607,7 @@ def _read_hazard_file(data, base_dir) -> str | None:
         text = str(exc)
         # a bad units, period or im is that field's problem, not the file's
         field = next((f for f in ("units", "period", "im") if text.startswith(f)), "file")
-        text = text.removeprefix(f"{field}: ") if field != "file" else text
-        return f"hazard.{field}: {text}"
+        return f"hazard.{field}: {text.removeprefix(f'{field}: ').removeprefix('path: ')}"
     hz["levels"], hz["rates"] = curve.levels.tolist(), curve.rates.tolist()
     hz["units"] = curve.units
     if curve.period is not None:
