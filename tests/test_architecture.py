@@ -303,3 +303,43 @@ def test_dynamics_modules_are_short():
         if (n := len(path.read_text().splitlines())) > MAX_MODULE_LINES
     }
     assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
+
+
+#: The modules users import names from: the package, its subpackages and its top-level modules.
+PUBLIC_MODULES = sorted(
+    [PACKAGE / "__init__.py"]
+    + [p for p in PACKAGE.glob("*/__init__.py") if not p.parent.name.startswith("_")]
+    + [p for p in PACKAGE.glob("study/*/__init__.py")]
+    + [p for p in PACKAGE.glob("*.py") if not p.name.startswith("_")]
+)
+
+
+def _declared_all(path: Path):
+    """The names of ``__all__`` assigned at the top of a module, or None."""
+    for node in ast.parse(path.read_text()).body:
+        targets = getattr(node, "targets", None) or [getattr(node, "target", None)]
+        if any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets if t):
+            return ast.literal_eval(node.value)
+    return None
+
+
+@pytest.mark.parametrize("path", PUBLIC_MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_every_public_module_declares_its_names(path):
+    """Each public module says what it exports (``__all__``), so that ``np``, ``math`` or ``Path``
+    imported inside it are not public names; every name it lists exists."""
+    import importlib
+
+    names = _declared_all(path)
+    assert names is not None, f"{path.relative_to(PACKAGE)} has no __all__"
+    dotted = ".".join(("rockstudy",) + path.relative_to(PACKAGE).with_suffix("").parts)
+    module = importlib.import_module(dotted.removesuffix(".__init__"))
+    missing = [n for n in names if not hasattr(module, n)]
+    assert not missing, f"{dotted} lists names it does not have: {missing}"
+
+
+def test_the_public_module_check_sees_a_module_without_all(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("import numpy as np\n\nX = 1\n")
+    assert _declared_all(path) is None
+    path.write_text("__all__ = ['X']\nX = 1\n")
+    assert _declared_all(path) == ["X"]

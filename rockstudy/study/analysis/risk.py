@@ -57,6 +57,7 @@ from ... import _validate, risk
 from ...constants import G
 from . import record_fragility as rf
 from .fragility_fit import (
+    N_BOOT,
     NO_MAXIMUM,
     bootstrap_rng,
     check_conf_level,
@@ -257,7 +258,7 @@ def object_risk(
     ds: xr.Dataset,
     hazard: risk.HazardCurve,
     years: float = 50.0,
-    n_boot: int = 200,
+    n_boot: int = N_BOOT,
     conf_level: float = 0.9,
     seed: int = 0,
     min_overturning: int = 5,
