@@ -89,7 +89,10 @@ def test_openquake_file(tmp_path):
         ('kind = "power_law"\nk0 = -1.0\nk = 2.3\nim = "pga"', "hazard.k0"),
         ('kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "pga"\nunits = "m/s"', "hazard.units"),
         ('kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "duration"', "hazard.im"),
-        ('kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "sa"\nperiod = 1.0', "hazard.period"),
+        (
+            'kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "sa"\nunits = "g"\nperiod = 1.0',
+            "hazard.period",
+        ),
         ('kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "pga"\nyears = 0', "hazard.years"),
         ('kind = "power_law"\nk0 = 1e-4\nk = 2.3\nim = "pga"\nfile = "x.csv"', "hazard.file"),
         ('kind = "file"\nfile = "missing.csv"\nim = "pga"', "hazard.file"),
@@ -113,7 +116,10 @@ def test_a_spectral_hazard_at_a_stored_period_is_taken(tmp_path):
 def test_monte_carlo_studies_refuse_a_hazard(tmp_path):
     from test_study import study_text  # the pulse study of the study-layer tests
 
-    text = study_text() + '\n[hazard]\nkind = "power_law"\nk0 = 1e-4\nk = 2.0\nim = "pga"\n'
+    text = (
+        study_text()
+        + '\n[hazard]\nkind = "power_law"\nk0 = 1e-4\nk = 2.0\nim = "pga"\nunits = "g"\n'
+    )
     assert "hazard: applies to a record [design]" in _problems(tmp_path, None, text)
 
 

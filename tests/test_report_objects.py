@@ -492,3 +492,27 @@ def test_the_risk_section_resamples_as_often_as_the_report_is_told(tmp_path):
     assert low.isna().all() and high.isna().all()
     rate, low, high = bands[1]
     assert np.isfinite(rate).all() and ((low <= rate) & (rate <= high)).all()
+
+
+def test_the_risk_section_draws_the_hazard_curve_with_the_records_on_it(tmp_path):
+    """The hazard curve as read is drawn with each record's own PGA (max |a_g| of the record,
+    in the curve's units) and each object's uplift level on it."""
+    from test_objects import _sine_record
+
+    from rockstudy import risk
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+    from rockstudy.study.report.risk import _records_measure
+
+    recs = [_sine_record(tp) for tp in (0.6, 0.9, 1.2, 1.5, 2.0, 2.5)]
+    objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
+    ds = incremental_dynamic_analysis(recs, objects, scan=0, step=0.05, tolerance=0.01)
+    hazard = risk.HazardCurve.from_csv(
+        Path(__file__).resolve().parents[1] / "data" / "hazard" / "site_pga.csv",
+        im="pga",
+        units="g",
+    )
+    pga = np.array([np.max(np.abs(r.acceleration)) for r in recs]) / G_UNIT
+    np.testing.assert_allclose(_records_measure(ds, hazard), pga, rtol=1e-12)
+    text = _text(record_report(ds, tmp_path / "r", n_boot=0, hazard=hazard))
+    assert (tmp_path / "r" / "hazard_curve.png").is_file()
+    assert "hazard curve as it was read" in text

@@ -193,7 +193,7 @@ def test_units_convert_and_cannot_trap():
     with pytest.raises(ValueError, match="units='m/s' is not a unit of 'pga'"):
         HazardCurve("pga", [0.1, 0.2], [1e-2, 1e-3], units="m/s")
     with pytest.raises(ValueError, match="units='g' is not a unit of 'pgv'"):
-        annual_rate(0.3, 0.4, HazardCurve.power_law(1e-3, 2.0, im="pgv"), units="g")
+        annual_rate(0.3, 0.4, HazardCurve.power_law(1e-3, 2.0, im="pgv", units="m/s"), units="g")
 
 
 @pytest.mark.parametrize(

@@ -19,6 +19,7 @@ import pytest
 import xarray as xr
 from test_hazard_study import STUDY
 
+from rockstudy import UnitsWarning
 from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.risk import HazardCurve, annual_rate, probability_in, rate_deaggregation
 from rockstudy.study.analysis.risk import object_risk
@@ -385,3 +386,58 @@ def test_the_seed_of_every_bootstrap_is_a_whole_number(seed):
             call()
     table = record_fragility.ida_fragility(_ida(), n_boot=2, seed=3)
     assert np.isfinite(np.asarray(table["theta"], float)).all()
+
+
+# ------------------------------------------------------------------ units of a hazard curve
+
+
+def _site_curve():
+    """The shipped synthetic site's PGA curve [g] and its 475-year PGA, found here by the
+    log-log interpolation of the tabulated points (the oracle of the bounds below)."""
+    data = np.loadtxt(DATA / "hazard" / "site_pga.csv", delimiter=",", skiprows=2)
+    x, rate = data[:, 0], data[:, 1]
+    x475 = float(np.exp(np.interp(np.log(1 / 475), np.log(rate[::-1]), np.log(x[::-1]))))
+    return x, rate, x475
+
+
+def test_a_curve_in_m_s2_read_as_g_is_refused_naming_units(tmp_path):
+    """The site's curve written in m/s^2 (levels up to 9.8, no header) and read as g would
+    put its 475-year PGA at 9.8 times the site's, 2.4 g, above any site's (2 g): refused,
+    naming units, in Python and in a study; read in m/s^2 it is the site's curve."""
+    x, rate, x475 = _site_curve()
+    keep = x * G_UNIT <= 9.81
+    path = tmp_path / "site_ms2.csv"
+    np.savetxt(path, np.column_stack([x[keep] * G_UNIT, rate[keep]]), delimiter=",")
+    assert x475 * G_UNIT > 2.0  # the premise: read as g, beyond the bound
+    with pytest.raises(ValueError, match=r"^units: the curve reaches its 475-year rate"):
+        HazardCurve.from_csv(path, im="pga", units="g")
+    curve = HazardCurve.from_csv(path, im="pga", units="m/s^2")
+    assert curve.to_units("g").rate(x475) == pytest.approx(1 / 475, rel=1e-9)
+    hazard = f'[hazard]\nkind = "file"\nfile = "{path}"\nim = "pga"\nunits = "g"'
+    text = STUDY.format(records=DATA / "records", hazard=hazard)
+    with pytest.raises(spec.StudyError) as err:
+        spec.validate_text(text, base_dir=tmp_path)
+    assert any(p.startswith("hazard.units: the curve reaches") for p in err.value.problems)
+
+
+def test_a_curve_whose_475_year_level_few_sites_reach_is_warned(tmp_path):
+    """Between the warning and the refusal bounds (1.2 to 2 g for a PGA), a UnitsWarning."""
+    x, rate, x475 = _site_curve()
+    factor = 1.5 / x475  # the site's curve stretched to a 475-year PGA of 1.5 g
+    keep = x * factor <= 9.0
+    with pytest.warns(UnitsWarning, match="475-year"):
+        curve = HazardCurve("pga", x[keep] * factor, rate[keep], units="g")
+    assert curve.rate(1.5) == pytest.approx(1 / 475, rel=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        HazardCurve("pga", x, rate, units="g")  # the site itself: no word
+
+
+def test_a_power_law_of_an_acceleration_needs_its_units():
+    """k0 is the rate at x = 1 in the units of x: without them the curve is refused, naming
+    units; a measure of one unit (a duration) needs none."""
+    with pytest.raises(ValueError, match=r"^units: a power law of 'pga' needs the units"):
+        HazardCurve.power_law(2e-4, 2.3, im="pga")
+    g, si = (HazardCurve.power_law(2e-4, 2.3, im="pga", units=u) for u in ("g", "m/s^2"))
+    assert g.to_si().rate(3.0) / si.rate(3.0) == pytest.approx(G_UNIT**2.3, rel=1e-12)
+    HazardCurve.power_law(1.0, 1.0, im="significant_duration")

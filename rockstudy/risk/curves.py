@@ -4,6 +4,7 @@ their units, and the power law of Cornell et al. (2002)."""
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -12,6 +13,7 @@ from .. import _validate
 from ..constants import STANDARD_GRAVITY
 from ..motions import measures
 from ..motions.records import IMPOSSIBLE_PGA
+from ..warnings import UnitsWarning
 from .readers import read_curve
 from .units import UNIT_FACTORS, units_for
 
@@ -97,6 +99,7 @@ class HazardCurve:
             )
         self._check_period()
         _check_plausible(self.im, levels, units)
+        _check_design_level(self.im, levels, rates, units)
         for arr in (levels, rates):
             arr.flags.writeable = False
         object.__setattr__(self, "units", units)
@@ -180,7 +183,9 @@ class HazardCurve:
         k : float
             The log-log slope, > 0.
         im, units, period
-            As for :class:`HazardCurve` (``k0`` depends on the units of x).
+            As for :class:`HazardCurve`. ``units`` is required where the IM's dimension has
+            several units (``pga``: g, m/s^2, cm/s^2): ``k0`` is the rate at x = 1 in them, so
+            the same k0 read in m/s^2 instead of g changes every rate by 9.81^k.
         levels : array_like, optional
             Where to tabulate it (default 40 levels over 1e-3 to 10 in ``units``); the
             log-log interpolation of :class:`HazardCurve` reproduces the power law exactly at
@@ -193,6 +198,14 @@ class HazardCurve:
             else _positive_increasing("levels", levels)
         )
         _check_representable(k0, k, x)
+        if units is None:
+            si = measures.measure(im).unit
+            choices = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
+            if len(choices) > 1:
+                raise ValueError(
+                    f"units: a power law of {im!r} needs the units of x, since k0 is the rate "
+                    f"at x = 1 in them (one of {choices})"
+                )
         return cls(im, x, k0 * x**-k, units, period, f"power law {k0:g} x^-{k:g}")
 
     @classmethod
@@ -259,6 +272,60 @@ def _check_plausible(im, levels, units) -> None:
         f"{quoted}): are they in other units (cm/s^2 or gal read as g, cm/s as m/s)? give "
         "the units the levels are in"
     )
+
+
+#: The annual rate of the usual design level: 10 % in 50 years (a 475-year return period).
+DESIGN_RATE = 1.0 / 475.0
+
+#: Where the level a curve of acceleration reaches at :data:`DESIGN_RATE` may lie, in g:
+#: (refused below, warned below, warned above, refused above), for a peak measure (PGA) and a
+#: spectral one (Sa, up to about 2.5 times PGA). Real sites' 475-year PGAs lie between about
+#: 0.02 g (stable regions) and 1.2 g (next to the fastest faults); a curve in m/s^2 read as g
+#: reads 9.8 times high, one in g read as m/s^2 9.8 times low.
+DESIGN_LEVEL_BOUNDS = {False: (0.002, 0.02, 1.2, 2.0), True: (0.0, 0.002, 3.0, 5.0)}
+
+
+def level_at_rate(levels, rates, rate: float) -> float:
+    """The level x at which the curve's rate of exceedance is ``rate`` [1/yr]: the log-log
+    interpolation of :meth:`HazardCurve.rate` inverted, its end intervals' power laws beyond
+    (NaN where a flat end interval never reaches it)."""
+    lev, lr, target = np.log(levels), np.log(rates), math.log(rate)
+    k = _slopes(lev, lr)
+    if target >= lr[0]:
+        return math.exp(lev[0] - (target - lr[0]) / k[0]) if k[0] > 0.0 else math.nan
+    if target <= lr[-1]:
+        return math.exp(lev[-1] + (lr[-1] - target) / k[-1])
+    i = int(np.flatnonzero(lr <= target)[0])  # lr[i - 1] > target >= lr[i]
+    return math.exp(lev[i - 1] + (lr[i - 1] - target) / k[i - 1])
+
+
+def _check_design_level(im, levels, rates, units) -> None:
+    """For a curve of acceleration (its measure's unit is m/s^2 in the registry): a ValueError
+    naming ``units`` where its 475-year level lies where no site's does
+    (:data:`DESIGN_LEVEL_BOUNDS`), a :class:`~rockstudy.warnings.UnitsWarning` where few do."""
+    m = measures.measure(im)
+    if m.unit != "m/s^2":
+        return
+    x = level_at_rate(levels, rates, DESIGN_RATE) * UNIT_FACTORS[units][0] / STANDARD_GRAVITY
+    if not math.isfinite(x):
+        return
+    refuse_low, warn_low, warn_high, refuse_high = DESIGN_LEVEL_BOUNDS[m.needs_period]
+    shown = f"{x * STANDARD_GRAVITY / UNIT_FACTORS[units][0]:.4g} {units}"
+    shown += "" if units == "g" else f" = {x:.3g} g"
+    said = f"units: the curve reaches its 475-year rate (1/475 per year) at {shown} of {im}"
+    if x < refuse_low or x > refuse_high:
+        raise ValueError(
+            f"{said}, where no site's 475-year level lies ({refuse_low:g} to {refuse_high:g} "
+            "g): are the levels in other units (m/s^2 read as g, or g as m/s^2)? give the "
+            "units the levels are in"
+        )
+    if x < warn_low or x > warn_high:
+        warnings.warn(
+            f"{said}, where few sites' 475-year level lies ({warn_low:g} to {warn_high:g} g): "
+            "check that the levels are in these units",
+            UnitsWarning,
+            stacklevel=4,
+        )
 
 
 def _slopes(log_levels, log_rates):

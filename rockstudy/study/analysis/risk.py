@@ -218,7 +218,7 @@ def horizontal(ds) -> bool:
     return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
-def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
+def _status(ida, theta, beta, n_over, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
     if not ida and theta == 0.0 and beta != np.inf:
@@ -227,7 +227,7 @@ def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
         return "no rise" if no_maximum == "no rise" else "separated"
     if not (np.isfinite(theta) and theta > 0 and 0 <= beta <= risk.MAX_DISPERSION):
         return "no fit" if n_over >= (2 if ida else 1) else "few"
-    return "ok" if n_over >= min(min_overturning, n_rec) else "few"
+    return "ok" if n_over >= min_overturning else "few"
 
 
 def _probability(years, rate):
@@ -243,7 +243,7 @@ def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning,
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
     n_over = count(j, every)
-    status = _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum(j))
+    status = _status(ida, theta, beta, n_over, min_overturning, no_maximum(j))
     if status in ("separated", "no rise"):  # the limit of the fit is no estimate
         theta, beta = np.nan, np.nan
     whole = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
@@ -293,7 +293,8 @@ def object_risk(
         a study's).
     min_overturning : int
         Records under which an object must have overturned for ``status`` "ok" (fewer:
-        "few"; capped at the number of records), a whole number >= 1.
+        "few", whatever the number of records: 3 of 3 records rest on 3 capacities), a whole
+        number >= 1.
 
     Returns
     -------

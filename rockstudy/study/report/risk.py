@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 from scipy import special
 
+from ... import risk
 from ..analysis.risk import object_risk
 from ._page import _log_ticks, _mpl_text, _plt
 
@@ -206,8 +207,63 @@ def _risk(page, ds, hazard, years, im_label, n_boot):
         hide_empty=optional,
         show=terms,
     )
+    _hazard_figure(page, ds, hazard, out, im_label)
     _deaggregation_figure(page, out, im_label)
     return out
+
+
+def _records_measure(ds, hazard):
+    """Each record's value of the hazard's measure, unscaled, in the hazard's units (None
+    where the design does not store it)."""
+    if hazard.im not in ds:
+        return None
+    values = ds[hazard.im]
+    if "period" in values.dims:
+        if hazard.period is None or hazard.period not in values["period"].values:
+            return None
+        values = values.sel(period=hazard.period)
+    return np.asarray(values.values, float) / risk.UNIT_FACTORS[hazard.units][0]
+
+
+def _hazard_figure(page, ds, hazard, out, im_label):
+    """The hazard curve as it was read, with the records' own (unscaled) intensities and each
+    object's uplift level on it: a curve read in the wrong units shows far from both."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.loglog(hazard.levels, hazard.rates, "o-", ms=3, color="k", label="hazard curve, as read")
+    ax.axhline(1 / 475, color="0.5", ls="--", lw=1, label="1/475 per year")
+    on_records = _records_measure(ds, hazard)
+    if on_records is not None:
+        ax.plot(
+            on_records,
+            np.full(on_records.size, hazard.rates[0]),
+            "|",
+            ms=14,
+            mew=1.5,
+            color="tab:blue",
+            label="the records, unscaled",
+        )
+    for j, level in enumerate(out["uplift"].values):
+        if np.isfinite(level):
+            ax.axvline(
+                level,
+                color="tab:red",
+                ls=":",
+                lw=1,
+                label="uplift level of each object" if j == 0 else None,
+            )
+    ax.set_xlabel(im_label(hazard.im, hazard.period), fontsize=10)
+    ax.set_ylabel("annual rate of exceedance [1/yr]", fontsize=10)
+    ax.tick_params(labelsize=9)
+    ax.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "hazard_curve",
+        f"The site's hazard curve as it was read ({_mpl_text(hazard.describe())}), with the "
+        "records' own intensities (ticks, before any scaling) and each object's uplift level "
+        "(dotted): a curve or records read in the wrong units lie far from each other",
+    )
 
 
 def _deaggregation_figure(page, out, im_label):
