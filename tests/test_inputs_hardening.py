@@ -1,0 +1,69 @@
+"""Inputs that are not what they should be -- an objects CSV of the wrong shape or of another
+kind of file, a scheduler file that is a pipe or a device, a registered measure that returns
+nonsense, API arguments out of the study file's ranges -- are refused in one line naming the
+file (and line) or the argument and what was expected, never the contents of a file.
+Oracles: the documented ranges and file rules, and the messages' own promises (no file
+content, no traceback)."""
+
+import pytest
+import test_objects
+
+from rockstudy.study import StudyError, load_study
+
+suite = test_objects.suite  # a folder of one small record (fixture)
+STUDY_OBJECTS = test_objects.STUDY_OBJECTS
+
+
+def _objects_problem(tmp_path, suite, content: bytes, file="objects.csv"):
+    """The one problem of a study whose objects CSV holds ``content``."""
+    if content is not None:
+        (tmp_path / file).write_bytes(content)
+    path = tmp_path / "study.toml"
+    path.write_text(STUDY_OBJECTS.format(objects=f"file = {file!r}", folder=suite))
+    with pytest.raises(StudyError) as err:
+        load_study(path)
+    problems = [p for p in err.value.problems if p.startswith("structure")]
+    assert len(problems) == 1, err.value.problems
+    assert "\n" not in problems[0]
+    return problems[0]
+
+
+@pytest.mark.parametrize(
+    ("content", "line"),
+    [
+        (b"name,width,height\nA,0.4,2.0\nZ,0.3,1.2,,9\n", 3),  # longer than the header
+        (b"name,width,height\nZ,0.3,1.2,,9\nA,0.4,2.0\n", 2),  # the long row first
+        (b"name,width,height,\nA,0.4,2.0,7\n", 2),  # a cell under a column without a name
+        (b"name,width,height\nA,0.4,2.0\rB,0.5,2.0\n", 2),  # a carriage return alone
+        (b'name,width,height\n"A,0.4,2.0\nB,0.5,2.0\n', 3),  # a quote left open
+    ],
+)
+def test_objects_csv_of_the_wrong_shape_names_the_line(tmp_path, suite, content, line):
+    text = _objects_problem(tmp_path, suite, content)
+    assert text.startswith("structure.file:") and "objects.csv" in text
+    assert f"line {line}:" in text
+    assert "0.3" not in text and "1.2" not in text and "0.4" not in text  # no cell quoted
+
+
+def test_objects_csv_trailing_empty_cells_are_nothing(tmp_path, suite):
+    """Spreadsheets end rows with empty cells: they carry nothing and are no error."""
+    (tmp_path / "objects.csv").write_text("name,width,height,\nA,0.4,2.0,\nB,0.5,2.5,,\n")
+    path = tmp_path / "study.toml"
+    path.write_text(STUDY_OBJECTS.format(objects='file = "objects.csv"', folder=suite))
+    study = load_study(path)
+    got = [(o.name, o.width, o.height) for o in study.structure.objects]
+    assert got == [("A", 0.4, 2.0), ("B", 0.5, 2.5)]
+
+
+def test_objects_file_of_another_kind_is_named_not_quoted(tmp_path, suite):
+    passwd = b"root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n"
+    text = _objects_problem(tmp_path, suite, passwd, file="passwd")
+    assert "passwd" in text and "line 1:" in text
+    assert "root:" not in text and "bash" not in text and "daemon" not in text
+    binary = bytes(range(1, 256)) * 2  # no NUL: read as latin-1 text
+    text = _objects_problem(tmp_path, suite, binary, file="blob.csv")
+    assert "blob.csv" in text and "line 2:" in text
+    assert not any(chr(b) in text for b in range(0x80, 0x100))
+    assert "\x01" not in text and "\x7f" not in text
+    text = _objects_problem(tmp_path, suite, b"name,colour\nA,red\n")
+    assert "line 1: column 2 of the header" in text and "red" not in text
