@@ -5,6 +5,8 @@ file (and line) or the argument and what was expected, never the contents of a f
 Oracles: the documented ranges and file rules, and the messages' own promises (no file
 content, no traceback)."""
 
+from pathlib import Path
+
 import pytest
 import test_objects
 
@@ -67,3 +69,32 @@ def test_objects_file_of_another_kind_is_named_not_quoted(tmp_path, suite):
     assert "\x01" not in text and "\x7f" not in text
     text = _objects_problem(tmp_path, suite, b"name,colour\nA,red\n")
     assert "line 1: column 2 of the header" in text and "red" not in text
+
+
+# ------------------------------------------------------------------------------ scheduler files
+
+import os  # noqa: E402
+import time  # noqa: E402
+
+from test_cli_errors import run_on_scheduler_file  # noqa: E402
+from test_store_safety import write_study  # noqa: E402
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device", "large"])
+def test_a_scheduler_file_that_is_no_file_is_one_line_in_time(tmp_path, kind):
+    """A pipe would be read without end, a device or a huge file fill the memory."""
+    study = write_study(tmp_path, n=20)
+    sched = tmp_path / "sched.json"
+    if kind == "fifo":
+        os.mkfifo(sched)
+    elif kind == "device":
+        sched = Path("/dev/zero")
+    else:
+        sched.write_text('{"address": "tcp://127.0.0.1:9", "pad": "' + "x" * 2**20 + '"}')
+    out = tmp_path / "c.zarr"
+    t0 = time.time()
+    line = run_on_scheduler_file(study, out, sched, timeout=90)
+    expect = {"fifo": "a FIFO", "device": "a character device", "large": "MiB allowed"}[kind]
+    assert str(sched) in line and expect in line and "not a dask scheduler file" in line
+    assert not out.exists()
+    assert time.time() - t0 < 60  # the start-up; no wait on the pipe

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...motions.records import read_text_file
 from ..designs.sampling import make_design
 from ..spec.schema import Study
 from . import store
@@ -154,6 +155,10 @@ def _check_workers(workers) -> None:
         raise ValueError(f"workers: {workers!r} is not allowed; give a whole number >= 1")
 
 
+#: Largest scheduler file read [bytes] (dask writes a few hundred).
+MAX_SCHEDULER_FILE_BYTES = 2**16
+
+
 def _scheduler_address(scheduler_file, timeout) -> str:
     """The address in a dask scheduler file, waiting up to ``timeout`` seconds for the file to
     appear (a scheduler that is starting writes it); SchedulerError if it does not, or if it is
@@ -167,15 +172,17 @@ def _scheduler_address(scheduler_file, timeout) -> str:
             f"the scheduler file {path} does not exist (waited {timeout:g} s): start the "
             "scheduler with --scheduler-file, or check the path"
         )
+    what = "a dask scheduler file (a JSON object whose 'address' is like tcp://HOST:PORT)"
+    try:  # a regular file of bounded size: a pipe would hang, a device fill the memory
+        text = read_text_file(path, MAX_SCHEDULER_FILE_BYTES)
+    except (OSError, ValueError) as exc:
+        raise SchedulerError(f"{exc}, so not {what}") from None
     try:
-        address = json.loads(path.read_text())["address"]
+        address = json.loads(text)["address"]
         if not isinstance(address, str) or "://" not in address:
             raise TypeError
-    except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError):
-        raise SchedulerError(
-            f"{path} is not a dask scheduler file (a JSON object whose 'address' is like "
-            "tcp://HOST:PORT)"
-        ) from None
+    except (ValueError, KeyError, TypeError):
+        raise SchedulerError(f"{path} is not {what}") from None
     return address
 
 
