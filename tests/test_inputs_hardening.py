@@ -98,3 +98,57 @@ def test_a_scheduler_file_that_is_no_file_is_one_line_in_time(tmp_path, kind):
     assert str(sched) in line and expect in line and "not a dask scheduler file" in line
     assert not out.exists()
     assert time.time() - t0 < 60  # the start-up; no wait on the pipe
+
+
+# ------------------------------------------------------------------------------ registered measures
+
+import math  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from rockstudy.motions import Record, measures, register_measure  # noqa: E402
+
+
+def _raises(record):
+    raise RuntimeError("no\nluck")
+
+
+@pytest.mark.parametrize(
+    ("function", "says"),
+    [
+        (lambda r: math.nan, "is nan"),
+        (lambda r: math.inf, "is inf"),
+        (lambda r: -0.5, "is -0.5"),
+        (lambda r: np.float64(-1e-3), "is -0.001"),
+        (_raises, "failed (RuntimeError: no luck)"),
+    ],
+)
+def test_a_measure_that_is_no_finite_number_on_a_record_is_not_registered(function, says):
+    with pytest.raises(ValueError) as err:
+        register_measure("odd_one", function, unit="m", power=1)
+    text = str(err.value)
+    assert "'odd_one'" in text and says in text and "not registered" in text
+    assert "\n" not in text
+    assert "odd_one" not in measures.MEASURES
+
+
+def test_a_measure_that_fails_on_one_record_is_named_where_that_record_is_measured():
+    """A measure may pass the probe and fail on another record: ValueError naming the
+    measure and the record there, and nothing else is changed."""
+
+    def short_only(record):
+        if record.duration > 6.0:
+            raise ArithmeticError("too long")
+        return record.duration
+
+    register_measure("short_only", short_only, unit="s", power=0)
+    try:
+        short = Record(np.sin(np.arange(300) * 0.1), dt=0.01, name="short")
+        long = Record(np.sin(np.arange(900) * 0.1), dt=0.01, name="long")
+        assert short.intensity_measures()["short_only"] == pytest.approx(short.duration)
+        with pytest.raises(ValueError, match="'short_only' of the record 'long' failed"):
+            long.intensity_measures()
+        assert long.intensity_measure("pga") == pytest.approx(np.max(np.abs(long.acceleration)))
+    finally:
+        measures.unregister_measure("short_only")
+    assert "short_only" not in long.intensity_measures()  # the process goes on without it
