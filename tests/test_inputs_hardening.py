@@ -5,14 +5,30 @@ file (and line) or the argument and what was expected, never the contents of a f
 Oracles: the documented ranges and file rules, and the messages' own promises (no file
 content, no traceback)."""
 
+import math
+import os
+import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import test_objects
+import xarray as xr
+from test_cli_errors import run_on_scheduler_file
+from test_risk_analysis import K0, K, _ida, _lognormal
+from test_store_safety import write_study
 
+import rockstudy as rs
+from rockstudy import risk
+from rockstudy.motions import HalfSinePulse, Record, measures, register_measure
 from rockstudy.study import StudyError, load_study
+from rockstudy.study.analysis.risk import object_risk
+from rockstudy.study.designs import records as rd
+from rockstudy.study.spec.schema import MAX_FRICTION
 
-suite = test_objects.suite  # a folder of one small record (fixture)
+# ------------------------------------------------------------------------------ objects CSV files
+
+suite = test_objects.suite  # a folder of two small records (fixture)
 STUDY_OBJECTS = test_objects.STUDY_OBJECTS
 
 
@@ -73,12 +89,6 @@ def test_objects_file_of_another_kind_is_named_not_quoted(tmp_path, suite):
 
 # ------------------------------------------------------------------------------ scheduler files
 
-import os  # noqa: E402
-import time  # noqa: E402
-
-from test_cli_errors import run_on_scheduler_file  # noqa: E402
-from test_store_safety import write_study  # noqa: E402
-
 
 @pytest.mark.parametrize("kind", ["fifo", "device", "large"])
 def test_a_scheduler_file_that_is_no_file_is_one_line_in_time(tmp_path, kind):
@@ -101,12 +111,6 @@ def test_a_scheduler_file_that_is_no_file_is_one_line_in_time(tmp_path, kind):
 
 
 # ------------------------------------------------------------------------------ registered measures
-
-import math  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-from rockstudy.motions import Record, measures, register_measure  # noqa: E402
 
 
 def _raises(record):
@@ -152,3 +156,77 @@ def test_a_measure_that_fails_on_one_record_is_named_where_that_record_is_measur
     finally:
         measures.unregister_measure("short_only")
     assert "short_only" not in long.intensity_measures()  # the process goes on without it
+
+
+# ------------------------------------------------------------------------------ API arguments
+
+
+BLOCK = rs.Block(half_diagonal=1.0, slenderness=0.2)
+PULSE = HalfSinePulse(amplitude=3.0, period=0.5)
+
+
+@pytest.mark.parametrize("mu", [1e9, 10.5, 0.0, -1.0, math.inf, math.nan])
+def test_simulate_takes_the_friction_range_of_a_study(mu):
+    with pytest.raises(ValueError, match=r"friction must lie in \(0, 10\]"):
+        rs.simulate(BLOCK, PULSE, friction=mu)
+
+
+def test_simulate_takes_the_largest_friction_of_a_study():
+    r = rs.simulate(BLOCK, PULSE, friction=MAX_FRICTION)
+    assert r.friction_demand is not None
+    assert MAX_FRICTION == 10.0  # the documented bound of both
+
+
+@pytest.mark.parametrize("value", [-3, 0, 2.5, True, "5", None])
+def test_object_risk_min_overturning_is_a_whole_number_of_records(value):
+    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 10)])
+    hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
+    with pytest.raises(ValueError, match="min_overturning must be a whole number >= 1"):
+        object_risk(_ida(cap), hazard, n_boot=0, min_overturning=value)
+
+
+def test_object_names_with_nul_are_refused_by_the_designs():
+    record = Record(np.sin(np.arange(300) * 0.1), dt=0.01, name="r")
+    with pytest.raises(ValueError, match="object 1 has the name 'B\\\\x00'"):
+        rd.multiple_stripes([record], {"A": BLOCK, "B\0": BLOCK}, [2.0])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "says"),
+    [
+        ({"ax": "axes"}, "ax must be a matplotlib Axes (or None), got str"),
+        ({"structure": 5}, "structure must be a name (a str) or None, got int"),
+        ({"structure": 5, "motion": "x"}, "structure must be a name (a str) or None, got int"),
+        ({"motion": ["x"]}, "motion must be a name (a str) or None, got list"),
+    ],
+)
+def test_plot_refuses_arguments_of_the_wrong_type_before_drawing(kwargs, says):
+    import matplotlib.pyplot as plt
+
+    result = rs.simulate(BLOCK, PULSE)
+    before = plt.get_fignums()
+    with pytest.raises(TypeError) as err:
+        result.plot(**kwargs)
+    assert str(err.value) == says
+    assert plt.get_fignums() == before  # no figure left half-drawn
+
+
+@pytest.mark.parametrize(
+    ("study", "says"),
+    [
+        ("not json {", "it is not JSON"),
+        ("", "it is not JSON"),
+        ('{"name": "x"}', "it is JSON but no study"),
+        (b"\xff\xfe", "it is not JSON"),
+    ],
+)
+def test_the_accessor_names_a_study_attribute_that_is_no_study(study, says):
+    import rockstudy.study  # noqa: F401 - registers ds.rocking
+
+    ds = xr.Dataset({"x": ("sample", [1.0])}, attrs={"study": study})
+    for read in (lambda: ds.rocking.study, lambda: ds.rocking.kind):
+        with pytest.raises(ValueError) as err:
+            read()
+        text = str(err.value)
+        assert text.startswith("ds.rocking.study: attrs['study'] must be the JSON text")
+        assert says in text and "Expecting" not in text and "\n" not in text

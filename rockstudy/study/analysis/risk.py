@@ -49,6 +49,8 @@ Structural Engineering 128(4), 526-533.
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 import xarray as xr
 
@@ -215,6 +217,13 @@ def horizontal(ds) -> bool:
     return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
+def _check_min_overturning(value) -> int:
+    """``min_overturning`` as an int >= 1, or a ValueError naming it."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"min_overturning must be a whole number >= 1, got {value!r}")
+    return int(value)
+
+
 def _status(ida, theta, beta, n_over, n_rec, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
@@ -320,6 +329,7 @@ def object_risk(
     """
     years = float(risk._positive("years", years))
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
+    min_overturning = _check_min_overturning(min_overturning)
     design = ds.attrs.get("design")
     if design not in ("ida", "stripes", "cloud"):
         raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")

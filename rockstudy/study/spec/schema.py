@@ -69,6 +69,7 @@ from pydantic import (
 from ... import _validate
 from ...constants import G
 from ...dynamics.methods import MAX_STEPS
+from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...structures.block import (
@@ -223,8 +224,12 @@ class EquivalentBlockSpec(_Model):
 OBJECT_KINDS = tuple(KINDS)
 
 
-#: Largest friction coefficient mu taken (a study's ``friction``; no contact needs more).
-MAX_FRICTION = 10.0
+def _a_name(value: str) -> str:
+    """A name (of a study or an object), not blank and without a NUL character (which no
+    store or report keeps)."""
+    if "\0" in value or not value.strip():
+        raise ValueError("must be a name: not blank, no NUL character")
+    return value
 
 
 class _ObjectBase(_Model):
@@ -237,6 +242,7 @@ class _ObjectBase(_Model):
     #: The friction coefficient mu of this object's contact (overrides the study's friction).
     friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
     _params: tuple = PrivateAttr(default=None)
+    _printable = field_validator("name")(lambda value: _a_name(value))
 
     @model_validator(mode="after")
     def _shape(self):
@@ -865,12 +871,7 @@ class Study(_Model):
     #: points of a design that free fall censors (:func:`.feasibility.notes`).
     _notes: list = PrivateAttr(default_factory=list)
 
-    @field_validator("name")
-    @classmethod
-    def _printable(cls, value):
-        if "\0" in value or not value.strip():
-            raise ValueError("must be a name: not blank, no NUL character")
-        return value
+    _printable = field_validator("name")(lambda value: _a_name(value))
 
     @property
     def source_text(self) -> str | None:
