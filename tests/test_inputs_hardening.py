@@ -7,28 +7,35 @@ content, no traceback)."""
 
 import math
 import os
+import resource
+import signal
+import subprocess
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import test_objects
+import test_record_studies
 import xarray as xr
-from test_cli_errors import run_on_scheduler_file
+from test_cli_errors import one_error_line, run_on_scheduler_file
 from test_risk_analysis import K0, K, _ida, _lognormal
-from test_store_safety import write_study
+from test_store_safety import ROCKSTUDY, write_study
 
 import rockstudy as rs
 from rockstudy import risk
 from rockstudy.motions import HalfSinePulse, Record, measures, register_measure
-from rockstudy.study import StudyError, load_study
+from rockstudy.study import StudyError, load_study, run_study
 from rockstudy.study.analysis.risk import object_risk
 from rockstudy.study.designs import records as rd
+from rockstudy.study.running import runner, store
+from rockstudy.study.running.store import open_result
 from rockstudy.study.spec.schema import MAX_FRICTION
 
 # ------------------------------------------------------------------------------ objects CSV files
 
 suite = test_objects.suite  # a folder of two small records (fixture)
+client = test_record_studies.client  # the one-worker cluster (fixture)
 STUDY_OBJECTS = test_objects.STUDY_OBJECTS
 
 
@@ -185,6 +192,17 @@ def test_object_risk_min_overturning_is_a_whole_number_of_records(value):
         object_risk(_ida(cap), hazard, n_boot=0, min_overturning=value)
 
 
+def test_object_names_with_nul_are_refused_in_study_files(tmp_path, suite):
+    path = tmp_path / "nul.toml"
+    objects = 'objects = [{ name = "A\\u0000B", width = 0.4, height = 2.0 }]'
+    path.write_text(STUDY_OBJECTS.format(objects=objects, folder=suite))
+    with pytest.raises(StudyError) as err:
+        load_study(path)
+    assert err.value.problems == [
+        "structure.objects[0] ('A\\x00B').name: must be a name: not blank, no NUL character"
+    ]
+
+
 def test_object_names_with_nul_are_refused_by_the_designs():
     record = Record(np.sin(np.arange(300) * 0.1), dt=0.01, name="r")
     with pytest.raises(ValueError, match="object 1 has the name 'B\\\\x00'"):
@@ -230,3 +248,107 @@ def test_the_accessor_names_a_study_attribute_that_is_no_study(study, says):
         text = str(err.value)
         assert text.startswith("ds.rocking.study: attrs['study'] must be the JSON text")
         assert says in text and "Expecting" not in text and "\n" not in text
+
+
+# ------------------------------------------------------------------------------ out of memory
+
+
+def _limit_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (1_000_000_000, 1_000_000_000))
+
+
+def test_out_of_memory_is_one_line_and_leaves_no_half_made_store(tmp_path):
+    """Under a 1 GB address space the run cannot start its threads or workers."""
+    study = write_study(tmp_path, n=60)
+    out = tmp_path / "x.zarr"
+    proc = subprocess.run(
+        [ROCKSTUDY, "run", str(study), "--out", str(out), "--quiet"],
+        capture_output=True, text=True, timeout=300, preexec_fn=_limit_memory,
+    )  # fmt: skip
+    assert proc.returncode == 1
+    line = one_error_line(proc.stderr)
+    assert "ran out of memory" in line and "__main__" not in line
+    if out.exists():  # kept only if --resume continues it
+        assert "continue with:" in line and store.read_marker(out)["template_complete"]
+    else:
+        assert "nothing was saved" in line
+
+
+def _read_or_empty(path) -> str:
+    """The text of a /proc file, or '' if its process or thread has ended."""
+    try:
+        return Path(path).read_text()
+    except OSError:
+        return ""
+
+
+def test_a_worker_killed_while_the_cluster_starts_is_one_line_without_script_advice(tmp_path):
+    study = write_study(tmp_path, n=20)
+    out = tmp_path / "y.zarr"
+    proc = subprocess.Popen(
+        [ROCKSTUDY, "run", str(study), "--out", str(out), "--quiet"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    killed, t0 = False, time.time()
+    while not killed and proc.poll() is None and time.time() - t0 < 120:
+        children = Path(f"/proc/{proc.pid}/task").glob("*/children")  # of every thread
+        for pid in " ".join(_read_or_empty(f) for f in children).split():
+            cmdline = _read_or_empty(Path(f"/proc/{pid}/cmdline"))
+            if "spawn_main" in cmdline:  # a worker process, long before it has imported dask
+                os.kill(int(pid), signal.SIGKILL)
+                killed = True
+        time.sleep(0.01)
+    _, err = proc.communicate(timeout=300)
+    assert killed and proc.returncode == 1, err
+    line = one_error_line(err)
+    assert "did not start" in line and "died" in line and "__main__" not in line
+    assert "nothing was saved" in line and not out.exists()
+
+
+def test_out_of_memory_after_a_chunk_keeps_a_store_that_resumes_whole(
+    tmp_path, client, monkeypatch
+):
+    study = load_study(write_study(tmp_path, n=40, chunk=10))
+    whole = tmp_path / "whole.zarr"
+    run_study(study, whole, client=client, progress=False, netcdf=False)
+    write, calls = store.ChunkWriter.write, []
+
+    def write_then_fail(self, a, b, result):
+        calls.append(a)
+        if len(calls) == 2:
+            raise MemoryError
+        write(self, a, b, result)
+
+    monkeypatch.setattr(store.ChunkWriter, "write", write_then_fail)
+    out = tmp_path / "cut.zarr"
+    with pytest.raises(runner.ResourceError, match="ran out of memory"):
+        run_study(study, out, client=client, progress=False, netcdf=False)
+    monkeypatch.setattr(store.ChunkWriter, "write", write)
+    assert int((store.read_status(out) != 0).sum()) == 10  # the first chunk is kept
+    report = run_study(study, out, client=client, progress=False, netcdf=False, resume=True)
+    assert len(report.chunks_computed) == 3
+    a, b = open_result(out).load(), open_result(whole).load()
+    for name in ("max_rotation", "overturned", "n_impacts", "status"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+@pytest.mark.parametrize(
+    ("text", "unguarded"),
+    [
+        ("run_study(study, 'c.zarr')\n", True),
+        ("if __name__ == '__main__':\n    run_study(study, 'c.zarr')\n", False),
+        ('if __name__=="__main__":\n    main()\n', False),
+    ],
+)
+def test_the_script_advice_is_for_scripts_without_a_main_guard(
+    tmp_path, monkeypatch, text, unguarded
+):
+    import sys
+    import types
+
+    script = tmp_path / "script.py"
+    script.write_text(text)
+    main = types.ModuleType("__main__")
+    main.__file__ = str(script)
+    monkeypatch.setitem(sys.modules, "__main__", main)
+    assert runner._unguarded_script() is unguarded
