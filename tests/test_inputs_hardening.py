@@ -71,8 +71,10 @@ def test_objects_csv_of_the_wrong_shape_names_the_line(tmp_path, suite, content,
 
 
 def test_objects_csv_trailing_empty_cells_are_nothing(tmp_path, suite):
-    """Spreadsheets end rows with empty cells: they carry nothing and are no error."""
-    (tmp_path / "objects.csv").write_text("name,width,height,\nA,0.4,2.0,\nB,0.5,2.5,,\n")
+    """Spreadsheets end rows with empty cells, and may begin the file with a byte-order mark:
+    they carry nothing and are no error."""
+    text = "\ufeffname,width,height,\r\nA,0.4,2.0,\r\nB,0.5,2.5,,\r\n"
+    (tmp_path / "objects.csv").write_bytes(text.encode("utf-8"))
     path = tmp_path / "study.toml"
     path.write_text(STUDY_OBJECTS.format(objects='file = "objects.csv"', folder=suite))
     study = load_study(path)

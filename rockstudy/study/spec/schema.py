@@ -1571,7 +1571,7 @@ def _object_rows(text: str) -> list[dict]:
     name, must be empty. Blank lines are skipped.
     """
     expected = f"a header line of columns among {list(OBJECT_COLUMNS)}, then one object a line"
-    reader = csv.reader(io.StringIO(text))
+    reader = csv.reader(io.StringIO(text.removeprefix("\ufeff")))  # a spreadsheet's BOM
     rows = []
     try:
         for cells in reader:
