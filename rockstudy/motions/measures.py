@@ -304,36 +304,32 @@ def register_measure(
         _flag("needs_period", needs_period),
         _flag("needs_damping", needs_damping),
         _flag("listed", listed),
-        checked=_PROBE,
+        checked=_PROBE_RECORD is not None,
     )
-    if _PROBE:
+    if measure.checked:
         _probe(measure)
     MEASURES[name] = measure
     return measure
 
 
-#: Whether :func:`register_measure` tries a measure on :func:`_probe_record` (and checks its
-#: values wherever it is used): every measure but the built-in ones, registered at import.
-_PROBE = False
+#: The small synthetic record every registered measure is tried on (see :func:`set_probe`);
+#: None while the built-in measures register, at import.
+_PROBE_RECORD = None
 
 
-def _probe_record():
-    """A small synthetic record (5 s at 100 Hz: a 0.8 s sine pulse of 0.3 g in a decaying
-    1.7 s oscillation) to try a measure on when it is registered."""
-    from .records import Record
-
-    t = np.arange(500) * 0.01
-    a = np.sin(2 * np.pi * t / 0.8) * np.exp(-((t - 1.5) ** 2)) + 0.3 * np.sin(
-        2 * np.pi * t / 1.7
-    ) * np.exp(-0.5 * t)
-    return Record(0.3 * STANDARD_GRAVITY * a, dt=0.01, name="synthetic probe")
+def set_probe(record) -> None:
+    """Try every measure registered from now on on ``record`` (at a period of 1 s and 5 %
+    damping where it takes them), and check its values wherever it is used. Set once by
+    :mod:`rockstudy.motions.records`, which defines records, after the built-in measures."""
+    global _PROBE_RECORD
+    _PROBE_RECORD = record
 
 
 def _probe(measure: Measure) -> None:
-    """ValueError naming the measure if it fails, or is not a finite number >= 0, on
-    :func:`_probe_record` (at a period of 1 s and 5 % damping where it takes them)."""
+    """ValueError naming the measure if it fails, or is not a finite number >= 0, on the
+    probe record."""
     try:
-        measure.of(_probe_record(), 1.0 if measure.needs_period else None, 0.05)
+        measure.of(_PROBE_RECORD, 1.0 if measure.needs_period else None, 0.05)
     except ValueError as exc:
         raise ValueError(f"function: {exc}; the measure is not registered") from None
 
@@ -451,4 +447,3 @@ def _builtins():
 
 
 _builtins()
-_PROBE = True
