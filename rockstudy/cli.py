@@ -286,7 +286,7 @@ def _run(args) -> int:
     from concurrent.futures import CancelledError
 
     from .study import load_study, run_study
-    from .study.running.runner import FailedSamplesError, SchedulerError
+    from .study.running.runner import FailedSamplesError, ResourceError, SchedulerError
     from .study.running.store import StoreError
 
     study = load_study(args.study)
@@ -317,6 +317,9 @@ def _run(args) -> int:
     except KeyboardInterrupt:
         print("\n" + _stopped(args, "interrupted: ", None), file=sys.stderr)
         return 130
+    except ResourceError as exc:  # out of memory, workers killed: kept only if resumable
+        print(_stopped(args, f"error: {exc}; ", None), file=sys.stderr)
+        return 1
     except SchedulerError as exc:  # the cluster was not reached: nothing ran
         print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
@@ -422,6 +425,15 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("\nrockstudy: interrupted", file=sys.stderr)
         return 130
+    except (MemoryError, RuntimeError, OSError) as exc:  # outside a run: see _run for those
+        from .study.running.runner import out_of_memory
+
+        if not out_of_memory(exc):
+            raise
+        print(
+            "error: rockstudy ran out of memory; give it more (a higher ulimit -v)", file=sys.stderr
+        )
+        return 1
     finally:
         if "zarr.core.sync" in sys.modules:  # else exit may print a zarr RuntimeError
             from .study.running.store import stop_zarr_io

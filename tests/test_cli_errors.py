@@ -34,6 +34,18 @@ def test_timeout_must_be_finite_seconds(tmp_path, value):
     assert not (tmp_path / "c.zarr").exists()
 
 
+def run_on_scheduler_file(study, out, sched, timeout=150):
+    """The one error line of ``rockstudy run`` of ``study`` on the scheduler file ``sched``
+    (with a timeout of 3 s), which must exit 1."""
+    proc = subprocess.run(
+        [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler-file", str(sched),
+         "--timeout", "3", "--quiet"],
+        capture_output=True, text=True, timeout=timeout,
+    )  # fmt: skip
+    assert proc.returncode == 1
+    return one_error_line(proc.stderr)
+
+
 @pytest.mark.parametrize("content", [None, "garbage\x00\x01", '{"address": 3}'])
 def test_a_scheduler_file_missing_or_garbage_is_one_line_in_time(tmp_path, content):
     study = write_study(tmp_path, n=20)
@@ -42,13 +54,7 @@ def test_a_scheduler_file_missing_or_garbage_is_one_line_in_time(tmp_path, conte
         sched.write_text(content)
     out = tmp_path / "c.zarr"
     t0 = time.time()
-    proc = subprocess.run(
-        [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler-file", str(sched),
-         "--timeout", "3", "--quiet"],
-        capture_output=True, text=True, timeout=150,
-    )  # fmt: skip
-    assert proc.returncode == 1
-    line = one_error_line(proc.stderr)
+    line = run_on_scheduler_file(study, out, sched)
     assert str(sched) in line and ("does not exist" if content is None else "not a dask") in line
     assert "--resume" not in line
     assert not out.exists()  # no half-made store

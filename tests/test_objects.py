@@ -255,7 +255,7 @@ def test_objects_study_errors_name_the_object_and_the_field(suite, tmp_path):
     assert 'sampler: is required (unless [structure] kind = "objects")' in err.value.problems
     (tmp_path / "o.csv").write_text("name,colour\nA,red\n")
     text = _problems(tmp_path, suite, 'file = "o.csv"')
-    assert "unknown columns ['colour']" in text
+    assert "o.csv" in text and "line 1: column 2 of the header is not an object column" in text
 
 
 def test_objects_geometry_is_that_of_the_block():

@@ -13,6 +13,18 @@ import numpy as np
 _OPTIONAL_ARRAYS = ("peak_times", "peak_rotations", "t_eval", "theta_eval", "theta_dot_eval")
 
 
+def _check_plot_arguments(ax, structure, motion) -> None:
+    """TypeError naming ``ax`` if it is neither None nor a matplotlib Axes, or ``structure``
+    or ``motion`` if it is neither None nor a string."""
+    from matplotlib.axes import Axes
+
+    if ax is not None and not isinstance(ax, Axes):
+        raise TypeError(f"ax must be a matplotlib Axes (or None), got {type(ax).__name__}")
+    for name, value in (("structure", structure), ("motion", motion)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{name} must be a name (a str) or None, got {type(value).__name__}")
+
+
 @dataclass(frozen=True)
 class RockingResult:
     """Response of one rocking structure to one ground motion.
@@ -282,6 +294,12 @@ class RockingResult:
             Names for the title, e.g. ``"Statue A"`` and ``"Northridge 1994"``; default the
             descriptions in ``info["structure"]`` and ``info["motion"]``.
 
+        Raises
+        ------
+        TypeError
+            Naming ``ax`` if it is no matplotlib Axes, ``structure`` or ``motion`` if it is no
+            string (checked before anything is drawn).
+
         Returns
         -------
         matplotlib Axes
@@ -289,6 +307,7 @@ class RockingResult:
         """
         import matplotlib.pyplot as plt
 
+        _check_plot_arguments(ax, structure, motion)
         drawn = self._ground_motion(ground)
         if ax is None:
             fig = plt.figure(layout="constrained", figsize=(7.0, 4.8 if drawn else 3.6))

@@ -23,6 +23,10 @@ from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
 from .result import RockingResult, describe
 
+#: Largest friction coefficient mu taken (simulate's ``friction`` and a study's; no contact
+#: needs more).
+MAX_FRICTION = 10.0
+
 #: simulate(method="linear") warns above this linearization error bound.
 LINEAR_WARN = 0.1
 
@@ -337,6 +341,15 @@ _RUNNERS = {
 }
 
 
+def check_friction(value) -> float:
+    """The friction coefficient mu in (0, :data:`MAX_FRICTION`] as a float, or a ValueError
+    naming ``friction``."""
+    value = _validate.number("friction", value)
+    if not (math.isfinite(value) and 0.0 < value <= MAX_FRICTION):
+        raise ValueError(f"friction must lie in (0, {MAX_FRICTION:g}], got {value!r}")
+    return value
+
+
 def simulate(
     structure,
     motion: Motion,
@@ -432,10 +445,11 @@ def simulate(
         or, without it, up to the end of the history (rest or overturning; the scene then
         runs twice, once to find that end).
     friction : float, optional
-        The friction coefficient mu > 0 of the contact: a :class:`~rockstudy.ContactWarning`
-        when ``result.friction_demand`` exceeds it (the block would slide) or the block lifts
-        off. Only for a :class:`~rockstudy.Block` and the methods that compute the demand
-        (all but ``"complex"``).
+        The friction coefficient mu in (0, 10] (:data:`MAX_FRICTION`, as in a study) of the
+        contact: a :class:`~rockstudy.ContactWarning` when ``result.friction_demand`` exceeds
+        it (the block would slide) or the block lifts off. Only for a
+        :class:`~rockstudy.Block` and the methods that compute the demand (all but
+        ``"complex"``).
 
     Returns
     -------
@@ -475,7 +489,7 @@ def simulate(
     t_eval = _validate.output_times(t_eval, dt_out, t_max)
     block = not hasattr(structure, "mechanism") and method_for(method).friction_demand
     if friction is not None:
-        friction = _validate.positive("friction", friction)
+        friction = check_friction(friction)
         if not block:
             name = type(structure).__name__
             raise ValueError(

@@ -61,6 +61,9 @@ class Measure:
     needs_period: bool = False
     needs_damping: bool = False
     listed: bool = True
+    #: A registered measure's values are checked (a finite number >= 0, its exceptions named);
+    #: not the built-in ones', which are NaN where undefined (the duration of a silent record).
+    checked: bool = False
 
     @property
     def scalable(self) -> bool:
@@ -70,14 +73,32 @@ class Measure:
     def of(self, record, period=None, damping: float = 0.05) -> float:
         """The measure of ``record`` [SI] (``period`` [s] and ``damping`` where it needs them).
 
-        Raises ValueError naming the measure if its function returns no real number.
+        Raises ValueError naming the measure if its function returns no real number, and,
+        for a registered measure, if it fails or returns NaN, an infinity or a negative value.
         """
+        if not self.checked:
+            return self._value(self._call(record, period, damping))
+        where = f"the measure {self.name!r} of the record {getattr(record, 'name', '')!r}"
+        try:
+            value = self._call(record, period, damping)
+        except Exception as exc:  # noqa: BLE001 - the user's function: named, in one line
+            text = " ".join(str(exc).split())[:200]
+            raise ValueError(f"{where} failed ({type(exc).__name__}: {text})") from None
+        value = self._value(value)
+        if not (math.isfinite(value) and value >= 0.0):
+            raise ValueError(f"{where} is {value!r}; a measure must be a finite number >= 0")
+        return value
+
+    def _call(self, record, period, damping):
+        """The function's answer for ``record``, with the arguments it takes."""
         if self.needs_period:
-            value = self.function(record, period, damping)
-        elif self.needs_damping:
-            value = self.function(record, damping)
-        else:
-            value = self.function(record)
+            return self.function(record, period, damping)
+        if self.needs_damping:
+            return self.function(record, damping)
+        return self.function(record)
+
+    def _value(self, value) -> float:
+        """The function's answer as a float, or ValueError naming the measure."""
         try:
             return _validate.number(f"the measure {self.name!r}", value)
         except ValueError as exc:
@@ -176,6 +197,21 @@ def _check_name(name, replace: bool) -> str:
     return name
 
 
+#: An SI unit of base units with integer powers (``m/s^2``, ``m^2/s^4``, ``kg m/s``), or ``1``
+#: for a dimensionless measure.
+_SI_UNIT = re.compile(r"(1|(m|s|kg|rad)(\^-?[1-9])?([ */](m|s|kg|rad)(\^-?[1-9])?)*)\Z")
+
+
+def _check_unit(unit) -> str:
+    unit = _text("unit", unit)
+    if not _SI_UNIT.match(unit):
+        raise ValueError(
+            f"unit must be an SI unit of m, s, kg and rad with integer powers, like 'm/s^2' or "
+            f"'m^2/s^4' ('1' for none), got {unit!r}"
+        )
+    return unit
+
+
 def _check_power(power) -> float:
     power = _validate.number("power", power)
     if not (math.isfinite(power) and power >= 0.0):
@@ -211,10 +247,14 @@ def register_measure(
         ``function(record) -> float`` [SI]; ``function(record, damping)`` if
         ``needs_damping``; ``function(record, period, damping)`` if ``needs_period``.
         ``record`` is a :class:`~rockstudy.motions.Record` (``.time`` [s],
-        ``.acceleration`` [m/s^2]). Values are cached per record.
+        ``.acceleration`` [m/s^2]). Values are cached per record. It is tried on a small
+        synthetic record when registered (at T = 1 s and 5 % damping where it takes them),
+        and wherever it is used it must return a finite number >= 0: else a ValueError
+        names the measure and the record (its own exceptions too, in one line).
     unit : str
-        SI unit of the value, e.g. ``"m/s^2"`` (a target in a study may then be written in
-        any unit of :data:`UNIT_ALIASES` of it).
+        SI unit of the value, of m, s, kg and rad with integer powers, e.g. ``"m/s^2"`` or
+        ``"m^2/s^4"`` (``"1"`` for a ratio); a target in a study may then be written in any
+        unit of :data:`UNIT_ALIASES` of it.
     power : float
         k >= 0 with IM(s a_g) = abs(s)^k IM(a_g) for the record scaled by s (1 for
         amplitudes, 2 for Arias intensity, 0 for durations: those cannot be scaled to).
@@ -239,13 +279,14 @@ def register_measure(
     Raises
     ------
     ValueError
-        Naming the argument that is not allowed, and what is.
+        Naming the argument that is not allowed, and what is, or the measure if its function
+        fails on the synthetic record (it is then not registered).
     """
     replace = _flag("replace", replace)
     name = _check_name(name, replace)
     if not callable(function):
         raise ValueError(f"function must be callable (record -> float), got {function!r}")
-    unit = _text("unit", unit)
+    unit = _check_unit(unit)
     power = _check_power(power)
     factor = _validate.positive("factor", factor)
     if quoted_unit is None and factor != 1.0:
@@ -263,9 +304,34 @@ def register_measure(
         _flag("needs_period", needs_period),
         _flag("needs_damping", needs_damping),
         _flag("listed", listed),
+        checked=_PROBE_RECORD is not None,
     )
+    if measure.checked:
+        _probe(measure)
     MEASURES[name] = measure
     return measure
+
+
+#: The small synthetic record every registered measure is tried on (see :func:`set_probe`);
+#: None while the built-in measures register, at import.
+_PROBE_RECORD = None
+
+
+def set_probe(record) -> None:
+    """Try every measure registered from now on on ``record`` (at a period of 1 s and 5 %
+    damping where it takes them), and check its values wherever it is used. Set once by
+    :mod:`rockstudy.motions.records`, which defines records, after the built-in measures."""
+    global _PROBE_RECORD
+    _PROBE_RECORD = record
+
+
+def _probe(measure: Measure) -> None:
+    """ValueError naming the measure if it fails, or is not a finite number >= 0, on the
+    probe record."""
+    try:
+        measure.of(_PROBE_RECORD, 1.0 if measure.needs_period else None, 0.05)
+    except ValueError as exc:
+        raise ValueError(f"function: {exc}; the measure is not registered") from None
 
 
 def unregister_measure(name: str) -> None:

@@ -697,3 +697,15 @@ def read_record(path, units: str = "g", columns=("time", "horizontal"), dt=None)
     if str(path).lower().endswith(".at2"):
         return Record.from_at2(path)
     return Record.from_csv(path, units=units, columns=columns, dt=dt)
+
+
+def _probe_record() -> Record:
+    """A small synthetic record (5 s at 100 Hz: a 0.8 s sine pulse of about 0.3 g in a
+    decaying 1.7 s oscillation) that every registered measure is tried on."""
+    t = np.arange(500) * 0.01
+    pulse = np.sin(2 * np.pi * t / 0.8) * np.exp(-((t - 1.5) ** 2))
+    ringing = 0.3 * np.sin(2 * np.pi * t / 1.7) * np.exp(-0.5 * t)
+    return Record(0.3 * STANDARD_GRAVITY * (pulse + ringing), dt=0.01, name="synthetic probe")
+
+
+measures.set_probe(_probe_record())

@@ -123,7 +123,10 @@ class RockingAccessor:
                 "ds.rocking.study: the cube has no 'study' attribute: it was not written by "
                 "a study run (a record design made in Python carries none)"
             )
-        return sampled.study_of(self._raw)
+        try:
+            return sampled.study_of(self._raw)
+        except ValueError as exc:
+            raise ValueError(f"ds.rocking.study: {exc}") from None
 
     def _records(self, method: str) -> str:
         """The kind of a record design, or a ValueError naming ``method``."""

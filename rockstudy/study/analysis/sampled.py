@@ -48,8 +48,24 @@ FailedPolicy = Literal["error", "drop", "impute"]
 
 
 def study_of(ds: xr.Dataset) -> Study:
-    """The study a cube was made from (its ``study`` attribute)."""
-    return Study.model_validate(json.loads(ds.attrs["study"]))
+    """The study a cube was made from (its ``study`` attribute), or a ValueError naming the
+    attribute and what it must be (never quoting it)."""
+    from pydantic import ValidationError
+
+    text = ds.attrs.get("study")
+    what = "attrs['study'] must be the JSON text of the study the cube was run from"
+    if not isinstance(text, str | bytes):
+        raise ValueError(f"{what}; it is {'missing' if text is None else type(text).__name__}")
+    try:
+        data = json.loads(text)
+    except (ValueError, RecursionError):  # JSONDecodeError and UnicodeDecodeError alike
+        raise ValueError(f"{what}; it is not JSON") from None
+    try:
+        return Study.model_validate(data)
+    except ValidationError as exc:
+        raise ValueError(
+            f"{what}; it is JSON but no study ({exc.error_count()} problem(s))"
+        ) from None
 
 
 def _values(ds, output, failed: FailedPolicy):

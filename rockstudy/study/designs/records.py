@@ -72,10 +72,14 @@ def _is_structure(value) -> bool:
 
 
 def _named(structures: dict) -> tuple[list[str], list]:
-    """The names and structures of a dict ``{name: structure}`` (names: non-empty strings)."""
+    """The names and structures of a dict ``{name: structure}`` (names: non-empty strings
+    without a NUL character, as in a study file)."""
     for i, (name, value) in enumerate(structures.items()):
-        if not isinstance(name, str) or not name.strip():
-            raise ValueError(f"structures: object {i} has the name {name!r}; give a non-empty str")
+        if not isinstance(name, str) or not name.strip() or "\0" in name:
+            raise ValueError(
+                f"structures: object {i} has the name {name!r}; give a non-empty str without "
+                "a NUL character"
+            )
         if not _is_structure(value):
             raise TypeError(
                 f"structures[{name!r}] must be a rockstudy Block or provide equivalent_block() "

@@ -8,10 +8,12 @@ nothing finished: ``resume=True`` computes only the chunks whose status is still
 
 from __future__ import annotations
 
+import errno
 import json
 import logging
 import math
 import multiprocessing
+import re
 import sys
 import threading
 import time
@@ -20,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...motions.records import read_text_file
 from ..designs.sampling import make_design
 from ..spec.schema import Study
 from . import store
@@ -136,6 +139,47 @@ class SchedulerError(RuntimeError):
     """The dask scheduler cannot be reached, or no worker joined it in time."""
 
 
+class ResourceError(RuntimeError):
+    """The run stopped for want of memory, or because worker processes died (were killed):
+    not a fault of the study. A store whose template was not finished is removed; one with
+    finished chunks is kept and can be resumed."""
+
+
+#: What to try when a run runs out of memory.
+_LESS_MEMORY = "give it more memory (a higher ulimit -v), fewer --workers or a smaller chunk_size"
+
+
+def out_of_memory(exc: BaseException) -> bool:
+    """Whether ``exc``, or an exception it was raised from or during, is this process running
+    out of memory: a MemoryError, a thread that could not start, an allocation refused."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, MemoryError):
+            return True
+        if isinstance(exc, RuntimeError) and "can't start new thread" in str(exc):
+            return True
+        if isinstance(exc, OSError) and exc.errno == errno.ENOMEM:
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+def _resource_error(exc: BaseException) -> ResourceError | None:
+    """``exc`` as a :class:`ResourceError` if it is a want of memory or a worker that died
+    (dask's KilledWorker: a chunk whose workers died on it four times), else None."""
+    from distributed import KilledWorker
+
+    if out_of_memory(exc):
+        return ResourceError(f"the run ran out of memory; {_LESS_MEMORY}")
+    if isinstance(exc, KilledWorker):
+        return ResourceError(
+            "a chunk's dask worker processes died four times (killed, most often for want of "
+            f"memory); {_LESS_MEMORY}"
+        )
+    return None
+
+
 class FailedSamplesError(RuntimeError):
     """More samples failed than the run allows; the cube is complete and kept.
 
@@ -154,6 +198,10 @@ def _check_workers(workers) -> None:
         raise ValueError(f"workers: {workers!r} is not allowed; give a whole number >= 1")
 
 
+#: Largest scheduler file read [bytes] (dask writes a few hundred).
+MAX_SCHEDULER_FILE_BYTES = 2**16
+
+
 def _scheduler_address(scheduler_file, timeout) -> str:
     """The address in a dask scheduler file, waiting up to ``timeout`` seconds for the file to
     appear (a scheduler that is starting writes it); SchedulerError if it does not, or if it is
@@ -167,15 +215,17 @@ def _scheduler_address(scheduler_file, timeout) -> str:
             f"the scheduler file {path} does not exist (waited {timeout:g} s): start the "
             "scheduler with --scheduler-file, or check the path"
         )
+    what = "a dask scheduler file (a JSON object whose 'address' is like tcp://HOST:PORT)"
+    try:  # a regular file of bounded size: a pipe would hang, a device fill the memory
+        text = read_text_file(path, MAX_SCHEDULER_FILE_BYTES)
+    except (OSError, ValueError) as exc:
+        raise SchedulerError(f"{exc}, so not {what}") from None
     try:
-        address = json.loads(path.read_text())["address"]
+        address = json.loads(text)["address"]
         if not isinstance(address, str) or "://" not in address:
             raise TypeError
-    except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError):
-        raise SchedulerError(
-            f"{path} is not a dask scheduler file (a JSON object whose 'address' is like "
-            "tcp://HOST:PORT)"
-        ) from None
+    except (ValueError, KeyError, TypeError):
+        raise SchedulerError(f"{path} is not {what}") from None
     return address
 
 
@@ -244,13 +294,37 @@ def _local_cluster(workers):
                 silence_logs=logging.CRITICAL,
             )
     except Exception as exc:  # noqa: BLE001 - reported in one sentence, with its cause
-        raise RuntimeError(
-            f"the local dask cluster did not start ({type(exc).__name__}: {exc}); if you "
-            f"called run_study from a script, {_GUARD}"
+        cause = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+        if _unguarded_script():
+            raise RuntimeError(
+                f"the local dask cluster did not start ({cause}); if you called run_study "
+                f"from a script, {_GUARD}"
+            ) from None
+        raise ResourceError(
+            f"the local dask cluster did not start ({cause}): a worker process died while it "
+            f"started (killed, or out of memory); {_LESS_MEMORY}"
         ) from None
     finally:
         if main_thread:
             signal.signal(signal.SIGINT, old)
+
+
+def _unguarded_script() -> bool:
+    """Whether the program is a Python script without an ``if __name__ == "__main__":``
+    guard, which dask's worker processes import again (run_study then refuses to run in
+    them): the one cause of a local cluster that does not start that its author can fix."""
+    path = getattr(sys.modules.get("__main__"), "__file__", None)
+    if path is None:  # interactive, a notebook: nothing is imported again
+        return False
+    try:
+        text = read_text_file(path, MAX_SCRIPT_BYTES)
+    except (OSError, ValueError):
+        return False
+    return not re.search(r"__name__\s*==\s*['\"]__main__['\"]", text)
+
+
+#: Largest script read to see whether it guards its run_study call [bytes].
+MAX_SCRIPT_BYTES = 2**20
 
 
 def _client(workers=None, scheduler=None, scheduler_file=None, security=None, timeout=60.0):
@@ -319,6 +393,17 @@ def run_study(
         TLS credentials for a ``tls://`` scheduler (default: dask's configuration).
     timeout : float
         Seconds to wait for a remote scheduler to answer and for its first worker [s].
+
+    Raises
+    ------
+    ResourceError
+        The run ran out of memory, or its worker processes died (while the local cluster
+        started, or four times on one chunk). A store whose template was not finished is
+        removed; one with finished chunks is kept for ``resume=True``.
+    SchedulerError
+        The remote scheduler was not reached, or no worker joined it in time.
+    FailedSamplesError
+        More samples failed than ``max_failed`` allows (the cube is complete and kept).
     """
     if getattr(multiprocessing.current_process(), "_inheriting", False):
         # a process being spawned (a worker of the local cluster) imports the user's script,
@@ -360,9 +445,12 @@ def run_study(
         )
         if nc is not None:
             report.netcdf = store.export_netcdf(out, nc)
-    except BaseException:
+    except BaseException as exc:
         if not complete:  # failed before its template was written: leave no trace
-            store.discard_if_unused(out, lock.made_folder)
+            _discard_unfinished(out, lock.made_folder, design, study)
+        resource = _resource_error(exc)
+        if resource is not None:
+            raise resource from exc
         raise
     finally:
         lock.release()
@@ -370,6 +458,22 @@ def run_study(
     if report.failed_samples > max_failed * n:
         raise FailedSamplesError(_failure_message(report, max_failed), report)
     return report
+
+
+def _discard_unfinished(out, made_folder, design, study) -> None:
+    """Remove what a run that stopped before its template was complete wrote in ``out``
+    (nothing finished: its marker says so), and the folder if the run made it. A folder that
+    holds files rockstudy did not write, or that cannot be cleared, is left for ``--resume``
+    (which writes the template again)."""
+    marker = store.read_marker(out)
+    if marker is None or marker.get("template_complete"):
+        return
+    names = [*design.variables, *store.output_table(study), "status", "error"]
+    try:
+        store.clear_template(out, names)
+        store.discard_if_unused(out, made_folder)
+    except (store.StoreError, OSError, MemoryError):
+        pass  # left as it is: --resume writes the template again
 
 
 def _failure_message(report, max_failed) -> str:

@@ -69,6 +69,7 @@ from pydantic import (
 from ... import _validate
 from ...constants import G
 from ...dynamics.methods import MAX_STEPS
+from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...risk import MAX_YEARS
@@ -225,8 +226,12 @@ class EquivalentBlockSpec(_Model):
 OBJECT_KINDS = tuple(KINDS)
 
 
-#: Largest friction coefficient mu taken (a study's ``friction``; no contact needs more).
-MAX_FRICTION = 10.0
+def _a_name(value: str) -> str:
+    """A name (of a study or an object), not blank and without a NUL character (which no
+    store or report keeps)."""
+    if "\0" in value or not value.strip():
+        raise ValueError("must be a name: not blank, no NUL character")
+    return value
 
 
 class _ObjectBase(_Model):
@@ -239,6 +244,7 @@ class _ObjectBase(_Model):
     #: The friction coefficient mu of this object's contact (overrides the study's friction).
     friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
     _params: tuple = PrivateAttr(default=None)
+    _printable = field_validator("name")(lambda value: _a_name(value))
 
     @model_validator(mode="after")
     def _shape(self):
@@ -867,12 +873,7 @@ class Study(_Model):
     #: points of a design that free fall censors (:func:`.feasibility.notes`).
     _notes: list = PrivateAttr(default_factory=list)
 
-    @field_validator("name")
-    @classmethod
-    def _printable(cls, value):
-        if "\0" in value or not value.strip():
-            raise ValueError("must be a name: not blank, no NUL character")
-        return value
+    _printable = field_validator("name")(lambda value: _a_name(value))
 
     @property
     def source_text(self) -> str | None:
@@ -1543,7 +1544,7 @@ OBJECT_COLUMNS = tuple(ObjectSpec.model_fields)
 def _read_objects_file(data, base_dir) -> str | None:
     """Read ``structure.file`` (a CSV of :data:`OBJECT_COLUMNS`, a header line then one object a
     line; empty cells are left out) into ``structure.objects`` of ``data``, in place; the
-    problem as one line, or None."""
+    problem as one line naming the file and the line, never its contents, or None."""
     st = data.get("structure")
     if not (isinstance(st, dict) and st.get("kind") == "objects" and "file" in st):
         return None
@@ -1558,26 +1559,74 @@ def _read_objects_file(data, base_dir) -> str | None:
     path = record_path(name, base_dir)
     try:
         text = read_text_file(path, MAX_STUDY_BYTES)
+        st["objects"] = _object_rows(text)
     except (OSError, ValueError) as exc:
         return f"structure.file: cannot read {str(path)!r} ({exc})"
-    rows = list(csv.DictReader(io.StringIO(text)))
-    header = list(rows[0]) if rows else []
-    unknown = [c for c in header if c is None or c.strip() not in OBJECT_COLUMNS]
-    if not rows or unknown:
-        return (
-            f"structure.file: {str(path)!r} must hold a header line of columns among "
-            f"{list(OBJECT_COLUMNS)} and one object a line"
-            + (f"; unknown columns {unknown}" if unknown else "; it holds no object")
-        )
-    st["objects"] = [
-        {
-            k.strip(): v.strip() if k.strip() in ("name", "kind") else _cell(v)
-            for k, v in row.items()
-            if v is not None and v.strip()
-        }
-        for row in rows
-    ]
     return None
+
+
+def _object_rows(text: str) -> list[dict]:
+    """The objects of the text of an objects CSV file, one dict a row without its empty cells;
+    ValueError naming the line and what was expected (never a cell: the file may be anything).
+
+    A row may be shorter than the header; cells beyond the header, or under a column without a
+    name, must be empty. Blank lines are skipped.
+    """
+    expected = f"a header line of columns among {list(OBJECT_COLUMNS)}, then one object a line"
+    reader = csv.reader(io.StringIO(text.removeprefix("\ufeff")))  # a spreadsheet's BOM
+    rows = []
+    try:
+        for cells in reader:
+            if any("\n" in c or "\r" in c for c in cells):
+                raise ValueError(
+                    f"line {reader.line_num}: a quoted cell spans lines; expected {expected}"
+                )
+            rows.append((reader.line_num, [c.strip() for c in cells]))
+    except csv.Error:  # a carriage return inside a line, a cell over csv's size limit
+        raise ValueError(
+            f"line {reader.line_num}: is not a line of comma-separated cells (a carriage "
+            f"return alone, or a cell too long); expected {expected}"
+        ) from None
+    rows = [(line, cells) for line, cells in rows if any(cells)]
+    if not rows:
+        raise ValueError(f"it holds no line; expected {expected}")
+    header = _object_header(*rows[0], expected)
+    if len(rows) == 1:
+        raise ValueError(f"it holds no object after its header; expected {expected}")
+    return [_object_row(line, cells, header) for line, cells in rows[1:]]
+
+
+def _object_header(line: int, cells: list[str], expected: str) -> list[str]:
+    """The column names of the header of an objects CSV file ('' for a column without a name,
+    which must stay empty); ValueError naming the first column that is no object column."""
+    for i, cell in enumerate(cells):
+        if cell and cell not in OBJECT_COLUMNS:
+            raise ValueError(
+                f"line {line}: column {i + 1} of the header is not an object column; "
+                f"expected {expected}"
+            )
+        if cell and cell in cells[:i]:
+            raise ValueError(f"line {line}: column {i + 1} of the header repeats a column")
+    if "name" not in cells:
+        raise ValueError(f"line {line}: the header has no name column; expected {expected}")
+    return cells
+
+
+def _object_row(line: int, cells: list[str], header: list[str]) -> dict:
+    """One object of an objects CSV file: its non-empty cells by column, names and kinds as
+    text and the rest as numbers where they read as one; ValueError for a non-empty cell
+    beyond the header or under a column without a name."""
+    stray = [i for i, cell in enumerate(cells) if cell and (i >= len(header) or not header[i])]
+    if stray:
+        raise ValueError(
+            f"line {line}: cell {stray[0] + 1} is not under a named column (the row has "
+            f"{len(cells)} cells, the header names {sum(map(bool, header))} columns)"
+        )
+    return {
+        header[i]: cell if header[i] in ("name", "kind") else _cell(cell)
+        for i, cell in enumerate(cells)
+        if cell
+    }
 
 
 def _read_hazard_file(data, base_dir) -> str | None:
