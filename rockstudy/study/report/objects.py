@@ -302,7 +302,13 @@ def object_fragility(page, ctx):
         "against the measure the efficiency table recommends; dotted vertical lines: each "
         "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
         "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
-        "the measure has one (PGA, PGA / uplift level)"
+        "the measure has one (PGA, PGA / uplift level); open circles, in the object's "
+        "colour: "
+        + {
+            "ida": "its capacities at the plotting positions (k - 1/2) / n of their ranks",
+            "stripes": "the share of its records that overturned at each stripe level",
+            "cloud": "each record's outcome (0 stood, 1 overturned)",
+        }[ctx.design]
         + (
             "; under these horizontal records nothing can overturn below it, so the fragility "
             "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "

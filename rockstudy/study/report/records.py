@@ -343,7 +343,9 @@ def _responses(page, ctx):
         "theta_max / alpha = 1)"
         + (
             "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive, shaded: the switch band"
+            "at which the block was seen to survive, shaded: the switch band; the axis spans "
+            "the capacities and the uplift level (the scan and switch bands above them run "
+            "off the top, the scan's crosses faint)"
             if design == "ida"
             else "; open circles: stood"
         )
