@@ -91,10 +91,20 @@ def test_plot_draws_theta_over_alpha_with_impacts_and_overturning(rocking, falli
     fig, given = plt.subplots()
     ax = falling.plot(ax=given)
     assert ax is given
-    cross = [ln for ln in ax.get_lines() if ln.get_label() == "overturned"]
-    assert cross and cross[0].get_xdata()[0] == falling.overturn_time
-    assert abs(cross[0].get_ydata()[0]) == pytest.approx((math.pi / 2) / 0.2)
+    # the cross where |theta| last passes theta_cr, between the two samples of the history
+    # around it, on the side of the fall; the axis shows the rocking up to 1.15 theta_cr
+    cross = [ln for ln in ax.get_lines() if ln.get_label().startswith("overturned")]
+    inside = np.flatnonzero(np.abs(falling.theta) < 0.2)[-1]
+    t_cr = cross[0].get_xdata()[0]
+    assert falling.t[inside] <= t_cr <= falling.t[inside + 1]
+    assert cross[0].get_ydata()[0] == np.sign(falling.theta[-1])
+    assert ax.get_ylim() == pytest.approx((-1.15, 1.15))
+    dashed = sorted(ln.get_ydata()[0] for ln in ax.get_lines() if ln.get_linestyle() == "--")
+    assert dashed == [-1.0, 1.0]  # |theta| = theta_cr
     plt.close(fig)
+    ax = rocking.plot()  # a rocking without a fall: the axis spans 1.2 times its peak
+    assert ax.get_ylim() == pytest.approx((-1.2 * rocking.max_rotation / 0.2,) * 2 * np.r_[1, -1])
+    plt.close(ax.figure)
 
 
 def test_batch_as_dataset_equals_the_dict():

@@ -278,8 +278,12 @@ class RockingResult:
         The curve passes through the exact peaks and the dense output, smooth between the
         history's points (their cubic Hermite interpolant in theta and theta_dot). Each
         impact is a short tick on the time axis (theta = 0, where it happens), so that a
-        long record with a hundred impacts stays readable; an overturning is a cross.
-        Without ``info["critical_rotation"]`` theta is drawn in rad.
+        long record with a hundred impacts stays readable; an overturning is a cross where
+        |theta| last passes theta_cr. Dashed lines mark |theta| = theta_cr where the axis
+        reaches them: the axis spans the rocking (1.2 times its peak), and for a fall the
+        rocking before it up to +-1.15 theta_cr (the fall runs off the axis). Without
+        ``info["critical_rotation"]`` theta is drawn in rad, the cross at the overturning
+        time.
 
         Parameters
         ----------
@@ -325,15 +329,18 @@ class RockingResult:
                 self.impact_times,
                 np.zeros(self.n_impacts),
                 "|",
-                color="0.35",
-                ms=7,
-                mew=0.8,
+                color="C1",
+                ms=11,
+                mew=1.2,
+                zorder=3,  # over the curve, which lies on theta = 0 at each impact
                 label=f"impacts ({self.n_impacts})",
             )
-        if self.overturned and np.isfinite(self.overturn_time):
+        if crit:
+            self._rocking_axis(ax, t, theta / crit)
+        elif self.overturned and np.isfinite(self.overturn_time):
             ax.plot(
                 [self.overturn_time],
-                [np.sign(self.theta[-1]) * self.max_rotation / scale],
+                [np.sign(self.theta[-1]) * self.max_rotation],
                 "rx",
                 ms=9,
                 label="overturned",
@@ -351,6 +358,25 @@ class RockingResult:
         g_ax.plot(g_t, drawn.ground_acceleration(g_t), lw=0.8, color="0.3")
         g_ax.set(xlabel="time t [s]", ylabel="a_g [m/s^2]")
         return ax
+
+    def _rocking_axis(self, ax, t, ratio):
+        """The axis of theta / theta_cr (``ratio`` on the times ``t``): dashed lines at +-1,
+        and limits that show the rocking before a fall (the fall itself, beyond theta_cr,
+        runs off the axis from the cross where it last passed theta_cr)."""
+        size = np.abs(ratio)
+        inside = np.flatnonzero(size < 1.0)
+        if self.overturned and inside.size and inside[-1] + 1 < size.size:
+            k = inside[-1]  # the last point inside: the fall passes theta_cr after it
+            t_cr = np.interp(1.0, size[k : k + 2], t[k : k + 2])
+            sign = np.sign(ratio[k + 1])
+            ax.plot([t_cr], [sign], "rx", ms=9, label="overturned (passes theta_cr)")
+            top = 1.15
+        else:
+            top = 1.2 * float(np.max(np.abs(ratio))) or 1.0
+        if top >= 1.0:
+            ax.axhline(1.0, ls="--", lw=0.8, color="C3", label="|theta| = theta_cr")
+            ax.axhline(-1.0, ls="--", lw=0.8, color="C3")
+        ax.set_ylim(-top, top)
 
     def _ground_motion(self, ground):
         """The motion to draw under the response: None, the result's own, or ``ground``."""

@@ -301,8 +301,9 @@ class Record(Motion):
         Parameters
         ----------
         method : {"wavelet", "mavroeidis"}
-            ``"wavelet"``: Baker (2007) and Shahi & Baker (2014), db4 wavelets, T_p the peak
-            of the extracted pulse's pseudo-velocity spectrum
+            ``"wavelet"``: Baker (2007) and Shahi & Baker (2014), db4 wavelets, T_p the
+            pseudo-period of the largest wavelet, s dt / F_c (the period of the peak of the
+            extracted pulse's 5 %-damped pseudo-velocity spectrum is ``psv_period``)
             (:class:`rockstudy.motions.wavelet_pulse.WaveletPulse`). ``"mavroeidis"``: a
             least-squares Mavroeidis-Papageorgiou (2003) pulse
             (:class:`rockstudy.motions.pulse_extraction.VelocityPulse`).

@@ -163,7 +163,12 @@ class _Page:
             f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
             "img{max-width:100%}table.t{border-collapse:collapse;font-size:12px}"
-            ".wide{overflow-x:auto;max-width:100%}"
+            # a wide table may use the whole width of a 1,400-pixel page, and its headings
+            # wrap between words (row headings do not)
+            ".wide{overflow-x:auto;width:min(1360px,100vw - 20px);position:relative;"
+            "left:50%;transform:translateX(-50%)}"
+            "table.t{margin:auto}table.t thead th{overflow-wrap:break-word}"
+            "table.t tbody th{white-space:nowrap}"
             "table.t td,table.t th{border:1px solid #ccc;padding:2px 6px}"
             ".cap{color:#555}.warn{border:2px solid #c60;background:#fff4e5;padding:6px 10px;"
             "margin:8px 0}</style></head><body>"
@@ -217,6 +222,18 @@ def _log_ticks(ax, axis="x"):
         target.set_major_locator(FixedLocator(ticks[(ticks >= lo) & (ticks <= hi)]))
         target.set_minor_formatter(NullFormatter())
     ax.tick_params(axis=axis, which="both", labelsize=8)
+
+
+def object_colors(names) -> dict[str, tuple]:
+    """One colour per object, keyed by its name: matplotlib's tab10 (tab20 beyond ten
+    objects, repeating beyond twenty) given in the sorted order of the names, so that every
+    figure of a report that is given the same objects, in any order (a ranking, a subset
+    drawn), colours each object alike."""
+    from matplotlib import colormaps
+
+    unique = sorted({str(n) for n in names})
+    cmap = colormaps["tab10" if len(unique) <= 10 else "tab20"]
+    return {n: cmap(k % cmap.N) for k, n in enumerate(unique)}
 
 
 def _mpl_text(text: str) -> str:

@@ -25,7 +25,15 @@ from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL, N_BOOT
 from ..analysis.risk import cut_levels, horizontal
 from ..analysis.sampled import fragility_curve
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
-from ._page import _log_ticks, _mpl_text, _names, _plt, separation_note, shown_separation
+from ._page import (
+    _log_ticks,
+    _mpl_text,
+    _names,
+    _plt,
+    object_colors,
+    separation_note,
+    shown_separation,
+)
 
 #: Font size of legends and tick labels of the per-object figures [pt] (print: >= 8).
 FONT = 8
@@ -96,6 +104,11 @@ class ReportContext:
         """Whether any simulated point left rest."""
         name = "step_max_rotation" if self.design == "ida" else "max_rotation"
         return bool((np.nan_to_num(self.ds[name].values) > 0).any()) or self.overturned
+
+    @property
+    def colors(self) -> dict:
+        """One colour per object, keyed by name (:func:`object_colors`): every figure's."""
+        return object_colors(self.ds["structure"].values)
 
     def relabel(self, label: str) -> str:
         """An :func:`im_label` in the report's acceleration units."""
@@ -211,9 +224,18 @@ def _unit(ctx) -> float:
     return STANDARD_GRAVITY if ctx.units == "g" else 1.0
 
 
-def _accel_factor(ctx, im) -> float:
-    """The factor from a fit's quoted units of ``im`` to the report's (g -> m/s^2)."""
-    return STANDARD_GRAVITY if im in ("pga", "sa") and ctx.units == "m/s^2" else 1.0
+def quoted_to_report(units, im) -> float:
+    """The factor from the quoted unit of ``im`` (the registry's, :func:`rf.quoted`: what the
+    fits give) to a report's: a measure quoted in g is shown in the report's acceleration
+    ``units`` (g or m/s^2, as :meth:`ReportContext.relabel` labels it); any other measure in
+    its quoted unit."""
+    return STANDARD_GRAVITY if rf.quoted(im)[0] == "g" and units == "m/s^2" else 1.0
+
+
+def si_to_report(units, im) -> float:
+    """The factor from the SI value of ``im`` (a stored level or measure) to a report's unit
+    of it (:func:`quoted_to_report`)."""
+    return rf.quoted(im)[1] * quoted_to_report(units, im)
 
 
 def _object_fit(ctx, im, period):
@@ -221,7 +243,7 @@ def _object_fit(ctx, im, period):
     fit = rf.ida_fragility if ctx.design == "ida" else rf.stripe_fragility
     with shown_separation():  # said on the page (separation_note)
         table = fit(ctx.ds, im=im, period=period, by="structure", n_boot=ctx.n_boot)
-    f = _accel_factor(ctx, im)
+    f = quoted_to_report(ctx.units, im)
     for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
         table[col] = table[col] * f
     table.index.name = "object"
@@ -280,7 +302,13 @@ def object_fragility(page, ctx):
         "against the measure the efficiency table recommends; dotted vertical lines: each "
         "object's uplift level (g tan alpha of a block; g lambda, eq. 10 of [003], of a "
         "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
-        "the measure has one (PGA, PGA / uplift level)"
+        "the measure has one (PGA, PGA / uplift level); open circles, in the object's "
+        "colour: "
+        + {
+            "ida": "its capacities at the plotting positions (k - 1/2) / n of their ranks",
+            "stripes": "the share of its records that overturned at each stripe level",
+            "cloud": "each record's outcome (0 stood, 1 overturned)",
+        }[ctx.design]
         + (
             "; under these horizontal records nothing can overturn below it, so the fragility "
             "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "
@@ -346,6 +374,32 @@ def _cut(ctx, im) -> np.ndarray:
     return level if im == "pga" else level / up
 
 
+def _observed(ctx, im, period, j) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) of object ``j``'s data beside its fitted curve, in the report's unit of ``im``:
+    for an IDA its capacities (first overturning intensities) at the plotting positions
+    (k - 1/2) / n of their ranks among its n records (a censored record counts, above them
+    all); for stripes the share of the points that overturned at each level (at the
+    geometric mean of the points' intensities there); for a cloud each record's outcome (0
+    stood, 1 overturned) at its intensity."""
+    f = quoted_to_report(ctx.units, im)
+    if ctx.design == "ida":
+        cap, _, cens, ok = rf.ida_arrays(ctx.ds, im, period)
+        n = int(ok[:, j].sum())
+        x = np.sort(cap[:, j][ok[:, j] & ~cens[:, j]]) * f
+        return x, (np.arange(1, x.size + 1) - 0.5) / max(n, 1)
+    x, y, ok = rf.stripe_arrays(ctx.ds, im, period)
+    if ctx.design == "cloud":
+        return x[ok[:, j], j] * f, (y[ok[:, j], j] == 1).astype(float)
+    x, y, ok = (a[:, j].reshape(a.shape[0], -1) for a in (x, y, ok))  # (record, level)
+    xs, ys = [], []
+    for k in range(x.shape[1]):
+        sel = ok[:, k]
+        if sel.any():
+            xs.append(float(np.exp(np.mean(np.log(x[sel, k])))) * f)
+            ys.append(float(np.mean(y[sel, k] == 1)))
+    return np.asarray(xs), np.asarray(ys)
+
+
 def _plot_objects(ax, ctx, t, im, period) -> bool:
     """Each object's fitted curve and band on ``ax``; False (nothing drawn) when no fit is
     defined."""
@@ -370,14 +424,14 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
         x_u = up[j] if up is not None else np.nan
         above = grid >= cut[j] if np.isfinite(cut[j]) else np.ones(grid.size, bool)
         p = np.where(above, c.probability, 0.0)
-        (line,) = ax.plot(grid, p, "-", label=ctx.text(str(g)))
+        color = ctx.colors[str(g)]
+        ax.plot(grid, p, "-", label=ctx.text(str(g)), color=color)
         if not above.all():  # the fitted lognormal's tail, where the object cannot rock
-            ax.plot(grid[~above], c.probability[~above], "--", lw=0.8, color=line.get_color())
-        ax.fill_between(
-            grid[above], c.lower[above], c.upper[above], alpha=shade, color=line.get_color()
-        )
+            ax.plot(grid[~above], c.probability[~above], "--", lw=0.8, color=color)
+        ax.fill_between(grid[above], c.lower[above], c.upper[above], alpha=shade, color=color)
         if up is not None:
-            ax.axvline(x_u, ls=":", lw=1.5, color=line.get_color())
+            ax.axvline(x_u, ls=":", lw=1.5, color=color)
+        ax.plot(*_observed(ctx, im, period, j), "o", ms=3.5, mfc="none", color=color)
     if not drawn:
         return False
     ax.set(xscale="log", ylim=(-0.02, 1.02), ylabel="probability of overturning [-]")
@@ -410,7 +464,7 @@ def _stripe_capacity(ctx):
     each record (the lowest overturning level, in the stripes' measure)."""
     ds = ctx.ds
     im = ds.attrs.get("im", "pga")
-    levels = ds["level"].values * (1.0 / _unit(ctx) if im in ("pga", "sa") else 1.0)
+    levels = ds["level"].values * si_to_report(ctx.units, im)
     over = ds["overturned"].values == 1  # (record, structure, level)
     first = np.where(over.any(-1), over.argmax(-1), -1).T
     cells = np.empty(first.shape, object)
@@ -502,12 +556,35 @@ def _ida_curve(ax, ctx, i, j, offset):
     name = ctx.text(ctx.record_names()[i])
     (line,) = ax.plot(x[upto], s[upto] * pga, "-", lw=1.2, label=name)
     color = line.get_color()
-    ax.plot(x[over] + offset, s[over] * pga, "x", color=color, ms=5, mew=1.2)
+    first = over & upto  # the first overturning; the scan above it drawn faint
+    ax.plot(x[first] + offset, s[first] * pga, "x", color=color, ms=5, mew=1.2)
+    ax.plot(x[over & ~upto] + offset, s[over & ~upto] * pga, "x", color=color, ms=4, alpha=0.35)
     above = (s > cap) & ~over
     ax.plot(x[above] + offset, s[above] * pga, "o", mfc="none", color=color, ms=5)
     top = ds["highest_survival_scale"].values[i, j]
     if np.isfinite(top) and np.isfinite(cap):
         ax.axhspan(cap * pga, top * pga, color=color, alpha=0.12, lw=0)
+
+
+#: Margin of an IDA panel's PGA axis around the capacities and the uplift level (a factor
+#: on a log axis): the ladder's scan and switch bands above them run off the top.
+IDA_AXIS_MARGIN = 1.3
+
+
+def ida_axis(ctx, j) -> tuple[float, float] | None:
+    """The PGA span (report units) of object ``j``'s IDA panel: from its uplift level and
+    lowest capacity to its highest capacity (or censoring level), widened by
+    :data:`IDA_AXIS_MARGIN`; None when none of these is known."""
+    ds = ctx.ds
+    cens = ds["censored"].values[:, j] == 1
+    scale = np.where(
+        cens, ds["capacity_scale_lower"].values[:, j], ds["capacity_scale"].values[:, j]
+    )
+    values = np.append(scale * ds["pga"].values / _unit(ctx), _uplift(ctx, "pga")[j])
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return None
+    return float(values.min()) / IDA_AXIS_MARGIN, float(values.max()) * IDA_AXIS_MARGIN
 
 
 def object_curves(page, ctx):
@@ -529,6 +606,8 @@ def object_curves(page, ctx):
         if np.isfinite(uplift[j]):  # NaN: a cube that does not say it
             ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
+        if ctx.design == "ida" and (span := ida_axis(ctx, j)) is not None:
+            ax.set_ylim(*span)
         ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
         ax.set_xlabel("peak rotation / slenderness, theta_max / alpha [-]", fontsize=FONT + 1)
@@ -542,11 +621,12 @@ def object_curves(page, ctx):
         "Every object under every record: "
         + (
             "the IDA curves, each record's simulated scales in increasing order up to the "
-            "first overturning (the line ends there); crosses: every scale that overturned "
-            "the object (the first overturning and the scan above it, drawn at "
-            "theta_max / alpha = 1); open circles: scales above the first overturning at "
+            "first overturning (the line ends there); crosses: the first overturning (drawn "
+            "at theta_max / alpha = 1), faint: the scales of the scan above it that "
+            "overturned too; open circles: scales above the first overturning at "
             "which the object stood; shaded: the switch band from the first overturning to "
-            "the highest scale at which it stood"
+            "the highest scale at which it stood; the axis spans the capacities "
+            "and uplift level (the scan and switch bands above them run off the top)"
             if ctx.design == "ida"
             else "the stripe points (open circles: stood; crosses: overturned, drawn at "
             "theta_max / alpha = 1)"

@@ -17,7 +17,6 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from ...constants import G
 from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
@@ -34,6 +33,7 @@ from ._page import (
     _Page,
     _plt,
     draw_fits,
+    object_colors,
     separation_note,
     shown_separation,
 )
@@ -233,37 +233,60 @@ def _record_fragility_table(page, tables):
     )
 
 
-def _efficiency(page, ctx):
-    table = ctx.efficiency()
+def _efficiency_frame(ctx, table, by=None) -> pd.DataFrame:
+    """An efficiency table of :func:`rf.im_efficiency` as the page shows it: each measure's
+    label and median capacity in the report's units (:func:`ro.quoted_to_report`), its
+    power as it is (0.5 stays 0.5); indexed by measure, or by ``by`` (the column of its
+    groups, e.g. "object") and measure."""
     rows = []
-    for (label, _), r in table.iterrows():
+    for (label, group), r in table.iterrows():
         name, _, rest = label.partition("(T=")
         period = float(rest.rstrip(" s)")) if rest else None
         rows.append(
             {
+                **({by: str(group)} if by else {}),
                 "intensity measure": ctx.relabel(im_label(name, period)),
                 "dispersion per power beta / k [-]": r["beta_linear"],
                 "beta / k, lower": r["beta_linear_lo"],
                 "beta / k, upper": r["beta_linear_hi"],
-                "power k": int(r["power"]),
+                "power k": float(r["power"]),
                 "dispersion beta [-]": r["beta"],
-                "median capacity": r["theta"],
+                "median capacity": r["theta"] * ro.quoted_to_report(ctx.units, name),
                 "points": int(r["n"]),
                 "dimensionless": bool(r["dimensionless"]),
                 "outcomes separated (no beta)": bool(r["separated"]),
                 "no rise (no beta)": bool(r["no_rise"]),
             }
         )
+    return pd.DataFrame(rows).set_index([by, "intensity measure"] if by else "intensity measure")
+
+
+def _efficiency(page, ctx):
     page.table(
-        pd.DataFrame(rows).set_index("intensity measure"),
+        _efficiency_frame(ctx, ctx.efficiency()),
         "im_efficiency",
         "Which measure predicts overturning best: the dispersion beta (MLE) of the fragility "
         "against each measure divided by the power k with which the measure follows a scale "
         "factor of the record (Arias intensity k = 2: its k-th root is as informative and "
-        "linear), pooled over all blocks (smaller is better; 90 % bands), dimensional and "
+        "linear), pooled over all "
+        + ("objects" if ctx.objects else "blocks")
+        + " (smaller is better; 90 % bands), dimensional and "
         "dimensionless; a measure in which the outcomes are separated (every overturned "
         "point at or above every one that stood), or in which they do not rise at all, has no "
         "beta and is not ranked",
+    )
+    if not ctx.objects:
+        return
+    with shown_separation():  # a separated measure: no beta, column "separated"
+        table = rf.im_efficiency(ctx.ds, by="structure", n_boot=ctx.n_boot)
+    page.table(
+        _efficiency_frame(ctx, table, "object"),
+        "im_efficiency_by_object",
+        "The same for each object alone, ranked within it: the measure that best predicts "
+        "the overturning of that object under these records (within one object a "
+        "dimensional measure and its ratio to the object's uplift level differ by a "
+        "constant and share their beta; pooled, the ratios can also bring objects of "
+        "different sizes together)",
     )
 
 
@@ -301,6 +324,8 @@ def _responses(page, ctx):
             xlim=(-0.04, 1.08),
             title=_structure_title(ds, j),
         )
+        if design == "ida" and (span := ro.ida_axis(ctx, j)) is not None:
+            ax.set_ylim(*span)
         _log_ticks(ax, "y")
     if len(names) <= 15:
         ro._shared_legend(fig, axes[0][0], len(names))
@@ -318,7 +343,9 @@ def _responses(page, ctx):
         "theta_max / alpha = 1)"
         + (
             "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive, shaded: the switch band"
+            "at which the block was seen to survive, shaded: the switch band; the axis spans "
+            "the capacities and the uplift level (the scan and switch bands above them run "
+            "off the top, the scan's crosses faint)"
             if design == "ida"
             else "; open circles: stood"
         )
@@ -329,7 +356,7 @@ def _responses(page, ctx):
 def _cloud_point(ax, ctx, i, j, offset):
     """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
     ds = ctx.ds
-    y = ds["pga"].values[i] / (G if ctx.units == "g" else 1.0)
+    y = ds["pga"].values[i] / ro._unit(ctx)
     over = bool(ds["overturned"].values[i, j] == 1)
     x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
     style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
@@ -438,7 +465,7 @@ def _side_by_side(page, ida, stripes, edges, n_boot, by=None):
                 }
             )
         if im == "pga":
-            _plot_pair(ax, t_ida, t_str, im)
+            _plot_pair(ax, t_ida, t_str, im, object_colors(ida["structure"].values) if by else {})
     if not rows:
         plt.close(fig)
         return
@@ -462,7 +489,9 @@ def _side_by_side(page, ida, stripes, edges, n_boot, by=None):
     page.table(table, "stripes_and_ida", "Stripes and IDA side by side (90 % bands)")
 
 
-def _plot_pair(ax, t_ida, t_str, im):
+def _plot_pair(ax, t_ida, t_str, im, colors):
+    """The IDA's (solid) and the stripes' (dashed) fragility of each group against ``im``,
+    an object in its colour of ``colors`` (by name; other groups in matplotlib's cycle)."""
     low = np.nanmin([t_ida["im_min"].min(), t_str["im_min"].min()])
     high = np.nanmax([t_ida["im_max"].max(), t_str["im_max"].max()])
     if not (np.isfinite(low) and np.isfinite(high) and high > low > 0):
@@ -472,7 +501,8 @@ def _plot_pair(ax, t_ida, t_str, im):
         curve = fragility_curve(table, grid)
         for g in curve.group.values:
             c = curve.sel(group=g)
-            (line,) = ax.plot(grid, c.probability, style, label=f"{what}: {g}")
+            color = colors.get(str(g))
+            (line,) = ax.plot(grid, c.probability, style, label=f"{what}: {g}", color=color)
             ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=line.get_color())
     ax.set(xscale="log", xlabel=im_label(im), ylabel="probability of overturning")
     _log_ticks(ax)
@@ -659,8 +689,10 @@ def record_report(
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
     units : {"g", "m/s^2"}
-        Units of the accelerations of the per-object sections and warnings (a study's
-        ``scale_to.units``).
+        Units of the accelerations of the per-object sections, the efficiency tables and
+        the warnings (a study's ``scale_to.units``): every measure the registry quotes in g
+        is shown in them, a registered one too; the record list, the size classes' fits and
+        the per-record breakdown say their own unit (g beside m/s^2 for PGA).
     max_scale_factor : float
         A warning box lists the stripe points or IDA capacities whose record is scaled by
         more than this (> 1; a study's ``design.max_scale_factor``).

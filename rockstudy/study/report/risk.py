@@ -11,7 +11,7 @@ from scipy import special
 
 from ... import risk
 from ..analysis.risk import object_risk
-from ._page import _log_ticks, _mpl_text, _plt
+from ._page import _log_ticks, _mpl_text, _plt, object_colors
 
 
 def section(page, ctx):
@@ -276,10 +276,12 @@ def _deaggregation_figure(page, out, im_label):
     lo, hi = out["im_lower"].values[1:-1], out["im_upper"].values[1:-1]
     fig, ax = plt.subplots(figsize=(8, 4.5))
     shown = np.flatnonzero(fitted)[:MAX_DEAGGREGATION_LINES]  # ranked: the highest rates
+    colors = object_colors(out["structure"].values)  # each object as in the other figures
     for j in shown:
         share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
         label = _mpl_text(str(out["structure"].values[j]))
-        line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label)[0]
+        color = colors[str(out["structure"].values[j])]
+        line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label, color=color)[0]
         if np.isfinite(out["uplift"].values[j]):
             ax.axvline(out["uplift"].values[j], color=line.get_color(), ls=":", lw=1)
     ax.set_xscale("log")
