@@ -36,8 +36,9 @@ def _designs(suite):
     yield "cloud with spectra", rd.cloud(suite, OBJECTS, periods=[0.3, 1.0])
     yield "stripes", rd.multiple_stripes(suite, OBJECTS, levels=[1.0, 2.0])
     yield "ida", rd.incremental_dynamic_analysis(suite, OBJECTS, max_pga_ratio=6.0)
-    yield "ida in sa", rd.incremental_dynamic_analysis(
-        suite, OBJECTS, im="sa", period=0.5, max_pga_ratio=6.0
+    yield (
+        "ida in sa",
+        rd.incremental_dynamic_analysis(suite, OBJECTS, im="sa", period=0.5, max_pga_ratio=6.0),
     )
 
 
