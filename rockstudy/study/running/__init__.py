@@ -2,7 +2,8 @@
 
 ``runner`` drives the run (:func:`~rockstudy.study.running.runner.run_study`); ``evaluate``
 is the function each task runs on a chunk of rows; ``store`` writes, resumes, verifies and
-opens the cube; ``_warmup`` compiles the numba kernels before the workers need them.
+opens the cube (its parts: ``_marker``, ``_lock``, ``_checksums``, ``_verify``, ``export``,
+``_files``); ``_warmup`` compiles the numba kernels before the workers need them.
 """
 
 __all__: list[str] = []  # the modules are imported by name
