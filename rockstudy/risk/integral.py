@@ -23,7 +23,7 @@ def _fragility(median, dispersion, hazard, units):
     """(ln theta, beta) broadcast together, with theta in the hazard's units."""
     if not isinstance(hazard, HazardCurve):
         raise TypeError(f"hazard must be a HazardCurve, got {type(hazard).__name__}")
-    units = units_for(hazard.im, units or hazard.units)
+    units = units_for(hazard.im, hazard.units if units is None else units)
     med = _array("median", median, lambda a: a > 0.0, f"finite and > 0 (in {units})")
     beta = _array(
         "dispersion",
@@ -129,7 +129,7 @@ def _threshold(threshold, units, hazard):
     threshold."""
     if threshold is None:
         return None
-    units = units_for(hazard.im, units or hazard.units)
+    units = units_for(hazard.im, hazard.units if units is None else units)
     x_u = _array("threshold", threshold, lambda a: a > 0.0, f"finite and > 0 (in {units})")
     factor = UNIT_FACTORS[units][0] / UNIT_FACTORS[hazard.units][0]
     return np.log(x_u) + np.log(factor)

@@ -32,6 +32,9 @@ OPENQUAKE_IMTS = {
 def read_curve(cls, path, im, units, period, site):
     """The :class:`~rockstudy.risk.HazardCurve` (``cls``) of a file; the arguments are those
     of :meth:`~rockstudy.risk.HazardCurve.from_csv`."""
+    for name, value in (("im", im), ("units", units)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{name} must be a name (a string) or None, got {value!r}")
     path = Path(path)
     try:
         text = read_text_file(path)

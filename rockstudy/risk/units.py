@@ -27,6 +27,8 @@ UNIT_FACTORS = {
 def units_for(im: str, units: str | None, name: str = "units") -> str:
     """``units`` checked against the dimension of ``im`` (its SI unit when None)."""
     si = measures.measure(im).unit
+    if units is not None and not isinstance(units, str):
+        raise TypeError(f"{name} must be a unit name (a string) or None, got {units!r}")
     if units is None or units == si:
         return si
     allowed = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
