@@ -277,7 +277,7 @@ def studies(draw):
     recs = draw(st.lists(record_files(), min_size=1, max_size=3))
     declared = draw(st.sampled_from(["g", "g", "m/s2", "cm/s2"]))
     files, defects = {}, []
-    for k, (name, data, stored, defect) in enumerate(recs):
+    for k, (name, data, _stored, defect) in enumerate(recs):
         files[f"records/r{k}_{name}"] = data
         if defect:
             defects.append(f"record {defect}")
