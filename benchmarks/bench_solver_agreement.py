@@ -11,13 +11,16 @@ g tan(alpha) (log-uniform), either sign. Each scene runs
   - the scipy reference (``simulate_reference``, DOP853, the same free-rocking map) at
     ``--rtol``.
 
-Printed: the scenes, the overturning decisions that differ, and over the scenes where both
-stand, the relative difference of max |theta| (median, p99, max) and the count above
-10 rtol, apart for the well-conditioned scenes (conditioning <= 1e-3) and the ill-conditioned
-ones, with the share of the latter. Scenes run in ``--jobs`` processes; ``--seconds`` bounds
-the run (the scenes done by then are reported).
+Printed: the scenes, the overturning decisions that differ, and per class of the
+conditioning c (:func:`classes`: well conditioned c <= 1e-5, sensitive up to 1e-3,
+ill-conditioned above) the share of the scenes and, over those where both stand, the
+relative difference of max |theta| (median, max), the count above 10 rtol and the
+difference over c. Scenes run in ``--jobs`` processes; ``--seconds`` bounds
+the run (the scenes done by then are reported); ``--save`` writes the rows, and
+``--summarize`` prints the table of several saved runs (other seeds) together.
 
     python benchmarks/bench_solver_agreement.py [--scenes 2000] [--rtol 1e-10] [--jobs 2]
+    python benchmarks/bench_solver_agreement.py --summarize a.npy b.npy
 """
 
 from __future__ import annotations
@@ -107,13 +110,23 @@ def run_scene(path, R, alpha, ratio, sign, rtol):
 
 #: Classes of the conditioning c (relative change of max |theta| under 1e-9 more amplitude):
 #: well conditioned, where rounding amplified by c / 1e-9 stays below 10 rtol at rtol 1e-10;
-#: sensitive; ill-conditioned (:data:`rockstudy.dynamics.conditioning.ILL_CONDITIONED`).
-CLASSES = (("c <= 1e-5", 0.0, 1e-5), ("1e-5 < c <= 1e-3", 1e-5, 1e-3), ("c > 1e-3", 1e-3, np.inf))
+#: sensitive; ill-conditioned (:mod:`rockstudy.dynamics.conditioning`).
+def classes():
+    """(name, low, high] of each class of the conditioning c."""
+    from rockstudy.dynamics.conditioning import ILL_CONDITIONED as ILL
+    from rockstudy.dynamics.conditioning import WELL_CONDITIONED as WELL
+
+    return (
+        (f"c <= {WELL:g}", 0.0, WELL),
+        (f"{WELL:g} < c <= {ILL:g}", WELL, ILL),
+        (f"c > {ILL:g}", ILL, np.inf),
+    )
 
 
 def summary(rows, rtol):
     """Print the counts, medians and shares of the agreement table, per conditioning class."""
-    k, k_over, r, r_over, cond, secs = (np.array(c) for c in zip(*rows, strict=True))
+    k, k_over, r, r_over, cond, secs = np.asarray(rows, dtype=float).T
+    k_over, r_over = k_over > 0, r_over > 0
     n = len(k)
     stand = ~k_over & ~r_over & (r > 0)
     rel = np.abs(k - r) / np.where(r > 0, r, 1.0)
@@ -123,7 +136,7 @@ def summary(rows, rtol):
         f"overturned in both: {int(np.sum(k_over & r_over))}; "
         f"overturning decisions that differ: {int(np.sum(k_over != r_over))}"
     )
-    for name, lo, hi in CLASSES:
+    for name, lo, hi in classes():
         inside = (cond > lo) & (cond <= hi) if lo > 0 else cond <= hi
         m = inside & stand
         line = f"{name}: {int(inside.sum())} scenes ({np.mean(inside):.1%})"
@@ -148,7 +161,11 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seconds", type=float, default=math.inf)
     ap.add_argument("--save", help="write the rows (.npy) here")
+    ap.add_argument("--summarize", nargs="+", help="only summarize rows saved by --save runs")
     args = ap.parse_args(argv)
+    if args.summarize:
+        summary(np.concatenate([np.load(f) for f in args.summarize]), args.rtol)
+        return 0
     paths = record_paths()
     print(f"records: {len(paths)} ({', '.join(p.stem for p in paths)})")
     table = scenes(args.scenes, args.seed, len(paths))

@@ -27,6 +27,11 @@ CONDITIONING_STEP = 1e-9
 #: ill-conditioned: its peak is not determined to better than this by the amplitude's ninth
 #: digit.
 ILL_CONDITIONED = 1e-3
+#: Relative change up to which a scene is well conditioned: the rounding of each step, amplified
+#: by change / CONDITIONING_STEP, stays below 10 rtol at rtol 1e-10, and the kernel and the
+#: scipy reference agree that closely (between the two, they differ by about 1e-5 times the
+#: change; benchmarks/bench_solver_agreement.py, docs/methods.rst).
+WELL_CONDITIONED = 1e-5
 
 
 def peak_change(max_rotation, overturned, max_perturbed, overturned_perturbed):

@@ -170,12 +170,14 @@ def _ground(motion):
     return _scalar_acceleration(motion), _scalar_vertical(motion) or (lambda t: 0.0)
 
 
-def _log_peaks(sol, s, max_u, peaks):
-    """Append the peaks of a phase's ``solve_ivp`` solution on side s to ``peaks``; returns
-    max_u [rad] raised to the largest of them."""
-    if sol.y_events[2].size:
-        max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
-        peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
+def _log_peaks(sol, s, max_u, peaks, before):
+    """Append the peaks of a phase's ``solve_ivp`` solution on side s before ``before`` [s]
+    (its impact, if any) to ``peaks``; returns max_u [rad] raised to the largest of them."""
+    inside = sol.t_events[2] < before
+    if np.any(inside):
+        u = sol.y_events[2][inside, 0]
+        max_u = max(max_u, float(np.max(s * u)))
+        peaks.extend(zip(sol.t_events[2][inside], u, strict=True))
     return max_u
 
 
@@ -196,9 +198,9 @@ def _stop_time(t, dur, breaks, t_end, p):
     return min(t_end, t + 100.0 / p)
 
 
-def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, dense_output, at_trough=False):
-    """One phase on side s by ``solve_ivp`` over ``span``, with the events of :func:`_events`;
-    a failed solve raises RuntimeError."""
+def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, at_trough=False):
+    """One phase on side s by ``solve_ivp`` over ``span``, with dense output and the events of
+    :func:`_events`; a failed solve raises RuntimeError."""
     sol = solve_ivp(
         rhs,
         span,
@@ -208,7 +210,7 @@ def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, dense_output, at_t
         rtol=rtol,
         atol=atol,
         events=_events(s, fall_at, span[0], at_trough),
-        dense_output=dense_output,
+        dense_output=True,
     )
     if sol.status < 0:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
@@ -227,32 +229,35 @@ def _side_after_impact(om_post, s, t, acc, vert, dur, body):
     return bool(at_rest), float(side), float(om)
 
 
-def _impact_of(sol, s, rhs, integrator, rtol, atol):
-    """The impact that ended a phase's solution ``sol`` on side s, as (time [s], theta_dot
-    just before it [rad/s]), or None: scipy's impact event, or a dip of s theta below zero
-    inside the step that ended at a trough (:func:`_events`). The dip's step is integrated
-    again from its start with dense output, and its impact is the root of s theta on that
-    interpolant (Brent's method)."""
+#: Points of each ``solve_ivp`` step at which the reference looks for s theta < 0 on the dense
+#: output: a short hop (down through zero and up again, with a peak before it) inside one step
+#: changes the sign of neither theta nor theta_dot between the step's ends, where scipy's
+#: events look.
+HOP_POINTS = 8
+
+
+def _impact_of(sol, s, t0):
+    """The first impact of a phase from t0 [s] on side s whose solution is ``sol`` (with dense
+    output), as (time [s], theta_dot just before it [rad/s]), or None: the first point of
+    :data:`HOP_POINTS` a step (and the steps' ends) where s theta < 0, located by Brent's
+    method on the interpolant, else scipy's impact event. That covers a dip through zero
+    inside one step, found at its trough (:func:`_events`) or at those points."""
+    impact = _events(s, 0.0, t0, False)[0]
+    t_stop = float(sol.t_events[0][0]) if sol.t_events[0].size else math.inf
+    frac = np.arange(1, HOP_POINTS + 1) / HOP_POINTS
+    a, b = sol.t[:-1], sol.t[1:]
+    pts = (a[:, None] + (b - a)[:, None] * frac).ravel()
+    pts = pts[pts < t_stop]
+    if pts.size:
+        below = np.flatnonzero(s * sol.sol(pts)[0] < 0.0)
+        if below.size:
+            k = int(below[0])
+            lo = float(pts[k - 1]) if k > 0 else t0
+            t_imp = brentq(lambda t_: impact(t_, sol.sol(t_)), lo, float(pts[k]), xtol=1e-15)
+            return t_imp, float(sol.sol(t_imp)[1])
     if sol.t_events[0].size:
-        return float(sol.t_events[0][0]), float(sol.y_events[0][0, 1])
-    if not sol.t_events[3].size or not s * sol.y[0, -1] < 0.0:
-        return None
-    t_a, t_b = float(sol.t[-2]), float(sol.t[-1])
-    again = solve_ivp(
-        rhs,
-        (t_a, t_b),
-        sol.y[:, -2],
-        method=integrator,
-        args=(s,),
-        rtol=rtol,
-        atol=atol,
-        dense_output=True,
-    )
-    u = lambda t_: s * float(again.sol(t_)[0])  # noqa: E731
-    if not u(t_b) < 0.0 < u(t_a):
-        return None  # a trough at zero within the integration's rounding: no impact
-    t_imp = brentq(u, t_a, t_b, xtol=1e-15)
-    return t_imp, float(again.sol(t_imp)[1])
+        return t_stop, float(sol.y_events[0][0, 1])
+    return None
 
 
 def _warn_incomplete(max_impacts, t):
@@ -351,6 +356,13 @@ def simulate_reference(
             s = -1.0 if acc(t) > 0 else 1.0
             at_rest = False
             ts.append(t), ths.append(0.0), oms.append(0.0)
+            if not lift(np.nextafter(t, math.inf)) > 0.0:
+                # lifted for less than an ulp of t: it falls straight back, its impact one ulp
+                # on and a rest there (the kernels' rule, ._events._impact)
+                t = float(np.nextafter(t, math.inf))
+                impacts.append(t), ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([0.0, 0.0])
+                at_rest = True
+                continue
         if t >= dur and free_map and not mapped:
             mapped = True
             over, peak, n_post = _free_map(s * th, s * om, s, p, alpha, eta, model, tab)
@@ -360,15 +372,15 @@ def simulate_reference(
         stop = _stop_time(t, dur, breaks, t_end, p)
         if t >= stop:
             break
-        sol = _solve(
-            rhs, (t, stop), [th, om], s, integrator, rtol, atol, fall_at, dense.wanted, at_trough
-        )
+        sol = _solve(rhs, (t, stop), [th, om], s, integrator, rtol, atol, fall_at, at_trough)
         at_trough = False
-        end = -1 if sol.status == 1 else None  # the event row is added below, exactly
-        ts.extend(sol.t[1:end]), ths.extend(sol.y[0, 1:end]), oms.extend(sol.y[1, 1:end])
-        max_u = _log_peaks(sol, s, max_u, peaks)
-        hit = _impact_of(sol, s, rhs, integrator, rtol, atol)
-        dense.fill(sol.sol, t, float(sol.t[-1]) if hit is None else hit[0])
+        hit = _impact_of(sol, s, t)
+        t_cut = math.inf if hit is None else hit[0]
+        rows = slice(1, -1 if sol.status == 1 else None)  # an event's row is added below
+        rows = np.flatnonzero(sol.t[rows] < t_cut) + 1
+        ts.extend(sol.t[rows]), ths.extend(sol.y[0, rows]), oms.extend(sol.y[1, rows])
+        max_u = _log_peaks(sol, s, max_u, peaks, t_cut)
+        dense.fill(sol.sol, t, min(float(sol.t[-1]), t_cut))
         if sol.t_events[1].size:
             t_ot = float(sol.t_events[1][0])
             ts.append(t_ot), ths.append(s * fall_at), oms.append(sol.y_events[1][0, 1])
