@@ -299,7 +299,8 @@ def studies(draw):
         defects.append("friction above 10")
     motion = f'[motion]\nkind = "record"\nfiles = "records"\nunits = "{declared}"\n'
     if design == "stripes":
-        motion += 'scale_to = { im = "pga", units = "g", value = { dist = "grid", values = [0.2, 0.5] } }\n'
+        levels = '{ dist = "grid", values = [0.2, 0.5] }'
+        motion += f'scale_to = {{ im = "pga", units = "g", value = {levels} }}\n'
     design_toml = f'[design]\nkind = "{design}"\n'
     if design == "ida":
         design_toml += "step = 0.1\nscan = 0\ntolerance = 0.05\nmax_pga_ratio = 8\n"

@@ -17,7 +17,7 @@ from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
-from . import _auto, _linear, _linear_record, _rocking
+from . import _auto, _linear, _linear_record, _rocking, conditioning
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 
@@ -34,6 +34,9 @@ OUTPUTS = _rocking.BATCH_COLUMNS + ("model",)
 #: Outputs returned only when ``outputs`` names them (each lifting row is run again with a
 #: history: see :mod:`._batch_contact`).
 CONTACT_OUTPUTS = ("friction_demand", "lift_off")
+#: Returned only when ``outputs`` names it: every row is run again with its amplitude times
+#: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
+CONDITIONING_OUTPUTS = ("conditioning",)
 # (trig-only, one thread) -> batch kernel: on one thread (a study's workers) the serial
 # variants, which compile without the parallel loop's cost
 _BATCH_KERNELS = {
@@ -257,7 +260,12 @@ def simulate_batch(
         :attr:`rockstudy.RockingResult.friction_demand`), for which every row that lifts is
         run again on its own with a history (the single-scene path, same model and rtol;
         1-40 ms a row), while a row that never lifts has ``max |u_h''| / (g + u_v'')``,
-        exactly, without a run.
+        exactly, without a run. Also never by default: ``conditioning``, the relative change
+        of ``max_rotation`` when the amplitude (a pulse's, a record's ``scale``) grows by
+        1e-9 (:func:`rockstudy.dynamics.conditioning.peak_change`: inf where the overturning
+        decision changes, NaN where a run reached the step limit), for which every row is run
+        again (twice the cost); above 1e-3 the scene is ill-conditioned, and no solver's
+        ``max_rotation`` is determined better than that (docs/methods.rst).
     max_steps : int
         Cap on the integrator steps in one rocking phase of a row, a whole number in
         [1, 1e12]; default :data:`rockstudy.dynamics.methods.MAX_STEPS`, as
@@ -317,14 +325,21 @@ def simulate_batch(
     p = np.ascontiguousarray(p, dtype=float)
     eta = np.ascontiguousarray(eta, dtype=float)
     rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
-    if model is not None:
-        out = _run(rows, np.arange(n), model, rtol, max_steps)
-        codes = np.full(n, _CODES[model], np.int8)
-    else:
-        linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
-        motion = pulse if record is None else None
-        out, codes = _auto_rows(rows, motion, cycles, rtol, max_steps, linear_ok)
+    linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
+
+    def solve(rows):
+        if model is not None:
+            return _run(rows, np.arange(n), model, rtol, max_steps), np.full(
+                n, _CODES[model], np.int8
+            )
+        return _auto_rows(
+            rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
+        )
+
+    out, codes = solve(rows)
     result = _outputs(out, codes, wanted)
+    if "conditioning" in wanted:
+        result["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
     if set(CONTACT_OUTPUTS) & set(wanted):
         _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps)
     if not as_dataset:
@@ -361,6 +376,26 @@ def _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps):
             result[name] = values
 
 
+def _perturbed_rows(rows):
+    """``rows`` with every amplitude (a pulse's, a record's scale: column 0 of the kernel
+    rows) times 1 + :data:`.conditioning.CONDITIONING_STEP`."""
+    mp = rows[4].copy()
+    mp[:, 0] *= 1.0 + conditioning.CONDITIONING_STEP
+    return rows[:4] + (mp,) + rows[5:]
+
+
+def _conditioning(out, out_perturbed):
+    """The ``conditioning`` output (:func:`.conditioning.peak_change`) of the kernel outputs
+    of the rows and of their perturbed copies; NaN where either run reached the step limit."""
+    cols = _rocking.BATCH_COLUMNS
+    i_max, i_over, i_status = (cols.index(c) for c in ("max_rotation", "overturned", "status"))
+    change = conditioning.peak_change(
+        out[:, i_max], out[:, i_over] > 0, out_perturbed[:, i_max], out_perturbed[:, i_over] > 0
+    )
+    ok = (out[:, i_status] == 0) & (out_perturbed[:, i_status] == 0)
+    return np.where(ok, change, np.nan)
+
+
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
 _BATCH_UNITS = {
     "half_diagonal": ("half-diagonal R", "m"),
@@ -382,6 +417,7 @@ _BATCH_UNITS = {
     "model": ("0 rest, 1 linear, 2 nonlinear", "1"),
     "friction_demand": ("max |F_h / F_v| at the contact", "1"),
     "lift_off": ("vertical contact force not compressive somewhere", "1"),
+    "conditioning": ("relative change of max |theta| under 1e-9 in the amplitude", "1"),
 }
 
 
@@ -409,7 +445,7 @@ def _requested_outputs(outputs):
     if outputs is None:
         return OUTPUTS
     names = [outputs] if isinstance(outputs, str) else list(outputs)
-    allowed = OUTPUTS + CONTACT_OUTPUTS
+    allowed = OUTPUTS + CONTACT_OUTPUTS + CONDITIONING_OUTPUTS
     unknown = sorted(set(names) - set(allowed))
     if unknown:
         raise ValueError(f"outputs: unknown name(s) {unknown}; allowed: {list(allowed)}")

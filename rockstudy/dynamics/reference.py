@@ -18,9 +18,11 @@ from scipy.optimize import brentq
 from .._warnings import IncompleteReferenceWarning
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
+from ._events import _zeno
 from ._rocking import (
     MODEL_LINEAR,
     MODEL_TABLE,
+    NO_TABLE,
     REST_FRACTION,
     _accel,
     _free_map_table,
@@ -55,31 +57,51 @@ def _scalar_acceleration(motion: Motion):
     return ricker
 
 
-def _uplift_time(excess, t0, dur, grid):
-    """First t >= t0 with excess(t) >= 0, by a scan on ``grid`` and Brent's method."""
-    if excess(t0) >= 0.0:
+#: Most ulps walked from Brent's root of the lift test to the first double at which it holds.
+LIFT_ULP_WALK = 64
+
+
+def _first_lift(lift, lo, hi):
+    """The first double in (lo, hi] at which ``lift`` > 0, where it is not > 0 at lo and is
+    at hi: Brent's root, then walked ulp by ulp to where the test switches, the time
+    :func:`._uplift.next_uplift` bisects to."""
+    t = brentq(lift, lo, hi, xtol=1e-15)
+    for _ in range(LIFT_ULP_WALK):
+        if lift(t) > 0.0:
+            break
+        t = np.nextafter(t, hi)
+    for _ in range(LIFT_ULP_WALK):
+        before = np.nextafter(t, lo)
+        if before <= lo or not lift(before) > 0.0:
+            break
+        t = before
+    return t if lift(t) > 0.0 else hi
+
+
+def _uplift_time(lift, t0, dur, grid):
+    """First t >= t0 at which a block at rest lifts (``lift`` > 0, the kernels' rule
+    :func:`._rhs._lift`), by a scan on ``grid`` and :func:`_first_lift`; inf if never."""
+    if lift(t0) > 0.0:
         return t0
     pts = np.concatenate([[t0], grid[grid > t0], [dur]])
     for lo, hi in zip(pts[:-1], pts[1:], strict=True):
-        if excess(hi) >= 0.0:
-            if hi <= lo:
-                return hi
-            return brentq(excess, lo, hi, xtol=1e-15)
+        if lift(hi) > 0.0:
+            return hi if hi <= lo else _first_lift(lift, lo, hi)
     return math.inf
 
 
-def _equations(p, alpha, model, tab, acc, vert):
-    """The uplift test excess(t) (>= 0 where a block at rest lifts: |u_h''| >= (g + u_v'')
-    tan alpha, or eq. 10 of [003] for a mechanism by the kernels' own test) and the
-    right-hand side rhs(t, y, s) of the model on side s, under the ground acceleration
-    functions acc and vert [m/s^2]."""
+def _equations(p, alpha, model, tab, acc, vert, dur):
+    """The lift test lift(t) of a block at rest under the ground just after t (> 0 where it
+    lifts: :func:`._rhs._lift`, the rule of every solver, with the still ground from the end
+    of the motion on, as :func:`._rhs._ground_after`) and the right-hand side rhs(t, y, s) of
+    the model on side s, under the ground acceleration functions acc and vert [m/s^2]."""
     linear = model == MODEL_LINEAR
-    thr = G * alpha if linear else G * math.tan(alpha)
+    table = NO_TABLE if tab is None else tab
 
-    def excess(t):
-        if tab is not None:
-            return _lift(acc(t), vert(t), p, alpha, MODEL_TABLE, tab)
-        return abs(acc(t)) - thr * (1.0 + vert(t) / G)
+    def lift(t):
+        if t >= dur:
+            return _lift(0.0, 0.0, p, alpha, model, table)
+        return _lift(acc(t), vert(t), p, alpha, model, table)
 
     def rhs(t, y, s):
         if tab is not None:
@@ -91,16 +113,27 @@ def _equations(p, alpha, model, tab, acc, vert):
         x = alpha * s - y[0]
         return [y[1], -p * p * (gv * math.sin(x) + a * math.cos(x))]
 
-    return excess, rhs
+    return lift, rhs
 
 
-def _events(s, fall_at):
-    """The ``solve_ivp`` events of a phase on side s: the impact (terminal), the fall at
-    rotation ``fall_at`` (terminal) and the peaks of s theta (each also receives s, the
-    ``args`` of the solve)."""
+def _events(s, fall_at, t0, at_trough):
+    """The ``solve_ivp`` events of a phase on side s from t0 [s]: the impact (terminal), the
+    fall at rotation ``fall_at`` (terminal), the peaks of s theta and its troughs (terminal;
+    each also receives s, the ``args`` of the solve).
+
+    scipy looks for an event only where its function changes sign between two step ends, and
+    locates it by Brent's method on the step's interpolant. Two consequences are ruled out
+    here. A phase that starts at theta = 0 (after an impact or a lift-off) would have its
+    impact found at the start itself if the block falls back within the first step: the
+    impact function is taken positive at t0 (s theta >= 0 there, and > 0 just after).
+    A dip of s theta through zero and back inside one step changes no sign at the step ends
+    and would be missed: every trough (s theta_dot from < 0 to > 0) ends the phase, where
+    :func:`_dip_impact` checks it (one sign change of theta_dot, which scipy does see). A
+    phase that starts at a trough (``at_trough``) takes its trough function positive at t0,
+    so that the trough it starts at is not found again."""
 
     def impact(t_, y, s=s):
-        return s * y[0]
+        return s * y[0] if t_ > t0 else 1.0
 
     def fall(t_, y, s=s):
         return s * y[0] - fall_at
@@ -108,10 +141,14 @@ def _events(s, fall_at):
     def peak(t_, y, s=s):
         return s * y[1]
 
+    def trough(t_, y, s=s):
+        return 1.0 if at_trough and t_ <= t0 else s * y[1]
+
     impact.terminal, impact.direction = True, -1
     fall.terminal, fall.direction = True, 1
     peak.direction = -1
-    return impact, fall, peak
+    trough.terminal, trough.direction = True, 1
+    return impact, fall, peak, trough
 
 
 def _free_map(u, v, s, p, alpha, eta, model, tab):
@@ -133,12 +170,14 @@ def _ground(motion):
     return _scalar_acceleration(motion), _scalar_vertical(motion) or (lambda t: 0.0)
 
 
-def _log_peaks(sol, s, max_u, peaks):
-    """Append the peaks of a phase's ``solve_ivp`` solution on side s to ``peaks``; returns
-    max_u [rad] raised to the largest of them."""
-    if sol.y_events[2].size:
-        max_u = max(max_u, float(np.max(s * sol.y_events[2][:, 0])))
-        peaks.extend(zip(sol.t_events[2], sol.y_events[2][:, 0], strict=True))
+def _log_peaks(sol, s, max_u, peaks, before):
+    """Append the peaks of a phase's ``solve_ivp`` solution on side s before ``before`` [s]
+    (its impact, if any) to ``peaks``; returns max_u [rad] raised to the largest of them."""
+    inside = sol.t_events[2] < before
+    if np.any(inside):
+        u = sol.y_events[2][inside, 0]
+        max_u = max(max_u, float(np.max(s * u)))
+        peaks.extend(zip(sol.t_events[2][inside], u, strict=True))
     return max_u
 
 
@@ -159,9 +198,9 @@ def _stop_time(t, dur, breaks, t_end, p):
     return min(t_end, t + 100.0 / p)
 
 
-def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, dense_output):
-    """One phase on side s by ``solve_ivp`` over ``span``, with the events of :func:`_events`;
-    a failed solve raises RuntimeError."""
+def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, at_trough=False):
+    """One phase on side s by ``solve_ivp`` over ``span``, with dense output and the events of
+    :func:`_events`; a failed solve raises RuntimeError."""
     sol = solve_ivp(
         rhs,
         span,
@@ -170,24 +209,55 @@ def _solve(rhs, span, y0, s, integrator, rtol, atol, fall_at, dense_output):
         args=(s,),
         rtol=rtol,
         atol=atol,
-        events=_events(s, fall_at),
-        dense_output=dense_output,
+        events=_events(s, fall_at, span[0], at_trough),
+        dense_output=True,
     )
     if sol.status < 0:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     return sol
 
 
-def _side_after_impact(om_post, s, t, acc, excess, omega_rest):
-    """The side after an impact at t [s] on side s that left the speed om_post: the other
-    side, or below ``omega_rest`` rest unless the ground lifts the block again (the Zeno
-    rule), which then restarts on the side it is pushed to. Returns (at rest, side, speed)."""
-    if not abs(om_post) < omega_rest:
-        return False, -s, om_post
-    a = acc(t)
-    if excess(t) < 0.0:
-        return True, s, 0.0
-    return False, (-1.0 if a > 0 else 1.0), 0.0
+def _side_after_impact(om_post, s, t, acc, vert, dur, body):
+    """The side after an impact at t [s] on side s that left the speed om_post, by the
+    kernels' rule (:func:`._events._zeno`: the other side, or below the rest speed at rest
+    unless the ground just after t lifts the block, which then restarts on the side it is
+    pushed to). ``body`` = (p, alpha, model, table, rest speed). Returns (at rest, side,
+    speed)."""
+    p, alpha, model, tab, omega_rest = body
+    a_g, a_v = (0.0, 0.0) if t >= dur else (acc(t), vert(t))
+    at_rest, side, om = _zeno(om_post, s, omega_rest, a_g, a_v, p, alpha, model, tab)
+    return bool(at_rest), float(side), float(om)
+
+
+#: Points of each ``solve_ivp`` step at which the reference looks for s theta < 0 on the dense
+#: output: a short hop (down through zero and up again, with a peak before it) inside one step
+#: changes the sign of neither theta nor theta_dot between the step's ends, where scipy's
+#: events look.
+HOP_POINTS = 8
+
+
+def _impact_of(sol, s, t0):
+    """The first impact of a phase from t0 [s] on side s whose solution is ``sol`` (with dense
+    output), as (time [s], theta_dot just before it [rad/s]), or None: the first point of
+    :data:`HOP_POINTS` a step (and the steps' ends) where s theta < 0, located by Brent's
+    method on the interpolant, else scipy's impact event. That covers a dip through zero
+    inside one step, found at its trough (:func:`_events`) or at those points."""
+    impact = _events(s, 0.0, t0, False)[0]
+    t_stop = float(sol.t_events[0][0]) if sol.t_events[0].size else math.inf
+    frac = np.arange(1, HOP_POINTS + 1) / HOP_POINTS
+    a, b = sol.t[:-1], sol.t[1:]
+    pts = (a[:, None] + (b - a)[:, None] * frac).ravel()
+    pts = pts[pts < t_stop]
+    if pts.size:
+        below = np.flatnonzero(s * sol.sol(pts)[0] < 0.0)
+        if below.size:
+            k = int(below[0])
+            lo = float(pts[k - 1]) if k > 0 else t0
+            t_imp = brentq(lambda t_: impact(t_, sol.sol(t_)), lo, float(pts[k]), xtol=1e-15)
+            return t_imp, float(sol.sol(t_imp)[1])
+    if sol.t_events[0].size:
+        return t_stop, float(sol.y_events[0][0, 1])
+    return None
 
 
 def _warn_incomplete(max_impacts, t):
@@ -268,23 +338,31 @@ def simulate_reference(
     atol = [rtol * alpha, rtol * p * alpha]
     grid, breaks = _grids(motion)
 
-    excess, rhs = _equations(p, alpha, model, tab, acc, vert)
+    lift, rhs = _equations(p, alpha, model, tab, acc, vert, dur)
+    body = (p, alpha, model, NO_TABLE if tab is None else tab, omega_rest)
     th, om = (float(x) for x in initial_state)
     ts, ths, oms, impacts, peaks = [0.0], [th], [om], [], []
     max_u = abs(th)
     t = 0.0
     at_rest = th == 0.0 and om == 0.0
-    mapped = False
+    mapped = at_trough = False
     s = math.copysign(1.0, th if th != 0.0 else om)
     while True:
         if at_rest:
-            t_up = _uplift_time(excess, t, dur, grid)
+            t_up = _uplift_time(lift, t, dur, grid)
             if t_up >= dur:
                 break
             t, th, om = t_up, 0.0, 0.0
             s = -1.0 if acc(t) > 0 else 1.0
             at_rest = False
             ts.append(t), ths.append(0.0), oms.append(0.0)
+            if not lift(np.nextafter(t, math.inf)) > 0.0:
+                # lifted for less than an ulp of t: it falls straight back, its impact one ulp
+                # on and a rest there (the kernels' rule, ._events._impact)
+                t = float(np.nextafter(t, math.inf))
+                impacts.append(t), ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([0.0, 0.0])
+                at_rest = True
+                continue
         if t >= dur and free_map and not mapped:
             mapped = True
             over, peak, n_post = _free_map(s * th, s * om, s, p, alpha, eta, model, tab)
@@ -294,30 +372,34 @@ def simulate_reference(
         stop = _stop_time(t, dur, breaks, t_end, p)
         if t >= stop:
             break
-        sol = _solve(rhs, (t, stop), [th, om], s, integrator, rtol, atol, fall_at, dense.wanted)
-        end = -1 if sol.status == 1 else None  # the event row is added below, exactly
-        ts.extend(sol.t[1:end]), ths.extend(sol.y[0, 1:end]), oms.extend(sol.y[1, 1:end])
-        dense.fill(sol.sol, t, float(sol.t[-1]))  # (a terminal event's time, if one came)
-        max_u = _log_peaks(sol, s, max_u, peaks)
+        sol = _solve(rhs, (t, stop), [th, om], s, integrator, rtol, atol, fall_at, at_trough)
+        at_trough = False
+        hit = _impact_of(sol, s, t)
+        t_cut = math.inf if hit is None else hit[0]
+        rows = slice(1, -1 if sol.status == 1 else None)  # an event's row is added below
+        rows = np.flatnonzero(sol.t[rows] < t_cut) + 1
+        ts.extend(sol.t[rows]), ths.extend(sol.y[0, rows]), oms.extend(sol.y[1, rows])
+        max_u = _log_peaks(sol, s, max_u, peaks, t_cut)
+        dense.fill(sol.sol, t, min(float(sol.t[-1]), t_cut))
         if sol.t_events[1].size:
             t_ot = float(sol.t_events[1][0])
             ts.append(t_ot), ths.append(s * fall_at), oms.append(sol.y_events[1][0, 1])
             return _pack(ts, ths, oms, fall_at, True, impacts, t_ot, peaks, dense)
-        if sol.t_events[0].size:
-            t = float(sol.t_events[0][0])
-            om_pre = float(sol.y_events[0][0, 1])
+        if hit is not None:
+            t, om_pre = hit
             om_post = eta * om_pre
             impacts.append(t)
             ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([om_pre, om_post])
             th = 0.0
-            at_rest, s, om = _side_after_impact(om_post, s, t, acc, excess, omega_rest)
-            if at_rest:
-                continue
-            if len(impacts) >= max_impacts:
+            at_rest, s, om = _side_after_impact(om_post, s, t, acc, vert, dur, body)
+            if not at_rest and len(impacts) >= max_impacts:
                 _warn_incomplete(max_impacts, t)
                 break
             continue
         t, th, om = float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1])
+        if sol.t_events[3].size:  # a trough above zero: on from it
+            at_trough = True
+            ts.append(t), ths.append(th), oms.append(om)
         max_u = max(max_u, s * th)
         if t >= t_end:
             break

@@ -88,6 +88,14 @@ class RockingResult:
         does not describe, so the result is outside the model. ``None`` where not computed.
         Both are computed from the history on first use (measured: 20-40 ms for a 20 s
         record with 8,600 history points, whose nonlinear run took 5 ms; 1 ms for a pulse).
+    conditioning : float or None
+        With ``simulate(..., conditioning=True)``: the relative change of ``max_rotation``
+        when the amplitude grows by 1e-9, the same method run again
+        (:func:`rockstudy.dynamics.conditioning.peak_change`; inf where the overturning
+        decision changes). Above 1e-3
+        (:data:`~rockstudy.dynamics.conditioning.ILL_CONDITIONED`) the scene is
+        ill-conditioned: its peak is not determined to better than that, by any solver.
+        ``None`` when not asked for.
     """
 
     t: np.ndarray
@@ -104,6 +112,7 @@ class RockingResult:
     t_eval: np.ndarray | None = None
     theta_eval: np.ndarray | None = None
     theta_dot_eval: np.ndarray | None = None
+    conditioning: float | None = None
     _contact: Callable[[], Any] | None = field(default=None, repr=False, compare=False)
     #: the motion and the structure that produced the result (for ``plot``), or None
     _motion: Any = field(default=None, repr=False, compare=False)

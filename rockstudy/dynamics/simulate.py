@@ -19,6 +19,7 @@ from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
 from . import _auto, _linear, _linear_record, _rocking, contact
 from ._vertical import refuse_free_fall, uplift_ratio
+from .conditioning import peak_change, perturbed
 from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
 from .result import RockingResult, describe
@@ -363,6 +364,7 @@ def simulate(
     t_eval=None,
     dt_out: float | None = None,
     friction: float | None = None,
+    conditioning: bool = False,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -450,6 +452,11 @@ def simulate(
         it (the block would slide) or the block lifts off. Only for a
         :class:`~rockstudy.Block` and the methods that compute the demand (all but
         ``"complex"``).
+    conditioning : bool
+        Also run the scene with the amplitude (a pulse's, a record's samples) times 1 + 1e-9,
+        by the same method, and give the relative change of ``max_rotation`` as
+        ``result.conditioning`` (:mod:`rockstudy.dynamics.conditioning`): above 1e-3 the
+        scene is ill-conditioned. Off by default: it doubles the cost.
 
     Returns
     -------
@@ -506,6 +513,10 @@ def simulate(
             warnings.simplefilter("ignore")
             t_eval = _validate.uniform_times(float(dt_out), float(run(*run_args).t[-1]))
     r = run(*run_args, t_eval=t_eval)
+    if conditioning:
+        other = run(*_with_motion(run_args, run is _simulate_structure, perturbed(motion)))
+        change = peak_change(r.max_rotation, r.overturned, other.max_rotation, other.overturned)
+        object.__setattr__(r, "conditioning", float(change))
     object.__setattr__(r, "_motion", motion)  # a fresh result: for plot(), at no cost
     object.__setattr__(r, "_structure", structure)
     r.info.update(
@@ -515,6 +526,13 @@ def simulate(
         initial_velocity=om0,
     )
     return contact.with_contact(r, motion, method, friction) if block else r
+
+
+def _with_motion(run_args, structure_first, motion):
+    """The arguments of a run (:func:`_simulate_structure`'s if ``structure_first``, else
+    :func:`_simulate_block`'s) with another motion."""
+    i = 1 if structure_first else 3
+    return (*run_args[:i], motion, *run_args[i + 1 :])
 
 
 def _simulate_block(p, alpha, eta, motion, method, rtol, t_max, max_steps, x0, l, t_eval=None):
