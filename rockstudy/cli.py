@@ -8,6 +8,7 @@ import logging
 import math
 import shlex
 import sys
+import warnings
 from pathlib import Path
 
 from . import __version__
@@ -16,7 +17,7 @@ __all__ = ["main"]
 
 
 def _simulate(args) -> int:
-    from . import Block, StepLimitError, simulate
+    from . import Block, ContactWarning, StepLimitError, simulate
 
     if (args.half_diagonal is None) != (args.slenderness is None) or (args.width is None) != (
         args.height is None
@@ -44,19 +45,27 @@ def _simulate(args) -> int:
     if motion is None:
         return _usage(described)
     try:
-        res = simulate(
-            block,
-            motion,
-            method=args.method,
-            rtol=args.rtol,
-            initial_rotation=args.initial_rotation,
-            initial_velocity=args.initial_velocity,
-            dt_out=args.dt_out,
-            **({} if args.max_steps is None else {"max_steps": args.max_steps}),
-        )
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always", ContactWarning)
+            res = simulate(
+                block,
+                motion,
+                method=args.method,
+                rtol=args.rtol,
+                initial_rotation=args.initial_rotation,
+                initial_velocity=args.initial_velocity,
+                dt_out=args.dt_out,
+                friction=args.friction,
+                **({} if args.max_steps is None else {"max_steps": args.max_steps}),
+            )
     except StepLimitError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    for w in said:  # the contact check in one line each; other warnings as Python says them
+        if issubclass(w.category, ContactWarning):
+            print(f"warning: {w.message}", file=sys.stderr)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     if args.out:
         _write_history(res, Path(args.out))
     summary = res.summary()
@@ -117,6 +126,7 @@ def _inputs(args, block, described) -> dict:
         **described,
         "method": args.method,
         "rtol": args.rtol,
+        **({} if args.friction is None else {"friction": args.friction}),
         "initial_rotation": args.initial_rotation,
         "initial_velocity": args.initial_velocity,
         "dt_out": args.dt_out,
@@ -555,6 +565,12 @@ def _add_simulate(sub) -> None:
         help="the model and solver",
     )
     sim.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance")
+    sim.add_argument(
+        "--friction",
+        type=float,
+        help="friction coefficient mu of the base, in (0, 10]: the friction demand and "
+        "lift-off are reported, with a warning where the block would slide or lift off",
+    )
     sim.add_argument(
         "--max-steps",
         type=_positive_int,

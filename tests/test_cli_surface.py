@@ -185,3 +185,26 @@ def test_compile_groups_are_the_warm_up_groups_and_a_group_compiles_alone(tmp_pa
     assert not any("dynamics" in p for p in saved), saved
     bad = cli("compile", "--group", "nope")
     assert bad.returncode == 2 and "invalid choice: 'nope'" in bad.stderr
+
+
+def test_simulate_with_a_friction_coefficient_reports_the_demand_and_warns_in_one_line(capsys):
+    """Below uplift the block moves with the ground: its friction demand is max |a_g| / g
+    (eq. of the contact forces of a block at rest); above mu the command says so on one
+    line, below it says nothing."""
+    from rockstudy.cli import main
+    from rockstudy.constants import G
+
+    argv = ["simulate", "--width", "0.4", "--height", "1.6", "--amplitude", "1.0"]
+    argv += ["--period", "0.5", "--json"]
+    assert main(argv + ["--friction", "0.05"]) == 0
+    out, err = capsys.readouterr()
+    result = json.loads(out)
+    assert result["inputs"]["friction"] == 0.05
+    assert result["result"]["friction_demand"] == pytest.approx(1.0 / G, rel=1e-12)
+    assert result["result"]["lift_off"] is False
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: ") and "above the friction" in lines[0]
+    assert main(argv + ["--friction", "0.5"]) == 0
+    assert capsys.readouterr().err == ""
+    assert main(argv + ["--friction", "20"]) == 2
+    assert capsys.readouterr().err.strip() == "error: friction must lie in (0, 10], got 20.0"
