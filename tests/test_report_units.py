@@ -347,3 +347,43 @@ def test_a_study_report_shows_accelerations_in_the_units_of_its_target(
 
     target = SimpleNamespace(im=im, unit_label=written)
     assert _acceleration_units(SimpleNamespace(motion=SimpleNamespace(scale_to=target))) == shown
+
+
+def test_the_deaggregation_is_a_density_in_ln_x_and_the_objects_are_ranked_by_p(
+    drawn, tmp_path, monkeypatch
+):
+    """Each deaggregation line, times the widths in ln x of the hazard's intervals, adds up to
+    the object's share of lambda_OT within the levels (from deaggregation.csv: uneven levels
+    do not shape it); the ranked chart lists the objects by P(years), highest first."""
+    from rockstudy import risk
+
+    recs = [
+        rs.motions.synthetic_near_fault(pulse_period=tp, pga=3.0, seed=k, duration=6.0)
+        for k, tp in enumerate((0.5, 0.8, 1.0, 1.2, 1.4, 1.6))
+    ]
+    ds = incremental_dynamic_analysis(recs, OBJECTS, step=0.05, scan=0, tolerance=0.01)
+    levels = np.array([0.01, 0.02, 0.1, 0.15, 0.3, 0.35, 0.8, 2.0])  # an uneven grid [g]
+    hazard = risk.HazardCurve("pga", levels, 1e-4 * levels**-2.5, units="g")
+    out = tmp_path / "r"
+    labels = {}
+    inner_figure = _page._Page.figure
+
+    def figure(self, fig, name, caption):
+        labels[name] = [t.get_text() for t in fig.axes[0].get_yticklabels()]
+        return inner_figure(self, fig, name, caption)
+
+    monkeypatch.setattr(_page._Page, "figure", figure)
+    record_report(ds, out, n_boot=0, hazard=hazard)
+    deagg = _csv(out, "deaggregation")
+    table = _csv(out, "annual_overturning")
+    inner = deagg.iloc[1:-1]  # the intervals between levels (the first and last are beyond)
+    width = np.log(levels[1:] / levels[:-1])
+    lines = {
+        label: y for _, y, _, _, label in drawn["deaggregation"][0] if not label.startswith("_")
+    }
+    for name, y in lines.items():
+        within = inner[name].sum() / table.loc[name, "lambda_OT [1/yr]"]
+        assert np.sum(y * width) == pytest.approx(within, rel=1e-9)
+    p = table["P(50 yr)"]
+    ranked = p[p > 0].sort_values(ascending=False, kind="stable").index.tolist()
+    assert len(ranked) >= 1 and labels["probability_ranked"] == ranked

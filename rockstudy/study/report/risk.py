@@ -207,6 +207,7 @@ def _risk(page, ds, hazard, years, im_label, n_boot):
         hide_empty=optional,
         show=terms,
     )
+    _probability_bars(page, out)
     _hazard_figure(page, ds, hazard, out, im_label)
     _deaggregation_figure(page, out, im_label)
     return out
@@ -266,6 +267,50 @@ def _hazard_figure(page, ds, hazard, out, im_label):
     )
 
 
+def _probability_bars(page, out):
+    """The objects ranked by their probability of overturning in the study's years, with the
+    band of each as an error bar; objects without a rate are named beside."""
+    p = out["probability"].values
+    rated = np.flatnonzero(np.isfinite(p) & (p > 0))
+    if not rated.size:
+        return
+    plt = _plt()
+    names = [str(v) for v in out["structure"].values]
+    rated = rated[np.argsort(-p[rated], kind="stable")]
+    colors = object_colors(out["structure"].values)
+    fig, ax = plt.subplots(figsize=(8, 0.9 + 0.32 * rated.size))
+    y = np.arange(rated.size)
+    lo, hi = out["probability_lo"].values[rated], out["probability_hi"].values[rated]
+    band = np.isfinite(lo) & np.isfinite(hi)
+    ax.barh(y, p[rated], color=[colors[names[j]] for j in rated], height=0.6)
+    err = np.vstack([p[rated] - lo, hi - p[rated]])[:, band]
+    ax.errorbar(p[rated][band], y[band], xerr=err, fmt="none", ecolor="k", capsize=3, lw=1)
+    for yi, j in zip(y, rated, strict=True):  # the value beside each bar: small ones show too
+        ax.annotate(
+            f"{p[j]:.3g}",
+            (0, yi),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="center",
+            fontsize=8,
+            color="k",
+        )
+    ax.set_yticks(y, [_mpl_text(names[j]) for j in rated], fontsize=9)
+    ax.invert_yaxis()
+    ax.set_xlim(left=0.0)
+    ax.set_xlabel(f"P(overturning in {out.attrs['years']:g} years)", fontsize=10)
+    ax.tick_params(labelsize=9)
+    fig.tight_layout()
+    without = [f"{names[j]} ({out['status'].values[j]})" for j in range(p.size) if j not in rated]
+    page.figure(
+        fig,
+        "probability_ranked",
+        f"The objects ranked by their probability of overturning in {out.attrs['years']:g} "
+        "years, highest first, with the 90 % band of each (resampling the records) where "
+        "there is one" + (f"; no rate: {_mpl_text(', '.join(without))}" if without else ""),
+    )
+
+
 def _deaggregation_figure(page, out, im_label):
     """One line per object: the share of lambda_OT from each interval of the hazard's levels."""
     fitted = np.isfinite(out["annual_rate"].values)
@@ -277,8 +322,9 @@ def _deaggregation_figure(page, out, im_label):
     fig, ax = plt.subplots(figsize=(8, 4.5))
     shown = np.flatnonzero(fitted)[:MAX_DEAGGREGATION_LINES]  # ranked: the highest rates
     colors = object_colors(out["structure"].values)  # each object as in the other figures
+    width = np.log(hi / lo)  # each interval's width in ln x: a density does not follow the grid
     for j in shown:
-        share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j]
+        share = out["deaggregation"].values[j, 1:-1] / out["annual_rate"].values[j] / width
         label = _mpl_text(str(out["structure"].values[j]))
         color = colors[str(out["structure"].values[j])]
         line = ax.plot(np.sqrt(lo * hi), share, "o-", ms=3, label=label, color=color)[0]
@@ -287,7 +333,7 @@ def _deaggregation_figure(page, out, im_label):
     ax.set_xscale("log")
     label = im_label(out.attrs["im"], out.attrs.get("period"))
     ax.set_xlabel(f"{label}, interval centre", fontsize=10)
-    ax.set_ylabel("share of lambda_OT from the interval", fontsize=10)
+    ax.set_ylabel("share of lambda_OT per unit of ln x", fontsize=10)
     ax.tick_params(labelsize=9)
     _log_ticks(ax)
     ax.legend(fontsize=8)
@@ -296,7 +342,10 @@ def _deaggregation_figure(page, out, im_label):
         fig,
         "deaggregation",
         "Deaggregation: the share of each object's annual rate of overturning that comes from "
-        "each interval between the hazard curve's levels (plotted at its geometric centre); "
+        "each interval between the hazard curve's levels, divided by the interval's width in "
+        "ln x (a density, so an uneven grid of levels does not shape it; plotted at the "
+        "interval's geometric centre; the area under each line over ln x is its share within "
+        "the levels); "
         "dotted: each object's uplift PGA (g tan alpha of a block, g lambda of another "
         "structure), below which it cannot leave rest (where the table says '0 below "
         "uplift', nothing comes from there; elsewhere that share is the lognormal's lower "
