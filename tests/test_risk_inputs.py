@@ -441,3 +441,35 @@ def test_a_power_law_of_an_acceleration_needs_its_units():
     g, si = (HazardCurve.power_law(2e-4, 2.3, im="pga", units=u) for u in ("g", "m/s^2"))
     assert g.to_si().rate(3.0) / si.rate(3.0) == pytest.approx(G_UNIT**2.3, rel=1e-12)
     HazardCurve.power_law(1.0, 1.0, im="significant_duration")
+
+
+def test_a_curve_in_g_read_as_m_s2_is_noted_against_the_records(tmp_path):
+    """The site's curve in g read as m/s^2 reads 9.8 times low, which its own numbers cannot
+    show; the shipped records' own PGAs then lie beyond its million-year level (their rate on
+    it, computed here by log-log interpolation, is below 1e-6): validate notes hazard.units,
+    and object_risk warns; read in g, neither says a word."""
+    x, rate, _ = _site_curve()
+    path = tmp_path / "site_plain.csv"
+    np.savetxt(path, np.column_stack([x, rate]), delimiter=",")  # no header: units unstated
+    from rockstudy.motions import load_suite
+
+    records = load_suite(sorted((DATA / "records").glob("NF0[12]*_H.AT2")))
+    pga = np.array([r.peak for r in records])  # [m/s^2]
+    wrong = np.exp(np.interp(np.log(pga), np.log(x), np.log(rate)))  # x read in m/s^2
+    assert np.median(wrong) < 1e-6 or pga.min() > x[-1]  # the premise (beyond its levels)
+    notes = {}
+    for units in ("m/s^2", "g"):
+        hazard = f'[hazard]\nkind = "file"\nfile = "{path}"\nim = "pga"\nunits = "{units}"'
+        study = spec.validate_text(STUDY.format(records=DATA / "records", hazard=hazard))
+        notes[units] = [n for n in study.notes if n.startswith("hazard.units:")]
+    assert len(notes["m/s^2"]) == 1 and "million-year level" in notes["m/s^2"][0]
+    assert notes["g"] == []
+    import rockstudy as rs
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+
+    ds = incremental_dynamic_analysis(records, {"A": rs.Block(0.8, 0.25)}, step=0.1, scan=0)
+    with pytest.warns(UnitsWarning, match="million-year"):
+        object_risk(ds, HazardCurve.from_csv(path, im="pga", units="m/s^2"), n_boot=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnitsWarning)
+        object_risk(ds, HazardCurve.from_csv(path, im="pga", units="g"), n_boot=0)

@@ -12,7 +12,7 @@ the hazard curves (:mod:`.curves`) and their units (:mod:`.units`), the files th
 (:mod:`.readers`) and the integral (:mod:`.integral`).
 """
 
-from .curves import IMPOSSIBLE_LEVELS, HazardCurve
+from .curves import IMPOSSIBLE_LEVELS, RECORD_RATES, HazardCurve, suite_off_curve
 from .integral import MAX_DISPERSION, MAX_YEARS, annual_rate, probability_in, rate_deaggregation
 from .readers import OPENQUAKE_IMTS
 from .units import UNIT_FACTORS
@@ -22,9 +22,11 @@ __all__ = [
     "MAX_DISPERSION",
     "MAX_YEARS",
     "OPENQUAKE_IMTS",
+    "RECORD_RATES",
     "UNIT_FACTORS",
     "HazardCurve",
     "annual_rate",
     "probability_in",
     "rate_deaggregation",
+    "suite_off_curve",
 ]

@@ -352,3 +352,32 @@ def _check_representable(k0, k, levels) -> None:
         f"{math.exp(LOG_TINY):.3g} to {math.exp(LOG_HUGE):.3g}); give a smaller k, a k0 nearer "
         "the rates of a real site, or levels nearer 1"
     )
+
+
+#: The annual rates of exceedance between which a suite's own intensities are expected to lie
+#: on the site's hazard curve: records chosen for a site are neither shaking it sees twice a
+#: year nor shaking beyond its million-year level.
+RECORD_RATES = (1e-6, 0.5)
+
+
+def suite_off_curve(curve: HazardCurve, values) -> str | None:
+    """Where a suite's own (unscaled) intensities ``values`` [SI] lie, by their median, outside
+    :data:`RECORD_RATES` on ``curve``, what to say of it; else None. A curve in g read as
+    m/s^2 (9.8 times low, which its own numbers cannot show) puts real records beyond its
+    million-year level."""
+    values = np.asarray(values, float)
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return None
+    si = curve.to_si()
+    rate = float(np.median(np.exp(si.log_rate(np.log(values)))))
+    low, high = RECORD_RATES
+    if low <= rate <= high:
+        return None
+    factor = UNIT_FACTORS[curve.units][0]
+    shown = f"{values.min() / factor:.3g} to {values.max() / factor:.3g} {curve.units}"
+    where = "beyond its million-year level" if rate < low else "more often than every other year"
+    return (
+        f"the records' own {curve.im} ({shown}) lie where the hazard curve's annual rate is "
+        f"{rate:.2g} by their median, {where} (a curve in g read as m/s^2 reads 9.8 times low)"
+    )

@@ -50,11 +50,14 @@ Structural Engineering 128(4), 526-533.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import xarray as xr
 
 from ... import _validate, risk
 from ...constants import G
+from ...warnings import UnitsWarning
 from . import record_fragility as rf
 from .fragility_fit import (
     N_BOOT,
@@ -66,7 +69,7 @@ from .fragility_fit import (
     separation,
 )
 
-__all__ = ["STATUSES", "object_risk", "share_below"]
+__all__ = ["STATUSES", "object_risk", "records_measure", "share_below"]
 
 #: What ``status`` of :func:`object_risk` says of an object's rate (module docstring).
 STATUSES = ("ok", "few", "none", "all", "separated", "no rise", "no fit")
@@ -218,6 +221,19 @@ def horizontal(ds) -> bool:
     return "vertical_component" in ds and not bool(ds["vertical_component"].any())
 
 
+def records_measure(ds, hazard) -> np.ndarray:
+    """Each record's own (unscaled) value of the hazard's measure [SI] as the design stores
+    it (empty where it does not)."""
+    if hazard.im not in ds:
+        return np.zeros(0)
+    values = ds[hazard.im]
+    if "period" in values.dims:
+        if hazard.period is None or hazard.period not in values["period"].values:
+            return np.zeros(0)
+        values = values.sel(period=hazard.period)
+    return np.asarray(values.values, float)
+
+
 def _status(ida, theta, beta, n_over, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
@@ -334,6 +350,9 @@ def object_risk(
     if design not in ("ida", "stripes", "cloud"):
         raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")
     im, period = _check_hazard(ds, hazard)
+    off = risk.suite_off_curve(hazard, records_measure(ds, hazard))
+    if off is not None:
+        warnings.warn(f"hazard: {off}; check the units of both", UnitsWarning, stacklevel=2)
     unit = rf.quoted(im)[0]
     ida = design == "ida"
     fitter = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)

@@ -10,7 +10,7 @@ import pandas as pd
 from scipy import special
 
 from ... import risk
-from ..analysis.risk import object_risk
+from ..analysis.risk import object_risk, records_measure
 from ._page import _log_ticks, _mpl_text, _plt, object_colors
 
 
@@ -213,19 +213,6 @@ def _risk(page, ds, hazard, years, im_label, n_boot):
     return out
 
 
-def _records_measure(ds, hazard):
-    """Each record's value of the hazard's measure, unscaled, in the hazard's units (None
-    where the design does not store it)."""
-    if hazard.im not in ds:
-        return None
-    values = ds[hazard.im]
-    if "period" in values.dims:
-        if hazard.period is None or hazard.period not in values["period"].values:
-            return None
-        values = values.sel(period=hazard.period)
-    return np.asarray(values.values, float) / risk.UNIT_FACTORS[hazard.units][0]
-
-
 def _hazard_figure(page, ds, hazard, out, im_label):
     """The hazard curve as it was read, with the records' own (unscaled) intensities and each
     object's uplift level on it: a curve read in the wrong units shows far from both."""
@@ -233,8 +220,8 @@ def _hazard_figure(page, ds, hazard, out, im_label):
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.loglog(hazard.levels, hazard.rates, "o-", ms=3, color="k", label="hazard curve, as read")
     ax.axhline(1 / 475, color="0.5", ls="--", lw=1, label="1/475 per year")
-    on_records = _records_measure(ds, hazard)
-    if on_records is not None:
+    on_records = records_measure(ds, hazard) / risk.UNIT_FACTORS[hazard.units][0]
+    if on_records.size:
         ax.plot(
             on_records,
             np.full(on_records.size, hazard.rates[0]),

@@ -17,6 +17,7 @@ from ..._validate import DESIGN_SHARE, GIB, MAX_ACCELERATION, SAMPLE_SHARE, mach
 from ...constants import G
 from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs, units_refusal
+from ...risk import suite_off_curve
 from ...structures.block import uplift_acceleration_block
 from .structures import KINDS
 
@@ -106,6 +107,7 @@ def notes(study, base_dir=None) -> list[str]:
     if mo.kind != "record":
         return uplift_notes(study) + size_notes(study)
     found = uplift_notes(study) + size_notes(study) + _scaling_notes(study, base_dir)
+    found += hazard_notes(study, base_dir)
     if study.design is None:
         return found
     for field, h, v in record_pairs(mo, base_dir):
@@ -234,6 +236,23 @@ def _scaling_notes(study, base_dir) -> list[str]:
             "another structure; check the value and its units)"
         )
     return found
+
+
+def hazard_notes(study, base_dir) -> list[str]:
+    """A note, naming ``hazard.units``, where the records' own (unscaled) intensities lie far
+    from the hazard curve (:func:`rockstudy.risk.suite_off_curve`)."""
+    hazard = getattr(study, "hazard", None)
+    if hazard is None or study.design is None:
+        return []
+    curve = hazard.curve()
+    values = [
+        read_pair(h, v, study.motion.units, field, field).intensity_measure(
+            curve.im, period=curve.period, damping=study.design.damping
+        )
+        for field, h, v in record_pairs(study.motion, base_dir)
+    ]
+    said = suite_off_curve(curve, values)
+    return [] if said is None else [f"hazard.units: {said}; check hazard.units and motion.units"]
 
 
 def _named_twice(pairs) -> list[str]:
