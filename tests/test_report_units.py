@@ -44,19 +44,22 @@ def records():
 
 @pytest.fixture(scope="module")
 def own_measures():
-    register_measure(
-        HALF,
-        lambda r: 0.5 * r.peak,
-        unit="m/s^2",
-        power=1,
-        quoted_unit="g",
-        factor=1 / G_UNIT,
-        label="half PGA",
-    )
-    register_measure(ROOT, lambda r: math.sqrt(r.peak), unit="m^0.5/s", power=0.5)
-    yield
-    measures.unregister_measure(HALF)
-    measures.unregister_measure(ROOT)
+    try:  # registered for this module only, whatever happens
+        register_measure(
+            HALF,
+            lambda r: 0.5 * r.peak,
+            unit="m/s^2",
+            power=1,
+            quoted_unit="g",
+            factor=1 / G_UNIT,
+            label="half PGA",
+        )
+        register_measure(ROOT, lambda r: math.sqrt(r.peak), unit="m^0.5/s", power=0.5)
+        yield
+    finally:
+        for name in (HALF, ROOT):
+            if name in measures.MEASURES:
+                measures.unregister_measure(name)
 
 
 @pytest.fixture(scope="module")

@@ -330,38 +330,27 @@ def simulate_reference(
     if free_map and t_eval is not None:
         raise ValueError("t_eval needs the free rocking integrated: free_map=False")
     dense = _Dense(t_eval)
-    acc, vert = _ground(motion)
-    dur = motion.duration
+    (acc, vert), dur = _ground(motion), motion.duration
     tab, fall_at = table if model == MODEL_TABLE else (None, FALL_ROTATION)
     omega_rest = REST_FRACTION * p * alpha
-    t_end = math.inf if t_max is None else float(t_max)
-    atol = [rtol * alpha, rtol * p * alpha]
+    t_end, atol = (math.inf if t_max is None else float(t_max)), [rtol * alpha, rtol * p * alpha]
     grid, breaks = _grids(motion)
 
     lift, rhs = _equations(p, alpha, model, tab, acc, vert, dur)
     body = (p, alpha, model, NO_TABLE if tab is None else tab, omega_rest)
     th, om = (float(x) for x in initial_state)
     ts, ths, oms, impacts, peaks = [0.0], [th], [om], [], []
-    max_u = abs(th)
-    t = 0.0
+    max_u, t = abs(th), 0.0
     at_rest = th == 0.0 and om == 0.0
     mapped = at_trough = False
     s = math.copysign(1.0, th if th != 0.0 else om)
     while True:
         if at_rest:
-            t_up = _uplift_time(lift, t, dur, grid)
-            if t_up >= dur:
+            lifted = _lift_from_rest(lift, acc, t, dur, grid, (ts, ths, oms, impacts))
+            if lifted is None:
                 break
-            t, th, om = t_up, 0.0, 0.0
-            s = -1.0 if acc(t) > 0 else 1.0
-            at_rest = False
-            ts.append(t), ths.append(0.0), oms.append(0.0)
-            if not lift(np.nextafter(t, math.inf)) > 0.0:
-                # lifted for less than an ulp of t: it falls straight back, its impact one ulp
-                # on and a rest there (the kernels' rule, ._events._impact)
-                t = float(np.nextafter(t, math.inf))
-                impacts.append(t), ts.extend([t, t]), ths.extend([0.0, 0.0]), oms.extend([0.0, 0.0])
-                at_rest = True
+            (t, s, at_rest), th, om = lifted, 0.0, 0.0
+            if at_rest:
                 continue
         if t >= dur and free_map and not mapped:
             mapped = True
@@ -404,6 +393,23 @@ def simulate_reference(
         if t >= t_end:
             break
     return _pack(ts, ths, oms, max_u, False, impacts, math.nan, peaks, dense)
+
+
+def _lift_from_rest(lift, acc, t, dur, grid, history):
+    """From rest at ``t``: (time, side, still at rest) after the next uplift, its states added
+    to ``history`` (ts, ths, oms, impacts); None where the block rests to the end of the
+    motion. A lift shorter than an ulp of its time falls straight back, its impact one ulp on
+    and a rest there (the kernels' rule, ``._events._impact``)."""
+    ts, ths, oms, impacts = history
+    t_up = _uplift_time(lift, t, dur, grid)
+    if t_up >= dur:
+        return None
+    ts.append(t_up), ths.append(0.0), oms.append(0.0)
+    if lift(np.nextafter(t_up, math.inf)) > 0.0:
+        return t_up, (-1.0 if acc(t_up) > 0 else 1.0), False
+    t_back = float(np.nextafter(t_up, math.inf))
+    impacts.append(t_back), ts.extend([t_back] * 2), ths.extend([0.0] * 2), oms.extend([0.0] * 2)
+    return t_back, 1.0, True
 
 
 class _Dense:

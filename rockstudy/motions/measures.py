@@ -197,17 +197,18 @@ def _check_name(name, replace: bool) -> str:
     return name
 
 
-#: An SI unit of base units with integer powers (``m/s^2``, ``m^2/s^4``, ``kg m/s``), or ``1``
-#: for a dimensionless measure.
-_SI_UNIT = re.compile(r"(1|(m|s|kg|rad)(\^-?[1-9])?([ */](m|s|kg|rad)(\^-?[1-9])?)*)\Z")
+#: An SI unit of base units with non-zero powers (``m/s^2``, ``m^2/s^4``, ``kg m/s``, and
+#: ``m^0.5/s`` for the root of a velocity), or ``1`` for a dimensionless measure.
+_POWER = r"(\^-?([1-9][0-9]*(\.[0-9]+)?|0\.[0-9]*[1-9][0-9]*))?"  # 2, -1, 0.5; never 0
+_SI_UNIT = re.compile(rf"(1|(m|s|kg|rad){_POWER}([ */](m|s|kg|rad){_POWER})*)\Z")
 
 
 def _check_unit(unit) -> str:
     unit = _text("unit", unit)
     if not _SI_UNIT.match(unit):
         raise ValueError(
-            f"unit must be an SI unit of m, s, kg and rad with integer powers, like 'm/s^2' or "
-            f"'m^2/s^4' ('1' for none), got {unit!r}"
+            f"unit must be an SI unit of m, s, kg and rad with non-zero powers, like 'm/s^2', "
+            f"'m^2/s^4' or 'm^0.5/s' ('1' for none), got {unit!r}"
         )
     return unit
 
@@ -252,7 +253,7 @@ def register_measure(
         and wherever it is used it must return a finite number >= 0: else a ValueError
         names the measure and the record (its own exceptions too, in one line).
     unit : str
-        SI unit of the value, of m, s, kg and rad with integer powers, e.g. ``"m/s^2"`` or
+        SI unit of the value, of m, s, kg and rad with non-zero powers, e.g. ``"m/s^2"`` or
         ``"m^2/s^4"`` (``"1"`` for a ratio); a target in a study may then be written in any
         unit of :data:`UNIT_ALIASES` of it.
     power : float
