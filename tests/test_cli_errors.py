@@ -136,6 +136,13 @@ sys.exit(cli.main(sys.argv[1:]))
 """
 
 
+def _ctrl_c_as_in_a_terminal():
+    """In the child before it starts: SIGINT at its default, as a shell starts a foreground
+    job, whatever this test process inherited (a child inherits an ignored SIGINT, and
+    Python then installs no KeyboardInterrupt)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_while_the_modules_load_is_one_line(tmp_path):
     """Ctrl-C as soon as the command has begun, while it loads numpy, xarray, dask: one line,
     exit 130 (Python's own would be a KeyboardInterrupt traceback and -2). Before ``main``
@@ -148,6 +155,7 @@ def test_ctrl_c_while_the_modules_load_is_one_line(tmp_path):
         [sys.executable, "-c", READY_THEN_MAIN, "run", str(study), "--out",
          str(tmp_path / "c.zarr"), "--quiet"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        preexec_fn=_ctrl_c_as_in_a_terminal,
     )  # fmt: skip
     assert proc.stdout.readline() == "ready\n"
     proc.send_signal(signal.SIGINT)  # main has just started: the command's modules load

@@ -115,7 +115,8 @@ def test_ctrl_c_prints_one_line_with_the_resume_command(tmp_path):
     proc = subprocess.Popen(
         [ROCKSTUDY, "run", str(study), "--out", str(out), "--workers", "1", "--quiet"],
         start_new_session=True,  # its own process group, as a terminal's foreground job
-        stdout=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # and Ctrl-C at its
+        stdout=subprocess.PIPE,  # default, whatever this test process inherited
         stderr=subprocess.PIPE,
         text=True,
     )
