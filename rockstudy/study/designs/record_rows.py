@@ -217,7 +217,7 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
 
 @lru_cache(maxsize=8)
 def _suite(motion_json: str, base_dir) -> tuple:
-    from ..spec.schema import RecordSpec
+    from ..spec.motion_spec import RecordSpec
 
     return tuple(record_pairs(RecordSpec.model_validate(json.loads(motion_json)), base_dir))
 
@@ -225,7 +225,7 @@ def _suite(motion_json: str, base_dir) -> tuple:
 @lru_cache(maxsize=32)
 def load_record(motion_json: str, base_dir, index: int):
     """Record ``index`` of a study's suite (read once per process)."""
-    from ..spec.schema import RecordSpec
+    from ..spec.motion_spec import RecordSpec
 
     units = RecordSpec.model_validate(json.loads(motion_json)).units
     field, h, v = _suite(motion_json, base_dir)[index]

@@ -24,7 +24,7 @@ from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
-from ..spec.schema import SAMPLER_LAYOUTS
+from ..spec.sampler_spec import SAMPLER_LAYOUTS
 from ._page import (
     _FRAGILITY_NAMES,
     NOT_REACHED,
@@ -691,7 +691,7 @@ def _acceleration_units(study) -> str:
 
 def _laid_out(layout):
     """Whether a study's sampler has ``layout`` (a value of
-    :data:`~rockstudy.study.spec.schema.SAMPLER_LAYOUTS`)."""
+    :data:`~rockstudy.study.spec.sampler_spec.SAMPLER_LAYOUTS`)."""
     return lambda study, ds: SAMPLER_LAYOUTS[study.sampler.kind] == layout
 
 

@@ -205,7 +205,7 @@ def _scaling_notes(study, base_dir) -> list[str]:
     design or Monte Carlo rows) or run unscaled (a cloud design): the records whose largest
     scale factor exceeds ``design.max_scale_factor`` (5 by default), and, when every record
     is horizontal only and even the highest level leaves every record's PGA below the lowest
-    uplift acceleration of the structures (:meth:`.schema.Study.uplift_span`: g tan(alpha) of
+    uplift acceleration of the structures (:meth:`.study_model.Study.uplift_span`: g tan(alpha) of
     a block, g lambda of another structure, eq. 10 of [003]), that nothing can rock (no
     structure leaves rest)."""
     de = study.design

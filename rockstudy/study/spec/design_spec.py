@@ -1,0 +1,77 @@
+"""The ``[design]`` table of a study file: a record design (cloud, stripes or IDA).
+
+Its IDA options are checked, and filled in, by :class:`.ida_options.IdaOptions`; a design's
+fit with the motion and the sampler is checked by the whole study
+(:class:`.study_model.Study`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from .feasibility import DEFAULT_MAX_SCALE_FACTOR
+from .ida_options import IdaOptionError, IdaOptions
+from .motion_spec import ScaleIM, _check_period
+from .parameters import _Damping, _Model, _Period
+from .structures import FieldError
+
+__all__ = ["DesignSpec"]
+
+
+class DesignSpec(_Model):
+    """A record design over records x structures (``sampler.n`` structures drawn by the
+    sampler) [x levels]: ``cloud`` (records unscaled), ``stripes`` (every record scaled to
+    each level of ``motion.scale_to.value``, a grid), or ``ida`` (the first overturning
+    intensity of each structure under each record in ``im``, by a ladder of ``step`` refined
+    by bisection to ``tolerance``; ``max_pga_ratio`` and ``scan`` as in
+    :class:`rockstudy.study.spec.ida_options.IdaOptions`, which holds their defaults and
+    ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
+    record, ``damping`` their damping ratio."""
+
+    kind: Literal["cloud", "stripes", "ida"]
+    periods: list[_Period] = Field(default=[], max_length=1000)
+    damping: _Damping = 0.05
+    im: ScaleIM | None = None
+    period: _Period | None = None
+    step: float | None = None
+    tolerance: float | None = None
+    max_pga_ratio: float | None = None
+    scan: int | None = None
+    growth: float | None = None  # replaced by step: refused with a message saying so
+    #: Scale factors above this are noted by validate (records scaled far from what they
+    #: recorded; cloud and stripes designs).
+    max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
+
+    @model_validator(mode="after")
+    def _ida_keys(self):
+        ida = ("im", "period", "step", "tolerance", "max_pga_ratio", "scan")
+        if self.growth is not None:
+            raise FieldError(
+                "growth",
+                "is no longer an option: the IDA climbs a ladder of rungs; give step (the "
+                "relative step between rungs, default 0.01) instead",
+            )
+        if self.kind != "ida":
+            for name in ida:
+                if getattr(self, name) is not None:
+                    raise FieldError(name, f"applies to kind = 'ida' only, not {self.kind!r}")
+            return self
+        _check_period(self.im or "pga", self.period, "period")
+        try:
+            options = self.ida()
+        except IdaOptionError as exc:
+            raise FieldError(exc.option, str(exc).partition(" ")[2]) from None
+        for name in ida:  # the stored study shows every option the run used
+            object.__setattr__(self, name, getattr(options, name))
+        return self
+
+    def ida(self) -> IdaOptions:
+        """The IDA's options (defaults filled in)."""
+        return IdaOptions.given(self.model_dump())
+
+    def ida_options(self) -> dict:
+        """Keyword arguments of the IDA (defaults filled in)."""
+        return asdict(self.ida())

@@ -1,0 +1,204 @@
+"""Named objects: ``[structure] kind = "objects"``, given in the study or in a CSV file.
+
+An object has a name, a kind of :data:`.structures.KINDS` (a block by default) and the fields
+of its kind's physics class; :class:`ObjectsSpec` lists them. ``file`` names a CSV file of
+:data:`OBJECT_COLUMNS`, read relative to the study file's folder into ``objects`` before the
+study is validated (``_read_objects_file``); its problems name the file and the line, never a
+cell.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from typing import Literal
+
+import numpy as np
+from pydantic import Field, PrivateAttr, create_model, field_validator, model_validator
+
+from ...dynamics.simulate import MAX_FRICTION
+from .parameters import MAX_STUDY_BYTES, _a_name, _describe, _Model
+from .structures import KINDS, check_object, object_fields
+
+__all__ = ["OBJECT_COLUMNS", "OBJECT_KINDS", "ObjectSpec", "ObjectsSpec"]
+
+
+#: Kinds an object of ``[structure] kind = "objects"`` may be (the registry
+#: :data:`.structures.KINDS`).
+OBJECT_KINDS = tuple(KINDS)
+
+
+class _ObjectBase(_Model):
+    """One named object of a kind of :data:`.structures.KINDS` (by default a block: ``width``
+    and ``height`` [m], or ``half_diagonal`` [m] and ``slenderness`` [rad]; restitution by
+    default Housner's), with the fields of its kind as its physics class takes them."""
+
+    name: str = Field(min_length=1)
+    kind: Literal[OBJECT_KINDS] = "block"
+    #: The friction coefficient mu of this object's contact (overrides the study's friction).
+    friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
+    _params: tuple = PrivateAttr(default=None)
+    _printable = field_validator("name")(lambda value: _a_name(value))
+
+    @model_validator(mode="after")
+    def _shape(self):
+        given = {f: getattr(self, f) for f in object_fields() if getattr(self, f) is not None}
+        structure, rocking = check_object(f"object {self.name!r}", self.kind, given)
+        R = float(getattr(structure, "half_diagonal", np.nan))
+        self._params = (*rocking, R)
+        return self
+
+    def geometry(self) -> tuple[float, float]:
+        """(half-diagonal R [m], NaN for a structure without one; theta_cr [rad], the
+        equivalent block's slenderness), as the design functions store them."""
+        return self._params[4], self._params[1]
+
+    def uplift(self) -> float:
+        """The ground acceleration that starts the object rocking [m/s^2]: g tan(alpha) of a
+        block, g lambda of another structure (eq. 10 of [003];
+        :func:`rockstudy.structures.uplift_acceleration`)."""
+        return self._params[3]
+
+    def rocking(self) -> tuple[float, float, float]:
+        """(p [rad/s], theta_cr [rad], eta) of the equivalent block of the object's physics
+        class (:func:`rockstudy.structures.block_parameters`)."""
+        return self._params[:3]
+
+
+ObjectSpec = create_model(
+    "ObjectSpec",
+    __base__=_ObjectBase,
+    __doc__=_ObjectBase.__doc__,
+    **{f: (float | None, None) for f in object_fields()},
+)
+
+
+class ObjectsSpec(_Model):
+    """Named objects studied one by one in a record ``[design]``: ``objects`` lists them (the
+    ``structure`` coordinate of the result carries their names), or ``file`` names a CSV file
+    of the same columns (read relative to the study file's folder into ``objects`` when the
+    study is validated)."""
+
+    kind: Literal["objects"]
+    objects: list[ObjectSpec] = Field(min_length=1)
+    file: str | None = None
+
+    @model_validator(mode="after")
+    def _unique(self):
+        seen = {}
+        for i, o in enumerate(self.objects):
+            if o.name in seen:
+                raise ValueError(
+                    f"object {i} is named {o.name!r} like object {seen[o.name]}; names must differ"
+                )
+            seen[o.name] = i
+        return self
+
+    def rocking(self) -> np.ndarray:
+        """(n, 3) array of (p [rad/s], theta_cr [rad], eta) of the objects, in order."""
+        return np.array([o.rocking() for o in self.objects], float)
+
+    def uplift(self) -> np.ndarray:
+        """(n,) array of the objects' uplift accelerations [m/s^2] (:meth:`ObjectSpec.uplift`)."""
+        return np.array([o.uplift() for o in self.objects], float)
+
+
+#: Columns of an objects CSV file (``[structure] kind = "objects"``, ``file = ...``).
+OBJECT_COLUMNS = tuple(ObjectSpec.model_fields)
+
+
+def _read_objects_file(data, base_dir) -> str | None:
+    """Read ``structure.file`` (a CSV of :data:`OBJECT_COLUMNS`, a header line then one object a
+    line; empty cells are left out) into ``structure.objects`` of ``data``, in place; the
+    problem as one line naming the file and the line, never its contents, or None."""
+    st = data.get("structure")
+    if not (isinstance(st, dict) and st.get("kind") == "objects" and "file" in st):
+        return None
+    name = st["file"]
+    if "objects" in st:
+        return "structure.file: give objects or file, not both"
+    if not isinstance(name, str) or not name.strip():
+        return f"structure.file: must be the path of a CSV file, got {_describe(name)}"
+    from ...motions.records import read_text_file
+    from .feasibility import record_path
+
+    path = record_path(name, base_dir)
+    try:
+        text = read_text_file(path, MAX_STUDY_BYTES)
+        st["objects"] = _object_rows(text)
+    except (OSError, ValueError) as exc:
+        return f"structure.file: cannot read {str(path)!r} ({exc})"
+    return None
+
+
+def _object_rows(text: str) -> list[dict]:
+    """The objects of the text of an objects CSV file, one dict a row without its empty cells;
+    ValueError naming the line and what was expected (never a cell: the file may be anything).
+
+    A row may be shorter than the header; cells beyond the header, or under a column without a
+    name, must be empty. Blank lines are skipped.
+    """
+    expected = f"a header line of columns among {list(OBJECT_COLUMNS)}, then one object a line"
+    reader = csv.reader(io.StringIO(text.removeprefix("\ufeff")))  # a spreadsheet's BOM
+    rows = []
+    try:
+        for cells in reader:
+            if any("\n" in c or "\r" in c for c in cells):
+                raise ValueError(
+                    f"line {reader.line_num}: a quoted cell spans lines; expected {expected}"
+                )
+            rows.append((reader.line_num, [c.strip() for c in cells]))
+    except csv.Error:  # a carriage return inside a line, a cell over csv's size limit
+        raise ValueError(
+            f"line {reader.line_num}: is not a line of comma-separated cells (a carriage "
+            f"return alone, or a cell too long); expected {expected}"
+        ) from None
+    rows = [(line, cells) for line, cells in rows if any(cells)]
+    if not rows:
+        raise ValueError(f"it holds no line; expected {expected}")
+    header = _object_header(*rows[0], expected)
+    if len(rows) == 1:
+        raise ValueError(f"it holds no object after its header; expected {expected}")
+    return [_object_row(line, cells, header) for line, cells in rows[1:]]
+
+
+def _object_header(line: int, cells: list[str], expected: str) -> list[str]:
+    """The column names of the header of an objects CSV file ('' for a column without a name,
+    which must stay empty); ValueError naming the first column that is no object column."""
+    for i, cell in enumerate(cells):
+        if cell and cell not in OBJECT_COLUMNS:
+            raise ValueError(
+                f"line {line}: column {i + 1} of the header is not an object column; "
+                f"expected {expected}"
+            )
+        if cell and cell in cells[:i]:
+            raise ValueError(f"line {line}: column {i + 1} of the header repeats a column")
+    if "name" not in cells:
+        raise ValueError(f"line {line}: the header has no name column; expected {expected}")
+    return cells
+
+
+def _object_row(line: int, cells: list[str], header: list[str]) -> dict:
+    """One object of an objects CSV file: its non-empty cells by column, names and kinds as
+    text and the rest as numbers where they read as one; ValueError for a non-empty cell
+    beyond the header or under a column without a name."""
+    stray = [i for i, cell in enumerate(cells) if cell and (i >= len(header) or not header[i])]
+    if stray:
+        raise ValueError(
+            f"line {line}: cell {stray[0] + 1} is not under a named column (the row has "
+            f"{len(cells)} cells, the header names {sum(map(bool, header))} columns)"
+        )
+    return {
+        header[i]: cell if header[i] in ("name", "kind") else _cell(cell)
+        for i, cell in enumerate(cells)
+        if cell
+    }
+
+
+def _cell(text: str):
+    """A CSV cell: a number if it reads as one, else the text (the schema then names it)."""
+    text = text.strip()
+    try:
+        return float(text)
+    except ValueError:
+        return text
