@@ -72,6 +72,7 @@ from ...dynamics.methods import MAX_STEPS
 from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
+from ...motions.units import acceleration_units
 from ...risk import MAX_YEARS
 from ...structures.block import (
     FREQUENCY_PARAMETER_RANGE,
@@ -451,14 +452,10 @@ def _check_period(im, period, field):
 
 def scale_units(im: str) -> dict:
     """Units a target of ``im`` may be written in: name -> factor to SI, the SI unit first
-    (:data:`rockstudy.motions.measures.UNIT_ALIASES` of its SI unit, and its quoted unit;
-    ``g`` is the standard gravity 9.80665 m/s^2, as for records); ``1`` for a ratio."""
-    if im in measures.RATIOS:
-        return {"1": 1.0}
-    m = measures.measure(im)
-    out = {m.unit: 1.0, **measures.UNIT_ALIASES.get(m.unit, {})}
-    out.setdefault(m.quoted_unit, 1.0 / m.factor)
-    return out
+    (:func:`rockstudy.motions.measures.units_of`: the units of its dimension, as for hazard
+    curves, and its quoted unit; ``g`` is the standard gravity 9.80665 m/s^2, as for
+    records); ``1`` for a ratio."""
+    return measures.units_of(im)
 
 
 class ScaleTo(_Model):
@@ -526,6 +523,11 @@ class VerticalRule(_Model):
         return value
 
 
+#: Units of a text record's acceleration column: those of an acceleration in the package's one
+#: table of units (:func:`rockstudy.motions.units.acceleration_units`).
+RECORD_UNITS = tuple(acceleration_units())
+
+
 class RecordSpec(_Model):
     """Recorded motions: a suite of record files, each scaled, or left unscaled in a design.
 
@@ -537,8 +539,9 @@ class RecordSpec(_Model):
     ``pga_ratio`` x a_up (the structure's uplift acceleration: g tan(alpha) of a block, g lambda
     of another structure, eq. 10 of [003]), or to ``scale_to``; a ``[design]`` runs every record.
 
-    ``units`` is the unit of the acceleration column of text records (``g``, ``m/s2`` or
-    ``m/s^2``, ``cm/s2`` or ``cm/s^2``); ``.AT2`` files are in g (PEER's format), and a
+    ``units`` is the unit of the acceleration column of text records (one of
+    :data:`RECORD_UNITS`: ``g``, ``m/s2`` or ``m/s^2``, ``cm/s2``, ``cm/s^2`` or ``gal``);
+    ``.AT2`` files are in g (PEER's format), and a
     suite of ``.AT2`` files alone with other units is refused.
 
     A path is absolute as written, or relative to the study file's folder (never to the
@@ -549,7 +552,7 @@ class RecordSpec(_Model):
     kind: Literal["record"]
     files: Annotated[str, Field(min_length=1)] | Annotated[list[str | HVPair], Field(min_length=1)]
     vertical: list[str] | VerticalRule | None = None
-    units: Literal["g", "m/s2", "m/s^2", "cm/s2", "cm/s^2"] = "g"
+    units: Literal[RECORD_UNITS] = "g"
     scale: Param | None = None
     pga_ratio: Param | None = None
     scale_to: ScaleTo | None = None
@@ -778,8 +781,13 @@ Structure = Annotated[
 MotionSpec = Annotated[PulseSpec | RecordSpec | StochasticSpec, Field(discriminator="kind")]
 
 
-#: Measures a ``[hazard]`` curve may be of: those a record design stores for every record.
-HAZARD_MEASURES = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd")
+def _hazard_im(name: str) -> str:
+    """A measure a ``[hazard]`` curve may be of: one of the registry's measures of power > 0
+    (:func:`rockstudy.motions.measures.scalable`, read when the study is validated, so a
+    measure registered after import is one), or a ValueError listing them."""
+    if name not in measures.scalable():
+        raise ValueError(f"must be one of {list(measures.scalable())}, got {name!r}")
+    return name
 
 
 class HazardSpec(_Model):
@@ -791,14 +799,15 @@ class HazardSpec(_Model):
     exceedance) or an OpenQuake hazard-curve CSV (:meth:`rockstudy.risk.HazardCurve.from_csv`).
     The file is read when the study is validated: its levels and rates are then part of the
     study (``levels``, ``rates``: not to be given by hand), so a stored result keeps the curve
-    it was reported with. ``im`` is the measure (one of :data:`HAZARD_MEASURES`; ``sa``,
-    ``psv`` and ``sd`` at a ``period`` [s] the design stores), ``units`` the units of its
-    levels (:data:`rockstudy.risk.UNIT_FACTORS`; default the IM's SI unit, or OpenQuake's
-    for its files) and ``years`` the exposure time of the probability reported (default 50).
+    it was reported with. ``im`` is the measure (a measure of the registry of power > 0, a
+    registered one too; ``sa``, ``psv`` and ``sd`` at a ``period`` [s] the design stores),
+    ``units`` the units of its levels (:func:`rockstudy.motions.measures.units_of` the
+    measure; default the IM's SI unit, or OpenQuake's for its files) and ``years`` the
+    exposure time of the probability reported (default 50).
     """
 
     kind: Literal["power_law", "file"]
-    im: Literal[HAZARD_MEASURES]
+    im: Annotated[str, AfterValidator(_hazard_im)]
     units: str | None = None
     period: _Period | None = None
     years: float = Field(default=50.0, gt=0, le=MAX_YEARS)
@@ -1011,7 +1020,7 @@ class Study(_Model):
                 "it integrates is fitted per structure over records, which a Monte Carlo "
                 "or Sobol study does not have",
             )
-        if hz.im in ("sa", "psv", "sd"):
+        if measures.measure(hz.im).needs_period:
             stored = set(de.periods) | {de.period}
             if self.motion.kind == "record" and self.motion.scale_to is not None:
                 stored.add(self.motion.scale_to.period)
@@ -1647,7 +1656,7 @@ def _read_hazard_file(data, base_dir) -> str | None:
 
     args = {k: hz.get(k) for k in ("im", "units", "period")}
     plain = all(v is None or isinstance(v, str | float | int) for v in args.values())
-    if args["im"] not in HAZARD_MEASURES or not plain:
+    if args["im"] not in measures.scalable() or not plain:
         return None  # the schema names the bad field; the file is read once it is right
     path = record_path(name, base_dir)
     try:
