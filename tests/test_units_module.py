@@ -357,3 +357,36 @@ def test_a_measure_registered_before_the_designs_reserve_its_name_is_refused():
             measures.reserve_names(["late_name_units_module"], "a test's table")
     finally:
         measures.unregister_measure("late_name_units_module")
+
+
+# ------------------------------------------------------------------ the risk of any measure
+
+
+def test_the_risk_of_a_measure_in_its_own_si_unit_is_that_of_the_same_measure_in_gal(
+    own_measures,
+):
+    """GAL (quoted in gal) and a copy of it whose unit, "m s^-2", is in no table: the same
+    records, the same curve in SI, so the same annual rate, and medians 100 apart (1 gal =
+    0.01 m/s^2)."""
+    from rockstudy import Block
+    from rockstudy.motions import load_suite
+    from rockstudy.study.analysis.risk import object_risk
+    from rockstudy.study.designs.records import multiple_stripes
+
+    copy = "si_copy_units_module"
+    register_measure(copy, lambda r: r.peak, unit="m s^-2", power=1)
+    try:
+        suite = load_suite(sorted((DATA / "records").glob("*_H.AT2")))
+        vase = {"vase": Block(half_diagonal=0.4, slenderness=0.3)}
+        ds = multiple_stripes(suite, vase, np.array([4.0, 6.0, 9.0]), im="pga")
+        levels_si = np.geomspace(0.5, 40.0, 12)
+        rates = 1e-2 * levels_si**-2.0
+        own = object_risk(ds, HazardCurve(copy, levels_si, rates, "m s^-2"), n_boot=0)
+        gal = object_risk(ds, HazardCurve(GAL, levels_si / 0.01, rates, "gal"), n_boot=0)
+    finally:
+        measures.unregister_measure(copy)
+    assert own["status"].values[0] == "ok"
+    rate = own["annual_rate"].values[0]
+    assert np.isfinite(rate) and rate > 0
+    assert gal["annual_rate"].values[0] == pytest.approx(rate, rel=1e-9)
+    assert gal["theta"].values[0] * 0.01 == pytest.approx(own["theta"].values[0], rel=1e-9)

@@ -153,7 +153,7 @@ def reserve_names(names, owner: str) -> None:
     taken = [n for n in names if n in MEASURES]
     if taken:
         raise ValueError(
-            f"the measure {taken[0]!r} takes a name reserved for {owner}, who store it beside "
+            f"the measure {taken[0]!r} takes a name reserved for {owner}, which store it beside "
             "the measures (its values would be overwritten): register it under another name"
         )
     for n in names:
@@ -221,8 +221,8 @@ def _check_quoted(unit: str, quoted: str, factor: float) -> None:
         )
     if not math.isclose(factor, 1.0 / to_si, rel_tol=1e-12):
         raise ValueError(
-            f"factor = {factor!r} is not the factor from {unit} to {quoted!r}, "
-            f"{1.0 / to_si!r}: give that (or leave factor out for the SI unit)"
+            f"factor = {factor!r} is not the factor from {unit} to {quoted!r}: give "
+            f"factor = {1.0 / to_si!r}"
         )
 
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 from ..motions import measures
 from ..motions.units import UNITS
 
+__all__ = ["UNIT_FACTORS", "to_si", "units_for"]
+
 #: Every unit name the package reads: name -> (factor to SI, SI unit), the table of
 #: :mod:`rockstudy.motions.units` ("g" is the unit g, standard gravity 9.80665 m/s^2, as for
 #: records and ``scale_to``). A curve's levels may be in any unit of its IM's dimension, or in
