@@ -283,39 +283,25 @@ def test_a_measure_quoted_in_its_own_unit_is_read_in_it_by_every_door(own_measur
 
 # ------------------------------------------------------------------ hazard measures
 
-STUDY = """
-name = "site"
-seed = 1
-[structure]
-kind = "objects"
-objects = [{{ name = "vase", width = 0.45, height = 1.9 }}]
-[motion]
-kind = "record"
-files = "{records}/NF0[12]*_H.AT2"
-[design]
-kind = "ida"
-periods = [0.5]
-[hazard]
-kind = "power_law"
-k0 = 2e-4
-k = 2.3
-im = "{im}"
-units = "g"
-"""
+#: The shipped museum study (records relative to its folder), its hazard section replaced.
+MUSEUM = Path(__file__).resolve().parents[1] / "studies" / "museum.toml"
 
 
-def test_a_registered_measure_can_be_a_study_hazard_measure(tmp_path, own_measures):
-    text = STUDY.format(records=DATA / "records", im=HALF)
-    study = spec.validate_text(text, base_dir=tmp_path)
+def _museum_with_hazard_of(im):
+    head = MUSEUM.read_text().split("[hazard]")[0]
+    return head + f'[hazard]\nkind = "power_law"\nk0 = 2e-4\nk = 2.3\nim = "{im}"\nunits = "g"\n'
+
+
+def test_a_registered_measure_can_be_a_study_hazard_measure(own_measures):
+    study = spec.validate_text(_museum_with_hazard_of(HALF), base_dir=MUSEUM.parent)
     curve = study.hazard.curve()
     assert curve.im == HALF
     np.testing.assert_allclose(curve.rate([0.3]), 2e-4 * 0.3**-2.3, rtol=1e-12)
 
 
-def test_an_unknown_hazard_measure_is_named_with_the_allowed_ones(tmp_path, own_measures):
-    text = STUDY.format(records=DATA / "records", im="pga_typo")
+def test_an_unknown_hazard_measure_is_named_with_the_allowed_ones(own_measures):
     with pytest.raises(spec.StudyError) as err:
-        spec.validate_text(text, base_dir=tmp_path)
+        spec.validate_text(_museum_with_hazard_of("pga_typo"), base_dir=MUSEUM.parent)
     problem = next(p for p in err.value.problems if "hazard.im" in p)
     assert "'pga_typo'" in problem
     for name in ("pga", "sa", "pgv", HALF):
