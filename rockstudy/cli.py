@@ -162,9 +162,26 @@ def _read_record(path, units):
         if message != str(exc):
             message += (
                 "; rockstudy simulate reads two columns, time [s] and the horizontal "
-                "acceleration in --units (g, m/s2 or cm/s2)"
+                f"acceleration in --units ({', '.join(_AccelerationUnits())})"
             )
         raise ValueError(message) from None
+
+
+class _AccelerationUnits:
+    """The names ``--units`` takes: the acceleration units of the package's one table of units
+    (:func:`rockstudy.motions.units.acceleration_units`), read when first asked for, so that
+    building the parser does not import the motions package."""
+
+    def _names(self) -> list[str]:
+        from .motions.units import acceleration_units
+
+        return list(acceleration_units())
+
+    def __contains__(self, name) -> bool:
+        return name in self._names()
+
+    def __iter__(self):
+        return iter(self._names())
 
 
 def _peaks_summary(res) -> dict:
@@ -550,7 +567,7 @@ def _add_simulate(sub) -> None:
     )
     sim.add_argument(
         "--units",
-        choices=["g", "m/s2", "cm/s2"],
+        choices=_AccelerationUnits(),
         help="acceleration units of a two-column --record (default: g; a .AT2 file is in g)",
     )
     sim.add_argument("--scale", type=float, help="factor on the record (default: 1)")

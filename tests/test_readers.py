@@ -149,8 +149,9 @@ def test_two_column_units(tmp_path):
     np.testing.assert_allclose(Record.from_csv(path, units="m/s2").acceleration, ACC)
     path.write_text("".join(f"{t} {100 * a}\n" for t, a in zip(TIMES, ACC, strict=True)))
     np.testing.assert_allclose(Record.from_csv(path, units="cm/s2").acceleration, ACC)
+    np.testing.assert_allclose(Record.from_csv(path, units="gal").acceleration, ACC)  # 1 cm/s^2
     with pytest.raises(ValueError, match="units"):
-        Record.from_csv(path, units="gal")
+        Record.from_csv(path, units="cm/s")  # a velocity
 
 
 def test_two_column_errors_name_the_problem(tmp_path):

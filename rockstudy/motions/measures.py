@@ -40,7 +40,7 @@ import numpy as np
 
 from .. import _validate
 from ..constants import STANDARD_GRAVITY
-from . import intensity
+from . import intensity, units
 
 
 @dataclass(frozen=True)
@@ -104,10 +104,11 @@ class Measure:
         except ValueError as exc:
             raise ValueError(f"{exc} (its function must return a real number)") from None
 
-    def quoted_label(self, period=None) -> str:
-        """The label with the quoted unit, e.g. 'PGA [g]' or 'Sa(T = 0.5 s) [g]'."""
+    def quoted_label(self, period=None, unit: str | None = None) -> str:
+        """The label with the quoted unit (or ``unit``, the one its values are shown in),
+        e.g. 'PGA [g]' or 'Sa(T = 0.5 s) [g]'."""
         head = self.label if period is None else f"{self.label}(T = {float(period):.3g} s)"
-        return f"{head} [{self.quoted_unit}]"
+        return f"{head} [{self.quoted_unit if unit is None else unit}]"
 
 
 @dataclass(frozen=True)
@@ -130,44 +131,34 @@ RATIOS = {
     "pgv_ratio": Ratio("pgv", 1, "PGV p / a_up"),
 }
 
-#: Names the designs store beside the measures (a measure may not take them).
-RESERVED = (
-    *RATIOS,
-    "pulse_period",
-    "pulse_amplitude",
-    "pulse_indicator",
-    "pulse_frequency_ratio",
-    "pulse_amplitude_ratio",
-    "scale",
-    "level",
-    "record",
-    "record_name",
-    "structure",
-    "period",
-    "target",
-    "half_diagonal",
-    "slenderness",
-    "restitution",
-    "frequency_parameter",
-    "critical_rotation",
-    "uplift_acceleration",
-    "max_rotation",
-    "overturned",
-    "n_impacts",
-    "overturn_time",
-    "status",
-    "censored",
-    "capacity",
-)
+#: Names a measure may not take: name -> who stores it beside the measures (the dimensionless
+#: scale targets here; the record designs add the variables of their tables when imported,
+#: :func:`reserve_names`).
+RESERVED: dict[str, str] = dict.fromkeys(RATIOS, "the dimensionless scale targets (RATIOS)")
 
-#: Units a target may be written in, per SI unit: name -> factor to SI (``g`` is the standard
-#: gravity, as for records; ``g s`` a velocity, as CAV is often quoted).
-UNIT_ALIASES = {
-    "m/s^2": {"m/s^2": 1.0, "m/s2": 1.0, "g": STANDARD_GRAVITY, "cm/s^2": 0.01, "cm/s2": 0.01},
-    "m/s": {"m/s": 1.0, "cm/s": 0.01, "g s": STANDARD_GRAVITY},
-    "m": {"m": 1.0, "cm": 0.01},
-    "s": {"s": 1.0},
-}
+
+def reserve_names(names, owner: str) -> None:
+    """Reserve ``names`` for ``owner`` (words naming who stores them beside the measures, for
+    the message): :func:`register_measure` then refuses them. Called by the modules that store
+    variables beside the measures (the record designs, at import), which the registry cannot
+    import.
+
+    Raises
+    ------
+    ValueError
+        Naming the measure and ``owner`` if a measure already has one of ``names`` (registered
+        before ``owner`` was imported): its values would be overwritten; nothing is reserved.
+    """
+    names = [_text("names", n) for n in names]
+    taken = [n for n in names if n in MEASURES]
+    if taken:
+        raise ValueError(
+            f"the measure {taken[0]!r} takes a name reserved for {owner}, which store it beside "
+            "the measures (its values would be overwritten): register it under another name"
+        )
+    for n in names:
+        RESERVED.setdefault(n, owner)
+
 
 _NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
 
@@ -191,7 +182,7 @@ def _check_name(name, replace: bool) -> str:
             f"letter, at most 64 characters), got {name!r}"
         )
     if name in RESERVED:
-        raise ValueError(f"name {name!r} is reserved (the designs store it); choose another")
+        raise ValueError(f"name {name!r} is reserved ({RESERVED[name]} store it); choose another")
     if name in MEASURES and not replace:
         raise ValueError(f"name {name!r} is already a measure; give replace=True to redefine it")
     return name
@@ -211,6 +202,28 @@ def _check_unit(unit) -> str:
             f"'m^2/s^4' or 'm^0.5/s' ('1' for none), got {unit!r}"
         )
     return unit
+
+
+def _check_quoted(unit: str, quoted: str, factor: float) -> None:
+    """A ValueError naming ``quoted_unit`` where it is a unit the package knows (a name of
+    :data:`rockstudy.motions.units.UNITS`, or an SI unit) of another dimension than ``unit``,
+    or ``factor`` where it is not that unit's factor from SI."""
+    if quoted in units.UNITS:
+        to_si, si = units.UNITS[quoted]
+    elif _SI_UNIT.match(quoted):
+        to_si, si = 1.0, quoted
+    else:
+        return  # a unit of the measure's own (its factor is the only definition)
+    if units.dimension(si) != units.dimension(unit):
+        raise ValueError(
+            f"quoted_unit {quoted!r} is a unit of {si}, not of the measure's unit {unit!r}: "
+            f"use one of {list(units.aliases(unit))}"
+        )
+    if not math.isclose(factor, 1.0 / to_si, rel_tol=1e-12):
+        raise ValueError(
+            f"factor = {factor!r} is not the factor from {unit} to {quoted!r}: give "
+            f"factor = {1.0 / to_si!r}"
+        )
 
 
 def _check_power(power) -> float:
@@ -255,13 +268,15 @@ def register_measure(
     unit : str
         SI unit of the value, of m, s, kg and rad with non-zero powers, e.g. ``"m/s^2"`` or
         ``"m^2/s^4"`` (``"1"`` for a ratio); a target in a study may then be written in any
-        unit of :data:`UNIT_ALIASES` of it.
+        unit of its dimension in :data:`rockstudy.motions.units.UNITS` (:func:`units_of`).
     power : float
         k >= 0 with IM(s a_g) = abs(s)^k IM(a_g) for the record scaled by s (1 for
         amplitudes, 2 for Arias intensity, 0 for durations: those cannot be scaled to).
     quoted_unit, factor : str, float
         The unit of tables and reports and the factor from SI to it (``"g"`` and
-        ``1 / 9.80665``); default ``unit`` and 1.
+        ``1 / 9.80665``); default ``unit`` and 1. A name of
+        :data:`rockstudy.motions.units.UNITS` (or an SI unit) must be of the dimension of
+        ``unit``, with its factor.
     label : str, optional
         Words for reports, without the unit (default the name with spaces).
     needs_period, needs_damping : bool
@@ -293,6 +308,7 @@ def register_measure(
     if quoted_unit is None and factor != 1.0:
         raise ValueError(f"factor = {factor!r} needs quoted_unit (the unit it converts SI to)")
     quoted = unit if quoted_unit is None else _text("quoted_unit", quoted_unit)
+    _check_quoted(unit, quoted, factor)
     label = name.replace("_", " ") if label is None else _text("label", label)
     measure = Measure(
         name,
@@ -355,9 +371,15 @@ def listed(period: bool) -> tuple[str, ...]:
     return tuple(k for k, m in MEASURES.items() if m.listed and m.needs_period == period)
 
 
+def scalable() -> tuple[str, ...]:
+    """Names of the measures a scale factor changes (power > 0): those a record can be scaled
+    to, and a study's ``[hazard]`` may be of."""
+    return tuple(k for k, m in MEASURES.items() if m.scalable)
+
+
 def scale_targets() -> tuple[str, ...]:
     """Names a record can be scaled to: every measure of power > 0, and :data:`RATIOS`."""
-    return tuple(k for k, m in MEASURES.items() if m.scalable) + tuple(RATIOS)
+    return scalable() + tuple(RATIOS)
 
 
 def target(name: str, argument: str = "im") -> Measure:
@@ -381,11 +403,39 @@ def quoted(name: str) -> tuple[str, float]:
     return m.quoted_unit, m.factor
 
 
-def label(name: str, period=None) -> str:
-    """Label with quoted unit of a measure or a ratio, e.g. 'Sa(T = 0.5 s) [g]'."""
+def label(name: str, period=None, unit: str | None = None) -> str:
+    """Label with quoted unit (or ``unit``, the one its values are shown in) of a measure or
+    a ratio, e.g. 'Sa(T = 0.5 s) [g]'."""
     if name in RATIOS:
         return f"{RATIOS[name].label} [-]"
-    return measure(name).quoted_label(period)
+    return measure(name).quoted_label(period, unit)
+
+
+def units_of(name: str) -> dict[str, float]:
+    """The units a value of the measure or ratio ``name`` may be written in: unit name ->
+    factor to SI, the SI unit first. Those of :data:`rockstudy.motions.units.UNITS` of its
+    dimension and its quoted unit; ``{"1": 1.0}`` for a ratio. Read by a study's
+    ``scale_to`` and by hazard curves alike."""
+    if name in RATIOS:
+        return {"1": 1.0}
+    m = measure(name)
+    out = units.aliases(m.unit)
+    out.setdefault(m.quoted_unit, 1.0 / m.factor)
+    return out
+
+
+def is_acceleration(name: str) -> bool:
+    """Whether the measure ``name`` is an acceleration: its SI unit is of the dimension m s^-2
+    (whatever its name; False for a ratio)."""
+    return name not in RATIOS and units.dimension(measure(name).unit) == units.ACCELERATION
+
+
+def acceleration_units() -> tuple[str, ...]:
+    """Every unit an acceleration may be quoted in: those of the table
+    (:func:`rockstudy.motions.units.acceleration_units`) and the quoted units of the
+    accelerations of the registry (:func:`is_acceleration`)."""
+    quoted = (m.quoted_unit for k, m in MEASURES.items() if is_acceleration(k))
+    return tuple(dict.fromkeys((*units.acceleration_units(), *quoted)))
 
 
 # ------------------------------------------------------------------------------ built-ins

@@ -18,13 +18,15 @@ from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity, measures
 from .base import Motion
 from .pulse_extraction import extract_pulse
+from .units import acceleration_units
 from .wavelet_pulse import extract_wavelet_pulse
 
 #: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
 MAX_RECORD_BYTES = 64 * 2**20
 
-#: Factor to m/s^2 of each acceleration unit; "g" is standard gravity (the PEER convention).
-_UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "m/s^2": 1.0, "cm/s2": 0.01, "cm/s^2": 0.01}
+#: Factor to m/s^2 of each acceleration unit of the package's one table of units
+#: (:mod:`rockstudy.motions.units`); "g" is standard gravity (the PEER convention).
+_UNITS = acceleration_units()
 
 #: A PGA no ground motion reaches [m/s^2] (the largest recorded is about 4 g): a file that
 #: reads above it is in other units than those it was read in (cm/s^2 read as g: 100 times).
@@ -392,8 +394,10 @@ class Record(Motion):
         Parameters
         ----------
         path : path-like
-        units : {"g", "m/s2", "cm/s2"}
-            Units of the acceleration columns (horizontal and vertical alike).
+        units : str
+            Units of the acceleration columns (horizontal and vertical alike): an acceleration
+            of :data:`rockstudy.motions.units.UNITS` (``"g"``, ``"m/s2"`` or ``"m/s^2"``,
+            ``"cm/s2"``, ``"cm/s^2"`` or ``"gal"``).
         delimiter : str, optional
             Column separator; by default commas or white space.
         vertical : path-like, optional

@@ -15,7 +15,7 @@ from ..motions import measures
 from ..motions.records import IMPOSSIBLE_PGA
 from ..warnings import UnitsWarning
 from .readers import read_curve
-from .units import UNIT_FACTORS, units_for
+from .units import to_si, units_for
 
 
 def _positive_increasing(name, values) -> np.ndarray:
@@ -52,9 +52,10 @@ class HazardCurve:
         Mean annual rates of exceeding each level [1/yr]: finite, > 0 and non-increasing,
         one per level; the last two must differ (the curve must fall above its last level).
     units : str, optional
-        The units of ``levels``, one of :data:`UNIT_FACTORS` of the IM's dimension (e.g.
-        ``"g"``, ``"m/s^2"`` or ``"cm/s^2"`` for ``pga``; ``"m/s"`` or ``"cm/s"`` for ``pgv``).
-        Default: the IM's SI unit.
+        The units of ``levels``, one of :func:`rockstudy.motions.measures.units_of` the IM:
+        those of :data:`UNIT_FACTORS` of its dimension (e.g. ``"g"``, ``"m/s^2"``, ``"cm/s^2"``
+        or ``"gal"`` for ``pga``; ``"m/s"``, ``"cm/s"`` or ``"g s"`` for ``pgv``) and its
+        quoted unit. Default: the IM's SI unit.
     period : float, optional
         The period T [s] of a spectral IM (``sa``, ``psv``, ``sd``): required for those,
         refused for the others.
@@ -131,6 +132,11 @@ class HazardCurve:
             f"exceedance {self.rates[0]:.4g} to {self.rates[-1]:.4g} /yr"
         )
 
+    @property
+    def si_factor(self) -> float:
+        """The factor from the curve's :attr:`units` to the SI unit of its IM."""
+        return to_si(self.im, self.units)
+
     def to_si(self) -> HazardCurve:
         """The same curve with its levels in the IM's SI unit (e.g. g -> m/s^2)."""
         return self.to_units(measures.measure(self.im).unit)
@@ -140,7 +146,7 @@ class HazardCurve:
         units = units_for(self.im, units)
         if units == self.units:
             return self
-        factor = UNIT_FACTORS[self.units][0] / UNIT_FACTORS[units][0]
+        factor = self.si_factor / to_si(self.im, units)
         return HazardCurve(
             self.im, self.levels * factor, self.rates, units, self.period, self.source
         )
@@ -199,8 +205,7 @@ class HazardCurve:
         )
         _check_representable(k0, k, x)
         if units is None:
-            si = measures.measure(im).unit
-            choices = sorted(u for u, (_, dim) in UNIT_FACTORS.items() if dim == si)
+            choices = list(measures.units_of(im))
             if len(choices) > 1:
                 raise ValueError(
                     f"units: a power law of {im!r} needs the units of x, since k0 is the rate "
@@ -261,14 +266,14 @@ def _check_plausible(im, levels, units) -> None:
     ground motion (:data:`IMPOSSIBLE_LEVELS`): a curve in cm/s^2 read as g reaches
     hundreds of g."""
     limit = IMPOSSIBLE_LEVELS.get(im)
-    top = float(levels[-1]) * UNIT_FACTORS[units][0]
+    top = float(levels[-1]) * to_si(im, units)
     if limit is None or top <= limit * (1.0 + 1e-9):  # (10 g in cm/s^2 rounds above it)
         return
-    quoted = "g" if UNIT_FACTORS[units][1] == "m/s^2" else UNIT_FACTORS[units][1]
-    shown = "" if units == quoted else f" = {top / UNIT_FACTORS[quoted][0]:.4g} {quoted}"
+    quoted = "g" if measures.is_acceleration(im) else measures.measure(im).unit
+    shown = "" if units == quoted else f" = {top / to_si(im, quoted):.4g} {quoted}"
     raise ValueError(
         f"units: the levels reach {float(levels[-1]):.4g} {units}{shown} of "
-        f"{im}, beyond any ground motion (above {limit / UNIT_FACTORS[quoted][0]:.3g} "
+        f"{im}, beyond any ground motion (above {limit / to_si(im, quoted):.3g} "
         f"{quoted}): are they in other units (cm/s^2 or gal read as g, cm/s as m/s)? give "
         "the units the levels are in"
     )
@@ -300,17 +305,20 @@ def level_at_rate(levels, rates, rate: float) -> float:
 
 
 def _check_design_level(im, levels, rates, units) -> None:
-    """For a curve of acceleration (its measure's unit is m/s^2 in the registry): a ValueError
-    naming ``units`` where its 475-year level lies where no site's does
-    (:data:`DESIGN_LEVEL_BOUNDS`), a :class:`~rockstudy.warnings.UnitsWarning` where few do."""
-    m = measures.measure(im)
-    if m.unit != "m/s^2":
+    """For a curve of acceleration (:func:`rockstudy.motions.measures.is_acceleration`, by its
+    measure's unit in the registry): a ValueError naming ``units`` where its 475-year level
+    lies where no site's does (:data:`DESIGN_LEVEL_BOUNDS`), a
+    :class:`~rockstudy.warnings.UnitsWarning` where few do."""
+    if not measures.is_acceleration(im):
         return
-    x = level_at_rate(levels, rates, DESIGN_RATE) * UNIT_FACTORS[units][0] / STANDARD_GRAVITY
+    factor = to_si(im, units)
+    x = level_at_rate(levels, rates, DESIGN_RATE) * factor / STANDARD_GRAVITY
     if not math.isfinite(x):
         return
-    refuse_low, warn_low, warn_high, refuse_high = DESIGN_LEVEL_BOUNDS[m.needs_period]
-    shown = f"{x * STANDARD_GRAVITY / UNIT_FACTORS[units][0]:.4g} {units}"
+    refuse_low, warn_low, warn_high, refuse_high = DESIGN_LEVEL_BOUNDS[
+        measures.measure(im).needs_period
+    ]
+    shown = f"{x * STANDARD_GRAVITY / factor:.4g} {units}"
     shown += "" if units == "g" else f" = {x:.3g} g"
     said = f"units: the curve reaches its 475-year rate (1/475 per year) at {shown} of {im}"
     if x < refuse_low or x > refuse_high:
@@ -374,7 +382,7 @@ def suite_off_curve(curve: HazardCurve, values) -> str | None:
     low, high = RECORD_RATES
     if low <= rate <= high:
         return None
-    factor = UNIT_FACTORS[curve.units][0]
+    factor = curve.si_factor
     shown = f"{values.min() / factor:.3g} to {values.max() / factor:.3g} {curve.units}"
     where = "beyond its million-year level" if rate < low else "more often than every other year"
     return (

@@ -9,7 +9,7 @@ from scipy.special import log_ndtr, ndtr
 
 from .. import _validate
 from .curves import LOG_HUGE, HazardCurve, _slopes
-from .units import UNIT_FACTORS, units_for
+from .units import to_si, units_for
 
 #: The largest dispersion beta of a fragility: ln C of a capacity C spread by more than 10
 #: (its 16-84 % range a factor e^20, about 5e8) says nothing of an object, and beyond it
@@ -31,7 +31,7 @@ def _fragility(median, dispersion, hazard, units):
         lambda a: (a >= 0.0) & (a <= MAX_DISPERSION),
         f"finite and in [0, {MAX_DISPERSION:g}]",
     )
-    factor = UNIT_FACTORS[units][0] / UNIT_FACTORS[hazard.units][0]
+    factor = to_si(hazard.im, units) / to_si(hazard.im, hazard.units)
     return _broadcast(median=np.log(med) + np.log(factor), dispersion=beta)
 
 
@@ -131,7 +131,7 @@ def _threshold(threshold, units, hazard):
         return None
     units = units_for(hazard.im, hazard.units if units is None else units)
     x_u = _array("threshold", threshold, lambda a: a > 0.0, f"finite and > 0 (in {units})")
-    factor = UNIT_FACTORS[units][0] / UNIT_FACTORS[hazard.units][0]
+    factor = to_si(hazard.im, units) / to_si(hazard.im, hazard.units)
     return np.log(x_u) + np.log(factor)
 
 

@@ -18,7 +18,6 @@ import numpy as np
 from .. import _validate
 from ..motions import measures
 from ..motions.records import read_text_file
-from .units import UNIT_FACTORS
 
 #: OpenQuake's IMT names -> (rockstudy IM, the unit OpenQuake gives its levels in).
 OPENQUAKE_IMTS = {
@@ -110,10 +109,11 @@ def _check_header_units(path, header, im, units) -> None:
             "column)"
         )
     stated = next((u for u, pattern in _HEADER_UNITS if re.search(pattern, name)), None)
-    given = measures.measure(im).unit if units is None else units
-    if stated is None or stated not in UNIT_FACTORS or given not in UNIT_FACTORS:
+    allowed = measures.units_of(im)  # name -> factor to SI, the SI unit first
+    given = next(iter(allowed)) if units is None else units
+    if stated is None or given not in allowed:
         return
-    if UNIT_FACTORS[stated] != UNIT_FACTORS[given]:
+    if allowed.get(stated) != allowed[given]:
         raise ValueError(
             f"units: {path.name}, line {n}: the level column's name states it in {stated}, "
             f"but the levels are read in {given!r}; give units = {stated!r} (or rename the "
@@ -268,7 +268,8 @@ def _from_openquake(cls, path, lines, im, units, period, site):
     _check_period(period, imt, file_period, path)
     levels, poe, i, n = _site_row(path, lines, site)
     first, keep = _certain_and_impossible(path, levels, poe, f"line {n}, site {i}")
-    if units is not None and UNIT_FACTORS.get(units) != UNIT_FACTORS[oq_units]:
+    allowed = measures.units_of(oq_im)
+    if units is not None and allowed.get(units) != allowed[oq_units]:
         raise ValueError(
             f"units: OpenQuake writes the levels of {imt} in {oq_units}, so {path.name} is "
             f"read in {oq_units}, not {units!r}; leave units out (or give {oq_units!r})"

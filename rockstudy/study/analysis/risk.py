@@ -57,6 +57,7 @@ import xarray as xr
 
 from ... import _validate, risk
 from ...constants import G
+from ...risk.units import to_si
 from ...warnings import UnitsWarning
 from . import record_fragility as rf
 from .fragility_fit import (
@@ -156,13 +157,13 @@ def _uplift(ds, hazard):
         return np.full(n, np.nan)
     if "uplift_acceleration" in ds.variables:
         level = ds["uplift_acceleration"].transpose("structure").values.astype(float)
-        return level / risk.UNIT_FACTORS[hazard.units][0]
+        return level / hazard.si_factor
     if not {"pga", "pga_ratio"} <= set(ds.variables):
         return np.full(n, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         level = (ds["pga"] / ds["pga_ratio"]).transpose("structure", ...).values.reshape(n, -1)
         level = np.nanmedian(np.where(np.isfinite(level) & (level > 0), level, np.nan), axis=1)
-    return level / risk.UNIT_FACTORS[hazard.units][0]
+    return level / hazard.si_factor
 
 
 def share_below(theta, beta, hazard, level, units=None) -> float:
@@ -172,7 +173,7 @@ def share_below(theta, beta, hazard, level, units=None) -> float:
     if not (np.isfinite(level) and level > 0 and np.isfinite(theta) and np.isfinite(beta)):
         return np.nan
     whole = risk.annual_rate(theta, beta, hazard, units)
-    factor = risk.UNIT_FACTORS[hazard.units][0] / risk.UNIT_FACTORS[units or hazard.units][0]
+    factor = hazard.si_factor / to_si(hazard.im, units or hazard.units)
     above = risk.annual_rate(theta, beta, hazard, units, threshold=level * factor)
     return float(1.0 - above / whole) if whole > 0 else np.nan
 
@@ -203,7 +204,7 @@ def cut_levels(ds, im, units, uplift):
     level = uplift
     if "critical_rotation" in ds:
         lifts = G * np.tan(ds["critical_rotation"].transpose("structure").values.astype(float))
-        level = np.fmin(uplift, lifts / risk.UNIT_FACTORS[units][0])
+        level = np.fmin(uplift, lifts / to_si(im, units))
     return np.where(np.isfinite(level) & (level > 0), level, np.nan)
 
 
@@ -359,7 +360,7 @@ def object_risk(
     n_rec = ds.sizes["record"]
     rng = bootstrap_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
-    to_hazard = risk.UNIT_FACTORS[unit][0] / risk.UNIT_FACTORS[hazard.units][0]
+    to_hazard = to_si(im, unit) / hazard.si_factor
     uplift = _uplift(ds, hazard)
     level = cut_levels(ds, hazard.im, hazard.units, uplift)
     # an overturning seen below that level (which the physics forbids): the data and the cut

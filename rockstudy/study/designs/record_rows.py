@@ -513,3 +513,37 @@ def scale_factors(study, record, cols, idx) -> np.ndarray:
     }
     measure = rd._record_measure(record, t.im, t.period, t.damping, structures)
     return rd._scale_for(cols["target"][idx], measure, t.im)
+
+
+#: Coordinates and variables of a record design's Dataset outside the tables above.
+OTHER_VARIABLES = (
+    "record",
+    "record_name",
+    "structure",
+    "level",
+    "level_index",
+    "period",
+    "step",
+    "scale",
+    "target",
+    "status",
+    "kernel_status",
+    "censored",
+    "vertical_component",
+    "error",
+)
+
+# the names of the tables above cannot be a measure's (they are stored beside the measures)
+measures.reserve_names(
+    (
+        *PULSE_VARIABLES,
+        *GROUP_VARIABLES,
+        *STRUCTURE_VARIABLES,
+        *_RUN,
+        *_IDA,
+        *CONTACT_VARIABLES,
+        *_STEPS,
+        *OTHER_VARIABLES,
+    ),
+    "the record designs",
+)

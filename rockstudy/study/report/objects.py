@@ -19,6 +19,7 @@ import pandas as pd
 import xarray as xr
 
 from ...constants import STANDARD_GRAVITY
+from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL, N_BOOT
@@ -111,8 +112,12 @@ class ReportContext:
         return object_colors(self.ds["structure"].values)
 
     def relabel(self, label: str) -> str:
-        """An :func:`im_label` in the report's acceleration units."""
-        return label.replace(" [g]", " [m/s^2]") if self.units == "m/s^2" else label
+        """An :func:`im_label` in the report's acceleration units: the unit of an acceleration
+        (any of :func:`rockstudy.motions.measures.acceleration_units`) read as the report's,
+        as :func:`quoted_to_report` converts its values."""
+        for unit in _ms.acceleration_units():
+            label = label.replace(f" [{unit}]", f" [{self.units}]")
+        return label
 
     text = staticmethod(_mpl_text)  # a name from a file, as matplotlib text
     log_ticks = staticmethod(_log_ticks)
@@ -226,10 +231,14 @@ def _unit(ctx) -> float:
 
 def quoted_to_report(units, im) -> float:
     """The factor from the quoted unit of ``im`` (the registry's, :func:`rf.quoted`: what the
-    fits give) to a report's: a measure quoted in g is shown in the report's acceleration
+    fits give) to a report's: an acceleration (by its unit in the registry,
+    :func:`rockstudy.motions.measures.is_acceleration`) is shown in the report's acceleration
     ``units`` (g or m/s^2, as :meth:`ReportContext.relabel` labels it); any other measure in
     its quoted unit."""
-    return STANDARD_GRAVITY if rf.quoted(im)[0] == "g" and units == "m/s^2" else 1.0
+    if im not in _ms.MEASURES or not _ms.is_acceleration(im):
+        return 1.0
+    to_si = _ms.units_of(im)
+    return to_si[rf.quoted(im)[0]] / to_si[units]
 
 
 def si_to_report(units, im) -> float:

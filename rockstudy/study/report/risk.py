@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 from scipy import special
 
-from ... import risk
+from ...motions import measures
 from ..analysis.risk import object_risk, records_measure
 from ._page import _log_ticks, _mpl_text, _plt, object_colors
 
@@ -208,19 +208,20 @@ def _risk(page, ds, hazard, years, im_label, n_boot):
         show=terms,
     )
     _probability_bars(page, out)
-    _hazard_figure(page, ds, hazard, out, im_label)
-    _deaggregation_figure(page, out, im_label)
+    _hazard_figure(page, ds, hazard, out)
+    _deaggregation_figure(page, out)
     return out
 
 
-def _hazard_figure(page, ds, hazard, out, im_label):
-    """The hazard curve as it was read, with the records' own (unscaled) intensities and each
-    object's uplift level on it: a curve read in the wrong units shows far from both."""
+def _hazard_figure(page, ds, hazard, out):
+    """The hazard curve as it was read (in its units), with the records' own (unscaled)
+    intensities and each object's uplift level on it: a curve read in the wrong units shows
+    far from both."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.loglog(hazard.levels, hazard.rates, "o-", ms=3, color="k", label="hazard curve, as read")
     ax.axhline(1 / 475, color="0.5", ls="--", lw=1, label="1/475 per year")
-    on_records = records_measure(ds, hazard) / risk.UNIT_FACTORS[hazard.units][0]
+    on_records = records_measure(ds, hazard) / hazard.si_factor
     if on_records.size:
         ax.plot(
             on_records,
@@ -240,7 +241,7 @@ def _hazard_figure(page, ds, hazard, out, im_label):
                 lw=1,
                 label="uplift level of each object" if j == 0 else None,
             )
-    ax.set_xlabel(im_label(hazard.im, hazard.period), fontsize=10)
+    ax.set_xlabel(measures.label(hazard.im, hazard.period, hazard.units), fontsize=10)
     ax.set_ylabel("annual rate of exceedance [1/yr]", fontsize=10)
     ax.tick_params(labelsize=9)
     ax.legend(fontsize=8, loc="lower left")
@@ -298,8 +299,9 @@ def _probability_bars(page, out):
     )
 
 
-def _deaggregation_figure(page, out, im_label):
-    """One line per object: the share of lambda_OT from each interval of the hazard's levels."""
+def _deaggregation_figure(page, out):
+    """One line per object: the share of lambda_OT from each interval of the hazard's levels
+    (in its units)."""
     fitted = np.isfinite(out["annual_rate"].values)
     if not fitted.any():
         page.text("No object has an annual rate: no deaggregation to show.")
@@ -318,7 +320,7 @@ def _deaggregation_figure(page, out, im_label):
         if np.isfinite(out["uplift"].values[j]):
             ax.axvline(out["uplift"].values[j], color=line.get_color(), ls=":", lw=1)
     ax.set_xscale("log")
-    label = im_label(out.attrs["im"], out.attrs.get("period"))
+    label = measures.label(out.attrs["im"], out.attrs.get("period"), out.attrs["units"])
     ax.set_xlabel(f"{label}, interval centre", fontsize=10)
     ax.set_ylabel("share of lambda_OT per unit of ln x", fontsize=10)
     ax.tick_params(labelsize=9)

@@ -681,10 +681,11 @@ def _contact(page, ds, study):
 
 def _acceleration_units(study) -> str:
     """The units of a record study's report accelerations: those of ``scale_to.units`` for
-    a target the registry quotes in g (g, else m/s^2), g otherwise."""
+    a target the registry says is an acceleration (g, else m/s^2), g otherwise."""
     target = getattr(study.motion, "scale_to", None)
-    measure = None if target is None else measures.MEASURES.get(target.im)
-    if measure is None or measure.quoted_unit != "g":
+    if target is None or target.im not in measures.MEASURES:
+        return "g"
+    if not measures.is_acceleration(target.im):
         return "g"
     return "g" if target.unit_label == "g" else "m/s^2"
 

@@ -6,19 +6,25 @@ before the study is validated (``_read_hazard_file``), so a stored study keeps i
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import AfterValidator, Field, model_validator
 
+from ...motions import measures
 from ...risk import MAX_YEARS
 from .parameters import _describe, _Model, _Period
 from .structures import FieldError
 
-__all__ = ["HAZARD_MEASURES", "HazardSpec"]
+__all__ = ["HazardSpec"]
 
 
-#: Measures a ``[hazard]`` curve may be of: those a record design stores for every record.
-HAZARD_MEASURES = ("pga", "pgv", "pgd", "arias", "cav", "spectrum_intensity", "sa", "psv", "sd")
+def _hazard_im(name: str) -> str:
+    """A measure a ``[hazard]`` curve may be of: one of the registry's measures of power > 0
+    (:func:`rockstudy.motions.measures.scalable`, read when the study is validated, so a
+    measure registered after import is one), or a ValueError listing them."""
+    if name not in measures.scalable():
+        raise ValueError(f"must be one of {list(measures.scalable())}, got {name!r}")
+    return name
 
 
 class HazardSpec(_Model):
@@ -30,14 +36,15 @@ class HazardSpec(_Model):
     exceedance) or an OpenQuake hazard-curve CSV (:meth:`rockstudy.risk.HazardCurve.from_csv`).
     The file is read when the study is validated: its levels and rates are then part of the
     study (``levels``, ``rates``: not to be given by hand), so a stored result keeps the curve
-    it was reported with. ``im`` is the measure (one of :data:`HAZARD_MEASURES`; ``sa``,
-    ``psv`` and ``sd`` at a ``period`` [s] the design stores), ``units`` the units of its
-    levels (:data:`rockstudy.risk.UNIT_FACTORS`; default the IM's SI unit, or OpenQuake's
-    for its files) and ``years`` the exposure time of the probability reported (default 50).
+    it was reported with. ``im`` is the measure (a measure of the registry of power > 0, a
+    registered one too; ``sa``, ``psv`` and ``sd`` at a ``period`` [s] the design stores),
+    ``units`` the units of its levels (:func:`rockstudy.motions.measures.units_of` the
+    measure; default the IM's SI unit, or OpenQuake's for its files) and ``years`` the
+    exposure time of the probability reported (default 50).
     """
 
     kind: Literal["power_law", "file"]
-    im: Literal[HAZARD_MEASURES]
+    im: Annotated[str, AfterValidator(_hazard_im)]
     units: str | None = None
     period: _Period | None = None
     years: float = Field(default=50.0, gt=0, le=MAX_YEARS)
@@ -107,7 +114,7 @@ def _read_hazard_file(data, base_dir) -> str | None:
 
     args = {k: hz.get(k) for k in ("im", "units", "period")}
     plain = all(v is None or isinstance(v, str | float | int) for v in args.values())
-    if args["im"] not in HAZARD_MEASURES or not plain:
+    if args["im"] not in measures.scalable() or not plain:
         return None  # the schema names the bad field; the file is read once it is right
     path = record_path(name, base_dir)
     try:

@@ -19,6 +19,7 @@ from pydantic import AfterValidator, Field, field_validator, model_validator
 from ... import _validate
 from ...motions import measures
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
+from ...motions.units import acceleration_units
 from .feasibility import draw_span as _draw_span
 from .parameters import (
     _RATIO_LABEL,
@@ -39,6 +40,7 @@ __all__ = [
     "HVPair",
     "MotionSpec",
     "PulseSpec",
+    "RECORD_UNITS",
     "RecordSpec",
     "ScaleIM",
     "ScaleTo",
@@ -147,14 +149,10 @@ def _check_period(im, period, field):
 
 def scale_units(im: str) -> dict:
     """Units a target of ``im`` may be written in: name -> factor to SI, the SI unit first
-    (:data:`rockstudy.motions.measures.UNIT_ALIASES` of its SI unit, and its quoted unit;
-    ``g`` is the standard gravity 9.80665 m/s^2, as for records); ``1`` for a ratio."""
-    if im in measures.RATIOS:
-        return {"1": 1.0}
-    m = measures.measure(im)
-    out = {m.unit: 1.0, **measures.UNIT_ALIASES.get(m.unit, {})}
-    out.setdefault(m.quoted_unit, 1.0 / m.factor)
-    return out
+    (:func:`rockstudy.motions.measures.units_of`: the units of its dimension, as for hazard
+    curves, and its quoted unit; ``g`` is the standard gravity 9.80665 m/s^2, as for
+    records); ``1`` for a ratio."""
+    return measures.units_of(im)
 
 
 class ScaleTo(_Model):
@@ -222,6 +220,11 @@ class VerticalRule(_Model):
         return value
 
 
+#: Units of a text record's acceleration column: those of an acceleration in the package's one
+#: table of units (:func:`rockstudy.motions.units.acceleration_units`).
+RECORD_UNITS = tuple(acceleration_units())
+
+
 class RecordSpec(_Model):
     """Recorded motions: a suite of record files, each scaled, or left unscaled in a design.
 
@@ -233,8 +236,9 @@ class RecordSpec(_Model):
     ``pga_ratio`` x a_up (the structure's uplift acceleration: g tan(alpha) of a block, g lambda
     of another structure, eq. 10 of [003]), or to ``scale_to``; a ``[design]`` runs every record.
 
-    ``units`` is the unit of the acceleration column of text records (``g``, ``m/s2`` or
-    ``m/s^2``, ``cm/s2`` or ``cm/s^2``); ``.AT2`` files are in g (PEER's format), and a
+    ``units`` is the unit of the acceleration column of text records (one of
+    :data:`RECORD_UNITS`: ``g``, ``m/s2`` or ``m/s^2``, ``cm/s2``, ``cm/s^2`` or ``gal``);
+    ``.AT2`` files are in g (PEER's format), and a
     suite of ``.AT2`` files alone with other units is refused.
 
     A path is absolute as written, or relative to the study file's folder (never to the
@@ -245,7 +249,7 @@ class RecordSpec(_Model):
     kind: Literal["record"]
     files: Annotated[str, Field(min_length=1)] | Annotated[list[str | HVPair], Field(min_length=1)]
     vertical: list[str] | VerticalRule | None = None
-    units: Literal["g", "m/s2", "m/s^2", "cm/s2", "cm/s^2"] = "g"
+    units: Literal[RECORD_UNITS] = "g"
     scale: Param | None = None
     pga_ratio: Param | None = None
     scale_to: ScaleTo | None = None

@@ -54,7 +54,7 @@ from ...dynamics.simulate import MAX_FRICTION
 from .design_spec import DesignSpec
 from .distributions import Distribution
 from .feasibility import notes, problems
-from .hazard_spec import HAZARD_MEASURES, HazardSpec, _read_hazard_file
+from .hazard_spec import HazardSpec, _read_hazard_file
 from .ida_options import IdaOptionError
 from .messages import _format_errors
 from .motion_spec import (
@@ -86,7 +86,6 @@ from .study_model import MAX_CHUNK_SIZE, Study, json_schema
 
 __all__ = [
     "CONTACT_OUTPUTS",
-    "HAZARD_MEASURES",
     "HOUSNER_MAX_SLENDERNESS",
     "MAX_CHUNK_SIZE",
     "MAX_DEPTH",

@@ -20,6 +20,7 @@ from pydantic import BaseModel, Field, PrivateAttr, field_validator, model_valid
 from ... import _validate
 from ...constants import G
 from ...dynamics.simulate import MAX_FRICTION
+from ...motions import measures
 from ...motions.pulses import PERIOD_RANGE
 from ...structures.block import uplift_acceleration_block
 from .design_spec import DesignSpec
@@ -202,7 +203,7 @@ class Study(_Model):
                 "it integrates is fitted per structure over records, which a Monte Carlo "
                 "or Sobol study does not have",
             )
-        if hz.im in ("sa", "psv", "sd"):
+        if measures.measure(hz.im).needs_period:
             stored = set(de.periods) | {de.period}
             if self.motion.kind == "record" and self.motion.scale_to is not None:
                 stored.add(self.motion.scale_to.period)
