@@ -259,6 +259,19 @@ def test_initiation_from_rest_follows_shenton(a_over_g, mu, expected):
         assert r.info["regime_sequence"][1][0] == 0.0 and r.max_rotation > 0.0
 
 
+def test_rest_ends_where_the_regime_test_says_so_to_the_last_bit():
+    """The solver leaves rest where |a_h| - min(mu_s, tan alpha) (g + a_v) > 0; the regime
+    it then enters must not be rest again, or the run stalls at that time (a ratio test
+    |a_h| / (g + a_v) <= mu disagrees within an ulp). Values an ulp or two around mu g_e."""
+    rng = np.random.default_rng(0)
+    for _ in range(20000):
+        mu, a_v = rng.uniform(0.05, 0.2), rng.uniform(-3, 3)
+        a = np.nextafter(mu * (G + a_v), np.inf) * (1 + rng.integers(-2, 3) * 2.2e-16)
+        leaves = abs(a) - mu * (G + a_v) > 0.0
+        regime, _ = sr.initiation_regime(a, a_v, mu, mu, R, ALPHA)
+        assert (regime != sr.REST) == leaves
+
+
 # ---------------------------------------------------------------- equations and impacts
 
 

@@ -173,11 +173,11 @@ def initiation_regime(a_h, a_v, static, kinetic, radius, slenderness):
     (``|F|`` <= mu_s N), else slide if mu_k <= tan(alpha) (the friction's resultant stays
     inside the base), else slide-rock. Returns (regime, side or slip direction
     -sign(a_h))."""
-    ratio, tan = abs(a_h) / (G + a_v), math.tan(slenderness)
+    tan = math.tan(slenderness)
     side = -1.0 if a_h > 0.0 else 1.0
-    if ratio <= min(static, tan):
+    if abs(a_h) <= min(static, tan) * (G + a_v):  # the solvers' rest test, to the last bit
         return REST, side
-    if ratio <= tan:
+    if abs(a_h) <= tan * (G + a_v):
         return SLIDE, side
     acc = rocking_acceleration(0.0, a_h, a_v, side, radius, slenderness)
     f_h, f_v = contact_forces(0.0, 0.0, acc, 0.0, a_h, a_v, side, radius, slenderness)

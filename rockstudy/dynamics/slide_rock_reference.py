@@ -66,6 +66,7 @@ class _Log:
         self.sequence, self.impact_losses = [], []
 
     def row(self, t, theta, theta_dot, u):
+        """A history row; the peaks of |theta| and |u| follow it."""
         self.t.append(t), self.theta.append(theta), self.theta_dot.append(theta_dot)
         self.u.append(u)
         self.max_theta = max(self.max_theta, abs(theta))
@@ -77,6 +78,7 @@ class _Log:
         self.impact_losses.append(energy)
 
     def spent(self, regime, t0, t1):
+        """[t0, t1] spent in ``regime`` (and the first slip, if it slips)."""
         self.times[sr.REGIMES[regime]] += float(t1 - t0)
         if not self.sequence or self.sequence[-1][1] != sr.REGIMES[regime]:
             self.sequence.append((float(t0), sr.REGIMES[regime]))
@@ -204,6 +206,8 @@ def _atol(scene, n):
 
 
 def _solve(scene, rhs, t0, t1, y0, events):
+    """One phase by ``solve_ivp`` from t0 to t1 [s] with the phase's events; a failed solve
+    raises RuntimeError."""
     sol = solve_ivp(
         rhs,
         (t0, t1),
@@ -260,7 +264,7 @@ def _leave_rest(scene, log, st):
     the motion's end)."""
     c = min(scene.static, math.tan(scene.alpha))
 
-    def leaves(t):
+    def leaves(t):  # > 0 exactly where initiation_regime is not rest
         a_h, a_v = scene.ground(t)
         return abs(a_h) - c * (G + a_v)
 
@@ -378,6 +382,9 @@ def _flight_slip(scene, y, side):
 
 
 def _flight_rhs(scene):
+    """d/dt of the flight state: the centre of mass falls freely in the ground's frame
+    (x_G'' = -u_h'', y_G'' = -(g + u_v'')), theta_dot is constant; the ground's work."""
+
     def rhs(t, y):
         a_h, a_v = scene.ground(t)
         return [y[3], y[4], y[5], -a_h, -(G + a_v), 0.0, -a_h * y[3] - a_v * y[4], 0.0]
@@ -546,6 +553,7 @@ def simulate_contact_reference(
 
 
 def _pack(scene, log, st, overturned, initial):
+    """The result dict of a run (see :func:`simulate_contact_reference`)."""
     u = np.asarray(log.u)
     energy = {**_energy(scene, st), "impact_losses": log.losses}
     energy["kinetic"] -= initial["kinetic"]
