@@ -270,6 +270,11 @@ def test_rest_ends_where_the_regime_test_says_so_to_the_last_bit():
         leaves = abs(a) - mu * (G + a_v) > 0.0
         regime, _ = sr.initiation_regime(a, a_v, mu, mu, R, ALPHA)
         assert (regime != sr.REST) == leaves
+        # above tan alpha the test is the rocking equation's: a block said to lift rises
+        tan = math.tan(ALPHA) * (G + a_v) * (1 + rng.integers(-2, 3) * 2.2e-16)
+        regime, side = sr.initiation_regime(tan, a_v, 0.5, 0.5, R, ALPHA)
+        rises = side * sr.rocking_acceleration(0.0, tan, a_v, side, R, ALPHA) > 0.0
+        assert (regime != sr.REST) == rises
 
 
 # ---------------------------------------------------------------- equations and impacts

@@ -166,18 +166,30 @@ def slide_rock_threshold(friction, slenderness):
     return math.inf if den <= 0.0 else (friction * (1.0 + 3.0 * c * c) - 3.0 * s * c) / den
 
 
+def leaves_rest(a_h, a_v, static, radius, slenderness):
+    """> 0 exactly where a block at rest under the ground (a_h, a_v) [m/s^2] leaves rest:
+    ``|a_h|`` - mu_s (g + a_v) where mu_s < tan(alpha) (it slides first), else s theta'' of
+    Housner's equation at theta = 0 on the side s = -sign(a_h) it is pushed to (the rocking
+    kernels' lift test, :func:`._rhs._lift`: a block said to lift does rise, to the last
+    bit)."""
+    if static < math.tan(slenderness):
+        return abs(a_h) - static * (G + a_v)
+    side = -1.0 if a_h > 0.0 else 1.0
+    return side * rocking_acceleration(0.0, a_h, a_v, side, radius, slenderness)
+
+
 def initiation_regime(a_h, a_v, static, kinetic, radius, slenderness):
     """The regime a block at rest (or stopping, slip velocity 0, theta = 0) enters under the
     ground (a_h, a_v) [m/s^2] (Shenton 1996): rest while ``|a_h|`` / g_e <= min(mu_s,
-    tan alpha); otherwise rock if the rocking forces at uplift stay inside the cone
-    (``|F|`` <= mu_s N), else slide if mu_k <= tan(alpha) (the friction's resultant stays
-    inside the base), else slide-rock. Returns (regime, side or slip direction
-    -sign(a_h))."""
+    tan alpha) (:func:`leaves_rest`, to the last bit); otherwise rock if the rocking forces
+    at uplift stay inside the cone (``|F|`` <= mu_s N), else slide if mu_k <= tan(alpha)
+    (the friction's resultant stays inside the base), else slide-rock. Returns (regime, side
+    or slip direction -sign(a_h))."""
     tan = math.tan(slenderness)
     side = -1.0 if a_h > 0.0 else 1.0
-    if abs(a_h) <= min(static, tan) * (G + a_v):  # the solvers' rest test, to the last bit
+    if not leaves_rest(a_h, a_v, static, radius, slenderness) > 0.0:
         return REST, side
-    if abs(a_h) <= tan * (G + a_v):
+    if static < tan and abs(a_h) <= tan * (G + a_v):
         return SLIDE, side
     acc = rocking_acceleration(0.0, a_h, a_v, side, radius, slenderness)
     f_h, f_v = contact_forces(0.0, 0.0, acc, 0.0, a_h, a_v, side, radius, slenderness)

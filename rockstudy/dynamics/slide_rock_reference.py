@@ -262,11 +262,10 @@ def _leave_rest(scene, log, st):
     """From rest at st.t: the next time the block leaves rest and its regime there; False
     where it rests to the end of the motion (the history then ends at the later of st.t and
     the motion's end)."""
-    c = min(scene.static, math.tan(scene.alpha))
 
     def leaves(t):  # > 0 exactly where initiation_regime is not rest
         a_h, a_v = scene.ground(t)
-        return abs(a_h) - c * (G + a_v)
+        return sr.leaves_rest(a_h, a_v, scene.static, scene.radius, scene.alpha)
 
     t_up = _uplift_time(leaves, st.t, scene.dur, scene.grid)
     if t_up >= min(scene.dur, scene.t_end):
