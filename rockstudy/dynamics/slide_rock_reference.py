@@ -19,6 +19,7 @@ import warnings
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from .._warnings import IncompleteReferenceWarning
 from ..constants import FALL_ROTATION, G
@@ -130,8 +131,9 @@ def _forces(scene, regime, side, slip, t, y):
 def _contact_events(scene, regime, side, slip, t0):
     """The events of a contact regime (terminal unless said): impact (s theta down through 0,
     taken positive at t0), fall (s theta = pi/2), stick (sigma u' down through 0), slip
-    (mu_s N -+ F down through 0), lift-off (N down through 0) and peaks (s theta', not
-    terminal)."""
+    (mu_s N -+ F down through 0), lift-off (N down through 0), peaks (s theta', not
+    terminal) and troughs (s theta' up through 0, where :func:`_dip` looks for a hop
+    through theta = 0 inside one step)."""
 
     def impact(t, y):
         return side * y[1] if t > t0 else 1.0
@@ -156,16 +158,40 @@ def _contact_events(scene, regime, side, slip, t0):
     def peak(t, y):
         return side * y[3]
 
+    def trough(t, y):
+        return side * y[3] if t > t0 else 1.0
+
     events = {"impact": impact, "fall": fall, "stick": stick, "slip+": slip_pos}
-    events.update({"slip-": slip_neg, "lift": lift, "peak": peak})
+    events.update({"slip-": slip_neg, "lift": lift, "peak": peak, "trough": trough})
     for name, event in events.items():
-        event.terminal, event.direction = name != "peak", -1 if name != "fall" else 1
+        event.terminal = name != "peak"
+        event.direction = 1 if name in ("fall", "trough") else -1
     wanted = {
         sr.SLIDE: ("stick",),
-        sr.ROCK: ("impact", "fall", "slip+", "slip-", "lift", "peak"),
-        sr.SLIDE_ROCK: ("impact", "fall", "stick", "lift", "peak"),
+        sr.ROCK: ("impact", "fall", "slip+", "slip-", "lift", "peak", "trough"),
+        sr.SLIDE_ROCK: ("impact", "fall", "stick", "lift", "peak", "trough"),
     }[regime]
     return wanted, [events[name] for name in wanted]
+
+
+#: Points of each step at which :func:`_dip` looks for s theta < 0 (as the rocking reference).
+HOP_POINTS = 8
+
+
+def _dip(sol, side, t0, t_end):
+    """The first time in (t0, t_end] at which s theta < 0 on the dense output, at
+    :data:`HOP_POINTS` a step, located by Brent's method; None if there is none. A hop down
+    through theta = 0 and up again inside one step changes the sign of s theta at no step's
+    end, where scipy's impact event looks."""
+    a, b = sol.t[:-1], sol.t[1:]
+    pts = (a[:, None] + (b - a)[:, None] * (np.arange(1, HOP_POINTS + 1) / HOP_POINTS)).ravel()
+    pts = pts[pts <= t_end]
+    below = np.flatnonzero(side * sol.sol(pts)[1] < 0.0) if pts.size else pts
+    if not below.size:
+        return None
+    k = int(below[0])
+    lo = float(pts[k - 1]) if k > 0 else t0
+    return brentq(lambda t: side * sol.sol(t)[1], lo, float(pts[k]), xtol=1e-15)
 
 
 def _first_event(sol, names):
@@ -216,6 +242,7 @@ def _solve(scene, rhs, t0, t1, y0, events):
         rtol=_rtol(scene, len(y0)),
         atol=_atol(scene, len(y0)),
         events=events,
+        dense_output=True,
     )
     if sol.status < 0:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
@@ -293,6 +320,10 @@ def _contact_phase(scene, log, st):
     sol = _solve(scene, _contact_rhs(scene, regime, side, slip), st.t, stop, st.y, events)
     hit = _first_event(sol, names)
     t1 = stop if hit is None else hit[1]
+    if regime != sr.SLIDE and (hit is None or hit[0] != "impact"):
+        t_dip = _dip(sol, side, st.t, t1)
+        if t_dip is not None:
+            hit, t1 = ("impact", t_dip, sol.sol(t_dip)), t_dip
     _log_solve(log, sol, t1, lambda y: (float(y[1]), float(y[3]), float(y[0])))
     log.spent(regime, st.t, t1)
     if hit is None:
@@ -309,6 +340,8 @@ def _contact_phase(scene, log, st):
         _impact(scene, log, st)
         return "on"
     log.row(st.t, float(st.y[1]), float(st.y[3]), float(st.y[0]))
+    if name == "trough":  # above theta = 0: on from it
+        return "on"
     if name == "lift":
         log.lift_off = True
         _take_off(scene, st)
