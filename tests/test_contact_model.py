@@ -21,6 +21,7 @@ from rockstudy.constants import G
 from rockstudy.dynamics import slide_rock as sr
 from rockstudy.dynamics.slide_rock_reference import simulate_contact_reference
 from rockstudy.motions import NoMotion, Record, RickerWavelet, SinePulse
+from rockstudy.structures import SymmetricFrame
 
 R, ALPHA = 1.0, 0.2
 BLOCK = rs.Block(half_diagonal=R, slenderness=ALPHA)
@@ -452,3 +453,5 @@ def test_result_outputs_and_arguments():
         rs.simulate(BLOCK, pulse, friction=0.3, method="linear")
     with pytest.raises(ValueError, match="t_eval/dt_out is not available"):
         rs.simulate(BLOCK, pulse, friction=0.3, dt_out=0.1, t_max=1.0)
+    with pytest.raises(ValueError, match="the contact model runs a Block, not a SymmetricFrame"):
+        rs.simulate(SymmetricFrame(1.0, 0.15, 0.5), pulse, friction=0.3)
