@@ -585,8 +585,8 @@ def _add_simulate(sub) -> None:
     sim.add_argument(
         "--friction",
         type=float,
-        help="friction coefficient mu of the base, in (0, 10]: the friction demand and "
-        "lift-off are reported, with a warning where the block would slide or lift off",
+        help="friction coefficient mu of the base, in (0, 10]: runs the contact model "
+        "(slide, rock, slide-rock, flight) and reports the slide",
     )
     sim.add_argument(
         "--max-steps",

@@ -187,10 +187,10 @@ def test_compile_groups_are_the_warm_up_groups_and_a_group_compiles_alone(tmp_pa
     assert bad.returncode == 2 and "invalid choice: 'nope'" in bad.stderr
 
 
-def test_simulate_with_a_friction_coefficient_reports_the_demand_and_warns_in_one_line(capsys):
-    """Below uplift the block moves with the ground: its friction demand is max |a_g| / g
-    (eq. of the contact forces of a block at rest); above mu the command says so on one
-    line, below it says nothing."""
+def test_simulate_with_a_friction_coefficient_runs_the_contact_model(capsys):
+    """Below uplift the rocking model's block moves with the ground: its friction demand is
+    max |a_g| / g (the contact forces of a block at rest). Above mu the contact model slides
+    it from the time a_g = mu g, sin(w t) = mu g / A; below, it stays put; no warning."""
     from rockstudy.cli import main
     from rockstudy.constants import G
 
@@ -201,10 +201,12 @@ def test_simulate_with_a_friction_coefficient_reports_the_demand_and_warns_in_on
     result = json.loads(out)
     assert result["inputs"]["friction"] == 0.05
     assert result["result"]["friction_demand"] == pytest.approx(1.0 / G, rel=1e-12)
-    assert result["result"]["lift_off"] is False
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("warning: ") and "above the friction" in lines[0]
+    assert result["result"]["lift_off"] is False and err == ""
+    slip = math.asin(0.05 * G / 1.0) / (2 * math.pi / 0.5)
+    assert result["result"]["first_slip_time"] == pytest.approx(slip, rel=1e-9)
+    assert result["result"]["max_slide"] > 0.0
     assert main(argv + ["--friction", "0.5"]) == 0
-    assert capsys.readouterr().err == ""
+    out, err = capsys.readouterr()
+    assert err == "" and json.loads(out)["result"]["max_slide"] == 0.0
     assert main(argv + ["--friction", "20"]) == 2
     assert capsys.readouterr().err.strip() == "error: friction must lie in (0, 10], got 20.0"

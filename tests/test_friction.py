@@ -229,19 +229,26 @@ def test_strong_vertical_lift_off_is_flagged():
     assert rs.simulate(BLOCK, with_v, method="scipy", rtol=1e-10).lift_off is True
     without = rs.simulate(BLOCK, Record(a_h, time=t))
     assert without.lift_off is False and math.isfinite(without.friction_demand)
-    with pytest.warns(rs.ContactWarning, match="lift-off"):
-        rs.simulate(BLOCK, with_v, friction=0.6)
+    # the contact model follows the scene instead: the base slips (slide-rock) as it unloads
+    contact = rs.simulate(BLOCK, with_v, friction=0.6)
+    assert contact.friction_demand == math.inf and contact.regime_times["slide_rock"] > 0.0
     assert r.summary()["lift_off"] is True and r.summary()["friction_demand"] is None
 
 
-def test_friction_warns_when_the_demand_exceeds_it():
+def test_friction_runs_the_contact_model_without_a_warning():
+    """simulate(friction=mu) runs the contact model (rockstudy.dynamics.slide_rock; its own
+    tests in test_contact_model.py): below the rocking model's demand the block slips,
+    above it it does not; the demand stays the rocking model's, and nothing warns."""
     pulse = SinePulse(amplitude=1.6 * UPLIFT, period=0.6)
-    with pytest.warns(rs.ContactWarning, match="friction demand"):
-        r = rs.simulate(BLOCK, pulse, friction=0.15)
+    demand = rs.simulate(BLOCK, pulse).friction_demand
     assert issubclass(rs.ContactWarning, rs.AccuracyWarning)
     with warnings.catch_warnings():
         warnings.simplefilter("error", rs.ContactWarning)
-        rs.simulate(BLOCK, pulse, friction=r.friction_demand * 1.01)
+        slips = rs.simulate(BLOCK, pulse, friction=0.15)
+        holds = rs.simulate(BLOCK, pulse, friction=demand * 1.01)
+    assert slips.friction_demand == holds.friction_demand == pytest.approx(demand, rel=1e-12)
+    assert slips.max_slide > 0.0 and math.isfinite(slips.first_slip_time)
+    assert holds.max_slide == 0.0 and math.isnan(holds.first_slip_time)
 
 
 def test_friction_argument_and_where_there_is_no_demand():

@@ -31,12 +31,10 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 
-from .._warnings import ContactWarning
 from ..constants import G
 from ..motions import _kernels as mk
 from . import _rocking
@@ -301,11 +299,9 @@ def check_contact(t, theta, theta_dot, motion, p, alpha, eta, linear=False, over
     return ContactCheck(best, False, when)
 
 
-def with_contact(result, motion, method, friction=None):
+def with_contact(result, motion, method):
     """``result`` whose ``friction_demand`` and ``lift_off`` come from :func:`check_contact`
-    on its history and the rocking parameters in its ``info`` (computed on first use); a
-    :class:`~rockstudy.ContactWarning` now when the demand exceeds ``friction`` (a lift-off
-    always does)."""
+    on its history and the rocking parameters in its ``info`` (computed on first use)."""
     info = result.info
     check = functools.partial(
         check_contact,
@@ -319,21 +315,4 @@ def with_contact(result, motion, method, friction=None):
         method in ("linear", "scipy-linear"),
         result.overturned,
     )
-    result = dataclasses.replace(result, _contact=check)
-    if friction is None:
-        return result
-    demand = result.friction_demand
-    if demand > friction:
-        what = (
-            "the vertical contact force stops being compressive (lift-off)"
-            if result.lift_off
-            else f"its friction demand |F_h / F_v| reaches {demand:.4g}"
-        )
-        warnings.warn(
-            f"at t = {result._contact_check().time:.4g} s {what}, above the friction "
-            f"coefficient {friction:g}: the block would slide or leave the ground, which the "
-            "rocking model (no sliding, no lift-off) does not describe",
-            ContactWarning,
-            stacklevel=3,
-        )
-    return result
+    return dataclasses.replace(result, _contact=check)

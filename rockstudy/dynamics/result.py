@@ -96,6 +96,20 @@ class RockingResult:
         (:data:`~rockstudy.dynamics.conditioning.ILL_CONDITIONED`) the scene is
         ill-conditioned: its peak is not determined to better than that, by any solver.
         ``None`` when not asked for.
+    slide : ndarray or None
+        With ``simulate(..., friction=mu)`` (the contact model): the slip u [m] on ``t``,
+        the horizontal displacement relative to the ground of the base's point under the
+        centre of mass of the upright block (:mod:`rockstudy.dynamics.slide_rock`). None
+        for Housner's no-slip model, as the four below.
+    max_slide, residual_slide : float or None
+        Peak ``|u|`` [m] over the response, and u at its end (NaN if the block overturned).
+    first_slip_time : float or None
+        When the block first slipped (slide or slide-rock) [s]; NaN if it never did.
+    regime_times : dict or None
+        Seconds spent in each regime: ``rest``, ``slide``, ``rock``, ``slide_rock``,
+        ``flight`` (up to the end of the history). With the contact model, ``lift_off``
+        says whether the block flew, and ``friction_demand`` is that of Housner's no-slip
+        model on the same scene.
     """
 
     t: np.ndarray
@@ -113,6 +127,11 @@ class RockingResult:
     theta_eval: np.ndarray | None = None
     theta_dot_eval: np.ndarray | None = None
     conditioning: float | None = None
+    slide: np.ndarray | None = None
+    max_slide: float | None = None
+    residual_slide: float | None = None
+    first_slip_time: float | None = None
+    regime_times: dict | None = None
     _contact: Callable[[], Any] | None = field(default=None, repr=False, compare=False)
     #: the motion and the structure that produced the result (for ``plot``), or None
     _motion: Any = field(default=None, repr=False, compare=False)
@@ -215,6 +234,12 @@ class RockingResult:
             coords={"time": ("time", self.t, {"units": "s", "long_name": "time"})},
             attrs=self._attributes(),
         )
+        if self.slide is not None:
+            ds["slide"] = (
+                "time",
+                self.slide,
+                {"units": "m", "long_name": "slip relative to the ground"},
+            )
         return ds
 
     def _peaks_and_dense(self, coordinate) -> dict:
@@ -449,8 +474,26 @@ class RockingResult:
         """friction_demand (None when unbounded: a lift-off) and lift_off, where computed."""
         if self._contact is None:
             return {}
-        demand = None if self.lift_off else float(self.friction_demand)
-        return {"friction_demand": demand, "lift_off": bool(self.lift_off)}
+        demand = float(self.friction_demand)
+        return {
+            "friction_demand": demand if np.isfinite(demand) else None,
+            "lift_off": bool(self.lift_off),
+        }
+
+    def _slide_summary(self) -> dict:
+        """The contact model's sliding outputs, where computed."""
+        if self.regime_times is None:
+            return {}
+
+        def number(x):
+            return float(x) if np.isfinite(x) else None
+
+        return {
+            "max_slide": self.max_slide,
+            "residual_slide": number(self.residual_slide),
+            "first_slip_time": number(self.first_slip_time),
+            "regime_times": dict(self.regime_times),
+        }
 
     def summary(self) -> dict:
         """The scalar outcomes as a JSON-ready dict."""
@@ -462,6 +505,7 @@ class RockingResult:
             "first_impact_time": float(self.impact_times[0]) if self.n_impacts else None,
             "overturn_time": None if np.isnan(self.overturn_time) else float(self.overturn_time),
             **self._contact_summary(),
+            **self._slide_summary(),
             **self.info,
         }
 

@@ -17,7 +17,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
-from . import _auto, _linear, _linear_record, _rocking, contact
+from . import _auto, _linear, _linear_record, _rocking, contact, contact_model
 from ._vertical import refuse_free_fall, uplift_ratio
 from .conditioning import peak_change, perturbed
 from .methods import MAX_STEPS, StepLimitError, method_for
@@ -342,15 +342,6 @@ _RUNNERS = {
 }
 
 
-def check_friction(value) -> float:
-    """The friction coefficient mu in (0, :data:`MAX_FRICTION`] as a float, or a ValueError
-    naming ``friction``."""
-    value = _validate.number("friction", value)
-    if not (math.isfinite(value) and 0.0 < value <= MAX_FRICTION):
-        raise ValueError(f"friction must lie in (0, {MAX_FRICTION:g}], got {value!r}")
-    return value
-
-
 def simulate(
     structure,
     motion: Motion,
@@ -446,12 +437,19 @@ def simulate(
         Instead of ``t_eval``: the uniform grid 0, dt_out, 2 dt_out, ... [s] up to ``t_max``
         or, without it, up to the end of the history (rest or overturning; the scene then
         runs twice, once to find that end).
-    friction : float, optional
-        The friction coefficient mu in (0, 10] (:data:`MAX_FRICTION`, as in a study) of the
-        contact: a :class:`~rockstudy.ContactWarning` when ``result.friction_demand`` exceeds
-        it (the block would slide) or the block lifts off. Only for a
-        :class:`~rockstudy.Block` and the methods that compute the demand (all but
-        ``"complex"``).
+    friction : float or (float, float), optional
+        Runs the planar contact model instead of Housner's no-slip one
+        (:mod:`rockstudy.dynamics.slide_rock`: rest, slide, rock, slide-rock and flight on a
+        base with Coulomb friction): the coefficient mu, or (mu_s, mu_k) with
+        mu_s >= mu_k, each in (0, 10] (:data:`MAX_FRICTION`, as in a study). Only for a
+        :class:`~rockstudy.Block`, with ``method`` "nonlinear", "scipy" or "auto" (all run
+        the model's ``solve_ivp`` reference at ``rtol``: milliseconds to seconds per
+        scene), from rest, without ``t_eval``/``dt_out`` or ``conditioning``. The result
+        adds ``slide``, ``max_slide``, ``residual_slide``, ``first_slip_time`` and
+        ``regime_times``; its ``lift_off`` is the contact model's (the block flew), its
+        ``friction_demand`` that of Housner's model on the scene (computed on first use).
+        None (default): Housner's model, whose ``friction_demand`` and ``lift_off`` say
+        where its no-slip, no-lift assumption fails.
     conditioning : bool
         Also run the scene with the amplitude (a pulse's, a record's samples) times 1 + 1e-9,
         by the same method, and give the relative change of ``max_rotation`` as
@@ -496,13 +494,15 @@ def simulate(
     t_eval = _validate.output_times(t_eval, dt_out, t_max)
     block = not hasattr(structure, "mechanism") and method_for(method).friction_demand
     if friction is not None:
-        friction = check_friction(friction)
+        friction = contact_model.friction_pair(friction, MAX_FRICTION)
         if not block:
             name = type(structure).__name__
             raise ValueError(
-                "friction: the friction demand is computed for a Block, not for "
+                "friction: the contact model runs a Block, not "
                 f"{'an' if name[0] in 'AEIOU' else 'a'} {name}"
             )
+        contact_model.refuse_options(method, x0, t_eval, conditioning)
+        return _simulate_contact(structure, motion, friction, method, rtol, t_max)
     run_args = (motion, method, rtol, t_max, int(max_steps), x0, l)
     if hasattr(structure, "mechanism"):
         run, run_args = _simulate_structure, (structure, *run_args)
@@ -525,7 +525,24 @@ def simulate(
         initial_rotation=th0,
         initial_velocity=om0,
     )
-    return contact.with_contact(r, motion, method, friction) if block else r
+    return contact.with_contact(r, motion, method) if block else r
+
+
+def _simulate_contact(block, motion, friction, method, rtol, t_max):
+    """The contact model of ``block`` (:mod:`.contact_model`); its ``friction_demand`` from
+    Housner's model run on first use by the same ``simulate``."""
+    p, alpha, eta = block_parameters(block)
+
+    def rocking():
+        return simulate(block, motion, rtol=rtol, t_max=t_max)
+
+    r = contact_model.simulate_contact(
+        p, alpha, eta, motion, friction, method, rtol, t_max, rocking
+    )
+    object.__setattr__(r, "_motion", motion)
+    object.__setattr__(r, "_structure", block)
+    r.info.update(motion=describe(motion), rtol_requested=rtol)
+    return r
 
 
 def _with_motion(run_args, structure_first, motion):
