@@ -68,6 +68,7 @@ from pydantic import (
 
 from ... import _validate
 from ...constants import G
+from ...dynamics import outputs as _outputs
 from ...dynamics.methods import MAX_STEPS
 from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
@@ -726,21 +727,11 @@ class SamplerSpec(_Model):
         return self
 
 
-Output = Literal[
-    "max_rotation",
-    "max_rotation_ratio",
-    "overturned",
-    "n_impacts",
-    "overturn_time",
-    "first_impact_time",
-    "steps",
-    "model",
-    "friction_demand",
-    "lift_off",
-]
+#: The outputs a study may keep: :data:`rockstudy.dynamics.outputs.STUDY_OUTPUTS`.
+Output = Literal[_outputs.STUDY_OUTPUTS]
 #: The outputs a study's ``friction`` adds (the contact check of
 #: :func:`rockstudy.simulate_batch`).
-CONTACT_OUTPUTS = ("friction_demand", "lift_off")
+CONTACT_OUTPUTS = _outputs.names("contact")
 
 
 #: Smallest relative tolerance taken: that of the solvers (:data:`rockstudy._validate.RTOL_MIN`,
