@@ -179,12 +179,11 @@ their logs needed (history rows, impact times, peaks)."""
 
 
 @njit(cache=True)
-def _exact_outcome(tallies, t_over):
+def _exact_outcome(tallies, over, t_over):
     """The :class:`ExactOutcome` of the tallies (an array of ``_rocking.new_tallies``) of a
-    scene that overturned at t_over [s] (NaN if it stands): max |theta| pi/2 and its time
-    t_over if it overturned."""
+    scene that overturned (``over``) at t_over [s] or stands (t_over NaN): max |theta| pi/2 and
+    its time t_over if it overturned."""
     ta = tallies[0]
-    over = not math.isnan(t_over)
     return ExactOutcome(
         status=STATUS_OK,
         max_rotation=FALL_ROTATION if over else ta.max_rotation,
@@ -348,7 +347,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         if not rocking:
             t_up = next_uplift(kind, mp, none, none, none, p, alpha, model, NO_TABLE, t)
             if t_up >= dur:  # the still ground after the motion never lifts a block
-                return _exact_outcome(tallies, np.nan)
+                return _exact_outcome(tallies, False, np.nan)
             a_up = ground_acceleration(kind, mp, none, none, t_up, np.int64(0))
             s = -1.0 if a_up > 0.0 else 1.0
             t = t_up
@@ -380,7 +379,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
             code, tau, th, v, s = _trig_phase(
                 alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, p, ta, rec
             )
-    return _exact_outcome(tallies, tau / p if code == PH_OVER else np.nan)
+    return _exact_outcome(tallies, code == PH_OVER, tau / p if code == PH_OVER else np.nan)
 
 
 @njit(cache=True, parallel=True)

@@ -552,7 +552,7 @@ def record_scene(
             if t_up >= dur:
                 if logging:
                     _push(log[0], ta, dur, 0.0, 0.0)
-                return _exact_outcome(tallies, np.nan)
+                return _exact_outcome(tallies, False, np.nan)
             a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t_up, k)
             s = -1.0 if a_g > 0.0 else 1.0
             tau, th, v = p * t_up, 0.0, 0.0
@@ -568,7 +568,7 @@ def record_scene(
         if lifted:  # kept in seconds: p (t_up + 1 ulp) / p may round back to t_up (no progress)
             t_rest = max(t_rest, _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
         k = segment_index(times, t_rest, k)
-    inside = _exact_outcome(tallies, tau / p if code == PH_OVER else np.nan)
+    inside = _exact_outcome(tallies, code == PH_OVER, tau / p if code == PH_OVER else np.nan)
     if code == PH_OVER:
         return inside
     # the free rocking after the record: trig_scene under a motion of zero length, from here
