@@ -343,3 +343,86 @@ def test_the_public_module_check_sees_a_module_without_all(tmp_path):
     assert _declared_all(path) is None
     path.write_text("__all__ = ['X']\nX = 1\n")
     assert _declared_all(path) == ["X"]
+
+
+#: Allocators whose first argument is a shape.
+_ALLOCATORS = {"empty", "zeros", "ones", "full"}
+#: The packages that compute, return or store the batch outputs.
+_OUTPUT_PACKAGES = ("dynamics", "study/running")
+
+
+def _outcome_names(function) -> set:
+    """Names assigned in ``function`` from a call to a scene kernel (``*scene``)."""
+    return {
+        t.id
+        for node in ast.walk(function)
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call)
+        for func in [node.value.func]
+        if getattr(func, "attr", getattr(func, "id", "")).endswith("scene")
+        for t in node.targets
+        if isinstance(t, ast.Name)
+    }
+
+
+def _is_int(node, values=None) -> bool:
+    return (
+        isinstance(node, ast.Constant)
+        and type(node.value) is int
+        and (values is None or node.value in values)
+    )
+
+
+def _width_literals(source: str, width: int) -> list:
+    """Lines of ``source`` that write the batch kernels' row width as a literal: an array
+    allocated with a shape holding ``width`` (``np.empty((n, 8))``), or the outcome of a scene
+    kernel (a name assigned from a call to ``*scene`` in the same function) read by a literal
+    index (``r[3]``)."""
+    tree = ast.parse(source)
+    lines = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and getattr(node.func, "attr", None) in _ALLOCATORS:
+            shape = node.args[0] if node.args else None
+            if isinstance(shape, ast.Tuple) and any(_is_int(e, {width}) for e in shape.elts):
+                lines.append(node.lineno)
+    for function in ast.walk(tree):
+        if isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            outcomes = _outcome_names(function)
+            lines += [
+                node.lineno
+                for node in ast.walk(function)
+                if isinstance(node, ast.Subscript)
+                and isinstance(node.value, ast.Name)
+                and node.value.id in outcomes
+                and _is_int(node.slice)
+            ]
+    return sorted(set(lines))
+
+
+def _row_width() -> int:
+    """The width of the batch kernels' row: one field per kernel output of the table."""
+    from rockstudy.dynamics import outputs
+
+    return len(outputs.KERNEL_ROW.names)
+
+
+def test_no_batch_width_literal():
+    """The batch outputs are declared once (rockstudy.dynamics.outputs): no module that computes
+    or stores them allocates their array with the width as a literal, nor reads a scene
+    kernel's outcome by position."""
+    paths = sorted(p for pkg in _OUTPUT_PACKAGES for p in (PACKAGE / pkg).rglob("*.py"))
+    assert PACKAGE / "dynamics" / "batch.py" in paths
+    found = {
+        str(path.relative_to(PACKAGE)): lines
+        for path in paths
+        if (lines := _width_literals(path.read_text(), _row_width()))
+    }
+    assert not found, f"the batch width {_row_width()} written as a literal at: {found}"
+
+
+def test_the_width_check_finds_a_literal():
+    w = _row_width()
+    assert _width_literals(f"import numpy as np\nout = np.empty((n, {w}))\n", w) == [2]
+    assert _width_literals("def f(p):\n    r = trig_scene(p)\n    return r[3]\n", w) == [3]
+    assert _width_literals("def f(p):\n    r = scene(p)\n    return r.steps\n", w) == []
+    assert _width_literals("def f(p):\n    r = g(p)\n    return r[3]\n", w) == []
+    assert _width_literals(f"out = np.empty((n, {w + 100}))\n", w) == []

@@ -437,7 +437,7 @@ def test_auto_outputs_outside_the_bound_come_from_the_kernel(tol):
     assert np.any(lean["model"] == _auto.MODEL_LINEAR)
     np.testing.assert_array_equal(lean["overturned"], ref["overturned"])
     with pytest.raises(ValueError, match="outputs"):
-        simulate_batch(**kw, method="auto", outputs=("max_rotation", "peak_time"))
+        simulate_batch(**kw, method="auto", outputs=("max_rotation", "peak_times"))
 
 
 def test_study_asks_the_engine_for_its_outputs():

@@ -26,7 +26,7 @@ SCENES = [
 def exact(block, record, use_map=False, scale=1.0):
     p, alpha, eta = block_parameters(block)
     times, samples = record.kernel_spec()[2:4]
-    return _linear_record.record_scene(
+    r = _linear_record.record_scene(
         p,
         alpha,
         eta,
@@ -38,7 +38,8 @@ def exact(block, record, use_map=False, scale=1.0):
         np.inf,
         NO_LOG,
         np.empty((0, 7)),
-    )[:6]
+    )
+    return r.status, r.max_rotation, r.overturned, r.n_impacts, r.overturn_time, r.first_impact_time
 
 
 @pytest.mark.parametrize("R, alpha, pga_ratio, seed", SCENES)
@@ -60,8 +61,8 @@ def test_exact_linear_record_matches_the_reference(R, alpha, pga_ratio, seed):
     row = _linear_record.record_batch(
         np.array([p]), np.array([a]), np.array([eta]), np.ones(1), times, samples
     )[0]
-    np.testing.assert_allclose(row[1], ref.max_rotation, rtol=1e-10)
-    assert bool(row[2]) == ref.overturned and row[5] == 0.0
+    np.testing.assert_allclose(row["max_rotation"], ref.max_rotation, rtol=1e-10)
+    assert bool(row["overturned"]) == ref.overturned and row["steps"] == 0
 
 
 def test_exact_linear_record_symmetries():
@@ -165,13 +166,13 @@ def test_rest_phase_jump_over_a_quiet_stretch_is_exact():
     tail = (True, np.inf, NO_LOG, np.empty((0, 7)))
     jump = _linear_record.record_scene(*args, loud, *tail)
     scan = _linear_record.record_scene(*args, every_sample, *tail)
-    np.testing.assert_equal(jump[:6], scan[:6])
+    np.testing.assert_equal(jump._asdict(), scan._asdict())
     ref = rs.simulate(block, record, method="scipy-linear", rtol=1e-12)
     assert not ref.overturned and ref.impact_times.size > 2
     assert ref.impact_times[0] < 2.0 and ref.impact_times[-1] > 20.3  # both pulses rock it
-    np.testing.assert_allclose(jump[1], ref.max_rotation, rtol=1e-10)
-    assert jump[3] == ref.impact_times.size
-    np.testing.assert_allclose(jump[5], ref.impact_times[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(jump.max_rotation, ref.max_rotation, rtol=1e-10)
+    assert jump.n_impacts == ref.impact_times.size
+    np.testing.assert_allclose(jump.first_impact_time, ref.impact_times[0], rtol=0, atol=1e-9)
 
 
 def _peak_at_the_uplift_level(alpha, sign, ulps, before=()):
@@ -282,13 +283,21 @@ def test_exact_linear_solver_on_the_shipped_and_real_records(records_dir):
                 )
                 for rtol in (1e-13, 3e-14)
             )
-            assert bool(out[i, 2]) == ref["overturned"] == finer["overturned"]
+            assert bool(out["overturned"][i]) == ref["overturned"] == finer["overturned"]
             spread = abs(ref["max_rotation"] - finer["max_rotation"])
             tol = 1e-10 * finer["max_rotation"] + 3.0 * spread
-            np.testing.assert_allclose(out[i, 1], finer["max_rotation"], rtol=0, atol=tol)
-            assert out[i, 2] or ref["max_rotation"] == 0.0 or spread < 1e-7 * ref["max_rotation"]
+            np.testing.assert_allclose(
+                out["max_rotation"][i], finer["max_rotation"], rtol=0, atol=tol
+            )
+            assert (
+                out["overturned"][i]
+                or ref["max_rotation"] == 0.0
+                or spread < 1e-7 * ref["max_rotation"]
+            )
             if finer["impact_times"].size:
-                np.testing.assert_allclose(out[i, 6], finer["impact_times"][0], rtol=0, atol=1e-8)
+                np.testing.assert_allclose(
+                    out["first_impact_time"][i], finer["impact_times"][0], rtol=0, atol=1e-8
+                )
 
 
 def _exact_segment_functions(sig):

@@ -21,6 +21,7 @@ end, one ulp above uplift).
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit, prange
@@ -28,6 +29,8 @@ from numba import njit, prange
 from .._roots import ULP_BISECTIONS, newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, KIND_TRIG, ground_acceleration, segment_index
+from ._free_map import free_peak_time
+from ._logs import raise_max
 from ._rocking import (
     MODEL_LINEAR,
     NO_TABLE,
@@ -47,7 +50,9 @@ from ._rocking import (
 from ._rocking import (
     _next_break as _ground_break,
 )
+from ._rows import new_rows, write_row
 from ._taylor import NO_REFCOUNT
+from .outputs import KERNEL_ROW
 
 # Impacts, peaks and falls are located to rounding: sigma is a time inside one phase, and the
 # root is the next phase's initial state, so its error would carry on through the history.
@@ -140,6 +145,8 @@ def _next_break(x, r0):
 
 #: Kind (last column) of a row of the phase log: a phase (ending in an impact or not), a peak.
 ROW_PHASE, ROW_IMPACT, ROW_PEAK = 0.0, 1.0, 2.0
+#: Columns of a row of the phase log: (tau0, tau1, A, B, s, q, kind) (:func:`_log_phase`).
+PHASE_LOG_WIDTH = 7
 
 
 @njit(cache=True, inline="always")
@@ -162,13 +169,32 @@ def _log_phase(rec, tau0, tau1, A, B, s, q, impact):
     rec[0, 0] = n + 1
 
 
+ExactOutcome = namedtuple("ExactOutcome", KERNEL_ROW.names + ("log_rows",))
+
+
+ExactOutcome.__doc__ = """What the exact linear solvers (:func:`trig_scene`,
+``_linear_record.record_scene``) return: a field per batch kernel output
+(:data:`.outputs.KERNEL_ROW`; ``steps`` 0: nothing is integrated), and ``log_rows``, the rows
+their logs needed (history rows, impact times, peaks)."""
+
+
 @njit(cache=True)
-def _tallied(tallies):
-    """The results in an array of ``_rocking.new_tallies``, read out as values: (max rotation
-    [rad], impacts, first impact time [s], (history rows, impact times, peaks))."""
+def _exact_outcome(tallies, over, t_over):
+    """The :class:`ExactOutcome` of the tallies (an array of ``_rocking.new_tallies``) of a
+    scene that overturned (``over``) at t_over [s] or stands (t_over NaN): max |theta| pi/2 and
+    its time t_over if it overturned."""
     ta = tallies[0]
-    log_rows = (ta.n_history, ta.n_impact_times, ta.n_peaks)
-    return ta.max_rotation, ta.n_impacts, ta.first_impact_time, log_rows
+    return ExactOutcome(
+        status=STATUS_OK,
+        max_rotation=FALL_ROTATION if over else ta.max_rotation,
+        overturned=over,
+        n_impacts=ta.n_impacts,
+        overturn_time=t_over,
+        steps=0,
+        first_impact_time=ta.first_impact_time,
+        peak_time=t_over if over else ta.peak_time,
+        log_rows=(ta.n_history, ta.n_impact_times, ta.n_peaks),
+    )
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -177,7 +203,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, p, ta, rec):
 
     theta and v = d theta / d tau are in rad; q = 0 gives free rocking; p [rad/s] gives the
     impact times in seconds (tau / p). ``ta`` holds the tallies (a ``_rocking.TALLIES``
-    record, updated in place); ``rec`` is a phase log (see :func:`_log_phase`; shape (0, 7) to
+    record, updated in place); ``rec`` is a phase log (see :func:`_log_phase`; no rows to
     skip logging). Returns (code, tau, theta, v, s).
     """
     c = q / (1.0 + W * W)
@@ -209,7 +235,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, p, ta, rec):
             if va >= 0.0 and _u(1, A, B, c, W, x0, alpha, s, end) <= 0.0:
                 s_pk = _root(1, 0.0, 1.0, A, B, c, W, x0, alpha, s, sa, end)
                 u_pk = _u(0, A, B, c, W, x0, alpha, s, s_pk)
-                ta.max_rotation = max(ta.max_rotation, u_pk)
+                raise_max(ta, u_pk, (tau0 + s_pk) / p)
                 if log:
                     _log_phase(rec, tau0 + s_pk, s * u_pk, 0.0, 0.0, s, q, ROW_PEAK)
             if s_imp >= 0.0:
@@ -220,7 +246,7 @@ def _trig_phase(alpha, eta, q, W, ph, tau_ex, tau0, th0, v0, s, p, ta, rec):
                     _log_phase(rec, tau0, tau0 + s_ot, A, B, s, q, 0.0)
                 ta.max_rotation = FALL_ROTATION
                 return PH_OVER, tau0 + s_ot, s * FALL_ROTATION, 0.0, s
-            ta.max_rotation = max(ta.max_rotation, ub)
+            raise_max(ta, ub, (tau0 + sb) / p)
             sa = sb
             va = vb
         if s_imp < 0.0:
@@ -299,8 +325,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
 
     With ``use_map`` the free rocking after the pulse is mapped, otherwise it is followed in
     closed form until rest, overturning or ``t_tail`` [s]. ``rec`` is the phase log of
-    :func:`_trig_phase` (with its peaks). Returns (status, max rotation, overturned, impacts,
-    overturning time [s], first impact time [s]).
+    :func:`_trig_phase` (with its peaks). Returns an :class:`ExactOutcome`.
     """
     a_g, w, ph, dur = mp[0], mp[1], mp[2], mp[3]
     q = a_g / G
@@ -322,8 +347,7 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
         if not rocking:
             t_up = next_uplift(kind, mp, none, none, none, p, alpha, model, NO_TABLE, t)
             if t_up >= dur:  # the still ground after the motion never lifts a block
-                peak, n_imp, first, _ = _tallied(tallies)
-                return STATUS_OK, peak, False, n_imp, np.nan, first
+                return _exact_outcome(tallies, False, np.nan)
             a_up = ground_acceleration(kind, mp, none, none, t_up, np.int64(0))
             s = -1.0 if a_up > 0.0 else 1.0
             t = t_up
@@ -345,30 +369,28 @@ def trig_scene(p, alpha, eta, mp, use_map, t_tail, rec, th_init=0.0, om_init=0.0
             )
             n_before = ta.n_impacts
             tau = _free_after_pulse(s * th, s * v, alpha, eta, tau_ex, p, ta, over)
+            if not over and peak > ta.max_rotation:
+                dt = free_peak_time(s * th, s * v * p, p, alpha, eta, model)
+                raise_max(ta, peak, dur + dt)
             if not over:
-                ta.max_rotation = max(ta.max_rotation, peak)
                 ta.n_impacts = n_before + n_post
             code = PH_OVER if over else PH_END
         else:
             code, tau, th, v, s = _trig_phase(
                 alpha, eta, 0.0, 1.0, 0.0, p * t_tail, tau_ex, th, v, s, p, ta, rec
             )
-    peak, n_imp, first, _ = _tallied(tallies)
-    if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p, first
-    return STATUS_OK, peak, False, n_imp, np.nan, first
+    return _exact_outcome(tallies, code == PH_OVER, tau / p if code == PH_OVER else np.nan)
 
 
 @njit(cache=True, parallel=True)
 def trig_batch(p, alpha, eta, mp):
-    """:func:`trig_scene` over rows, in parallel; an (n, 7) array of ``BATCH_COLUMNS``."""
-    out = np.empty((p.shape[0], 7))
-    no_log = np.empty((0, 7))
+    """:func:`trig_scene` over rows, in parallel; an array of :data:`.outputs.KERNEL_ROW`."""
+    out = new_rows(p.shape[0])
+    no_log = np.empty((0, PHASE_LOG_WIDTH))
     for i in prange(p.shape[0]):
         t_tail = free_tail_end(p[i], eta[i], mp[i, 3])
         r = trig_scene(p[i], alpha[i], eta[i], mp[i], True, t_tail, no_log)
-        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
-        out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
+        write_row(out, i, r)
     return out
 
 

@@ -35,7 +35,15 @@ from numba import njit, prange
 from .._roots import ULP_BISECTIONS, newton_bisect
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
-from ._linear import ROOT_MAX_ITER, ROOT_TOL, _tallied, trig_scene
+from ._linear import (
+    PHASE_LOG_WIDTH,
+    ROOT_MAX_ITER,
+    ROOT_TOL,
+    ExactOutcome,
+    _exact_outcome,
+    trig_scene,
+)
+from ._logs import raise_max
 from ._rocking import (
     MODEL_LINEAR,
     NO_TABLE,
@@ -49,6 +57,7 @@ from ._rocking import (
     new_tallies,
     tally_impact,
 )
+from ._rows import new_rows, write_row
 from ._taylor import FMA, NO_REFCOUNT
 
 #: Below this |sigma| the segment functions are Taylor polynomials: the first term left out
@@ -288,7 +297,7 @@ def _slow_segment(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta, 
             )
         if hi < length and u_hi > 0.0 and u_hi - s * (g0 + f1 * hi) < 0.0:  # u'' < 0: a peak
             _push_peak(log[2], ta, (tau + hi) / p, th_hi)
-        ta.max_rotation = max(ta.max_rotation, u_hi)
+        raise_max(ta, u_hi, (tau + hi) / p)
         lo, u_lo = hi, u_hi
     return -1.0, False
 
@@ -305,7 +314,7 @@ def _segment_event(th, v, g0, f1, s, length, th_end, v_end, sh, cm1, tau, p, ta,
     if _monotone(v, v_end, d0, d1, length):
         du0, du1 = s * v, s * v_end
         if 0.0 < u_end < FALL_ROTATION:
-            ta.max_rotation = max(ta.max_rotation, u_end)
+            raise_max(ta, u_end, (tau + length) / p)
             return -1.0, False
         if u_end >= FALL_ROTATION:
             return (
@@ -516,9 +525,7 @@ def record_scene(
     ``log`` = (history (t, theta, theta_dot), impact times, peaks (t, theta), dense (t,
     theta, theta_dot)) inside the record, each of length 0 for none.
 
-    Returns (status, max rotation [rad], overturned, impacts, overturning time [s], first
-    impact time [s], (history rows, impacts, peaks) logged), as ``_linear.trig_scene`` with
-    the log counts.
+    Returns an ``_linear.ExactOutcome`` (its ``log_rows`` those of ``log``).
 
     Horizontal only: the closed form needs constant coefficients, which a vertical
     component (p^2 (1 + u_v''/g) in time) breaks; the callers run the kernel with
@@ -545,8 +552,7 @@ def record_scene(
             if t_up >= dur:
                 if logging:
                     _push(log[0], ta, dur, 0.0, 0.0)
-                peak, n_imp, first, n_log = _tallied(tallies)
-                return STATUS_OK, peak, False, n_imp, np.nan, first, n_log
+                return _exact_outcome(tallies, False, np.nan)
             a_g = ground_acceleration(KIND_RECORD, mp, times, samples, t_up, k)
             s = -1.0 if a_g > 0.0 else 1.0
             tau, th, v = p * t_up, 0.0, 0.0
@@ -562,30 +568,47 @@ def record_scene(
         if lifted:  # kept in seconds: p (t_up + 1 ulp) / p may round back to t_up (no progress)
             t_rest = max(t_rest, _record_lift_end(p, alpha, mp, times, samples, t_up, k_up))
         k = segment_index(times, t_rest, k)
-    peak, n_imp, first, n_log = _tallied(tallies)
+    inside = _exact_outcome(tallies, code == PH_OVER, tau / p if code == PH_OVER else np.nan)
     if code == PH_OVER:
-        return STATUS_OK, FALL_ROTATION, True, n_imp, tau / p, first, n_log
+        return inside
     # the free rocking after the record: trig_scene under a motion of zero length, from here
     t_free = max(t_tail - dur, 0.0)
     tail = trig_scene(
         p, alpha, eta, np.array([0.0, 1.0, 0.0, 0.0]), use_map, t_free, tail_log, th, v * p
     )
-    first = first if n_imp > 0 else tail[5] + dur
-    return STATUS_OK, max(peak, tail[1]), tail[2], n_imp + tail[3], tail[4] + dur, first, n_log
+    return _then_tail(inside, tail, dur)
+
+
+@njit(cache=True)
+def _then_tail(inside, tail, dur):
+    """The :class:`ExactOutcome` of a record (``inside``) followed by the free rocking after it
+    (``tail``, its times from the record's end ``dur`` [s])."""
+    n_imp = inside.n_impacts
+    later = tail.max_rotation > inside.max_rotation
+    return ExactOutcome(
+        status=STATUS_OK,
+        max_rotation=tail.max_rotation if later else inside.max_rotation,
+        overturned=tail.overturned,
+        n_impacts=n_imp + tail.n_impacts,
+        overturn_time=tail.overturn_time + dur,
+        steps=0,
+        first_impact_time=inside.first_impact_time if n_imp > 0 else tail.first_impact_time + dur,
+        peak_time=tail.peak_time + dur if later else inside.peak_time,
+        log_rows=inside.log_rows,
+    )
 
 
 @njit(cache=True, parallel=True)
 def record_batch(p, alpha, eta, scale, times, samples):
-    """:func:`record_scene` over rows (one record, scaled row by row), in parallel; an (n, 7)
-    array of ``BATCH_COLUMNS``."""
-    out = np.empty((p.shape[0], 7))
+    """:func:`record_scene` over rows (one record, scaled row by row), in parallel; an array
+    of :data:`.outputs.KERNEL_ROW`."""
+    out = new_rows(p.shape[0])
     loud = loud_table(samples)
     no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
-    no_tail = np.empty((0, 7))
+    no_tail = np.empty((0, PHASE_LOG_WIDTH))
     for i in prange(p.shape[0]):
         r = record_scene(
             p[i], alpha[i], eta[i], scale[i], times, samples, loud, True, np.inf, no_log, no_tail
         )
-        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r[0], r[1], r[2], r[3]
-        out[i, 4], out[i, 5], out[i, 6] = r[4], 0.0, r[5]
+        write_row(out, i, r)
     return out

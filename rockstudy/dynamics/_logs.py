@@ -11,13 +11,15 @@ from ._rhs import _step
 from ._taylor import NO_REFCOUNT, poly_value
 
 #: The running tallies of one scene, one record updated in place by the kernel and the exact
-#: linear solvers: max |theta| [rad], the first impact time [s] (NaN before it), impacts,
+#: linear solvers: max |theta| [rad] and the time it was reached [s] (NaN before any rotation),
+#: the first impact time [s] (NaN before it), impacts,
 #: integrator steps (0 in the exact solvers), and the rows the logs needed (history rows,
 #: impact times, peaks: more than an array holds means it overflowed), with the requested
 #: times of the dense output passed so far (the index of the next one to serve).
 TALLIES = np.dtype(
     [
         ("max_rotation", np.float64),
+        ("peak_time", np.float64),
         ("first_impact_time", np.float64),
         ("n_impacts", np.int64),
         ("steps", np.int64),
@@ -33,7 +35,8 @@ TALLIES = np.dtype(
 @njit(cache=True)
 def new_tallies(max_rotation):
     """An array of one :data:`TALLIES` record: no impact yet (first_impact_time NaN), all
-    counts 0, max |theta| from ``max_rotation`` [rad] (the start's).
+    counts 0, max |theta| from ``max_rotation`` [rad] (the start's, reached at t = 0; NaN for
+    its time if it is 0).
 
     The kernels pass its element ``tallies[0]`` down (a numba Record, by reference) and
     update it in place. The element does not keep the array alive, and numba frees an array
@@ -44,8 +47,18 @@ def new_tallies(max_rotation):
     tallies = np.zeros(1, TALLIES)
     ta = tallies[0]
     ta.max_rotation = max_rotation
+    ta.peak_time = 0.0 if max_rotation > 0.0 else np.nan
     ta.first_impact_time = np.nan
     return tallies
+
+
+@njit(cache=True, inline="always")
+def raise_max(ta, u, t):
+    """Raise the largest rotation of the tallies ``ta`` to u [rad], reached at t [s], if u is
+    larger (its time kept with it)."""
+    if u > ta.max_rotation:
+        ta.max_rotation = u
+        ta.peak_time = t
 
 
 @njit(cache=True, inline="always")

@@ -15,7 +15,7 @@ from numba import njit
 
 from ..motions._kernels import KIND_RECORD, KIND_TRIG, segment_index
 from ._events import EV_NONE, EV_OVER, EV_REJECT, _impact, _zeno
-from ._logs import _log_dop853_step, _log_peak, _log_poly_step, _push
+from ._logs import _log_dop853_step, _log_peak, _log_poly_step, _push, raise_max
 from ._rhs import _accel, _ground_after, _vertical_after
 from ._steps import _dop853_attempt, _taylor_attempt, _taylor_trig_attempt
 from ._taylor import NO_REFCOUNT, work_arrays
@@ -107,7 +107,7 @@ def _peak_inside(peaks, ta, u_pk, t_pk, s):
     """Log the peak of u = s theta that a step found inside it (``u_pk`` >= 0 at ``t_pk``
     [s]; -1 for none) and raise the largest rotation to it."""
     if u_pk >= 0.0:
-        ta.max_rotation = max(ta.max_rotation, u_pk)
+        raise_max(ta, u_pk, t_pk)
         _log_peak(peaks, ta, t_pk, s * u_pk)
 
 
@@ -115,7 +115,7 @@ def _peak_inside(peaks, ta, u_pk, t_pk, s):
 def _reached(hist, ta, t, th, om, u):
     """A step's end (t [s], theta [rad], theta_dot [rad/s]) with u = s theta: the largest
     rotation raised to u, and the history row appended when a history is kept."""
-    ta.max_rotation = max(ta.max_rotation, u)
+    raise_max(ta, u, t)
     if hist.shape[0] > 0:
         _push(hist, ta, t, th, om)
 
@@ -125,6 +125,7 @@ def _fell(hist, ta, t, th, om, fall):
     """The fall at t [s], theta = +-``fall`` [rad]: the largest rotation is ``fall``, the
     history row appended when a history is kept; returns (t, theta, theta_dot)."""
     ta.max_rotation = fall
+    ta.peak_time = t
     if hist.shape[0] > 0:
         _push(hist, ta, t, th, om)
     return t, th, om

@@ -12,9 +12,10 @@ from numba import njit, prange
 
 from ..constants import FALL_ROTATION
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
-from ._free_map import free_rocking_map, free_tail_end
-from ._logs import _push, new_tallies
+from ._free_map import free_peak_time, free_rocking_map, free_tail_end
+from ._logs import _push, new_tallies, raise_max
 from ._phase import PhaseState, Stepping, _phase, _phase_trig, _variant_named, _work_arrays
+from ._rows import new_rows, write_row
 from ._tables import _free_map_table
 from ._uplift import next_uplift
 from .constants import (
@@ -33,6 +34,7 @@ from .constants import (
     STATUS_OK,
     TOL_SAFETY,
 )
+from .outputs import KERNEL_ROW
 
 Body = namedtuple("Body", ("p", "alpha", "eta", "model", "fall", "table"))
 
@@ -74,6 +76,7 @@ SceneOutcome = namedtuple(
         "steps",
         "first_impact_time",
         "n_peaks",
+        "peak_time",
     ),
 )
 
@@ -83,7 +86,8 @@ STATUS_MAX_STEPS), ``max_rotation`` max |theta| [rad], ``overturned``, ``n_impac
 ``overturn_time`` [s] (NaN if it stands), the rows the log needed (``n_history`` history
 rows, ``n_impact_times`` impact times, ``n_peaks`` peaks: more than the arrays hold means
 they overflowed), ``steps`` (integrator steps: DOP853, or Taylor inside a record) and
-``first_impact_time`` [s] (NaN if none)."""
+``first_impact_time`` [s] (NaN if none), ``peak_time`` [s] when max |theta| was reached (the
+overturning time if it overturned; NaN if it never rocked)."""
 
 
 @njit(cache=True)
@@ -103,6 +107,7 @@ def _outcome(code, state, tallies):
         steps=ta.steps,
         first_impact_time=ta.first_impact_time,
         n_peaks=ta.n_peaks,
+        peak_time=state.t if over else ta.peak_time,
     )
 
 
@@ -128,6 +133,20 @@ def _block_map_from(state, p, alpha, eta, model, omega_rest):
     """:func:`._free_map.free_rocking_map` from the state of a phase (a :class:`PhaseState`)."""
     u, v = state.side * state.theta, state.side * state.theta_dot
     return free_rocking_map(u, v, p, alpha, eta, model, omega_rest)
+
+
+@njit(cache=True, inline="always")
+def _raise_to_mapped_peak(ta, state, body, peak):
+    """Raise the largest rotation of the tallies ``ta`` to the ``peak`` that the free-rocking
+    map found from ``state`` (a :class:`PhaseState`), at its time (:func:`free_peak_time`; NaN
+    for a mechanism's table, whose free rocking has no closed-form time)."""
+    if peak > ta.max_rotation:
+        if body.model == MODEL_TABLE:
+            dt = np.nan
+        else:
+            u, v = state.side * state.theta, state.side * state.theta_dot
+            dt = free_peak_time(u, v, body.p, body.alpha, body.eta, body.model)
+        raise_max(ta, peak, state.t + dt)
 
 
 @njit(cache=True, inline="always")
@@ -227,7 +246,7 @@ def _make_scene(general):
                     state, body.p, body.alpha, eta, body.model, omega_rest
                 )
             if controls.free_map and not over and eta < 1.0:
-                ta.max_rotation = max(ta.max_rotation, peak)
+                _raise_to_mapped_peak(ta, state, body, peak)
                 ta.n_impacts += n_post
             else:  # integrate the free rocking: for the history, to time the overturning, or to
                 # count the impacts of a block that never rests (eta = 1) up to the tail's end
@@ -248,16 +267,8 @@ scene = _make_scene(True)
 scene_trig = _make_scene(False)
 
 
-#: Columns of the batch output array.
-BATCH_COLUMNS = (
-    "status",
-    "max_rotation",
-    "overturned",
-    "n_impacts",
-    "overturn_time",
-    "steps",
-    "first_impact_time",
-)
+#: The fields of a batch kernel's row (:data:`.outputs.KERNEL_ROW`).
+BATCH_COLUMNS = KERNEL_ROW.names
 
 
 def _make_scene_batch(general, parallel=True):
@@ -273,9 +284,9 @@ def _make_scene_batch(general, parallel=True):
         """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
         (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
 
-        Returns an (n, 7) float array with the columns of :data:`BATCH_COLUMNS`.
+        Returns an array of :data:`.outputs.KERNEL_ROW` rows.
         """
-        out = np.empty((p.shape[0], 7))
+        out = new_rows(p.shape[0])
         no_log = (np.empty((0, 3)), np.empty(0), np.empty((0, 2)), np.empty((0, 3)))
         for i in prange(p.shape[0]):
             body = Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE)
@@ -285,9 +296,7 @@ def _make_scene_batch(general, parallel=True):
                 r = scene(body, mot, ctl, Start(0.0, 0.0), no_log)
             else:
                 r = scene_trig(body, mot, ctl, Start(0.0, 0.0), no_log)
-            out[i, 0], out[i, 1], out[i, 2] = r.status, r.max_rotation, r.overturned
-            out[i, 3], out[i, 4] = r.n_impacts, r.overturn_time
-            out[i, 5], out[i, 6] = r.steps, r.first_impact_time
+            write_row(out, i, r)
         return out
 
     return scene_batch

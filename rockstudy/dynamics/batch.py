@@ -17,7 +17,7 @@ from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
-from . import _auto, _linear, _linear_record, _rocking, conditioning
+from . import _auto, _linear, _linear_record, _rocking, conditioning, outputs
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 
@@ -30,13 +30,14 @@ _CODES = {
     _rocking.MODEL_LINEAR: _auto.MODEL_LINEAR,
 }
 
-OUTPUTS = _rocking.BATCH_COLUMNS + ("model",)
+#: The outputs returned by default (:data:`.outputs.OUTPUTS`: the kernels' and the model).
+OUTPUTS = outputs.names("kernel", "batch")
 #: Outputs returned only when ``outputs`` names them (each lifting row is run again with a
 #: history: see :mod:`._batch_contact`).
-CONTACT_OUTPUTS = ("friction_demand", "lift_off")
+CONTACT_OUTPUTS = outputs.names("contact")
 #: Returned only when ``outputs`` names it: every row is run again with its amplitude times
 #: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
-CONDITIONING_OUTPUTS = ("conditioning",)
+CONDITIONING_OUTPUTS = outputs.names("conditioning")
 # (trig-only, one thread) -> batch kernel: on one thread (a study's workers) the serial
 # variants, which compile without the parallel loop's cost
 _BATCH_KERNELS = {
@@ -287,6 +288,8 @@ def simulate_batch(
         (until rest; with restitution 1 the block never rests, and the impacts are counted up
         to duration + 100/p, the end of :func:`rockstudy.simulate`'s default history),
         ``overturn_time`` [s] (NaN if it survived), ``first_impact_time`` [s] (NaN if none),
+        ``peak_time`` [s] (when |theta| reached ``max_rotation``, after the motion too; the
+        overturning time if overturned, NaN if it never lifted),
         ``status`` (0 ok, 1 step limit reached), ``steps`` (integrator steps taken: DOP853,
         or Taylor steps inside a record; 0 for the exact solver), ``model`` (0 rest without
         integration, 1 linear, 2 nonlinear: what each row ran); only those of ``outputs`` (and
@@ -354,12 +357,9 @@ def simulate_batch(
 
 
 def _outputs(out, codes, wanted) -> dict:
-    """The kernel's (n, 7) ``out`` (:data:`BATCH_COLUMNS`) and the model ``codes`` as the
-    typed output arrays named in ``wanted`` (the contact outputs apart)."""
-    cols = dict(zip(_rocking.BATCH_COLUMNS, out.T, strict=True))
-    for name in ("status", "n_impacts", "steps"):
-        cols[name] = cols[name].astype(np.int64)
-    cols["overturned"] = cols["overturned"].astype(bool)
+    """The kernels' rows ``out`` (:data:`.outputs.KERNEL_ROW`) and the model ``codes`` as the
+    output arrays named in ``wanted`` (the contact outputs apart)."""
+    cols = {name: np.ascontiguousarray(out[name]) for name in out.dtype.names}
     cols["model"] = codes
     return {name: cols[name] for name in wanted if name in cols}
 
@@ -387,17 +387,19 @@ def _perturbed_rows(rows):
 def _conditioning(out, out_perturbed):
     """The ``conditioning`` output (:func:`.conditioning.peak_change`) of the kernel outputs
     of the rows and of their perturbed copies; NaN where either run reached the step limit."""
-    cols = _rocking.BATCH_COLUMNS
-    i_max, i_over, i_status = (cols.index(c) for c in ("max_rotation", "overturned", "status"))
     change = conditioning.peak_change(
-        out[:, i_max], out[:, i_over] > 0, out_perturbed[:, i_max], out_perturbed[:, i_over] > 0
+        out["max_rotation"],
+        out["overturned"],
+        out_perturbed["max_rotation"],
+        out_perturbed["overturned"],
     )
-    ok = (out[:, i_status] == 0) & (out_perturbed[:, i_status] == 0)
+    ok = (out["status"] == 0) & (out_perturbed["status"] == 0)
     return np.where(ok, change, np.nan)
 
 
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
 _BATCH_UNITS = {
+    **{o.name: (o.long_name, o.units) for o in outputs.OUTPUTS.values()},
     "half_diagonal": ("half-diagonal R", "m"),
     "frequency_parameter": ("frequency parameter p", "rad s-1"),
     "slenderness": ("slenderness alpha", "rad"),
@@ -407,17 +409,6 @@ _BATCH_UNITS = {
     "period": ("pulse period T_p", "s"),
     "cycles": ("pulse cycles", "1"),
     "scale": ("factor on the record", "1"),
-    "max_rotation": ("maximum |theta|", "rad"),
-    "overturned": ("overturned", "1"),
-    "n_impacts": ("number of impacts", "1"),
-    "overturn_time": ("time of overturning", "s"),
-    "first_impact_time": ("time of the first impact", "s"),
-    "status": ("0 ok, 1 step limit reached", "1"),
-    "steps": ("integrator steps (DOP853, or Taylor inside a record)", "1"),
-    "model": ("0 rest, 1 linear, 2 nonlinear", "1"),
-    "friction_demand": ("max |F_h / F_v| at the contact", "1"),
-    "lift_off": ("vertical contact force not compressive somewhere", "1"),
-    "conditioning": ("relative change of max |theta| under 1e-9 in the amplitude", "1"),
 }
 
 
@@ -453,8 +444,9 @@ def _requested_outputs(outputs):
 
 
 def _run(rows, idx, model, rtol, max_steps):
-    """Outputs (n, 7) of the rows ``idx`` under one model. The exact linear record solver
-    has constant coefficients: a record with a vertical component runs the kernel."""
+    """The kernel rows (:data:`.outputs.KERNEL_ROW`) of the rows ``idx`` under one model. The
+    exact linear record solver has constant coefficients: a record with a vertical component
+    runs the kernel."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
     args = (p[idx], alpha[idx], eta[idx])
     if model == _rocking.MODEL_LINEAR and kind == mk.KIND_TRIG:
@@ -486,9 +478,7 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
         codes[(codes == _auto.MODEL_NONLINEAR) & one_cycle & (bound <= tolerance)] = (
             _auto.MODEL_LINEAR
         )
-    out = np.zeros((n, len(_rocking.BATCH_COLUMNS)))
-    for name in ("overturn_time", "first_impact_time"):  # NaN for a block at rest
-        out[:, _rocking.BATCH_COLUMNS.index(name)] = np.nan
+    out = _rows_at_rest(n)
     for code, model, rtol in (
         (_auto.MODEL_LINEAR, _rocking.MODEL_LINEAR, tolerance),
         (_auto.MODEL_NONLINEAR, _rocking.MODEL_NONLINEAR, _auto.kernel_rtol(tolerance)),
@@ -496,10 +486,19 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
         idx = np.flatnonzero(codes == code)
         if idx.size:
             out[idx] = _run(rows, idx, model, rtol, max_steps)
-    ratio = out[:, _rocking.BATCH_COLUMNS.index("max_rotation")] / alpha
+    ratio = out["max_rotation"] / alpha
     small = np.flatnonzero((codes == _auto.MODEL_NONLINEAR) & (ratio < _auto.SMALL_ROTATION))
     rtols = _auto.kernel_rtol_small(tolerance, ratio[small])
     for rtol in np.unique(rtols):
         idx = small[rtols == rtol]
         out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps)
     return out, codes
+
+
+def _rows_at_rest(n):
+    """n kernel rows (:data:`.outputs.KERNEL_ROW`) of scenes that never lift: each output's
+    ``at_rest`` value."""
+    out = np.empty(n, outputs.KERNEL_ROW)
+    for name in outputs.KERNEL_ROW.names:
+        out[name] = outputs.OUTPUTS[name].at_rest
+    return out

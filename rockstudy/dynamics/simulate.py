@@ -155,10 +155,8 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
     _check_end(t_eval, t_tail)
     cap = 1024
     while True:
-        rec = np.zeros((cap, 7))
-        status, max_rot, over, n_imp, t_ot, _ = _linear.trig_scene(
-            p, alpha, eta, mp, False, t_tail, rec, x0[0], x0[1]
-        )
+        rec = np.zeros((cap, _linear.PHASE_LOG_WIDTH))
+        r = _linear.trig_scene(p, alpha, eta, mp, False, t_tail, rec, x0[0], x0[1])
         if rec[0, 0] < cap - 1:
             break
         cap *= 4
@@ -166,15 +164,15 @@ def _linear_exact(p, alpha, eta, motion, model, rtol, t_max, max_steps, method, 
     dense = {}
     if t_eval is not None:
         th_e, om_e = _linear.phase_states(rec, p, alpha, mp[1], mp[2], t_eval, x0)
-        dense = _dense_fields(t_eval, th_e, om_e, over, t_ot)
+        dense = _dense_fields(t_eval, th_e, om_e, r.overturned, r.overturn_time)
     return RockingResult(
         t,
         th,
         om,
-        float(max_rot),
-        bool(over),
+        float(r.max_rotation),
+        bool(r.overturned),
         impacts,
-        float(t_ot),
+        float(r.overturn_time),
         method,
         {"solver": "exact piecewise (eq. 3.4 of [000])"},
         *_linear.phase_peaks(rec, p),
@@ -198,9 +196,10 @@ def _linear_record_exact(p, alpha, eta, motion, t_max, method, x0, t_eval=None):
     while True:
         log = (np.empty((cap, 3)), np.empty(cap), np.empty((cap, 2)), np.zeros((t_in.size, 3)))
         log[3][:, 0] = t_in
-        tail = np.zeros((cap, 7))
+        tail = np.zeros((cap, _linear.PHASE_LOG_WIDTH))
         args = (p, alpha, eta, mp[0], times, samples, loud, False, t_tail, log, tail)
-        _, max_rot, over, _, t_ot, _, counts = _linear_record.record_scene(*args, *x0)
+        r = _linear_record.record_scene(*args, *x0)
+        counts = r.log_rows
         if max(counts) <= cap and tail[0, 0] < cap - 1:
             break
         cap *= 4
@@ -217,15 +216,15 @@ def _linear_record_exact(p, alpha, eta, motion, t_max, method, x0, t_eval=None):
         th_after, om_after = _linear.phase_states(tail, p, alpha, 1.0, 0.0, after)
         theta = np.concatenate([log[3][:, 1], th_after])
         theta_dot = np.concatenate([log[3][:, 2], om_after])
-        dense = _dense_fields(t_eval, theta, theta_dot, over, t_ot)
+        dense = _dense_fields(t_eval, theta, theta_dot, r.overturned, r.overturn_time)
     return RockingResult(
         np.concatenate([hist[:, 0], t_free[1:] + dur]),
         np.concatenate([hist[:, 1], th_free[1:]]),
         np.concatenate([hist[:, 2], om_free[1:]]),
-        float(max_rot),
-        bool(over),
+        float(r.max_rotation),
+        bool(r.overturned),
         np.concatenate([log[1][:ni], imp_free + dur]),
-        float(t_ot),
+        float(r.overturn_time),
         method,
         {
             "solver": "exact piecewise: eq. (3.1) of [000] in closed form on each record segment",

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...dynamics import outputs as _outputs
 from ...dynamics.batch import CONTACT_OUTPUTS, simulate_batch
 from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ...motions import stochastic_record
@@ -22,23 +23,17 @@ from ..spec.schema import Study
 
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
 
-#: Outputs: (long_name, units, dtype, fill value for failed rows)
-OUTPUTS = {
-    "max_rotation": ("max |theta| (pi/2 if overturned)", "rad", "f8", np.nan),
-    "max_rotation_ratio": ("max |theta| / theta_cr", "1", "f8", np.nan),
-    "overturned": ("overturned (1) or survived (0); -1 if failed", "1", "i1", -1),
-    "n_impacts": ("impacts until rest; -1 if failed", "1", "i8", -1),
-    "overturn_time": ("time at which |theta| reached pi/2 (NaN if it survived)", "s", "f8", np.nan),
-    "first_impact_time": ("time of the first impact (NaN if none)", "s", "f8", np.nan),
-    "steps": ("DOP853 steps taken (0 for the exact linear solver)", "1", "i8", -1),
-    "model": (
-        "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear; -1 if failed",
-        "1",
-        "i1",
-        -1,
-    ),
-    **record_rows.CONTACT_VARIABLES,
-}
+
+def _stored(output) -> tuple:
+    """(long_name, units, dtype, fill value for failed rows) of a study's output, from its
+    entry in :data:`rockstudy.dynamics.outputs.OUTPUTS` (the fill named where it is not NaN)."""
+    fill = output.fill
+    failed = "" if np.isnan(fill) else f"; {fill} if failed"
+    return (output.long_name + failed, output.units, output.store_dtype, fill)
+
+
+#: Outputs a study may keep: (long_name, units, dtype, fill value for failed rows)
+OUTPUTS = {name: _stored(_outputs.OUTPUTS[name]) for name in _outputs.STUDY_OUTPUTS}
 
 
 def resolve_file(name: str, base_dir) -> Path:

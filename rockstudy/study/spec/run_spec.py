@@ -7,6 +7,7 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from ... import _validate
+from ...dynamics import outputs as _outputs
 from ...dynamics.methods import MAX_STEPS
 from .parameters import _Model
 from .structures import FieldError
@@ -14,21 +15,11 @@ from .structures import FieldError
 __all__ = ["CONTACT_OUTPUTS", "MIN_RTOL", "STEPS_PER_CYCLE", "Output", "RunSpec"]
 
 
-Output = Literal[
-    "max_rotation",
-    "max_rotation_ratio",
-    "overturned",
-    "n_impacts",
-    "overturn_time",
-    "first_impact_time",
-    "steps",
-    "model",
-    "friction_demand",
-    "lift_off",
-]
+#: The outputs a study may keep: :data:`rockstudy.dynamics.outputs.STUDY_OUTPUTS`.
+Output = Literal[_outputs.STUDY_OUTPUTS]
 #: The outputs a study's ``friction`` adds (the contact check of
 #: :func:`rockstudy.simulate_batch`).
-CONTACT_OUTPUTS = ("friction_demand", "lift_off")
+CONTACT_OUTPUTS = _outputs.names("contact")
 
 
 #: Smallest relative tolerance taken: that of the solvers (:data:`rockstudy._validate.RTOL_MIN`,

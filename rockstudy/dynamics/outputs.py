@@ -1,0 +1,178 @@
+"""The batch outputs, declared once: what :func:`rockstudy.simulate_batch` returns and a study
+stores.
+
+Each entry of :data:`OUTPUTS` gives an output's name, the dtype :func:`simulate_batch` returns
+it in, its CF units and long name, how a study stores it (dtype and the fill value of a failed
+row), the models that compute it and the stage that does. Everything else is read from here:
+the row the batch kernels write (:data:`KERNEL_ROW`, one field per ``"kernel"`` output),
+:data:`rockstudy.dynamics.batch.OUTPUTS`, the variables of a batch dataset, the outputs of a
+study's runner (:data:`rockstudy.study.running.evaluate.OUTPUTS`) and the outputs a study file
+may ask for (``run.outputs``).
+
+Adding an output: an entry here, and the kernels that compute it (for a ``"kernel"`` output,
+the field of their outcome and :func:`._rows.write_row`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "KERNEL_MODELS",
+    "KERNEL_ROW",
+    "MODELS",
+    "OUTPUTS",
+    "STAGES",
+    "STUDY_OUTPUTS",
+    "Output",
+    "names",
+]
+
+#: The models a batch runs (:func:`rockstudy.simulate_batch`): Housner's block by the
+#: Taylor/DOP853 kernel, the linearized block by the same kernel (a record with a vertical
+#: component), the exact piecewise linear solution under a trigonometric pulse and under a
+#: record, and the rest of ``method="auto"`` (no uplift, nothing integrated).
+MODELS = ("nonlinear", "linear", "exact_linear", "exact_linear_record", "rest")
+#: The models whose kernel writes a row of :data:`KERNEL_ROW`.
+KERNEL_MODELS = MODELS[:4]
+#: Where an output is computed: in every batch kernel's row (``kernel``), by
+#: :func:`simulate_batch` around the kernels (``batch``), by its contact pass (``contact``) or
+#: its conditioning pass (``conditioning``), or by a study from another output (``study``).
+STAGES = ("kernel", "batch", "contact", "conditioning", "study")
+
+
+@dataclass(frozen=True)
+class Output:
+    """One batch output.
+
+    Attributes
+    ----------
+    name : str
+        The name it has in :func:`rockstudy.simulate_batch`, a batch dataset and a study.
+    dtype : str
+        The numpy dtype :func:`rockstudy.simulate_batch` returns it in.
+    units : str
+        CF units.
+    long_name : str
+        What it is.
+    store_dtype : str
+        The dtype a study stores it in.
+    fill : float or int
+        A study's value for a row that failed.
+    models : tuple of str
+        The models of :data:`MODELS` that compute it.
+    stage : str
+        Where it is computed (:data:`STAGES`).
+    in_study : bool
+        Whether a study's ``run.outputs`` may name it.
+    at_rest : float or int
+        Its value for a scene that never lifts (``"kernel"`` outputs: what ``method="auto"``
+        gives the rows it decides are at rest without a kernel).
+    """
+
+    name: str
+    dtype: str
+    units: str
+    long_name: str
+    store_dtype: str
+    fill: float | int
+    models: tuple = KERNEL_MODELS
+    stage: str = "kernel"
+    in_study: bool = True
+    at_rest: float | int = 0
+
+    def __post_init__(self):
+        if self.stage not in STAGES:
+            raise ValueError(f"{self.name}: stage must be one of {STAGES}, got {self.stage!r}")
+        if not set(self.models) <= set(MODELS):
+            raise ValueError(f"{self.name}: models must be among {MODELS}, got {self.models}")
+
+
+_NAN = float("nan")
+_BLOCK_MODELS = ("nonlinear", "linear")
+
+
+def _f8(name, units, long_name, **where):
+    """A float output (a study stores it as such, NaN for a failed row)."""
+    return Output(name, "f8", units, long_name, "f8", _NAN, **where)
+
+
+def _int(name, dtype, long_name, store_dtype="i8", **where):
+    """A count or code without units (a study stores it as ``store_dtype``, -1 for a failed
+    row)."""
+    return Output(name, dtype, "1", long_name, store_dtype, -1, **where)
+
+
+#: The batch outputs, in the order :func:`rockstudy.simulate_batch` returns them.
+OUTPUTS = {
+    o.name: o
+    for o in (
+        _int("status", "i8", "0 ok, 1 step limit reached", in_study=False),
+        _f8("max_rotation", "rad", "max |theta| (pi/2 if overturned)"),
+        _int("overturned", "bool", "overturned (1) or survived (0)", "i1"),
+        _int("n_impacts", "i8", "impacts until rest"),
+        _f8(
+            "overturn_time",
+            "s",
+            "time at which |theta| reached pi/2 (NaN if it survived)",
+            at_rest=_NAN,
+        ),
+        _int("steps", "i8", "integrator steps (DOP853 or Taylor; 0 for the exact solvers)"),
+        _f8("first_impact_time", "s", "time of the first impact (NaN if none)", at_rest=_NAN),
+        _f8(
+            "peak_time",
+            "s",
+            "time at which |theta| reached max_rotation (the overturning time if overturned; "
+            "NaN if it never rocked)",
+            at_rest=_NAN,
+        ),
+        _int(
+            "model",
+            "i1",
+            "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear",
+            "i1",
+            models=MODELS,
+            stage="batch",
+        ),
+        _f8("max_rotation_ratio", "1", "max |theta| / theta_cr", stage="study"),
+        _f8(
+            "friction_demand",
+            "1",
+            "friction demand max |F_h / F_v| at the contact (inf with a lift-off)",
+            models=_BLOCK_MODELS,
+            stage="contact",
+        ),
+        _int(
+            "lift_off",
+            "i1",
+            "1 if the vertical contact force was not compressive somewhere",
+            "i1",
+            models=_BLOCK_MODELS,
+            stage="contact",
+        ),
+        _f8(
+            "conditioning",
+            "1",
+            "relative change of max |theta| under 1e-9 in the amplitude",
+            models=MODELS,
+            stage="conditioning",
+            in_study=False,
+        ),
+    )
+}
+
+
+def names(*stages: str) -> tuple:
+    """The names of the outputs computed at ``stages`` (:data:`STAGES`), in table order."""
+    unknown = set(stages) - set(STAGES)
+    if unknown:
+        raise ValueError(f"stages must be among {STAGES}, got {sorted(unknown)}")
+    return tuple(o.name for o in OUTPUTS.values() if o.stage in stages)
+
+
+#: The outputs a study may ask for (``run.outputs``), in table order.
+STUDY_OUTPUTS = tuple(o.name for o in OUTPUTS.values() if o.in_study)
+#: The row every batch kernel writes per scene: one field per ``"kernel"`` output.
+KERNEL_ROW = np.dtype([(name, OUTPUTS[name].dtype) for name in names("kernel")])
