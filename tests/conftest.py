@@ -1,4 +1,7 @@
-"""The shared real records, for the tests that need them (``records_dir``).
+"""Fixtures shared by the test modules: the shared real records (``records_dir``) and one
+in-process dask client (``client``).
+
+The shared real records are for the tests that need them (``records_dir``).
 
 They are looked for in ``ROCKSTUDY_RECORDS`` if set, else in ``../shared/records`` beside the
 project. Without them those tests are skipped on a workstation, but under CI (``CI=true``) a
@@ -24,6 +27,18 @@ RECORDS = Path(
 
 def _under_ci() -> bool:
     return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
+
+
+@pytest.fixture(scope="session")
+def client():
+    """One in-process dask client for the whole session (each xdist worker has its own): a
+    local cluster of threads in the test process, so that ``run_study(..., client=client)``
+    starts no worker process. The tests of the worker processes themselves (kills, Ctrl-C,
+    lost workers) start their own clusters or real ``rockstudy run`` processes."""
+    from distributed import Client
+
+    with Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=":0") as c:
+        yield c
 
 
 @pytest.fixture(scope="session")

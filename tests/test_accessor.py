@@ -19,10 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from _helpers import constructed_ida, ishigami_analytic, ishigami_cube
+from _helpers import ida_dataset as _ida_dataset
 from scipy import optimize, stats
-from test_analysis import ishigami_analytic, ishigami_cube
-from test_records_fragility import _ida_dataset
-from test_records_similarity import constructed_ida
 
 import rockstudy.study  # noqa: F401 - registers ds.rocking
 from rockstudy import risk

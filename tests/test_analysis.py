@@ -7,26 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 import xarray as xr
+from _helpers import ishigami_analytic, ishigami_cube, rocking_with_falls
 
 from rockstudy.study import analysis, make_design, validate_text
-
-ISHIGAMI = """
-name = "ishigami"
-seed = 3
-[sampler]
-kind = "sobol"
-n = {n}
-[structure]
-kind = "equivalent_block"
-frequency_parameter = {{ dist = "uniform", low = 1.0, high = 3.0 }}
-critical_rotation = {{ dist = "uniform", low = 0.1, high = 0.2 }}
-restitution = {{ dist = "uniform", low = 0.5, high = 0.9 }}
-[motion]
-kind = "pulse"
-amplitude_ratio = 2.0
-frequency_ratio = 1.0
-"""
-
 
 SOBOL_PULSE = """
 name = "sobol_pulse_design"
@@ -44,36 +27,6 @@ kind = "pulse"
 amplitude_ratio = { dist = "uniform", low = 1.0, high = 4.0 }
 period = { dist = "loguniform", low = 0.1, high = 2.0 }
 """
-
-
-def ishigami_cube(n=2**13):
-    """The Ishigami function on the study pipeline's own design: make_design draws the
-    scrambled Sobol' points in the Saltelli layout and maps them through the three uniform
-    distributions; each input is mapped back linearly onto [-pi, pi]."""
-    from SALib.test_functions import Ishigami
-
-    study = validate_text(ISHIGAMI.format(n=n))
-    ds = make_design(study)
-    names = list(study.parameters())
-    x = np.column_stack(
-        [
-            -math.pi + 2 * math.pi * (ds[name].values - dist.low) / (dist.high - dist.low)
-            for name, dist in study.parameters().items()
-        ]
-    )
-    assert x.min() >= -math.pi and x.max() <= math.pi
-    ds["y"] = ("sample", Ishigami.evaluate(x))
-    ds["status"] = ("sample", np.ones(ds.sizes["sample"], np.int8))
-    ds.attrs["study"] = study.normalized()
-    return ds, names
-
-
-def ishigami_analytic(a=7.0, b=0.1):
-    v1 = 0.5 * (1 + b * math.pi**4 / 5) ** 2
-    v2 = a * a / 8
-    v13 = b * b * math.pi**8 * (1 / 18 - 1 / 50)
-    v = v1 + v2 + v13
-    return np.array([v1, v2, 0.0]) / v, np.array([v1 + v13, v2, v13]) / v
 
 
 def test_ishigami_indices_through_the_study_pipeline():
@@ -300,28 +253,10 @@ def test_fragility_bad_arguments_are_named():
         analysis.fragility_curve(ds.to_dataframe(), [1.0])
 
 
-def _rocking_with_falls(n=4000, seed=3):
-    """Samples whose survivors' peak rotation ratio depends on the amplitude alone, and whose
-    overturned samples carry the fall rotation pi/2 over alpha (the cube's convention): any
-    index of alpha on the ratio comes from the falls."""
-    rng = np.random.default_rng(seed)
-    alpha, amp = rng.uniform(0.05, 0.3, n), rng.uniform(1.0, 5.0, n)
-    over = (amp > 2.0).astype(np.int8)  # all but the weakest pulses overturn
-    ratio = np.where(over == 1, 0.5 * np.pi / alpha, 0.1 * amp)
-    return xr.Dataset(
-        {
-            "slenderness": ("sample", alpha),
-            "amplitude_ratio": ("sample", amp),
-            "overturned": ("sample", over),
-            "max_rotation_ratio": ("sample", ratio),
-        }
-    )
-
-
 def test_first_order_of_a_rotation_warns_when_the_falls_are_in_it():
     """On every sample the falls give alpha a large index, and the call warns; on the
     survivors (as the report computes it) alpha has none and amplitude has it all."""
-    ds = _rocking_with_falls()
+    ds = rocking_with_falls()
     names = ["slenderness", "amplitude_ratio"]
     with pytest.warns(UserWarning, match="fall rotation"):
         mixed = analysis.first_order_given_data(ds, "max_rotation_ratio", names)

@@ -426,3 +426,39 @@ def test_the_width_check_finds_a_literal():
     assert _width_literals("def f(p):\n    r = scene(p)\n    return r.steps\n", w) == []
     assert _width_literals("def f(p):\n    r = g(p)\n    return r[3]\n", w) == []
     assert _width_literals(f"out = np.empty((n, {w + 100}))\n", w) == []
+
+
+# ------------------------------------------------------------- the test modules stand alone
+
+TESTS = Path(__file__).resolve().parent
+#: What a test module may import from the tests folder: its fixtures and its helpers.
+SHARED_TEST_MODULES = {"conftest", "_helpers"}
+
+
+def _test_modules_imported(source: str) -> set[str]:
+    """The modules of the tests folder (but conftest and _helpers) that ``source`` imports,
+    at top level or inside a function."""
+    local = {p.stem for p in TESTS.glob("*.py")} - SHARED_TEST_MODULES
+    names = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            names |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module.split(".")[0])
+    return names & local
+
+
+def test_no_test_module_imports_another():
+    """Shared fixtures live in conftest.py and shared helpers in _helpers.py: a test module
+    that imports another runs that module's fixtures and tests' set-up in its own."""
+    found = {
+        path.name: sorted(_test_modules_imported(path.read_text()))
+        for path in sorted(TESTS.glob("*.py"))
+    }
+    assert {name: mods for name, mods in found.items() if mods} == {}
+
+
+def test_the_test_import_check_sees_imports_of_test_modules():
+    source = "import os\nfrom _helpers import tree\ndef f():\n    import test_study\n"
+    assert _test_modules_imported(source) == {"test_study"}
+    assert _test_modules_imported("from test_risk import x\nimport conftest\n") == {"test_risk"}

@@ -1,8 +1,9 @@
 """Issue 26, section 4 (and 3, first bullet): each of these gives one clear line and a
 non-zero exit, never a traceback, and leaves no half-made store.
 
-Real ``rockstudy`` processes; the oracle is the contract itself: one line, its words, the exit
-code and the files on disk.
+The command runs in this process (``rockstudy.cli.main``), but for Ctrl-C while its modules
+load, which needs a real process; the oracle is the contract itself: one line, its words, the
+exit code and the files on disk.
 """
 
 import json
@@ -13,37 +14,25 @@ import time
 from pathlib import Path
 
 import pytest
-from test_store_safety import ROCKSTUDY, rockstudy_run, tree, write_study
-
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def one_error_line(err):
-    lines = [line for line in err.strip().splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in err, err
-    assert lines[0].startswith("error: "), err
-    return lines[0]
+from _helpers import (
+    ROOT,
+    cli,
+    finished_run,
+    one_error_line,
+    rockstudy_run,
+    run_on_scheduler_file,
+    tree,
+    write_study,
+)
 
 
 @pytest.mark.parametrize("value", ["nan", "-1", "inf", "0", "soon"])
 def test_timeout_must_be_finite_seconds(tmp_path, value):
     study = write_study(tmp_path, n=20)
-    code, _, err = rockstudy_run(study, tmp_path / "c.zarr", "--timeout", value, timeout=120)
+    code, _, err = rockstudy_run(study, tmp_path / "c.zarr", "--timeout", value)
     assert code == 2
     assert "--timeout" in one_error_line(err)
     assert not (tmp_path / "c.zarr").exists()
-
-
-def run_on_scheduler_file(study, out, sched, timeout=150):
-    """The one error line of ``rockstudy run`` of ``study`` on the scheduler file ``sched``
-    (with a timeout of 3 s), which must exit 1."""
-    proc = subprocess.run(
-        [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler-file", str(sched),
-         "--timeout", "3", "--quiet"],
-        capture_output=True, text=True, timeout=timeout,
-    )  # fmt: skip
-    assert proc.returncode == 1
-    return one_error_line(proc.stderr)
 
 
 @pytest.mark.parametrize("content", [None, "garbage\x00\x01", '{"address": 3}'])
@@ -66,25 +55,18 @@ def test_a_scheduler_file_missing_or_garbage_is_one_line_in_time(tmp_path, conte
 def test_tls_without_certificates_is_one_line(tmp_path):
     study = write_study(tmp_path, n=20)
     out = tmp_path / "c.zarr"
-    proc = subprocess.run(
-        [ROCKSTUDY, "run", str(study), "--out", str(out), "--scheduler", "tls://127.0.0.1:9",
-         "--timeout", "3", "--quiet"],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 1
-    line = one_error_line(proc.stderr)
+    code, _, err = cli(
+        "run", study, "--out", out, "--scheduler", "tls://127.0.0.1:9", "--timeout", "3", "--quiet"
+    )
+    assert code == 1
+    line = one_error_line(err)
     assert "--tls-ca-file" in line and "certificates" in line
     assert not out.exists()
 
 
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("errors")
-    study = write_study(folder, n=20)
-    out = folder / "cube.zarr"
-    code, _, err = rockstudy_run(study, out)
-    assert code == 0, err
-    return study, out
+    return finished_run(tmp_path_factory.mktemp("errors"), n=20)
 
 
 @pytest.mark.parametrize("marker", ["list", "folder"])
@@ -202,11 +184,9 @@ def test_a_design_that_lists_a_file_twice_is_refused(tmp_path):
     files = ", ".join(f'"{p}"' for p in (first, second, again))
     study = tmp_path / "dup.toml"
     study.write_text(DUPLICATE.format(files=files))
-    proc = subprocess.run(
-        [ROCKSTUDY, "validate", str(study)], capture_output=True, text=True, timeout=300
-    )
-    assert proc.returncode == 2 and "Traceback" not in proc.stderr
-    assert "motion.files[2]" in proc.stderr and "already motion.files[0]" in proc.stderr
+    code, _, err = cli("validate", study)
+    assert code == 2 and "Traceback" not in err
+    assert "motion.files[2]" in err and "already motion.files[0]" in err
 
 
 def test_messages_show_numbers_not_numpy_reprs(tmp_path, monkeypatch, capsys):

@@ -1,4 +1,5 @@
-"""The command line as a user meets it: the real ``rockstudy`` command in a subprocess."""
+"""The command line as a user meets it: ``rockstudy.cli.main`` in this process, its exit code,
+stdout and stderr; a real process where a fresh numba cache is the point."""
 
 import json
 import math
@@ -10,20 +11,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import cli as rockstudy_cli
 
 ROOT = Path(__file__).resolve().parents[1]
 PULSE = ["--amplitude", "3.0", "--period", "0.5"]
 
 
 def cli(*args):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "NUMBA_NUM_THREADS": "1"}
-    return subprocess.run(
-        [sys.executable, "-m", "rockstudy.cli", *args],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=300,
-    )
+    """``rockstudy ARGS`` in this process (``rockstudy.cli.main``): its exit code, stdout and
+    stderr as a finished process's."""
+    code, out, err = rockstudy_cli(*args)
+    return subprocess.CompletedProcess(args, code, out, err)
 
 
 def test_version_is_the_package_version():

@@ -6,10 +6,9 @@ run and checks that every door names that variable and that chunk.
 
 import json
 import shutil
-import subprocess
 
 import pytest
-from test_store_safety import ROCKSTUDY, rockstudy_run, tree, write_study
+from _helpers import cli, finished_run, one_line, rockstudy_run, tree
 
 from rockstudy.study import open_result
 from rockstudy.study.running.store import DamagedCube
@@ -17,23 +16,7 @@ from rockstudy.study.running.store import DamagedCube
 
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("verify")
-    study = write_study(folder, n=60, chunk=10)
-    out = folder / "cube.zarr"
-    code, _, err = rockstudy_run(study, out)
-    assert code == 0, err
-    return study, out
-
-
-def cli(*args):
-    proc = subprocess.run([ROCKSTUDY, *map(str, args)], capture_output=True, text=True, timeout=300)
-    return proc.returncode, proc.stdout, proc.stderr
-
-
-def one_line(text):
-    lines = [line for line in text.strip().splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in text, text
-    return lines[0]
+    return finished_run(tmp_path_factory.mktemp("verify"), n=60, chunk=10)
 
 
 def _flip(path, at=None):

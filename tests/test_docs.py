@@ -7,7 +7,6 @@ examples executed) and points ``ROCKSTUDY_DOCS_HTML`` at it; run alone, this tes
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +14,7 @@ from pathlib import Path
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
+from _helpers import chromium_dom
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "docs" / "examples").glob("plot_*.py"))
@@ -72,29 +72,13 @@ f.src = pages[0];
 
 
 def render_all(html, pages, workdir):
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    assert exe, "headless Chromium is needed (make test installs Debian's chromium)"
     harness = html / "_render_check.html"
     harness.write_text(HARNESS % json.dumps([p.relative_to(html).as_posix() for p in pages]))
-    out = subprocess.run(
-        [
-            exe,
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--allow-file-access-from-files",
-            f"--user-data-dir={workdir / 'chromium-profile'}",
-            "--virtual-time-budget=60000",
-            "--dump-dom",
-            harness.as_uri(),
-        ],
-        capture_output=True,
-        text=True,
+    out = chromium_dom(
+        harness,
+        workdir / "chromium-profile",
+        budget_ms=60000,
+        extra=["--allow-file-access-from-files"],
         timeout=300,
     )
     harness.unlink()

@@ -28,7 +28,13 @@ UPLIFT = G * math.tan(ALPHA)
 
 
 def test_block_half_diagonal_from_p():
-    assert contact.half_diagonal(P) == pytest.approx(R, rel=1e-14)
+    """Rectangles of half-width b and half-height h: R = sqrt(b^2 + h^2), and the pendulum
+    frequency about a corner p = sqrt(3 g / (4 R)) (I_O = 4/3 m R^2), written here."""
+    b, h = np.array([0.1, 0.225, 0.5, 2.0]), np.array([0.8, 0.95, 0.5, 6.0])
+    R_rect = np.hypot(b, h)
+    p = np.sqrt(3 * G / (4 * R_rect))
+    np.testing.assert_allclose(contact.half_diagonal(p), R_rect, rtol=1e-14)
+    assert contact.half_diagonal(float(p[1])) == pytest.approx(R_rect[1], rel=1e-14)
 
 
 @pytest.mark.parametrize("side", [1.0, -1.0])

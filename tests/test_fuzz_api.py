@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 import pytest
-from test_fuzz_studies import time_limit
+from _helpers import time_limit
 
 import rockstudy as rs
 import rockstudy.study as study_api

@@ -27,11 +27,9 @@ the full fuzz runs 400).
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import re
-import signal
 import tempfile
 import warnings
 from pathlib import Path
@@ -39,6 +37,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 import pytest
+from _helpers import time_limit
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -65,20 +64,6 @@ UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
 #: A field path at the start of a problem line: ``motion.files[2]``, ``structure.objects``, ...
 FIELD = re.compile(r"""^[A-Za-z_][\w.\[\]\-]*(?: \((?:'[^']*'|"[^"]*")\))?[\w.\[\]]*:""")
 SECONDS = 60
-
-
-@contextlib.contextmanager
-def time_limit(seconds, what):
-    def _raise(*_):
-        raise TimeoutError(f"{what} took more than {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, _raise)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 # ------------------------------------------------------------------------------ records

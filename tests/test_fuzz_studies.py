@@ -12,26 +12,24 @@ function each dask task runs), and every sample must come back ok with finite ou
 import json
 import math
 import random
-import signal
 import subprocess
-import sys
 from collections import Counter
-from contextlib import contextmanager
 from pathlib import Path
 from typing import get_args
 
 import numpy as np
 import pytest
+from _helpers import cli, time_limit
 
 from rockstudy.motions.suites import RECORD_SUFFIXES
 from rockstudy.study import StudyError, load_study
 from rockstudy.study.designs.sampling import make_design
 from rockstudy.study.running.evaluate import STATUS_OK, evaluate_chunk
+from rockstudy.study.spec.samplers import SAMPLERS, kinds_laid_out
 from rockstudy.study.spec.schema import Output
 
 N_FILES = 240
 SEED = 20261125
-ROCKSTUDY = str(Path(sys.executable).with_name("rockstudy"))
 PLUMBING = ("tagged-union", "function-after", "Input should", "Value error", "Extra inputs")
 HOSTILE = [
     "<script>alert(document.domain)</script>",
@@ -230,16 +228,16 @@ class Gen:
             key = "half_diagonal" if "half_diagonal" in st else "frequency_parameter"
             st[key] = {"dist": "uniform", "low": 1.0, "high": 2.0}
             distributed = [(st, key)]
-        kind = r.choice(["monte_carlo", "monte_carlo", "lhs", "sobol", "grid"])
-        if kind == "sobol" and len(distributed) < 2:
-            kind = "lhs"
+        kind = r.choice([*kinds_laid_out("random"), *SAMPLERS])  # every sampler of the registry
+        if SAMPLERS[kind].layout == "saltelli" and len(distributed) < 2:
+            kind = r.choice(kinds_laid_out("random"))
         sampler = {"kind": kind}
-        if kind == "grid":
+        if SAMPLERS[kind].layout == "grid":
             for part, k in distributed:
                 lo, hi = self._bounds(part[k])
                 part[k] = {"dist": "grid", "low": lo, "high": hi, "n": r.choice([2, 3])}
-        elif kind == "sobol":
-            sampler["n"] = r.choice([2, 4])
+        elif SAMPLERS[kind].layout == "saltelli":
+            sampler["n"] = r.choice([2, 4])  # powers of two
         else:
             sampler["n"] = r.randint(3, 16)
         outputs = list(get_args(Output))
@@ -449,20 +447,6 @@ def _ungrid(study):
 # ---------------------------------------------------------------------- the test
 
 
-@contextmanager
-def time_limit(seconds, what):
-    def fail(*_):
-        raise TimeoutError(f"{what} took more than {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, fail)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
-
-
 def run_in_process(study, base_dir):
     """Evaluate every row as the dask tasks would, chunk by chunk; return the failures."""
     design = make_design(study, base_dir)
@@ -558,7 +542,15 @@ def test_fuzz_each_file_is_refused_by_field_or_runs_clean(corpus, capsys):
     assert len(files) >= 200 and counts["refused"] >= 50 and counts["succeeded"] >= 50
 
 
-def test_fuzz_files_through_the_real_cli(corpus):
+def _validate_in_process(paths, seconds=300):
+    """``rockstudy validate PATHS`` through ``rockstudy.cli.main`` in this process (a file that
+    would be read without end fails by the time limit): a finished process's fields."""
+    with time_limit(seconds, "rockstudy validate"):
+        code, out, err = cli("validate", *paths)
+    return subprocess.CompletedProcess(["validate", *paths], code, out, err)
+
+
+def test_fuzz_files_through_the_cli(corpus):
     """A handful of the same files through ``rockstudy validate``: exit 2 with the problems,
     or 0 with ok; never a traceback."""
     folder, files = corpus
@@ -569,9 +561,7 @@ def test_fuzz_files_through_the_real_cli(corpus):
             if field is None:
                 valid.add(cat)
     paths = [str(p) for p in picked.values()]
-    out = subprocess.run(
-        [ROCKSTUDY, "validate", *paths], capture_output=True, text=True, timeout=300
-    )
+    out = _validate_in_process(paths)
     assert "Traceback" not in out.stderr, out.stderr[-3000:]
     for cat, path in picked.items():
         if cat in valid:
@@ -722,7 +712,7 @@ class RecordGen:
         study = {
             "name": f"rec{r.randint(0, 10**6)}",
             "seed": r.randint(0, 2**31 - 1),
-            "sampler": {"kind": r.choice(["monte_carlo", "lhs"]), "n": r.randint(1, 3)},
+            "sampler": {"kind": r.choice(kinds_laid_out("random")), "n": r.randint(1, 3)},
             "structure": self.structure(),
             "motion": motion,
             "run": {"method": r.choice(["nonlinear", "nonlinear", "auto"]), "rtol": 1e-6,
@@ -941,7 +931,7 @@ def _cli_block(stderr: str, path: str) -> str:
     return ""
 
 
-def test_record_study_files_through_the_real_cli(tmp_path):
+def test_record_study_files_through_the_cli(tmp_path):
     """One record study of each category through ``rockstudy validate``: exit 2 with the
     problems naming the field and the file, or ok; never a traceback."""
     files = record_corpus(tmp_path, 120)
@@ -949,9 +939,7 @@ def test_record_study_files_through_the_real_cli(tmp_path):
     for path, cat, words in files:
         picked.setdefault(cat.split(":")[0] if words is None else cat, (path, words))
     paths = [str(p) for p, _ in picked.values()]
-    out = subprocess.run(
-        [ROCKSTUDY, "validate", *paths], capture_output=True, text=True, timeout=300
-    )
+    out = _validate_in_process(paths)
     assert "Traceback" not in out.stderr, out.stderr[-3000:]
     for path, words in picked.values():
         if words is None:

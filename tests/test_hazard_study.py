@@ -8,25 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _helpers import HAZARD_STUDY as STUDY
+from _helpers import study_text
 
 from rockstudy.study.running.store import input_hashes
 from rockstudy.study.spec import schema as spec
 
 DATA = Path(__file__).resolve().parents[1] / "data"
-STUDY = """
-name = "museum"
-seed = 1
-[structure]
-kind = "objects"
-objects = [{{ name = "Statue <A> & B", width = 0.45, height = 1.9 }}]
-[motion]
-kind = "record"
-files = "{records}/NF0[12]*_H.AT2"
-[design]
-kind = "ida"
-periods = [0.5]
-{hazard}
-"""
 
 
 def _study(tmp_path, hazard):
@@ -114,7 +102,6 @@ def test_a_spectral_hazard_at_a_stored_period_is_taken(tmp_path):
 
 
 def test_monte_carlo_studies_refuse_a_hazard(tmp_path):
-    from test_study import study_text  # the pulse study of the study-layer tests
 
     text = (
         study_text()

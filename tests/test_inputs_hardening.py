@@ -15,12 +15,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import test_objects
-import test_record_studies
 import xarray as xr
-from test_cli_errors import one_error_line, run_on_scheduler_file
-from test_risk_analysis import K0, K, _ida, _lognormal
-from test_store_safety import ROCKSTUDY, write_study
+from _helpers import (
+    K0,
+    ROCKSTUDY,
+    STUDY_OBJECTS,
+    K,
+    lognormal_sample,
+    one_error_line,
+    pga_ida,
+    run_on_scheduler_file,
+    write_study,
+    write_two_records,
+)
 
 import rockstudy as rs
 from rockstudy import risk
@@ -34,9 +41,11 @@ from rockstudy.study.spec.schema import MAX_FRICTION
 
 # ------------------------------------------------------------------------------ objects CSV files
 
-suite = test_objects.suite  # a folder of two small records (fixture)
-client = test_record_studies.client  # the one-worker cluster (fixture)
-STUDY_OBJECTS = test_objects.STUDY_OBJECTS
+
+@pytest.fixture(scope="module")
+def suite(tmp_path_factory):
+    """A folder of two small synthetic records."""
+    return write_two_records(tmp_path_factory.mktemp("records"))
 
 
 def _objects_problem(tmp_path, suite, content: bytes, file="objects.csv"):
@@ -112,7 +121,7 @@ def test_a_scheduler_file_that_is_no_file_is_one_line_in_time(tmp_path, kind):
         sched.write_text('{"address": "tcp://127.0.0.1:9", "pad": "' + "x" * 2**20 + '"}')
     out = tmp_path / "c.zarr"
     t0 = time.time()
-    line = run_on_scheduler_file(study, out, sched, timeout=90)
+    line = run_on_scheduler_file(study, out, sched)
     expect = {"fifo": "a FIFO", "device": "a character device", "large": "MiB allowed"}[kind]
     assert str(sched) in line and expect in line and "not a dask scheduler file" in line
     assert not out.exists()
@@ -188,10 +197,10 @@ def test_simulate_takes_the_largest_friction_of_a_study():
 
 @pytest.mark.parametrize("value", [-3, 0, 2.5, True, "5", None])
 def test_object_risk_min_overturning_is_a_whole_number_of_records(value):
-    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 10)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 10, 10)])
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     with pytest.raises(ValueError, match="min_overturning must be a whole number >= 1"):
-        object_risk(_ida(cap), hazard, n_boot=0, min_overturning=value)
+        object_risk(pga_ida(cap), hazard, n_boot=0, min_overturning=value)
 
 
 def test_object_names_with_nul_are_refused_in_study_files(tmp_path, suite):

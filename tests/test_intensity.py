@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from _helpers import study_text
 from scipy import integrate, optimize, signal
 
 from rockstudy.constants import STANDARD_GRAVITY, G
@@ -435,7 +436,6 @@ def test_shared_records_plausible(records_dir):
 def test_a_study_cube_states_both_gravities(tmp_path):
     """The cube says which g the physics used and which g a record in g was read with."""
     import xarray as xr
-    from test_study import study_text
 
     from rockstudy.study import make_design, validate_text
     from rockstudy.study.running.store import claim, create_store

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_record_studies import rows_study, run_rows, suite  # noqa: F401  (a fixture)
+from _helpers import rows_study, run_rows, write_near_fault_pairs
 
 from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.constants import G
@@ -29,6 +29,12 @@ def first_half_peak(record) -> float:
     """max |a| over the first half of the record [m/s^2], by numpy on its samples."""
     a = np.asarray(record.acceleration)
     return float(np.max(np.abs(a[record.time <= 0.5 * record.duration])))
+
+
+@pytest.fixture(scope="module")
+def suite(tmp_path_factory):
+    """A folder of three synthetic near-fault records: horizontal and vertical .AT2 files."""
+    return write_near_fault_pairs(tmp_path_factory.mktemp("records"))
 
 
 @pytest.fixture
@@ -248,14 +254,18 @@ def test_bad_registrations_are_refused_naming_the_argument(kwargs, argument):
 
 
 def test_replace_redefines_and_the_records_recompute(records):
+    """The record's values follow the registry: its PGD before, the replacement's value (the
+    area under |a|, by hand: (0 + 3 + 4 + 1) m/s^2 x 0.01 s = 0.08 m/s), its PGD again."""
     rec = Record(np.array([0.0, 3.0, -4.0, 1.0]), dt=0.01)
+    before = rec.intensity_measure("pgd")
     old = measures.MEASURES["pgd"]
     try:
-        register_measure("pgd", lambda r: 7.0, unit="m", power=1, replace=True)
-        assert rec.intensity_measure("pgd") == 7.0
+        area = lambda r: float(np.abs(r.acceleration).sum() * r.dt)  # noqa: E731
+        register_measure("pgd", area, unit="m/s", power=1, replace=True)
+        assert rec.intensity_measure("pgd") == pytest.approx(0.08, rel=1e-15)
     finally:
         measures.MEASURES["pgd"] = old
-    assert rec.intensity_measure("pgd") != 7.0
+    assert rec.intensity_measure("pgd") == before and before != pytest.approx(0.08)
     with pytest.raises(ValueError, match="name must be one of"):
         measures.unregister_measure("nothing")
 

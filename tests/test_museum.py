@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from test_study import ROCKSTUDY
+from _helpers import ROCKSTUDY
 
 from rockstudy import risk
 from rockstudy.study import load_study

@@ -7,10 +7,11 @@ import math
 
 import numpy as np
 import pytest
+from _helpers import STUDY_OBJECTS, unit_sine_record, write_two_records
 
 import rockstudy as rs
 from rockstudy.constants import G
-from rockstudy.motions import Record, synthetic_near_fault
+from rockstudy.motions import synthetic_near_fault
 from rockstudy.structures.block import frequency_parameter
 from rockstudy.study.analysis import record_fragility as rf
 from rockstudy.study.designs import records as rd
@@ -29,14 +30,6 @@ OBJECTS = {
     "Column B": rs.Block(half_diagonal=1.2, slenderness=0.18),
     "Vase": rs.Block(half_diagonal=0.4, slenderness=0.3, restitution=0.85),
 }
-
-
-def _sine_record(omega_ratio, half_diagonal=1.0):
-    """One cycle of a unit sine pulse, then rest: overturning is monotone in its scale."""
-    T = 2 * np.pi / (omega_ratio * frequency_parameter(half_diagonal))
-    dt = T / 200
-    t = np.arange(0, 3 * T, dt)
-    return Record(np.where(t <= T, np.sin(2 * np.pi * t / T), 0.0), dt=dt, name="sine")
 
 
 def test_cloud_keeps_the_names_and_each_object_responds_as_alone(records):
@@ -72,7 +65,7 @@ def test_stripes_keep_the_names_into_the_fragility_table(records):
 def test_ida_capacity_of_a_named_object_is_that_of_the_block_alone():
     # one sine cycle at omega/p = 1.5 for the R = 1 block: overturning is monotone in scale,
     # so the first overturning scale of a dense scan of the block alone brackets the capacity
-    rec = _sine_record(1.5)
+    rec = unit_sine_record(1.5)
     objects = {"Stele": rs.Block(1.0, 0.2), "Urn": rs.Block(0.5, 0.25)}
     ds = rd.incremental_dynamic_analysis(rec, objects, scan=0)
     assert list(ds["structure"].values) == ["Stele", "Urn"]
@@ -112,38 +105,17 @@ def test_named_objects_bad_input(records):
 
 # ------------------------------------------------------------------------------ study files
 
-import test_record_studies  # noqa: E402
-
 from rockstudy.motions import load_suite  # noqa: E402
 from rockstudy.study import StudyError, load_study, run_study  # noqa: E402
 from rockstudy.study.running.store import open_result  # noqa: E402
 
-client = test_record_studies.client  # the one-worker cluster fixture
-write_at2 = test_record_studies.write_at2
-
 
 @pytest.fixture(scope="module")
 def suite(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("records")
-    for i, tp in enumerate((0.5, 1.0)):
-        rec = synthetic_near_fault(pulse_period=tp, pga=3.0, seed=20 + i, duration=4.0)
-        write_at2(folder / f"r{i}.AT2", rec)
-    return folder
+    """A folder of two small synthetic records."""
+    return write_two_records(tmp_path_factory.mktemp("records"))
 
 
-STUDY_OBJECTS = """
-name = "museum"
-seed = 1
-[structure]
-kind = "objects"
-{objects}
-[motion]
-kind = "record"
-files = "{folder}"
-scale_to = {{ im = "pga", value = {{ dist = "grid", values = [2.0, 5.0] }} }}
-[design]
-kind = "stripes"
-"""
 LISTED = """objects = [
   { name = "Statue A", width = 0.45, height = 1.9 },
   { name = "Column B", half_diagonal = 1.2, slenderness = 0.18 },

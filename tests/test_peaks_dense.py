@@ -283,27 +283,16 @@ def test_plot_passes_through_the_exact_peaks():
 
 def test_cli_writes_peaks_and_the_dt_out_grid(tmp_path):
     import json
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
 
     import xarray as xr
+    from _helpers import cli
 
-    root = Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONPATH": str(root), "NUMBA_NUM_THREADS": "1"}
     args = ["simulate", "--half-diagonal", "1", "--slenderness", str(ALPHA)]
     args += ["--amplitude", "3.0", "--period", "0.5", "--dt-out", "0.01", "--json"]
-    out = subprocess.run(
-        [sys.executable, "-m", "rockstudy.cli", *args, "--out", str(tmp_path / "h.nc")],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=300,
-    )
-    assert out.returncode == 0, out.stderr
+    code, stdout, err = cli(*args, "--out", tmp_path / "h.nc")
+    assert code == 0, err
     r = rs.simulate(BLOCK, PULSE, dt_out=0.01)
-    peaks = json.loads(out.stdout)["result"]["peaks"]
+    peaks = json.loads(stdout)["result"]["peaks"]
     assert peaks["count"] == r.peak_times.size
     assert abs(peaks["largest_rotation"]) == pytest.approx(r.max_rotation, rel=1e-12)
     with xr.open_dataset(tmp_path / "h.nc") as ds:

@@ -7,8 +7,9 @@ import math
 
 import numpy as np
 import pytest
+from _helpers import REAL_RECORD_FILES as FILES
+from _helpers import load_real_record as load
 from scipy.integrate import solve_ivp
-from test_records_rocking import FILES, load
 
 import rockstudy as rs
 from rockstudy.constants import G

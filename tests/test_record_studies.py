@@ -12,67 +12,33 @@ import shutil
 import numpy as np
 import pytest
 import scipy.signal
-from distributed import Client, LocalCluster
+from _helpers import (
+    RECORD_STUDY_HEAD as HEAD,
+)
+from _helpers import (
+    chromium_figures,
+    rows_study,
+    run_rows,
+    write_at2,
+    write_near_fault_pairs,
+)
 
 import rockstudy as rs
 from rockstudy import simulate_batch
 from rockstudy.constants import STANDARD_GRAVITY, G
-from rockstudy.motions import Record, load_suite, synthetic_near_fault
+from rockstudy.motions import Record, load_suite
 from rockstudy.study import StudyError, load_study, run_study
 from rockstudy.study.designs import records as rd
 from rockstudy.study.designs.sampling import make_design
-from rockstudy.study.running.evaluate import STATUS_OK, evaluate_chunk
+from rockstudy.study.running.evaluate import STATUS_OK
 from rockstudy.study.running.store import open_result
-
-
-def write_at2(path, record):
-    """A PEER .AT2 file of ``record`` (in g)."""
-    values = record.acceleration / STANDARD_GRAVITY
-    lines = [
-        "PEER STRONG MOTION DATABASE RECORD",
-        "synthetic near-fault record for the tests",
-        "ACCELERATION TIME SERIES IN UNITS OF G",
-        f"NPTS= {values.size}, DT= {record.dt:.4f} SEC",
-    ]
-    lines += [" ".join(f"{v:.9e}" for v in values[i : i + 5]) for i in range(0, values.size, 5)]
-    path.write_text("\n".join(lines) + "\n")
 
 
 @pytest.fixture(scope="module")
 def suite(tmp_path_factory):
     """A folder of three synthetic near-fault records: horizontal and vertical .AT2 files."""
-    folder = tmp_path_factory.mktemp("records")
-    for i, tp in enumerate((0.5, 0.8, 1.2)):
-        rec = synthetic_near_fault(
-            pulse_period=tp, pga=3.0, seed=10 + i, duration=5.0, vertical=True
-        )
-        write_at2(folder / f"nf{i}_H.AT2", rec)
-        write_at2(folder / f"nf{i}_UP.AT2", Record(rec.vertical, dt=rec.dt))
-    return folder
+    return write_near_fault_pairs(tmp_path_factory.mktemp("records"))
 
-
-@pytest.fixture(scope="module")
-def client():
-    with (
-        LocalCluster(
-            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
-        ) as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
-HEAD = """
-name = "designs"
-seed = 5
-[sampler]
-kind = "lhs"
-n = 3
-[structure]
-kind = "block"
-half_diagonal = { dist = "uniform", low = 0.3, high = 1.2 }
-slenderness = { dist = "uniform", low = 0.15, high = 0.25 }
-"""
 
 MOTION = """
 [motion]
@@ -299,25 +265,6 @@ def test_a_record_that_fails_in_its_task_fails_its_rows_and_is_counted(suite, cl
 # ---------------------------------------------------------------- Monte Carlo rows, targets
 
 
-def rows_study(folder, where, motion_extra, n=6):
-    text = HEAD.replace('kind = "lhs"\nn = 3', f'kind = "monte_carlo"\nn = {n}') + (
-        f'[motion]\nkind = "record"\nfiles = "{folder}/*_H.AT2"\n{motion_extra}\n'
-        '[run]\noutputs = ["max_rotation", "overturned"]\n'
-    )
-    path = where / "rows.toml"
-    path.write_text(text)
-    return load_study(path)
-
-
-def run_rows(study, where):
-    design = make_design(study, where)
-    cols = {k: v.values for k, v in design.data_vars.items() if v.dims == ("sample",)}
-    cols["sample"] = design["sample"].values
-    out = evaluate_chunk(study.normalized(), cols, where)
-    assert np.all(out["status"] == STATUS_OK), out["error"]
-    return design, out
-
-
 def test_rows_scaled_to_sa_reach_it_by_an_independent_oscillator(suite, tmp_path):
     """scale_to = Sa(0.5 s) of a distribution: each sample's record, scaled by the factor the
     run applied, has that Sa, by scipy's exact solution of the oscillator (lsim)."""
@@ -501,7 +448,6 @@ def test_no_record_of_a_folder_is_skipped(suite, tmp_path):
 def test_report_of_a_record_study_shows_its_file_and_target_units(suite, client, tmp_path):
     """Monte Carlo rows scaled to a PGV distribution: the report renders in Chromium, names the
     target in its units in the inputs table, and shows the study file as written."""
-    from test_report import chromium_figures
 
     from rockstudy.study.report import make_report
 

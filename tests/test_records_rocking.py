@@ -2,27 +2,12 @@
 
 import numpy as np
 import pytest
+from _helpers import REAL_RECORD_FILES as FILES
+from _helpers import load_real_record as load
 
 import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.dynamics.batch import simulate_batch
-
-FILES = [
-    "RSN126_GAZLI_GAZ000.AT2",
-    "RSN183_IMPVALL.H_H-E08140.AT2",
-    "RSN948_NORTHR_CAM009.AT2",
-    "RSN982_NORTHR_JEN292.AT2",
-    "elcentro_NS.dat",
-]
-
-
-def load(records_dir, name):
-    path = records_dir / name
-    return (
-        rs.motions.Record.from_at2(path)
-        if name.endswith(".AT2")
-        else rs.motions.Record.from_csv(path, units="g")
-    )
 
 
 @pytest.mark.parametrize("name", FILES)

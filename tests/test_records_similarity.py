@@ -5,9 +5,8 @@ import math
 
 import numpy as np
 import pytest
-import xarray as xr
+from _helpers import constructed_ida
 
-from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.motions import Record, synthetic_near_fault
 from rockstudy.structures.block import frequency_parameter
 from rockstudy.study.analysis.record_similarity import size_class_medians, size_classes
@@ -66,26 +65,6 @@ def test_pooled_over_frequencies_the_sizes_spread_apart(similar_ida):
     assert theta[-1] > theta[0] * (1 + 10 * TOL)
     assert spread.loc["all", "ratio"] == pytest.approx(theta.max() / theta.min(), rel=1e-12)
     assert medians["unit"].iloc[0] == "g"
-
-
-def constructed_ida(theta, beta=0.4, n_rec=7):
-    """IDA layout with capacities ln c_jk = ln theta_k + beta z_j, z symmetric about 0: the
-    lognormal MLE median of class k is exactly theta_k [g]."""
-    z = np.linspace(-1.5, 1.5, n_rec)
-    cap = np.asarray(theta)[None, :] * np.exp(beta * z)[:, None]  # PGA [g]
-    n = len(theta)
-    ds = xr.Dataset(
-        {
-            "pga": ("record", np.full(n_rec, G_UNIT)),  # 1 g: the scale is the capacity in g
-            "half_diagonal": ("structure", np.geomspace(0.3, 5.0, n)),
-            "capacity_scale": (("record", "structure"), cap),
-            "capacity_scale_lower": (("record", "structure"), cap / (1 + TOL)),
-            "censored": (("record", "structure"), np.zeros((n_rec, n), bool)),
-            "status": (("record", "structure"), np.zeros((n_rec, n), np.int64)),
-        },
-        attrs={"design": "ida", "im": "pga"},
-    )
-    return ds
 
 
 def test_ratio_and_log_std_of_known_medians():

@@ -1,12 +1,11 @@
 """The report: sections by what the cube holds, rendered in headless Chromium."""
 
 import re
-import shutil
-import subprocess
 
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
+from _helpers import chromium_figures, rocking_with_falls
 
 from rockstudy.study import run_study, validate_text
 from rockstudy.study.report import make_report
@@ -52,35 +51,6 @@ frequency_ratio = { dist = "loguniform", low = 0.5, high = 12.0 }
 method = "linear"
 outputs = ["max_rotation", "max_rotation_ratio", "overturned"]
 """
-
-
-def chromium_figures(page):
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    assert exe, "headless Chromium is needed (make test installs Debian's chromium)"
-    out = subprocess.run(
-        [
-            exe,
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            f"--user-data-dir={page.parent / 'chromium-profile'}",
-            "--virtual-time-budget=5000",
-            "--dump-dom",
-            page.as_uri(),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    # the page's own check writes "shown/total" into a data attribute, never into its text
-    m = re.search(r'<body[^>]*data-figures="(\d+)/(\d+)"', out.stdout)
-    assert m, out.stdout[-2000:]
-    return int(m.group(1)), int(m.group(2))
 
 
 @pytest.mark.parametrize("text", [SOBOL, SIMILAR], ids=["sobol", "similarity"])
@@ -291,11 +261,10 @@ def test_the_reports_first_order_indices_of_the_rotation_leave_out_the_falls(tmp
     from types import SimpleNamespace
 
     import pandas as pd
-    from test_analysis import _rocking_with_falls
 
     from rockstudy.study.report import sampled as report
 
-    ds = _rocking_with_falls()
+    ds = rocking_with_falls()
     study = SimpleNamespace(parameters=lambda: {"slenderness": None, "amplitude_ratio": None})
     page = report._Page(tmp_path)
     report._first_order(page, ds, study)

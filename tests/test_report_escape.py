@@ -4,10 +4,10 @@ run no script in headless Chromium."""
 import json
 import re
 import shutil
-import subprocess
 
 import pytest
 import zarr
+from _helpers import chromium_dom
 
 from rockstudy.study import run_study, validate_text
 from rockstudy.study.report import make_report
@@ -43,40 +43,17 @@ outputs = ["max_rotation", "overturned"]
 
 
 def dump_dom(page):
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
-    assert exe, "headless Chromium is needed (make test installs Debian's chromium)"
-    out = subprocess.run(
-        [
-            exe,
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            f"--user-data-dir={page.parent / 'chromium-profile'}",
-            "--virtual-time-budget=3000",
-            "--dump-dom",
-            page.as_uri(),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    out = chromium_dom(page, page.parent / "chromium-profile", budget_ms=3000)
     assert "</html>" in out.stdout, out.stderr[-2000:]
     return out.stdout
 
 
 @pytest.fixture(scope="module")
-def hostile_cube(tmp_path_factory):
+def hostile_cube(tmp_path_factory, client):
     tmp = tmp_path_factory.mktemp("escape")
     text = STUDY.format(name=json.dumps(HOSTILE[0]), description=json.dumps(" ".join(HOSTILE)))
     cube = tmp / "cube.zarr"
-    from distributed import Client
-
-    with Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as c:
-        run_study(validate_text(text), cube, client=c, progress=False, netcdf=False)
+    run_study(validate_text(text), cube, client=client, progress=False, netcdf=False)
     return cube
 
 

@@ -8,7 +8,7 @@ import matplotlib.image as mpimg
 import numpy as np
 import pandas as pd
 import pytest
-from test_report import chromium_figures
+from _helpers import chromium_figures
 
 from rockstudy.constants import G
 from rockstudy.motions import Record, load_suite

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from _helpers import chromium_dom, chromium_figures
 from scipy import optimize, special
 
 import rockstudy as rs
@@ -291,9 +292,6 @@ def test_wide_tables_fit_a_page_1400_pixels_wide(tmp_path):
     """The eight shipped records under three objects (a records table of 17 columns, a
     capacity table of ten): rendered in headless Chromium 1,400 pixels wide, no table
     scrolls sideways and neither does the page."""
-    import subprocess
-
-    from test_report import chromium_figures
 
     records = load_suite(sorted(DATA.glob("*_H.AT2")))
     objects = {f"Object {k}": rs.Block(0.3 + 0.3 * k, 0.15 + 0.03 * k) for k in range(3)}
@@ -309,22 +307,7 @@ def test_wide_tables_fit_a_page_1400_pixels_wide(tmp_path):
     )
     probed = page.parent / "probe.html"
     probed.write_text(page.read_text().replace("</body>", probe + "</body>"))
-    out = subprocess.run(
-        [
-            "chromium",
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--window-size=1400,1000",
-            f"--user-data-dir={tmp_path / 'profile'}",
-            "--virtual-time-budget=5000",
-            "--dump-dom",
-            probed.as_uri(),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    out = chromium_dom(probed, tmp_path / "profile", extra=["--window-size=1400,1000"])
     over, tables, width = map(int, re.search(r'data-overflow="([^"]*)"', out.stdout)[1].split("/"))
     assert tables >= 6 and over == 0
     assert width <= 1400

@@ -398,9 +398,14 @@ def test_levels_beyond_any_ground_motion_are_refused_naming_units(im, levels, un
 def test_a_default_power_law_converts_to_every_unit_of_its_measure():
     """Its levels end at 10 g, the limit itself: in any unit it stays readable."""
     curve = HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
-    for units in ("m/s^2", "cm/s^2", "gal", "g"):
-        again = curve.to_units(units).to_units("g")
-        np.testing.assert_allclose(again.levels, curve.levels, rtol=1e-12)
+    # 1 g = 9.80665 m/s^2 (the standard gravity, by definition); 1 gal = 1 cm/s^2
+    per_g = {"m/s^2": 9.80665, "cm/s^2": 980.665, "gal": 980.665, "g": 1.0}
+    for units, factor in per_g.items():
+        there = curve.to_units(units)
+        assert there.units == units
+        np.testing.assert_allclose(there.levels, curve.levels * factor, rtol=1e-15)
+        np.testing.assert_array_equal(there.rates, curve.rates)
+        assert there.levels[-1] == pytest.approx(10 * factor, rel=1e-15)  # the limit, 10 g
 
 
 def test_an_openquake_curve_in_other_units_than_openquake_writes_is_refused(tmp_path):

@@ -6,48 +6,24 @@ delta method on the known lognormal; the hazard's units (g against m/s^2, the sa
 a tabulated curve against the power law it was tabulated from; objects that never or always
 overturn, marked by what the data can say."""
 
+import math
+
 import numpy as np
 import pytest
 import xarray as xr
+from _helpers import K0, K, lognormal_sample, pga_ida, unit_sine_record
 
 from rockstudy import risk
 from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
 from rockstudy.study.analysis.risk import object_risk
 
-K0, K = 2e-4, 2.3  # lambda(x) = k0 x^-k, x in g
-
-
-def _ida(capacities_g, censored=None, names=None):
-    """An IDA dataset of capacities [g of PGA] on (record, structure): every record has a
-    PGA of 1 g, so the capacity scale is the capacity in g."""
-    cap = np.asarray(capacities_g, float)
-    cens = np.zeros(cap.shape, bool) if censored is None else np.asarray(censored)
-    n_rec, n_st = cap.shape
-    names = names or [f"object {j}" for j in range(n_st)]
-    ds = xr.Dataset(
-        {
-            "pga": ("record", np.full(n_rec, G_UNIT)),
-            "capacity_scale": (("record", "structure"), np.where(cens, np.nan, cap)),
-            "capacity_scale_lower": (("record", "structure"), cap / 1.001),
-            "censored": (("record", "structure"), cens),
-            "status": (("record", "structure"), np.zeros(cap.shape, int)),
-        },
-        coords={"structure": names},
-        attrs={"design": "ida", "im": "pga"},
-    )
-    return ds
-
-
-def _lognormal(theta, beta, n, seed):
-    return theta * np.exp(beta * np.random.default_rng(seed).standard_normal(n))
-
 
 def test_rate_of_a_known_lognormal_capacity_matches_cornell_within_its_sampling_error():
     # two objects of known capacity distributions; 400 records
     n, truth = 400, [(0.3, 0.4), (0.6, 0.25)]
-    cap = np.column_stack([_lognormal(t, b, n, s) for s, (t, b) in enumerate(truth)])
+    cap = np.column_stack([lognormal_sample(t, b, n, s) for s, (t, b) in enumerate(truth)])
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
-    out = object_risk(_ida(cap, names=["Statue", "Column"]), hazard, n_boot=100, seed=1)
+    out = object_risk(pga_ida(cap, names=["Statue", "Column"]), hazard, n_boot=100, seed=1)
     for name, (theta, beta) in zip(["Statue", "Column"], truth, strict=True):
         row = out.sel(structure=name)
         exact = K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
@@ -66,10 +42,10 @@ def test_rate_of_a_known_lognormal_capacity_matches_cornell_within_its_sampling_
 
 
 def test_band_contains_the_point_estimate_and_is_seeded():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 12, 3), _lognormal(0.8, 0.3, 12, 4)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 12, 3), lognormal_sample(0.8, 0.3, 12, 4)])
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
-    a = object_risk(_ida(cap), hazard, n_boot=200, seed=7)
-    b = object_risk(_ida(cap), hazard, n_boot=200, seed=7)
+    a = object_risk(pga_ida(cap), hazard, n_boot=200, seed=7)
+    b = object_risk(pga_ida(cap), hazard, n_boot=200, seed=7)
     lam, lo, hi = (a[k].values for k in ("annual_rate", "annual_rate_lo", "annual_rate_hi"))
     assert np.all(lo < lam) and np.all(lam < hi)
     assert np.all(a["probability_lo"] < a["probability"])
@@ -82,32 +58,32 @@ def test_band_contains_the_point_estimate_and_is_seeded():
 
 
 def test_units_g_or_si_give_the_same_rate():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 15, 5)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 15, 5)])
     in_g = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     in_si = in_g.to_units("m/s^2")
-    a = object_risk(_ida(cap), in_g, n_boot=20)
-    b = object_risk(_ida(cap), in_si, n_boot=20)
+    a = object_risk(pga_ida(cap), in_g, n_boot=20)
+    b = object_risk(pga_ida(cap), in_si, n_boot=20)
     assert b["annual_rate"].item() == pytest.approx(a["annual_rate"].item(), rel=1e-10)
     assert b["theta"].item() == pytest.approx(a["theta"].item() * G_UNIT, rel=1e-12)
 
 
 def test_a_tabulated_curve_gives_the_rate_of_its_power_law_source():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 15, 6), _lognormal(1.2, 0.3, 15, 8)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 15, 6), lognormal_sample(1.2, 0.3, 15, 8)])
     source = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     levels = np.geomspace(0.05, 2.0, 12)
     table = risk.HazardCurve("pga", levels, K0 * levels**-K, units="g")
-    a = object_risk(_ida(cap), source, n_boot=0)
-    b = object_risk(_ida(cap), table, n_boot=0)
+    a = object_risk(pga_ida(cap), source, n_boot=0)
+    b = object_risk(pga_ida(cap), table, n_boot=0)
     np.testing.assert_allclose(b["annual_rate"], a["annual_rate"], rtol=1e-9)
 
 
 def test_objects_that_never_overturn_are_marked_with_an_upper_bound_not_a_rate():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 9), np.linspace(1.5, 3.0, 10)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 10, 9), np.linspace(1.5, 3.0, 10)])
     cens = np.zeros(cap.shape, bool)
     cens[:, 1] = True  # the second object stood at the top of every IDA
     cens[:2, 0] = True  # the first, under two records
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
-    out = object_risk(_ida(cap, cens, ["A", "B"]), hazard, n_boot=20)
+    out = object_risk(pga_ida(cap, cens, ["A", "B"]), hazard, n_boot=20)
     b = out.sel(structure="B")
     assert str(b["status"].values) == "none"
     assert np.isnan(float(b["annual_rate"])) and np.isnan(float(b["probability"]))
@@ -119,11 +95,11 @@ def test_objects_that_never_overturn_are_marked_with_an_upper_bound_not_a_rate()
 
 
 def test_few_overturning_records_are_marked():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 10, 10)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 10, 10)])
     cens = np.ones(cap.shape, bool)
     cens[:3, 0] = False
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
-    out = object_risk(_ida(cap, cens), hazard, n_boot=10)
+    out = object_risk(pga_ida(cap, cens), hazard, n_boot=10)
     assert str(out["status"].values[0]) == "few"
     assert int(out["n_overturning"].values[0]) == 3
 
@@ -159,19 +135,19 @@ def test_stripes_overturned_everywhere_give_a_lower_bound():
 
 
 def test_a_hazard_the_design_cannot_express_is_refused():
-    cap = np.column_stack([_lognormal(0.4, 0.5, 5, 11)])
+    cap = np.column_stack([lognormal_sample(0.4, 0.5, 5, 11)])
     sa = risk.HazardCurve.power_law(K0, K, im="sa", units="g", period=0.5)
     with pytest.raises(ValueError, match="hazard: the design cannot express"):
-        object_risk(_ida(cap), sa)
+        object_risk(pga_ida(cap), sa)
     dur = risk.HazardCurve.power_law(1.0, 1.0, im="significant_duration")
     no_fragility = "hazard: its im 'significant_duration' is not a measure a scale factor"
     with pytest.raises(ValueError, match=no_fragility):
-        object_risk(_ida(cap), dur)
+        object_risk(pga_ida(cap), dur)
     with pytest.raises(TypeError, match="hazard must be"):
-        object_risk(_ida(cap), "pga")
+        object_risk(pga_ida(cap), "pga")
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     with pytest.raises(ValueError, match="years"):
-        object_risk(_ida(cap), hazard, years=0)
+        object_risk(pga_ida(cap), hazard, years=0)
 
 
 def test_share_below_a_level_matches_the_closed_form_of_a_power_law():
@@ -193,18 +169,31 @@ def test_share_below_a_level_matches_the_closed_form_of_a_power_law():
 
 
 def test_the_uplift_share_is_given_for_a_pga_hazard():
-    cap = np.column_stack([_lognormal(0.4, 0.8, 30, 12)])
-    ds = _ida(cap)
+    cap = np.column_stack([lognormal_sample(0.4, 0.8, 30, 12)])
+    ds = pga_ida(cap)
     ds["pga_ratio"] = (("record", "structure"), np.full((30, 1), 1 / 0.2))  # uplift 0.2 g
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     out = object_risk(ds, hazard, n_boot=0)
     assert out["uplift"].item() == pytest.approx(0.2, rel=1e-12)
     row = out.isel(structure=0)
-    from rockstudy.study.analysis.risk import share_below
+    expected = _share_of_rate_below(row["theta"].item(), row["beta"].item(), 0.2)
+    assert row["share_below_uplift"].item() == pytest.approx(expected, rel=1e-7)
+    assert 0.05 < expected < 0.95
 
-    expected = share_below(row["theta"].item(), row["beta"].item(), hazard, 0.2)
-    assert row["share_below_uplift"].item() == pytest.approx(expected, rel=1e-12)
-    assert 0 < expected < 1
+
+def _share_of_rate_below(theta, beta, level):
+    """The share of lambda_OT = int F(x) |dlambda/dx| dx from x < ``level`` [g], F the
+    lognormal fragility and lambda = K0 x^-K, by the trapezoidal rule in ln x on a fine grid
+    (|dlambda/dx| dx = K K0 x^-K d(ln x)), from far below theta to where x^-K is negligible."""
+    from scipy.stats import norm
+
+    def rate(upper):
+        u = np.linspace(math.log(theta) - 15 * beta, math.log(upper), 400_001)
+        integrand = norm.cdf((u - math.log(theta)) / beta) * K * K0 * np.exp(-K * u)
+        return np.trapezoid(integrand, u)
+
+    whole = rate(theta * math.exp(15 * beta + 60 / K))  # x^-K down by e^-60 beyond
+    return rate(level) / whole
 
 
 def _truncated_cornell(theta, beta, x_u):
@@ -223,8 +212,8 @@ def _two_objects(vertical):
     about 0.6 g with beta 0.3, uplift at 0.05 g. The whole lognormal ranks A first (its wide
     lower tail); with the fragility 0 below uplift, B."""
     z = np.random.default_rng(21).standard_normal(300)
-    cap = np.column_stack([0.45 * np.exp(2.0 * np.abs(z)), _lognormal(0.6, 0.3, 300, 22)])
-    ds = _ida(cap, names=["A", "B"])
+    cap = np.column_stack([0.45 * np.exp(2.0 * np.abs(z)), lognormal_sample(0.6, 0.3, 300, 22)])
+    ds = pga_ida(cap, names=["A", "B"])
     ds["uplift_acceleration"] = ("structure", np.array([0.45, 0.05]) * G_UNIT)
     ds["vertical_component"] = ("record", np.arange(300) == 7 if vertical else np.zeros(300, bool))
     return ds
@@ -284,7 +273,6 @@ def test_the_cut_is_where_the_simulated_block_lifts_when_that_is_lower():
     """An arch's equivalent block (what a design simulates) lifts off at g tan(theta_cr),
     below the arch's own g lambda: nothing overturns below the lower of the two, so the cut
     is there; the IDA's capacities of a real arch all lie above it."""
-    from test_objects import _sine_record
 
     from rockstudy.constants import G
     from rockstudy.structures import Arch, uplift_acceleration
@@ -294,7 +282,7 @@ def test_the_cut_is_where_the_simulated_block_lifts_when_that_is_lower():
     block_lifts = G * np.tan(arch.equivalent_block().slenderness) / G_UNIT  # [g]
     own = uplift_acceleration(arch) / G_UNIT
     assert block_lifts < own * 0.9  # (an arch: 14 % lower)
-    recs = [_sine_record(tp) for tp in (2.0, 3.0, 4.0)]
+    recs = [unit_sine_record(tp) for tp in (2.0, 3.0, 4.0)]
     ida = incremental_dynamic_analysis(recs, {"arch": arch}, scan=0, step=0.05, tolerance=0.01)
     hazard = risk.HazardCurve.power_law(K0, K, im="pga", units="g")
     out = object_risk(ida, hazard, n_boot=0)

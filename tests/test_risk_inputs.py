@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from test_hazard_study import STUDY
+from _helpers import HAZARD_STUDY as STUDY
+from _helpers import cli, time_limit
 
 from rockstudy import UnitsWarning
 from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
@@ -110,17 +111,13 @@ def test_a_device_a_fifo_and_a_huge_file_are_refused_before_reading(tmp_path):
 def test_a_study_whose_hazard_file_is_a_fifo_or_a_device_is_one_line(tmp_path, command):
     fifo = tmp_path / "pipe.csv"
     os.mkfifo(fifo)
-    rockstudy = Path(sys.executable).with_name("rockstudy")
     for name, what in (("pipe.csv", "FIFO"), ("/dev/zero", "character device")):
         (tmp_path / "s.toml").write_text(_study_text(name))
-        args = [str(tmp_path / "s.toml")] + (
-            ["--out", str(tmp_path / "c.zarr")] * (command == "run")
-        )
-        proc = subprocess.run(
-            [rockstudy, command, *args], capture_output=True, text=True, timeout=120
-        )
-        assert proc.returncode != 0 and "Traceback" not in proc.stderr, proc.stderr
-        assert "hazard.file" in proc.stderr and what in proc.stderr, proc.stderr
+        args = [tmp_path / "s.toml"] + (["--out", tmp_path / "c.zarr"] * (command == "run"))
+        with time_limit(120, f"rockstudy {command} of a study on {name}"):  # a read would hang
+            code, _, err = cli(command, *args)
+        assert code != 0 and "Traceback" not in err, err
+        assert "hazard.file" in err and what in err, err
         assert not (tmp_path / "c.zarr").exists()
 
 

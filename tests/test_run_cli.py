@@ -2,7 +2,9 @@
 failed samples, Ctrl-C, scripts without a main guard, worker counts, schedulers without
 workers or out of reach, operational errors, TLS, and no dashboard nobody asked for.
 
-The runs are real ``rockstudy run`` processes on small pulse studies.
+The runs are on small pulse studies: in this process (``rockstudy.cli.main``) where the
+message is the point, real ``rockstudy run`` processes where the process is (Ctrl-C, a file
+size limit, TLS from dask's environment, a clean exit).
 """
 
 import os
@@ -20,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from test_study import ROCKSTUDY, SLOW, study_text  # the studies of the study-layer tests
+from _helpers import ROCKSTUDY, SLOW, cli, rockstudy_process, study_text
 
 from rockstudy.study import run_study, validate_text
 
@@ -32,13 +34,6 @@ def write_study(folder, n=40, chunk=10, max_steps=1_000_000, motion="pulse"):
     text = SLOW.format(chunk=chunk, n=n) if motion == "stochastic" else None
     path.write_text(text or study_text(chunk=chunk, n=n, max_steps=max_steps))
     return path
-
-
-def rockstudy(*args, timeout=300, **kw):
-    proc = subprocess.run(
-        [ROCKSTUDY, *map(str, args)], capture_output=True, text=True, timeout=timeout, **kw
-    )
-    return proc.returncode, proc.stdout, proc.stderr
 
 
 def error_lines(stderr):
@@ -53,7 +48,7 @@ def error_lines(stderr):
 def test_failed_samples_exit_nonzero_with_a_summary(tmp_path):
     study = write_study(tmp_path, max_steps=3)
     out = tmp_path / "cube.zarr"
-    code, _, err = rockstudy("run", study, "--out", out, "--workers", "1", "--quiet")
+    code, _, err = cli("run", study, "--out", out, "--workers", "1", "--quiet")
     assert code == 1, err
     cube = xr.open_zarr(out)
     failed = int((cube.status.values == 2).sum())
@@ -61,7 +56,7 @@ def test_failed_samples_exit_nonzero_with_a_summary(tmp_path):
     assert f"{failed} of {cube.sizes['sample']} samples failed" in err
     assert f"{failed:8d} x kernel stopped: more than max_steps=3 steps" in err
     assert out.with_suffix(".nc").is_file()  # the cube is complete and kept
-    code, _, err = rockstudy("run", study, "--out", out, "--resume", "--max-failed", "1", "--quiet")
+    code, _, err = cli("run", study, "--out", out, "--resume", "--max-failed", "1", "--quiet")
     assert code == 0, err
 
 
@@ -154,9 +149,7 @@ def test_script_without_main_guard_gets_one_sentence(tmp_path):
 @pytest.mark.parametrize("workers", ["0", "-1"])
 def test_worker_count_must_be_positive(tmp_path, workers):
     study = write_study(tmp_path)
-    code, _, err = rockstudy(
-        "run", study, "--out", tmp_path / "c.zarr", "--workers", workers, timeout=60
-    )
+    code, _, err = cli("run", study, "--out", tmp_path / "c.zarr", "--workers", workers)
     assert code == 2 and "--workers" in err and ">= 1" in err
     assert not (tmp_path / "c.zarr").exists()
     with pytest.raises(ValueError, match="workers"):
@@ -197,9 +190,9 @@ def _wait_for_port(port, timeout=60):
 def test_scheduler_without_workers_or_out_of_reach_is_said_in_time(tmp_path):
     study = write_study(tmp_path)
     port = _free_port()
-    code, _, err = rockstudy(
+    code, _, err = cli(
         "run", study, "--out", tmp_path / "a.zarr", "--scheduler", f"tcp://127.0.0.1:{port}",
-        "--timeout", "3", timeout=60,
+        "--timeout", "3",
     )  # fmt: skip
     lines = error_lines(err)
     assert code == 1 and len(lines) == 1 and "cannot reach the dask scheduler" in lines[0], err
@@ -209,9 +202,9 @@ def test_scheduler_without_workers_or_out_of_reach_is_said_in_time(tmp_path):
     try:
         _wait_for_port(port)
         t0 = time.time()
-        code, _, err = rockstudy(
+        code, _, err = cli(
             "run", study, "--out", tmp_path / "b.zarr", "--scheduler", f"tcp://127.0.0.1:{port}",
-            "--timeout", "3", timeout=120,
+            "--timeout", "3",
         )  # fmt: skip
         lines = error_lines(err)
         assert code == 1 and len(lines) == 1, err
@@ -273,7 +266,7 @@ def test_a_failing_write_is_one_error_line_and_resume_finishes(tmp_path):
     assert lines[0].startswith("error: ") and "4000 of 4000 samples are saved" in lines[0]
     assert f"rockstudy run {study} --out {out} --resume" in lines[0]
     assert not out.with_suffix(".nc").exists()  # no partial export left in its place
-    code, _, err = rockstudy("run", study, "--out", out, "--resume", "--workers", "1", "--quiet")
+    code, _, err = cli("run", study, "--out", out, "--resume", "--workers", "1", "--quiet")
     assert code == 0, err
     assert np.all(xr.open_dataset(out.with_suffix(".nc")).status.values == 1)
 
@@ -346,7 +339,7 @@ def test_tls_scheduler_from_flags_and_from_dask_config(tmp_path):
             )  # fmt: skip
         )
         study = write_study(tmp_path)
-        code, _, err = rockstudy(
+        code, _, err = rockstudy_process(
             "run", study, "--out", tmp_path / "flags.zarr", "--scheduler", address, *tls,
             "--quiet", env=env,
         )  # fmt: skip
@@ -356,7 +349,7 @@ def test_tls_scheduler_from_flags_and_from_dask_config(tmp_path):
             "DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT": str(cert),
             "DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY": str(key),
         }
-        code, _, err = rockstudy(
+        code, _, err = rockstudy_process(
             "run", study, "--out", tmp_path / "config.zarr", "--scheduler", address, "--quiet",
             env={**env, **config},
         )  # fmt: skip
@@ -390,15 +383,15 @@ def test_exit_waits_for_zarrs_io_thread(tmp_path):
     :func:`stop_zarr_io`, which the command line calls last, leaves a clean stderr."""
     study = write_study(tmp_path, n=10)
     out = tmp_path / "cube.zarr"
-    code, _, err = rockstudy("run", study, "--out", out, "--workers", "1", "--quiet")
+    code, _, err = rockstudy_process("run", study, "--out", out, "--workers", "1", "--quiet")
     assert code == 0 and err == "", err
     proc = subprocess.run(
         [sys.executable, "-c", BUSY_ZARR, str(out)], capture_output=True, text=True, timeout=120
     )
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     for _ in range(2):  # and runs end cleanly, again and again
-        code, _, err = rockstudy("run", study, "--out", out, "--resume", "--quiet")
+        code, _, err = rockstudy_process("run", study, "--out", out, "--resume", "--quiet")
         assert code == 0 and err == "", err
     for _ in range(5):
-        code, _, err = rockstudy("verify", out)
+        code, _, err = rockstudy_process("verify", out)
         assert code == 0 and err == "", err

@@ -13,12 +13,13 @@ import shutil
 
 import numpy as np
 import pytest
-import test_cube_verify
 import xarray as xr
-from test_cube_verify import cli, one_line
-from test_store_safety import (
+from _helpers import (
     assert_engine_results,
-    assert_one_error_line,
+    cli,
+    finished_run,
+    one_error_line,
+    one_line,
     rockstudy_run,
     tree,
     write_study,
@@ -30,7 +31,11 @@ from rockstudy.study.running import store
 from rockstudy.study.running.evaluate import evaluate_chunk
 from rockstudy.study.running.store import DamagedCube, StoreError
 
-finished = test_cube_verify.finished  # the fixture: a finished run of 60 samples in 6 chunks
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished run of 60 samples in 6 chunks: (study file, store)."""
+    return finished_run(tmp_path_factory.mktemp("integrity"), n=60, chunk=10)
 
 
 def _copy(src, tmp_path):
@@ -156,7 +161,7 @@ def _refused_on_resume(study, out, words):
     before = tree(out)
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code == 2, err
-    assert_one_error_line(err)
+    one_error_line(err)
     assert all(w in err for w in words), err
     assert tree(out) == before
 
@@ -240,9 +245,9 @@ def test_a_template_never_finished_is_said_so_by_verify(finished, tmp_path, monk
     def killed(*args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(store, "write_template_sums", killed)
     out = tmp_path / "cube.zarr"
-    with pytest.raises(KeyboardInterrupt):
+    with monkeypatch.context() as patched, pytest.raises(KeyboardInterrupt):
+        patched.setattr(store, "write_template_sums", killed)
         _run_in_process(study, out)
     code, _, err = cli("verify", out)
     line = one_line(err)

@@ -1,8 +1,9 @@
 """The study store never destroys, overwrites, mixes or loses work (issue 12, section 1).
 
-Every test runs real ``rockstudy run`` processes on small pulse studies (one worker), and checks
-results against the engine called directly (:func:`rockstudy.simulate_batch`), not against the
-store itself.
+Every test runs ``rockstudy run`` on small pulse studies (one worker): in this process
+(``rockstudy.cli.main``, its worker a thread), but for a second run beside a running one and a
+killed run, which are real processes. Results are checked against the engine called directly
+(:func:`rockstudy.simulate_batch`), not against the store itself.
 """
 
 import json
@@ -17,55 +18,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from test_study import ROCKSTUDY, study_text  # the pulse study of the study-layer tests
-
-from rockstudy import simulate_batch
-
-
-def write_study(folder, n=60, chunk=10, seed=7, name="study.toml"):
-    path = Path(folder) / name
-    path.write_text(study_text(chunk=chunk, n=n).replace("seed = 7", f"seed = {seed}"))
-    return path
-
-
-def rockstudy_run(study, out, *extra, timeout=300):
-    """A real ``rockstudy run`` process on one worker: (returncode, stdout, stderr)."""
-    proc = subprocess.run(
-        [ROCKSTUDY, "run", str(study), "--out", str(out), "--workers", "1", "--quiet", *extra],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
-    return proc.returncode, proc.stdout, proc.stderr
-
-
-def assert_one_error_line(stderr):
-    lines = [line for line in stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: "), stderr
-    assert "Traceback" not in stderr
-
-
-def assert_engine_results(cube):
-    """The cube holds what the engine computes for its design rows (an independent call)."""
-    ref = simulate_batch(
-        half_diagonal=cube["half_diagonal"].values,
-        slenderness=cube["slenderness"].values,
-        pulse="sine",
-        amplitude=cube["amplitude"].values,
-        period=cube["period"].values,
-    )
-    assert np.all(cube["status"].values == 1)
-    np.testing.assert_array_equal(cube["max_rotation"].values, ref["max_rotation"])
-    np.testing.assert_array_equal(cube["n_impacts"].values, ref["n_impacts"])
-
-
-def tree(folder):
-    """Every file of a folder and its bytes (the lock names its last holder: left out)."""
-    return {
-        str(p.relative_to(folder)): p.read_bytes()
-        for p in sorted(Path(folder).rglob("*"))
-        if p.is_file() and p.name != ".rockstudy.lock"
-    }
+from _helpers import (
+    ROCKSTUDY,
+    assert_engine_results,
+    one_error_line,
+    rockstudy_run,
+    tree,
+    write_study,
+)
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +51,7 @@ def test_resume_into_a_user_folder_touches_nothing(tmp_path):
     before = tree(user)
     code, _, err = rockstudy_run(study, user, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "not a rockstudy store" in err
     assert tree(user) == before  # not one file added, changed or removed
     assert not (tmp_path / "thesis.nc").exists()
@@ -104,7 +64,7 @@ def test_export_never_replaces_what_it_did_not_write(tmp_path):
     foreign.write_text("my own cube.nc")
     code, _, err = rockstudy_run(study, out)
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "--overwrite" in err and foreign.read_text() == "my own cube.nc"
     assert not out.exists()  # refused before anything ran
     code, _, err = rockstudy_run(study, out, "--overwrite")
@@ -115,7 +75,7 @@ def test_export_never_replaces_what_it_did_not_write(tmp_path):
     (tmp_path / "other.nc" / "inside").mkdir(parents=True)
     code, _, err = rockstudy_run(study, other, "--overwrite")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "is a folder" in err and (tmp_path / "other.nc" / "inside").is_dir()
 
 
@@ -146,19 +106,10 @@ def test_second_run_is_refused_and_a_killed_runs_lock_is_stale(tmp_path):
             time.sleep(0.05)
         assert (_lock_holder(out) or {}).get("pid") == first.pid, "the first run never started"
         t0 = time.time()
-        seconds = [
-            subprocess.Popen(
-                [ROCKSTUDY, "run", str(study), "--out", str(out), "--workers", "1", *extra],
-                stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE,
-                text=True,
-            )  # fmt: skip
-            for extra in (["--resume"], [])
-        ]
-        for second in seconds:
-            _, err = second.communicate(timeout=120)
-            assert second.returncode != 0
-            assert_one_error_line(err)
+        for extra in (["--resume"], []):  # a second run, in this process
+            code, _, err = rockstudy_run(study, out, *extra)
+            assert code != 0
+            one_error_line(err)
             assert f"PID {first.pid}" in err and "in use" in err, err
         assert first.poll() is None and time.time() - t0 < 60  # refused at once
     finally:
@@ -210,12 +161,12 @@ def test_damaged_metadata_is_reported_never_replaced(finished, tmp_path):
     before = tree(out)
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert ".zmetadata is damaged" in err
     other = write_study(tmp_path, seed=8, name="other.toml")  # another study over the damage
     code, _, err = rockstudy_run(other, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "different study" in err
     assert tree(out) == before
 
@@ -265,7 +216,7 @@ def test_resume_refuses_changed_inputs_and_versions(tmp_path):
     _record(tmp_path / "rec.txt", 0.4)  # the record changes between runs
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "rec.txt" in err and "changed" in err
     _record(tmp_path / "rec.txt", 0.3)
     marker = json.loads((out / ".rockstudy").read_text())
@@ -273,7 +224,7 @@ def test_resume_refuses_changed_inputs_and_versions(tmp_path):
     (out / ".rockstudy").write_text(json.dumps({**marker, "rockstudy": "0.0.0-older"}))
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "0.0.0-older" in err
 
 
@@ -334,7 +285,7 @@ def test_a_stray_lock_never_makes_a_folder_of_user_files_a_store(tmp_path, extra
     (demo / ".rockstudy.lock").touch()
     code, _, err = rockstudy_run(study, demo, *extra)
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert (demo / "thesis.tex").read_text() == "precious"
     assert sorted(p.name for p in demo.iterdir()) == [".rockstudy.lock", "thesis.tex"]
     assert _lock_bytes(demo) == b""  # not even the lock was written to
@@ -361,7 +312,7 @@ def test_a_store_without_its_marker_is_adopted_only_if_its_cube_checks(tmp_path)
     before, lock = tree(out), _lock_bytes(out)
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "rec.txt" in err and "changed" in err
     assert tree(out) == before and _lock_bytes(out) == lock  # nothing changed, lock included
     _record(tmp_path / "rec.txt", 0.3)  # restored: the cube's own hashes now agree
@@ -383,7 +334,7 @@ def test_a_store_without_marker_whose_cube_cannot_be_checked_is_refused(finished
     before = tree(out)
     code, _, err = rockstudy_run(study, out, "--resume")
     assert code != 0
-    assert_one_error_line(err)
+    one_error_line(err)
     assert "new --out" in err and "afresh" in err
     assert tree(out) == before
 
@@ -398,7 +349,7 @@ def test_a_refused_run_leaves_the_lock_as_it_was(finished, tmp_path):
     for args in ((study, out), (other, out, "--resume")):
         code, _, err = rockstudy_run(*args)
         assert code != 0
-        assert_one_error_line(err)
+        one_error_line(err)
         assert "resume=True" not in err
         assert _lock_bytes(out) == lock
 

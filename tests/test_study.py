@@ -11,65 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from _helpers import ROCKSTUDY, ROOT, SLOW, study_text
 
 from rockstudy.cli import main as cli_main
 from rockstudy.study import StudyError, make_design, run_study, validate_text
 from rockstudy.study.spec.schema import json_schema
-
-ROOT = Path(__file__).resolve().parents[1]
-ROCKSTUDY = str(Path(sys.executable).with_name("rockstudy"))
-
-BASE = """
-name = "t"
-seed = 7
-chunk_size = {chunk}
-
-[sampler]
-kind = "{sampler}"
-n = {n}
-
-[structure]
-kind = "block"
-half_diagonal = {{ dist = "uniform", low = 0.5, high = 3.0 }}
-slenderness = {{ dist = "uniform", low = 0.1, high = 0.3 }}
-
-[motion]
-kind = "pulse"
-shape = "sine"
-amplitude_ratio = {{ dist = "uniform", low = 0.8, high = 5.0 }}
-period = {{ dist = "loguniform", low = 0.1, high = 2.0 }}
-
-[run]
-outputs = ["max_rotation", "overturned", "n_impacts", "first_impact_time"]
-max_steps = {max_steps}
-"""
-
-SLOW = """
-name = "slow"
-seed = 11
-chunk_size = {chunk}
-
-[sampler]
-kind = "monte_carlo"
-n = {n}
-
-[structure]
-kind = "block"
-half_diagonal = {{ dist = "uniform", low = 0.5, high = 2.0 }}
-slenderness = {{ dist = "uniform", low = 0.15, high = 0.3 }}
-
-[motion]
-kind = "stochastic"
-pga_ratio = {{ dist = "uniform", low = 0.8, high = 2.5 }}
-duration = 20.0
-
-[run]
-outputs = ["max_rotation", "overturned", "n_impacts"]
-"""
-
-
-def study_text(chunk=100, sampler="monte_carlo", n=600, max_steps=1_000_000):
-    return BASE.format(chunk=chunk, sampler=sampler, n=n, max_steps=max_steps)
 
 
 def outputs(path):

@@ -21,8 +21,8 @@ from itertools import combinations
 
 import numpy as np
 import pytest
+from _helpers import ARCH, FRAME, WALL, write_at2  # the examples of the kinds' tests
 from scipy.optimize import minimize
-from test_structure_kinds import ARCH, FRAME, WALL  # the examples of the kinds' tests
 
 import rockstudy as rs
 from rockstudy.constants import G
@@ -173,10 +173,6 @@ def test_the_dynamics_start_at_the_uplift_acceleration(name):
 
 # ------------------------------------------------------------------ the doors
 
-import test_record_studies  # noqa: E402
-
-client = test_record_studies.client  # the one-worker cluster fixture
-
 OBJECTS = f"""
 [[structure.objects]]
 name = "Wall"
@@ -230,7 +226,7 @@ def _sine_record(period=0.6, dt=0.005):
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     folder = tmp_path_factory.mktemp("uplift_records")
-    test_record_studies.write_at2(folder / "sine.AT2", _sine_record().scaled(G))
+    write_at2(folder / "sine.AT2", _sine_record().scaled(G))
     return folder
 
 
@@ -296,7 +292,7 @@ def test_ida_ladder_tops_at_max_pga_ratio_times_the_uplift_pga(folder, tmp_path)
 
     short = tmp_path / "short"  # a 0.05 s sine: nothing overturns below 1.5 a_up
     short.mkdir()
-    test_record_studies.write_at2(short / "short.AT2", _sine_record(0.05, 0.001).scaled(G))
+    write_at2(short / "short.AT2", _sine_record(0.05, 0.001).scaled(G))
     folder = short
     rec = load_suite(folder)[0]
     objects = _objects()
