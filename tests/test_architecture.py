@@ -343,3 +343,51 @@ def test_the_public_module_check_sees_a_module_without_all(tmp_path):
     assert _declared_all(path) is None
     path.write_text("__all__ = ['X']\nX = 1\n")
     assert _declared_all(path) == ["X"]
+
+
+# The design kinds (cloud, stripes, IDA) are told apart by their entries in one registry: no
+# module but the registry selects behaviour by a kind's name.
+DESIGN_REGISTRY = PACKAGE / "study" / "spec" / "design_kinds.py"
+
+
+def kind_selections(source: str, names) -> list[int]:
+    """Line numbers of ``source`` that select by a design kind's name: a comparison of one
+    (``==``, ``!=``, ``in``, ``not in``, a kind's name alone or in a tuple, list or set) or a
+    dict keyed by one."""
+
+    def named(node) -> bool:
+        if isinstance(node, ast.Constant):
+            return node.value in names
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            return any(named(e) for e in node.elts)
+        return False
+
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Compare) and any(named(n) for n in [node.left, *node.comparators]):
+            lines.append(node.lineno)
+        elif isinstance(node, ast.Dict) and any(k is not None and named(k) for k in node.keys):
+            lines.append(node.lineno)
+    return sorted(lines)
+
+
+def test_no_module_but_the_registry_selects_by_a_design_kind_name():
+    from rockstudy.study.spec.design_kinds import DESIGN_KINDS
+
+    assert DESIGN_REGISTRY.exists()
+    found = {
+        str(path.relative_to(PACKAGE)): lines
+        for path in sorted(PACKAGE.rglob("*.py"))
+        if path != DESIGN_REGISTRY
+        and (lines := kind_selections(path.read_text(), set(DESIGN_KINDS)))
+    }
+    assert not found, f"design kinds selected by name outside {DESIGN_REGISTRY.name}: {found}"
+
+
+def test_the_kind_check_sees_each_way_of_selecting_by_name():
+    names = {"ida", "stripes"}
+    source = (
+        'a = k == "ida"\nb = "stripes" != k\nc = k in ("ida", "x")\nd = {"ida": 1}[k]\n'
+        'e = k not in ["stripes"]\nf = k == "cloudy"\ng = dict(design="ida")\n'
+    )
+    assert kind_selections(source, names) == [1, 2, 3, 4, 5]

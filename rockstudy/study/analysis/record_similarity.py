@@ -25,6 +25,7 @@ import pandas as pd
 import xarray as xr
 
 from ...motions import measures
+from ..spec.design_kinds import kind_of
 from .fragility_fit import N_BOOT, NO_MAXIMUM, fit_binomial_limit, separation
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
@@ -120,7 +121,7 @@ def _median_fitter(ds, im, period):
     needs_period = im in measures.MEASURES and measures.MEASURES[im].needs_period
     if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
-    if ds.attrs.get("design") == "ida":
+    if kind_of(ds, default="stripes").capacities:
         cap, top, cens, ok = ida_arrays(ds, im, period)
         x = np.where(cens, top, cap)  # capacities, and the censoring levels
 

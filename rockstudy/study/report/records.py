@@ -22,13 +22,13 @@ from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
+from ..spec.design_kinds import DESIGN_KINDS, design_kind, kind_of
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from . import objects as ro
 from ._page import (
     _FRAGILITY_NAMES,
     _capacities_as_measured,
     _log_ticks,
-    _mpl_text,
     _names,
     _Page,
     _plt,
@@ -40,17 +40,12 @@ from ._page import (
 from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
 
-#: Designs this report reads (``ds.attrs["design"]``).
-DESIGNS = ("cloud", "stripes", "ida")
+#: Designs this report reads (``ds.attrs["design"]``): every kind of the registry.
+DESIGNS = tuple(DESIGN_KINDS)
 
 #: The dimensionless group of the pulse in words (the measures' and ratios' labels are those of
 #: the registry, :func:`rockstudy.motions.measures.label`).
 GROUP_NAMES = {"pulse_amplitude_ratio": "pulse amplitude omega_p A_p / a_up [-]"}
-_DESIGN_NAMES = {
-    "cloud": "cloud (records unscaled)",
-    "stripes": "multiple-stripe analysis",
-    "ida": "incremental dynamic analysis (a ladder of rungs, refined by bisection)",
-}
 #: Units of the report's accelerations: as given (a study's scale_to.units) -> as shown.
 REPORT_UNITS = {"g": "g", "m/s^2": "m/s^2", "m/s2": "m/s^2"}
 #: What the page's ratios divide by, said once at its top.
@@ -92,7 +87,7 @@ def _measures(ds) -> list[tuple[str, float | None]]:
 def _fit(ds, im, period, edges, n_boot, by=None):
     """The design's fragility table against ``im``, by size class when there are sizes (or
     ``by`` a coordinate, e.g. ``"structure"`` for named objects)."""
-    fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
+    fit = rf.fragility_of(ds)
     by = by if edges is None else "half_diagonal"
     with shown_separation():  # said on the page (separation_note)
         table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
@@ -109,24 +104,24 @@ def _fit(ds, im, period, edges, n_boot, by=None):
 
 
 def _summary(page, ds, relabel=str):
-    design = ds.attrs.get("design")
+    kind = kind_of(ds)
     rows = {
-        "design": _DESIGN_NAMES.get(design, str(design)),
+        "design": kind.description,
         "records": int(ds.sizes["record"]),
         "structures": int(ds.sizes["structure"]),
         "simulations": int(ds.attrs.get("n_simulations", 0)),
         "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
-    if design in ("stripes", "ida"):
+    if kind.scaled:
         rows["scaling measure"] = relabel(
             im_label(
                 ds.attrs.get("im", "pga"),
                 ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
             )
         )
-    if design == "stripes":
+    if kind.levels:
         rows["levels"] = int(ds.sizes["level"])
-    if design == "ida":
+    if kind.capacities:
         rows["ladder step (relative)"] = float(ds.attrs.get("step", np.nan))
         rows["bisection tolerance (relative)"] = float(ds.attrs.get("tolerance", np.nan))
         reason = ds["censored_reason"].values
@@ -209,11 +204,7 @@ def _record_fragility_figure(page, fig, ds, edges):
         "Lognormal fragility curves with 90 % pointwise bands of the probability over both "
         "the median and beta"
         + (" by block size" if edges is not None else "")
-        + (
-            ": the fit of the IDA capacities (first overturning levels)"
-            if ds.attrs.get("design") == "ida"
-            else ": the binomial maximum-likelihood fit (Baker 2015)"
-        )
+        + f": {kind_of(ds).text['fit']}"
         + "; dashed: the median lies outside the observed intensities",
     )
 
@@ -302,8 +293,8 @@ def _representatives(ds, k=3) -> list[int]:
 def _responses(page, ctx):
     """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes (the
     per-object panels' drawing; markers of the records offset in x, survivors hollow)."""
-    ds = ctx.ds
-    design = ds.attrs.get("design")
+    ds, kind = ctx.ds, ctx.kind
+    draw = getattr(ro, kind.draw)
     names = _names(ds)
     picks = _representatives(ds)
     plt = _plt()
@@ -311,12 +302,7 @@ def _responses(page, ctx):
     spread = 0.015 * (np.arange(len(names)) - (len(names) - 1) / 2)
     for ax, j in zip(axes[0], picks, strict=True):
         for i in range(len(names)):
-            if design == "ida":
-                ro._ida_curve(ax, ctx, i, j, spread[i])
-            elif design == "stripes":
-                ro._stripe_points(ax, ctx, i, j, spread[i])
-            else:
-                _cloud_point(ax, ctx, i, j, spread[i])
+            draw(ax, ctx, i, j, spread[i])
         ax.set(
             xlabel="peak rotation / slenderness, theta_max / alpha [-]",
             ylabel=f"PGA of the scaled record [{ctx.units}]",
@@ -324,52 +310,30 @@ def _responses(page, ctx):
             xlim=(-0.04, 1.08),
             title=_structure_title(ds, j),
         )
-        if design == "ida" and (span := ro.ida_axis(ctx, j)) is not None:
+        if kind.capacities and (span := ro.ida_axis(ctx, j)) is not None:
             ax.set_ylim(*span)
         _log_ticks(ax, "y")
     if len(names) <= 15:
         ro._shared_legend(fig, axes[0][0], len(names))
     else:
         fig.tight_layout()
-    what = {
-        "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
-        "stripes": "Stripe points: each record scaled to each level",
-        "cloud": "The cloud: each record unscaled",
-    }.get(design, "Responses")
     page.figure(
         fig,
-        f"{design}_points",
-        f"{what}, for blocks spanning the design's sizes; crosses: overturned (drawn at "
-        "theta_max / alpha = 1)"
-        + (
-            "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive, shaded: the switch band; the axis spans "
-            "the capacities and the uplift level (the scan and switch bands above them run "
-            "off the top, the scan's crosses faint)"
-            if design == "ida"
-            else "; open circles: stood"
-        )
+        f"{kind.name}_points",
+        f"{kind.text['points']}, for blocks spanning the design's sizes; crosses: overturned "
+        "(drawn at theta_max / alpha = 1)"
+        + kind.text["points_note"]
         + "; markers of the records offset slightly in x so that none hides another",
     )
 
 
-def _cloud_point(ax, ctx, i, j, offset):
-    """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
-    ds = ctx.ds
-    y = ds["pga"].values[i] / ro._unit(ctx)
-    over = bool(ds["overturned"].values[i, j] == 1)
-    x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
-    style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
-    ax.plot([x + offset], [y], ls="none", label=_mpl_text(ctx.record_names()[i]), **style)
-
-
 def _per_record(page, ds):
     names = _names(ds)
-    design = ds.attrs.get("design")
+    capacities = kind_of(ds).capacities
     rows = {}
     for i, name in enumerate(names):
         row = {"simulations": None, "failed points": int((ds["status"].values[i] != 0).sum())}
-        if design == "ida":
+        if capacities:
             cap = rf.intensity(ds.isel(record=[i]), "pga", scale="capacity_scale").values[0]
             ratio = rf.intensity(ds.isel(record=[i]), "pga_ratio", scale="capacity_scale")
             ratio = ratio.values[0]
@@ -614,14 +578,14 @@ SECTIONS = [
     ro.object_capacity,
     ro.object_curves,
     _section(
-        lambda ctx: {"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[ctx.design],
+        lambda ctx: ctx.kind.text["heading"],
         lambda page, ctx: _responses(page, ctx),
-        when=lambda ctx: not ctx.objects or ctx.design == "cloud",
+        when=lambda ctx: not ctx.objects or not ctx.kind.text["objects"],
     ),
     _section(
         "Switch band",
         lambda page, ctx: _switch_band(page, ctx.ds),
-        when=lambda ctx: ctx.design == "ida",
+        when=lambda ctx: "Switch band" in ctx.kind.sections,
     ),
     _section(
         "Stripes and IDA side by side",
@@ -639,9 +603,19 @@ SECTIONS = [
 
 
 def _compare(page, ctx):
-    ida, stripes = (ctx.ds, ctx.compare) if ctx.design == "ida" else (ctx.compare, ctx.ds)
+    ida, stripes = (ctx.ds, ctx.compare) if ctx.kind.capacities else (ctx.compare, ctx.ds)
     by = "structure" if ctx.objects else None
     _side_by_side(page, ida, stripes, ctx.edges, ctx.n_boot, by)
+
+
+def _comparable(kind, compare) -> bool:
+    """Whether ``compare`` can be shown beside a design of ``kind``: one of the two gives
+    capacities (an IDA), the other the outcomes at levels (stripes)."""
+    other = compare.attrs.get("design")
+    if other not in DESIGN_KINDS:
+        return False
+    pair = (kind, design_kind(other))
+    return any(a.capacities and not b.capacities and b.levels for a, b in (pair, pair[::-1]))
 
 
 def record_report(
@@ -708,15 +682,13 @@ def record_report(
         overturning, with the probability in ``years`` [yr] (default 50) and a deaggregation
         figure (:func:`~rockstudy.study.analysis.risk.object_risk`).
     """
-    design = ds.attrs.get("design")
-    if design not in DESIGNS:
-        raise ValueError(f"ds: attrs['design'] must be one of {DESIGNS}, got {design!r}")
+    kind = kind_of(ds)
     if units not in REPORT_UNITS:
         raise ValueError(f"units: must be one of {list(REPORT_UNITS)}, got {units!r}")
     if not (isinstance(max_scale_factor, (int, float)) and max_scale_factor > 1):
         raise ValueError(f"max_scale_factor: must be a number > 1, got {max_scale_factor!r}")
-    if compare is not None and {design, compare.attrs.get("design")} != {"ida", "stripes"}:
-        kinds = {design, compare.attrs.get("design")}
+    if compare is not None and not _comparable(kind, compare):
+        kinds = {kind.name, compare.attrs.get("design")}
         raise ValueError(
             f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
         )

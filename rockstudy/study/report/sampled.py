@@ -24,6 +24,7 @@ from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
+from ..spec.design_kinds import DESIGN_KINDS
 from ..spec.schema import SAMPLER_LAYOUTS
 from ._page import (
     _FRAGILITY_NAMES,
@@ -733,7 +734,7 @@ def make_report(result, out=None, verify: bool = True) -> Path:
     out = Path(out) if out is not None else result.with_name(result.stem + "_report")
     ds = open_result(result, verify=verify).load()  # a missing cube leaves no report folder
     out.mkdir(parents=True, exist_ok=True)
-    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design
+    if ds.attrs.get("design") in DESIGN_KINDS:  # a record design
         from .records import record_report
 
         if "study" not in ds.attrs:  # a design run from Python and saved: no study file

@@ -79,6 +79,7 @@ from ...structures.block import (
     MIN_SLENDERNESS,
     uplift_acceleration_block,
 )
+from .design_kinds import DESIGN_KINDS, design_kind
 from .distributions import Distribution
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR, notes, problems
 from .feasibility import draw_span as _draw_span
@@ -615,7 +616,7 @@ class DesignSpec(_Model):
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio."""
 
-    kind: Literal["cloud", "stripes", "ida"]
+    kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
     damping: _Damping = 0.05
     im: ScaleIM | None = None
@@ -638,7 +639,7 @@ class DesignSpec(_Model):
                 "is no longer an option: the IDA climbs a ladder of rungs; give step (the "
                 "relative step between rungs, default 0.01) instead",
             )
-        if self.kind != "ida":
+        if not design_kind(self.kind).capacities:
             for name in ida:
                 if getattr(self, name) is not None:
                     raise FieldError(name, f"applies to kind = 'ida' only, not {self.kind!r}")
@@ -971,11 +972,11 @@ class Study(_Model):
                 f"does not apply to a [design] (kind = {de.kind!r}); "
                 + (
                     "give motion.scale_to with a grid of levels"
-                    if de.kind == "stripes"
+                    if design_kind(de.kind).levels
                     else "remove it"
                 ),
             )
-        if de.kind == "stripes":
+        if design_kind(de.kind).levels:
             if mo.scale_to is not None and mo.scale_to.damping != de.damping:
                 raise FieldError(
                     "motion.scale_to.damping",
@@ -993,7 +994,11 @@ class Study(_Model):
             raise FieldError(
                 "motion.scale_to",
                 f"does not apply to a {de.kind!r} design"
-                + ("; give the IDA's measure as design.im" if de.kind == "ida" else ""),
+                + (
+                    "; give the IDA's measure as design.im"
+                    if design_kind(de.kind).capacities
+                    else ""
+                ),
             )
         if self.sampler.replicates > 1:
             raise FieldError("sampler.replicates", "does not apply to a [design]")
@@ -1172,7 +1177,7 @@ class Study(_Model):
 
     def levels(self) -> int:
         """Intensity levels of each record and structure of a design (1 but for stripes)."""
-        if self.design is not None and self.design.kind == "stripes":
+        if self.design is not None and design_kind(self.design.kind).levels:
             return self.motion.scale_to.value.size()
         return 1
 
