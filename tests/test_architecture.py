@@ -305,13 +305,16 @@ def test_dynamics_modules_are_short():
     assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
 
 
-#: The modules users import names from: the package, its subpackages and its top-level modules.
-PUBLIC_MODULES = sorted(
-    [PACKAGE / "__init__.py"]
-    + [p for p in PACKAGE.glob("*/__init__.py") if not p.parent.name.startswith("_")]
-    + [p for p in PACKAGE.glob("study/*/__init__.py")]
-    + [p for p in PACKAGE.glob("*.py") if not p.name.startswith("_")]
-)
+def _public(path: Path) -> bool:
+    """Whether users may import names from ``path``: no part of its path below the package
+    starts with an underscore (``__init__.py`` aside)."""
+    parts = path.relative_to(PACKAGE).parts
+    return not any(p.startswith("_") and p != "__init__.py" for p in parts)
+
+
+#: The modules users import names from: every module of the package, its subpackages and
+#: theirs (rockstudy.risk.curves, rockstudy.similarity, ...), but the private ones.
+PUBLIC_MODULES = sorted(p for p in PACKAGE.rglob("*.py") if _public(p))
 
 
 def _declared_all(path: Path):
@@ -335,6 +338,17 @@ def test_every_public_module_declares_its_names(path):
     module = importlib.import_module(dotted.removesuffix(".__init__"))
     missing = [n for n in names if not hasattr(module, n)]
     assert not missing, f"{dotted} lists names it does not have: {missing}"
+
+
+def test_every_module_of_a_public_package_is_checked():
+    names = {str(p.relative_to(PACKAGE)) for p in PUBLIC_MODULES}
+    assert {
+        "similarity.py",
+        "risk/curves.py",
+        "risk/readers.py",
+        "study/spec/design_kinds.py",
+    } <= names
+    assert not {"_validate.py", "dynamics/_linear.py", "study/report/_page.py"} & names
 
 
 def test_the_public_module_check_sees_a_module_without_all(tmp_path):

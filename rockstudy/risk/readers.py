@@ -20,6 +20,8 @@ from ..motions import measures
 from ..motions.records import read_text_file
 from .units import UNIT_FACTORS
 
+__all__ = ["OPENQUAKE_IMTS", "read_curve"]
+
 #: OpenQuake's IMT names -> (rockstudy IM, the unit OpenQuake gives its levels in).
 OPENQUAKE_IMTS = {
     "PGA": ("pga", "g"),

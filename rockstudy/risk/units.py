@@ -5,6 +5,8 @@ from __future__ import annotations
 from ..constants import STANDARD_GRAVITY
 from ..motions import measures
 
+__all__ = ["UNIT_FACTORS", "units_for"]
+
 #: Units a hazard curve's levels may be given in: name -> (factor to SI, SI unit). An IM's SI
 #: unit is that of the registry (:mod:`rockstudy.motions.measures`); its levels may be in any
 #: unit here of that dimension ("g" is the unit g, standard gravity 9.80665 m/s^2, as for

@@ -31,8 +31,10 @@ from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from ..spec.design_kinds import DESIGN_KINDS, kind_of
 from .fragility_fit import (
+    CONF_LEVEL,
     N_BOOT,
     NO_MAXIMUM,
+    SEED,
     binomial_covariance,
     bootstrap_rng,
     capacities_covariance,
@@ -240,9 +242,10 @@ def stripe_fragility(
     period=None,
     by=None,
     bins=None,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> pd.DataFrame:
     """Lognormal fragility of a stripe (or cloud) design by the binomial MLE (Baker 2015).
 
@@ -266,6 +269,8 @@ def stripe_fragility(
     n_boot, conf_level, seed
         Intervals of theta and beta by resampling records (with replacement) and refitting
         both; ``n_boot=0`` gives their Wald intervals instead. ``conf_level`` in (0, 1).
+        Keywords only, in this order in every function that takes them (defaults
+        :data:`~rockstudy.study.analysis.fragility_fit.N_BOOT`, ``CONF_LEVEL`` and ``SEED``).
 
     Returns
     -------
@@ -354,9 +359,10 @@ def ida_fragility(
     period=None,
     by=None,
     bins=None,
-    conf_level: float = 0.9,
+    *,
     n_boot: int = N_BOOT,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> pd.DataFrame:
     """Lognormal fit of IDA capacities (first overturning levels) in any stored measure.
 
@@ -468,7 +474,7 @@ def _specs(ds, candidates):
 
 
 def im_efficiency(
-    ds: xr.Dataset, candidates=None, by=None, bins=None, n_boot: int = N_BOOT, **kw
+    ds: xr.Dataset, candidates=None, by=None, bins=None, *, n_boot: int = N_BOOT, **kw
 ) -> pd.DataFrame:
     """Which intensity measure predicts overturning best: the dispersion of each, per power.
 

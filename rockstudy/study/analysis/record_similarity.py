@@ -26,8 +26,10 @@ import xarray as xr
 
 from ...motions import measures
 from ..spec.design_kinds import kind_of
-from .fragility_fit import N_BOOT, NO_MAXIMUM, fit_binomial_limit, separation
+from .fragility_fit import CONF_LEVEL, N_BOOT, NO_MAXIMUM, SEED, fit_binomial_limit, separation
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
+
+__all__ = ["FREQUENCY_GROUP", "size_class_medians", "size_classes", "size_edges", "size_label"]
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"
@@ -153,9 +155,10 @@ def size_class_medians(
     period=None,
     size_bins=3,
     frequency_bins=None,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Median overturning intensity theta of each size class, and its spread across classes.
 

@@ -61,8 +61,10 @@ from ...warnings import UnitsWarning
 from ..spec.design_kinds import design_kind, kind_of
 from . import record_fragility as rf
 from .fragility_fit import (
+    CONF_LEVEL,
     N_BOOT,
     NO_MAXIMUM,
+    SEED,
     bootstrap_rng,
     check_conf_level,
     check_n_boot,
@@ -275,9 +277,10 @@ def object_risk(
     ds: xr.Dataset,
     hazard: risk.HazardCurve,
     years: float = 50.0,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
     min_overturning: int = 5,
 ) -> xr.Dataset:
     """Per object: the fragility in the hazard's IM, lambda_OT, P(OT in ``years``) and bands.

@@ -33,6 +33,26 @@ from ..spec.design_kinds import design_kind
 from ..spec.feasibility import record_pairs
 from . import records as rd
 
+__all__ = [
+    "CONTACT_VARIABLES",
+    "design_dataset",
+    "design_rows",
+    "empty_rows",
+    "evaluate_rows",
+    "GROUP_VARIABLES",
+    "ida_steps",
+    "load_record",
+    "outputs",
+    "PULSE_VARIABLES",
+    "record_variables",
+    "sample_measures",
+    "sample_outputs",
+    "scale_factors",
+    "stored_periods",
+    "STRUCTURE_VARIABLES",
+    "uplift_column",
+]
+
 #: Per-record variables of the pulse in the design Dataset: (long_name, units).
 PULSE_VARIABLES = {
     "pulse_period": ("period T_p of the extracted velocity pulse", "s"),
@@ -262,8 +282,9 @@ def empty_rows(study, n: int) -> dict:
     }
 
 
-def _run_design(study, record, structures, levels):
-    """The design function of :mod:`.records` on one record (its kind's ``run``)."""
+def _run_design(study, record, structures, levels, friction):
+    """The design function of :mod:`.records` on one record (its kind's ``run``), with the
+    friction coefficients of its structures (None: no friction check)."""
     de, run = study.design, study.run
     kind = design_kind(de.kind)
     kw = dict(
@@ -273,7 +294,7 @@ def _run_design(study, record, structures, levels):
         rtol=run.rtol,
         max_steps=run.max_steps,
     )
-    kw["contact"] = study.friction_coefficients() is not None
+    kw["friction"] = friction
     if kind.levels:
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
         kw.update(levels=levels, im=t.im, period=t.period)
@@ -291,6 +312,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     motion_json = study.motion.model_dump_json()
     on_levels = design_kind(study.design.kind).levels
     levels_all = study.motion.scale_to.levels() if on_levels else np.ones(1)
+    friction = study.friction_coefficients()
     for r in np.unique(cols["record"]):
         rows = np.flatnonzero(cols["record"] == r)
         rec = load_record(motion_json, base_dir, int(r))
@@ -303,7 +325,9 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "uplift_acceleration": uplift_column(study, cols, first),
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
-        ds = _run_design(study, rec, structures, levels_all[lev_ids])
+        mu = friction if friction is None or friction.size > 1 else float(friction[0])
+        mu = mu[st_ids] if isinstance(mu, np.ndarray) else mu
+        ds = _run_design(study, rec, structures, levels_all[lev_ids], mu)
         _fill(result, outs, ds, rows, st_pos, lev_pos, width)
     return result
 

@@ -36,6 +36,21 @@ from ._page import (
     shown_separation,
 )
 
+__all__ = [
+    "FONT",
+    "friction_check",
+    "ida_axis",
+    "IDA_AXIS_MARGIN",
+    "object_capacity",
+    "object_curves",
+    "object_fragility",
+    "outcome",
+    "quoted_to_report",
+    "ReportContext",
+    "scale_factors",
+    "si_to_report",
+]
+
 #: Font size of legends and tick labels of the per-object figures [pt] (print: >= 8).
 FONT = 8
 

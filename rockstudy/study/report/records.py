@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import xarray as xr
 
 from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
@@ -32,6 +31,7 @@ from ._page import (
     _names,
     _Page,
     _plt,
+    dataset_of,
     draw_fits,
     object_colors,
     separation_note,
@@ -39,6 +39,17 @@ from ._page import (
 )
 from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
+
+__all__ = [
+    "DESIGNS",
+    "FREQUENCY_BINS",
+    "GROUP_NAMES",
+    "im_label",
+    "record_report",
+    "REPORT_UNITS",
+    "SECTIONS",
+    "UPLIFT_NOTE",
+]
 
 #: Designs this report reads (``ds.attrs["design"]``): every kind of the registry.
 DESIGNS = tuple(DESIGN_KINDS)
@@ -619,13 +630,14 @@ def _comparable(kind, compare) -> bool:
 
 
 def record_report(
-    ds: xr.Dataset,
+    ds,
     out,
     title: str = "Record design",
     description: str = "",
+    *,
     n_boot: int = N_BOOT,
     appendix=None,
-    compare: xr.Dataset | None = None,
+    compare=None,
     units: str = "g",
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
     friction=None,
@@ -642,11 +654,13 @@ def record_report(
 
     Parameters
     ----------
-    ds : xarray.Dataset
+    ds : xarray.Dataset or path-like
         From :func:`~rockstudy.study.designs.records.cloud`,
         :func:`~rockstudy.study.designs.records.multiple_stripes` or
         :func:`~rockstudy.study.designs.records.incremental_dynamic_analysis` (``design`` in its
-        attributes), or a result cube of the same layout.
+        attributes), or a result cube of the same layout, or the path of one (read with
+        :func:`~rockstudy.study.running.store.open_result`; as
+        :func:`~rockstudy.study.report.sampled.make_report` takes either).
     out : path-like
         Folder of the page, its PNG figures and CSV tables (created if missing).
     title, description : str
@@ -658,7 +672,7 @@ def record_report(
         intervals and rates without bands.
     appendix : callable, optional
         Called with the page last, to add sections (a study's report adds its study file).
-    compare : xarray.Dataset, optional
+    compare : xarray.Dataset or path-like, optional
         The other of an IDA and a stripes design on the same records and structures: the
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
@@ -672,7 +686,7 @@ def record_report(
         more than this (> 1; a study's ``design.max_scale_factor``).
     friction : float or array_like, optional
         The friction coefficient mu (one, or one per structure): with ``friction_demand`` in
-        ``ds`` (``contact=True`` of the design functions, or a study's ``friction``) the page
+        ``ds`` (``friction=`` of the design functions, or a study's ``friction``) the page
         counts the scenes whose demand exceeds it or that lift off, with a warning box.
     study : rockstudy.study.spec.Study, optional
         The study the dataset was run from, for the sections that read its settings
@@ -682,6 +696,8 @@ def record_report(
         overturning, with the probability in ``years`` [yr] (default 50) and a deaggregation
         figure (:func:`~rockstudy.study.analysis.risk.object_risk`).
     """
+    ds = dataset_of(ds, "ds")[0]
+    compare = None if compare is None else dataset_of(compare, "compare")[0]
     kind = kind_of(ds)
     if units not in REPORT_UNITS:
         raise ValueError(f"units: must be one of {list(REPORT_UNITS)}, got {units!r}")

@@ -22,6 +22,25 @@ from ...structures.block import uplift_acceleration_block
 from .design_kinds import design_kind
 from .structures import KINDS
 
+__all__ = [
+    "DEFAULT_MAX_SCALE_FACTOR",
+    "design_bytes",
+    "draw_span",
+    "free_fall_scale",
+    "hazard_notes",
+    "LARGE_OBJECT",
+    "MAX_CHUNK_ROWS",
+    "notes",
+    "problems",
+    "read_problems",
+    "record_pairs",
+    "record_path",
+    "size_notes",
+    "UPLIFT_NOTE_GAP",
+    "uplift_notes",
+    "vertical_refusal",
+]
+
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
 #: Default of ``[design] max_scale_factor`` (and the bound of Monte Carlo rows scaled to a

@@ -87,6 +87,51 @@ from .ida_options import IdaOptionError, IdaOptions
 from .samplers import SAMPLERS, kinds_laid_out
 from .structures import KINDS, FieldError, FieldErrors, check_all, check_object, object_fields
 
+__all__ = [
+    "BlockSpec",
+    "CONTACT_OUTPUTS",
+    "DesignSpec",
+    "EquivalentBlockSpec",
+    "HAZARD_MEASURES",
+    "HazardSpec",
+    "HOUSNER_MAX_SLENDERNESS",
+    "HVPair",
+    "json_schema",
+    "load_study",
+    "MAX_CHUNK_SIZE",
+    "MAX_DEPTH",
+    "MAX_RATIO",
+    "MAX_SCALE",
+    "MAX_STUDY_BYTES",
+    "MIN_RATIO",
+    "MIN_RTOL",
+    "MIN_SCALE",
+    "MotionSpec",
+    "OBJECT_COLUMNS",
+    "OBJECT_KINDS",
+    "ObjectSpec",
+    "ObjectsSpec",
+    "Output",
+    "Param",
+    "PulseSpec",
+    "RecordSpec",
+    "RunSpec",
+    "SAMPLER_LAYOUTS",
+    "samplers_laid_out",
+    "SamplerSpec",
+    "scale_units",
+    "ScaleIM",
+    "ScaleTo",
+    "STEPS_PER_CYCLE",
+    "StochasticSpec",
+    "Structure",
+    "Study",
+    "StudyError",
+    "validate_text",
+    "VerticalRule",
+    "WallSpec",
+]
+
 
 def _param_tag(value):
     """Which member of a parameter union a TOML value is meant for (a table is a
