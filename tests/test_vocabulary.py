@@ -204,3 +204,34 @@ def test_every_error_type_is_exported_from_the_top():
     missing = sorted(n for n, c in errors.items() if getattr(rs, n, None) is not c)
     assert not missing, f"not exported from rockstudy: {missing}"
     assert set(errors) <= set(rs.__all__)
+
+
+def test_a_study_with_friction_gives_its_rows_the_friction_check(record, tmp_path):
+    """The study's ``friction`` reaches the design functions as ``friction=``: each row's
+    demand is simulate(friction=)'s of the record as run (a cloud: unscaled)."""
+    from rockstudy.constants import STANDARD_GRAVITY
+    from rockstudy.study import validate_text
+    from rockstudy.study.designs import record_rows
+    from rockstudy.study.designs.sampling import make_design
+
+    t = np.arange(record.acceleration.size) * record.dt
+    np.savetxt(
+        tmp_path / "r.csv",
+        np.column_stack([t, record.acceleration / STANDARD_GRAVITY]),
+        "%.17g",
+        ",",
+    )
+    text = (
+        'name = "f"\nseed = 1\nfriction = 0.4\n[sampler]\nkind = "lhs"\nn = 2\n'
+        '[structure]\nkind = "block"\nhalf_diagonal = { dist = "uniform", low = 0.4, high = 1.2 }\n'
+        'slenderness = { dist = "uniform", low = 0.15, high = 0.25 }\n'
+        f'[motion]\nkind = "record"\nfiles = "{tmp_path}/*.csv"\n[design]\nkind = "cloud"\n'
+    )
+    study = validate_text(text, base_dir=tmp_path)
+    design = make_design(study, tmp_path)
+    cols = {k: design[k].values for k in design.data_vars} | {"sample": design["sample"].values}
+    rows = record_rows.evaluate_rows(study, cols, tmp_path)
+    for k in range(design.sizes["sample"]):
+        block = rs.Block(float(design["half_diagonal"][k]), float(design["slenderness"][k]))
+        r = rs.simulate(block, record, rtol=study.run.rtol, friction=0.4)
+        np.testing.assert_allclose(rows["friction_demand"][k], r.friction_demand, rtol=1e-6)
