@@ -176,10 +176,11 @@ def _check(name, arr, low, high):
 
 def _friction_check(friction, contact, n: int) -> bool:
     """Whether the design computes the friction check (``friction_demand``, ``lift_off``):
-    ``friction`` is the friction coefficient mu in (0, :data:`~rockstudy.dynamics.simulate.
-    MAX_FRICTION`], one number or one per structure (``n``; NaN: none for that structure), or
-    None. ``contact`` is its deprecated spelling (True or False, with a FutureWarning).
-    A ValueError or TypeError names ``friction`` (or ``contact``) otherwise."""
+    ``friction`` is the friction coefficient mu in (0, 10]
+    (:data:`~rockstudy.dynamics.simulate.MAX_FRICTION`), one number or one per structure
+    (``n``; NaN: none for that structure), or None. ``contact`` is its deprecated spelling
+    (True or False, with a FutureWarning). A ValueError or TypeError names ``friction`` (or
+    ``contact``) otherwise."""
     if contact is not None:
         contact = _validate.flag("contact", contact)
         warnings.warn(

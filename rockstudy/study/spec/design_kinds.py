@@ -13,8 +13,8 @@ function that runs it, and a fitter if none of the existing ones applies).
 
 The entries name their functions in the layers above this one (which this module cannot
 import: a study's flow runs spec -> designs -> running -> analysis -> report); each layer
-looks the name up in its own module, and
-``tests/test_design_registry.py`` checks that every name is there.
+looks the name up in its own module. ``tests/test_design_registry.py`` checks that every name
+is there, and ``tests/test_architecture.py`` that no other module selects by a kind's name.
 """
 
 from __future__ import annotations
