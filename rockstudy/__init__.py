@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
+from ._validate import NotANumberError
 from .warnings import (
     AccuracyWarning,
     ClosedFormValidityWarning,
@@ -34,7 +35,13 @@ from .warnings import (
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
     from . import closedform, motions, risk, similarity, structures
     from .dynamics import RockingResult, StepLimitError, simulate, simulate_batch
+    from .motions.records import UnitsError
     from .structures import Block
+    from .study.running.runner import FailedSamplesError, ResourceError, SchedulerError
+    from .study.running.store import DamagedCube, StoreError
+    from .study.spec.ida_options import IdaOptionError
+    from .study.spec.schema import StudyError
+    from .study.spec.structures import FieldError, FieldErrors
 
 __version__ = "0.1.0"
 
@@ -50,6 +57,16 @@ _LAZY = {
     "risk": (".risk", None),
     "similarity": (".similarity", None),
     "UnitsError": (".motions.records", "UnitsError"),
+    # the study layer's errors, each where it is raised (loading the study layer on first use)
+    "StudyError": (".study.spec.schema", "StudyError"),
+    "FieldError": (".study.spec.structures", "FieldError"),
+    "FieldErrors": (".study.spec.structures", "FieldErrors"),
+    "IdaOptionError": (".study.spec.ida_options", "IdaOptionError"),
+    "StoreError": (".study.running.store", "StoreError"),
+    "DamagedCube": (".study.running.store", "DamagedCube"),
+    "SchedulerError": (".study.running.runner", "SchedulerError"),
+    "ResourceError": (".study.running.runner", "ResourceError"),
+    "FailedSamplesError": (".study.running.runner", "FailedSamplesError"),
     "structures": (".structures", None),
     # the study layer (xarray, dask, pydantic, scipy): on first use of ``rockstudy.study``,
     # which also registers the ``ds.rocking`` accessor of xarray Datasets
@@ -73,6 +90,16 @@ __all__ = [
     "UpliftWarning",
     "StepLimitError",
     "UnitsError",
+    "NotANumberError",
+    "StudyError",
+    "FieldError",
+    "FieldErrors",
+    "IdaOptionError",
+    "StoreError",
+    "DamagedCube",
+    "SchedulerError",
+    "ResourceError",
+    "FailedSamplesError",
     "closedform",
     "motions",
     "risk",

@@ -401,13 +401,15 @@ def _validate(args) -> int:
             study = load_study(path)
             size = f"{study.samples()} samples"
             if study.design is not None:
+                from .study.spec.design_kinds import design_kind
                 from .study.spec.feasibility import record_pairs
 
                 records = len(record_pairs(study.motion, Path(path).resolve().parent))
+                capacities = design_kind(study.design.kind).capacities
                 size = (
                     f"{study.design.kind} design: {records} records x "
                     f"{study.samples() // study.levels()} structures"
-                    + ("" if study.design.kind == "ida" else f" x {study.levels()} levels")
+                    + ("" if capacities else f" x {study.levels()} levels")
                 )
             print(
                 f"{path}: ok ({study.sampler.kind}, {size}, "

@@ -305,13 +305,16 @@ def test_dynamics_modules_are_short():
     assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
 
 
-#: The modules users import names from: the package, its subpackages and its top-level modules.
-PUBLIC_MODULES = sorted(
-    [PACKAGE / "__init__.py"]
-    + [p for p in PACKAGE.glob("*/__init__.py") if not p.parent.name.startswith("_")]
-    + [p for p in PACKAGE.glob("study/*/__init__.py")]
-    + [p for p in PACKAGE.glob("*.py") if not p.name.startswith("_")]
-)
+def _public(path: Path) -> bool:
+    """Whether users may import names from ``path``: no part of its path below the package
+    starts with an underscore (``__init__.py`` aside)."""
+    parts = path.relative_to(PACKAGE).parts
+    return not any(p.startswith("_") and p != "__init__.py" for p in parts)
+
+
+#: The modules users import names from: every module of the package, its subpackages and
+#: theirs (rockstudy.risk.curves, rockstudy.similarity, ...), but the private ones.
+PUBLIC_MODULES = sorted(p for p in PACKAGE.rglob("*.py") if _public(p))
 
 
 def _declared_all(path: Path):
@@ -335,6 +338,17 @@ def test_every_public_module_declares_its_names(path):
     module = importlib.import_module(dotted.removesuffix(".__init__"))
     missing = [n for n in names if not hasattr(module, n)]
     assert not missing, f"{dotted} lists names it does not have: {missing}"
+
+
+def test_every_module_of_a_public_package_is_checked():
+    names = {str(p.relative_to(PACKAGE)) for p in PUBLIC_MODULES}
+    assert {
+        "similarity.py",
+        "risk/curves.py",
+        "risk/readers.py",
+        "study/spec/design_kinds.py",
+    } <= names
+    assert not {"_validate.py", "dynamics/_linear.py", "study/report/_page.py"} & names
 
 
 def test_the_public_module_check_sees_a_module_without_all(tmp_path):
@@ -462,3 +476,51 @@ def test_the_test_import_check_sees_imports_of_test_modules():
     source = "import os\nfrom _helpers import tree\ndef f():\n    import test_study\n"
     assert _test_modules_imported(source) == {"test_study"}
     assert _test_modules_imported("from test_risk import x\nimport conftest\n") == {"test_risk"}
+
+
+# The design kinds (cloud, stripes, IDA) are told apart by their entries in one registry: no
+# module but the registry selects behaviour by a kind's name.
+DESIGN_REGISTRY = PACKAGE / "study" / "spec" / "design_kinds.py"
+
+
+def kind_selections(source: str, names) -> list[int]:
+    """Line numbers of ``source`` that select by a design kind's name: a comparison of one
+    (``==``, ``!=``, ``in``, ``not in``, a kind's name alone or in a tuple, list or set) or a
+    dict keyed by one."""
+
+    def named(node) -> bool:
+        if isinstance(node, ast.Constant):
+            return node.value in names
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            return any(named(e) for e in node.elts)
+        return False
+
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Compare) and any(named(n) for n in [node.left, *node.comparators]):
+            lines.append(node.lineno)
+        elif isinstance(node, ast.Dict) and any(k is not None and named(k) for k in node.keys):
+            lines.append(node.lineno)
+    return sorted(lines)
+
+
+def test_no_module_but_the_registry_selects_by_a_design_kind_name():
+    from rockstudy.study.spec.design_kinds import DESIGN_KINDS
+
+    assert DESIGN_REGISTRY.exists()
+    found = {
+        str(path.relative_to(PACKAGE)): lines
+        for path in sorted(PACKAGE.rglob("*.py"))
+        if path != DESIGN_REGISTRY
+        and (lines := kind_selections(path.read_text(), set(DESIGN_KINDS)))
+    }
+    assert not found, f"design kinds selected by name outside {DESIGN_REGISTRY.name}: {found}"
+
+
+def test_the_kind_check_sees_each_way_of_selecting_by_name():
+    names = {"ida", "stripes"}
+    source = (
+        'a = k == "ida"\nb = "stripes" != k\nc = k in ("ida", "x")\nd = {"ida": 1}[k]\n'
+        'e = k not in ["stripes"]\nf = k == "cloudy"\ng = dict(design="ida")\n'
+    )
+    assert kind_selections(source, names) == [1, 2, 3, 4, 5]

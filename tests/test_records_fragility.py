@@ -341,9 +341,9 @@ def test_the_scaling_power_is_the_measures_own():
 def test_bad_fragility_arguments_are_named():
     ida = _ida_dataset([[1.0], [2.0], [3.0]], [G_UNIT] * 3, [1.0] * 3, [1.0], [1.0])
     cloud = _cloud([0.1, 0.2, 0.3], [0, 1, 1])
-    with pytest.raises(ValueError, match="ds: stripe_fragility needs a stripes or cloud"):
+    with pytest.raises(ValueError, match="ds: stripe_fragility needs a dataset of design 'cloud'"):
         rf.stripe_fragility(ida)
-    with pytest.raises(ValueError, match="ds: ida_fragility needs an IDA"):
+    with pytest.raises(ValueError, match="ds: ida_fragility needs a dataset of design 'ida'"):
         rf.ida_fragility(cloud)
     with pytest.raises(ValueError, match="candidates must be a non-empty"):
         rf.im_efficiency(ida, candidates=[])

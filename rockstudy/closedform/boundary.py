@@ -10,6 +10,8 @@ from numba import njit, prange
 
 from . import sine
 
+__all__ = ["Case", "overturning_boundary"]
+
 Case = Literal["2", "1.2", "1.1", "1.1-approx", "limit"]
 
 

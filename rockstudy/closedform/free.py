@@ -11,6 +11,8 @@ import numpy as np
 from .. import _validate
 from ..structures.block import FREQUENCY_PARAMETER_RANGE
 
+__all__ = ["free_rocking_period", "overturning_time_constant_acceleration"]
+
 _P_LOW, _P_HIGH = FREQUENCY_PARAMETER_RANGE
 _P_LABEL = f"finite, in [{_P_LOW:g}, {_P_HIGH:g}] rad/s"
 

@@ -26,6 +26,37 @@ from .. import _validate
 from .._roots import newton_bisect
 from .._warnings import ClosedFormValidityWarning
 
+__all__ = [
+    "build_all",
+    "case11_residual",
+    "case11_residual_approx",
+    "case12_residual",
+    "case2_residual",
+    "d0_star",
+    "FIRST_IMPACT_MAX_ITER",
+    "first_impact_time_after_pulse",
+    "first_impact_time_during_pulse",
+    "first_impact_time_during_pulse_approx",
+    "FIRST_IMPACT_TOL",
+    "impact_velocity_after_pulse",
+    "impact_velocity_during_pulse",
+    "kappa",
+    "lambda_",
+    "limit_residual",
+    "max_rotation",
+    "max_rotation_small",
+    "MODES",
+    "NO_UPLIFT",
+    "OVER_IMPACT",
+    "OVER_NO_IMPACT",
+    "overturning_mode",
+    "overturning_mode_code",
+    "pulse_end_time",
+    "restitution_scaling_function",
+    "SAFE_AFTER",
+    "SAFE_DURING",
+]
+
 _F2 = [float64(float64, float64)]
 _F3 = [float64(float64, float64, float64)]
 

@@ -21,6 +21,8 @@ from . import _auto, _linear, _linear_record, _rocking, conditioning, outputs
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 
+__all__ = ["CONDITIONING_OUTPUTS", "CONTACT_OUTPUTS", "OUTPUTS", "PulseName", "simulate_batch"]
+
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
 #: batch method -> kernel model (None: chosen row by row); what each method can run is in
 #: :data:`rockstudy.dynamics.methods.METHODS`

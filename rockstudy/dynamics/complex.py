@@ -32,6 +32,15 @@ from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
 from ._rocking import STEP_GROW_LIMIT, STEP_SAFETY, STEP_SHRINK_LIMIT
 
+__all__ = [
+    "BAD_STEP_SHRINK",
+    "chi_c",
+    "FROM_REST_WARNING",
+    "LARGE_L",
+    "LARGE_L_WARNING",
+    "simulate_complex",
+]
+
 _A = tuple(tuple(float(x) for x in row) for row in RK45.A)
 _B = tuple(float(x) for x in RK45.B)
 _C = tuple(float(x) for x in RK45.C)

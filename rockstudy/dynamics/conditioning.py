@@ -21,6 +21,8 @@ import numpy as np
 from ..motions import Record
 from ..motions.pulses import NoMotion
 
+__all__ = ["CONDITIONING_STEP", "ILL_CONDITIONED", "peak_change", "perturbed", "WELL_CONDITIONED"]
+
 #: Relative change of the amplitude with which the conditioning is measured.
 CONDITIONING_STEP = 1e-9
 #: Relative change of max |theta| (under :data:`CONDITIONING_STEP`) above which a scene is

@@ -14,6 +14,46 @@ import numpy as np
 
 from ..motions._kernels import KIND_TRIG
 
+__all__ = [
+    "ATOL_FRACTION",
+    "FIRST",
+    "FIRST_STEP",
+    "IMPACT_RETRY_SHRINK",
+    "MIN_STEP",
+    "MODEL_LINEAR",
+    "MODEL_NONLINEAR",
+    "MODEL_TABLE",
+    "NEVER_AT_REST",
+    "NO_STOP",
+    "NO_TABLE",
+    "PH_END",
+    "PH_FAIL",
+    "PH_IMPACT",
+    "PH_OVER",
+    "PH_REST",
+    "REST_FRACTION",
+    "STATUS_HISTORY_FULL",
+    "STATUS_MAX_STEPS",
+    "STATUS_OK",
+    "STEP_GROW_LIMIT",
+    "STEP_SAFETY",
+    "STEP_SHRINK_LIMIT",
+    "TAB_B",
+    "TAB_DB",
+    "TAB_DG",
+    "TAB_DI",
+    "TAB_DV",
+    "TAB_G",
+    "TAB_I",
+    "TAB_PHI",
+    "TAB_V",
+    "TABLE_BISECTIONS",
+    "TAYLOR_TOL_FRACTION",
+    "TOL_SAFETY",
+    "TRIG",
+    "UNDAMPED_WINDOW",
+]
+
 MODEL_NONLINEAR = 0
 MODEL_LINEAR = 1
 MODEL_TABLE = 2  # a mechanism, eq. (8) of [003], from tabulated I, G, B (structures/mechanism)

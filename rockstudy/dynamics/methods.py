@@ -13,6 +13,17 @@ from dataclasses import dataclass
 
 from .constants import STATUS_MAX_STEPS
 
+__all__ = [
+    "MAX_STEPS",
+    "Method",
+    "method_for",
+    "METHODS",
+    "STATUS_STEP_LIMIT",
+    "StepLimitError",
+    "supports",
+    "unsupported_message",
+]
+
 #: Default cap on the integrator steps in one rocking phase, for :func:`rockstudy.simulate`
 #: (exceeded: :class:`StepLimitError`) and :func:`rockstudy.simulate_batch` (exceeded: the
 #: row's ``status`` is :data:`STATUS_STEP_LIMIT`), and the default of a study's

@@ -31,6 +31,8 @@ from ._rocking import (
 )
 from ._vertical import refuse_free_fall
 
+__all__ = ["HOP_POINTS", "LIFT_ULP_WALK", "simulate_reference"]
+
 
 def _scalar_vertical(motion: Motion):
     """A plain-Python u_v''(t) [m/s^2, upwards] for the reference path, or None."""

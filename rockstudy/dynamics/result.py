@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["describe", "RockingResult"]
+
 #: The optional arrays of a result (peaks and dense output), in field order.
 _OPTIONAL_ARRAYS = ("peak_times", "peak_rotations", "t_eval", "theta_eval", "theta_dot_eval")
 

@@ -24,6 +24,15 @@ from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
 from .result import RockingResult, describe
 
+__all__ = [
+    "check_friction",
+    "EXACT_EQUIVALENTS",
+    "LINEAR_WARN",
+    "MAX_FRICTION",
+    "Method",
+    "simulate",
+]
+
 #: Largest friction coefficient mu taken (simulate's ``friction`` and a study's; no contact
 #: needs more).
 MAX_FRICTION = 10.0

@@ -6,6 +6,8 @@ import numpy as np
 
 from . import _kernels
 
+__all__ = ["Motion"]
+
 
 class Motion:
     """Base class of ground motions: horizontal acceleration of the base in time.

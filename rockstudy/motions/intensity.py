@@ -38,6 +38,37 @@ from .. import _validate
 from ..constants import G
 from . import _spectrum
 
+__all__ = [
+    "arias_intensity",
+    "baseline_offset",
+    "check_damping",
+    "check_periods",
+    "cumulative_absolute_velocity",
+    "displacement_baseline",
+    "ground_displacement",
+    "ground_velocity",
+    "mean_period",
+    "MEAN_PERIOD_BAND",
+    "MEAN_PERIOD_DF",
+    "MIN_PERIOD",
+    "MIN_PHASE_STEP",
+    "pseudo_velocity_peak_period",
+    "PSV_PEAK_POINTS",
+    "PSV_PEAK_SPAN",
+    "response_spectrum",
+    "response_spectrum_dataset",
+    "rigid_limit_displacement",
+    "RIGID_LIMIT_RTOL",
+    "significant_duration",
+    "spectral_displacement",
+    "spectrum_intensity",
+    "SPECTRUM_INTENSITY_PERIODS",
+    "SPECTRUM_INTENSITY_STEP",
+    "SPECTRUM_MAX_WORK",
+    "SPECTRUM_PHASE_STEP",
+    "uniform_samples",
+]
+
 #: Band of the mean period [Hz] and the largest frequency step of its spectrum [Hz]
 #: (Rathje et al. 2004).
 MEAN_PERIOD_BAND = (0.25, 20.0)

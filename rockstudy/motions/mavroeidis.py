@@ -14,6 +14,8 @@ import math
 
 import numpy as np
 
+__all__ = ["mp_pulse_acceleration", "mp_pulse_velocity"]
+
 
 def _phases(t, period, gamma, center):
     tau = np.asarray(t, dtype=float) - center

@@ -42,6 +42,25 @@ from .. import _validate
 from ..constants import STANDARD_GRAVITY
 from . import intensity, units
 
+__all__ = [
+    "label",
+    "listed",
+    "Measure",
+    "measure",
+    "MEASURES",
+    "power",
+    "quoted",
+    "Ratio",
+    "RATIOS",
+    "register_measure",
+    "RESERVED",
+    "scale_targets",
+    "set_probe",
+    "target",
+    "UNIT_ALIASES",
+    "unregister_measure",
+]
+
 
 @dataclass(frozen=True)
 class Measure:

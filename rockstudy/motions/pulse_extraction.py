@@ -38,6 +38,18 @@ from scipy import fft, optimize
 from .intensity import ground_velocity, uniform_samples
 from .mavroeidis import mp_pulse_velocity
 
+__all__ = [
+    "baker_indicator",
+    "extract_pulse",
+    "GAMMA_BOUNDS",
+    "OUTSIDE",
+    "PULSE_LIKE_INDICATOR",
+    "SCAN_GAMMAS",
+    "SCAN_PERIODS",
+    "SCAN_SAMPLES",
+    "VelocityPulse",
+]
+
 #: Grid of the scan: number of periods and the values of gamma.
 SCAN_PERIODS = 40
 SCAN_GAMMAS = (1.2, 1.6, 2.0, 2.5, 3.0)

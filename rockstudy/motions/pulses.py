@@ -15,6 +15,20 @@ from .. import _validate
 from . import _kernels
 from .base import Motion
 
+__all__ = [
+    "check_period",
+    "CosinePulse",
+    "HalfSinePulse",
+    "MAX_CYCLES",
+    "NoMotion",
+    "PERIOD_RANGE",
+    "pulse_kernel_rows",
+    "PULSES",
+    "ricker_half_width",
+    "RickerWavelet",
+    "SinePulse",
+]
+
 #: Pulse periods T_p [s] taken: a microsecond to about 11.6 days (far beyond any ground
 #: motion at both ends; below ~1e-160 s the kernels' divisions by omega_g underflow).
 PERIOD_RANGE = (1e-6, 1e6)

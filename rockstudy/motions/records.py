@@ -21,6 +21,20 @@ from .pulse_extraction import extract_pulse
 from .units import acceleration_units
 from .wavelet_pulse import extract_wavelet_pulse
 
+__all__ = [
+    "COLUMNS",
+    "IMPOSSIBLE_PGA",
+    "MAX_RECORD_BYTES",
+    "not_a_file",
+    "PULSE_METHODS",
+    "read_record",
+    "read_text_file",
+    "Record",
+    "UnitsError",
+    "WEAK_PGA",
+    "WEAKEST_PGA",
+]
+
 #: Largest record file read [bytes]: a PEER record is ~0.1 MB; anything beyond this is no record.
 MAX_RECORD_BYTES = 64 * 2**20
 

@@ -15,6 +15,15 @@ import numpy as np
 from ..constants import STANDARD_GRAVITY as G_UNIT
 from .synthetic import synthetic_near_fault
 
+__all__ = [
+    "at2_text",
+    "SHIPPED_DT",
+    "SHIPPED_SUITE",
+    "shipped_suite_texts",
+    "SHIPPED_VERTICAL_RULE",
+    "write_shipped_suite",
+]
+
 #: The synthetic near-fault suite shipped in ``data/records`` (no download needed): name,
 #: pulse period T_p [s], PGA [g] and seed of each record, each with a vertical component.
 SHIPPED_SUITE = (

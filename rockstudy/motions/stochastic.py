@@ -13,6 +13,8 @@ import numpy as np
 from .. import _validate
 from .records import Record
 
+__all__ = ["envelope_jennings", "kanai_tajimi_filter", "stochastic_record"]
+
 
 def envelope_jennings(t, rise: float, plateau_end: float, decay: float):
     r"""Jennings-Housner-Tsai trapezoidal intensity envelope [-].

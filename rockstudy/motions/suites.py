@@ -13,6 +13,8 @@ from pathlib import Path
 
 from .records import Record, UnitsError, not_a_file
 
+__all__ = ["load_suite", "read_pair", "RECORD_SUFFIXES", "suite_pairs", "units_refusal"]
+
 #: Suffixes (case-insensitive) of the files read from a folder.
 RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
 

@@ -14,6 +14,8 @@ from .mavroeidis import mp_pulse_acceleration
 from .records import Record
 from .stochastic import stochastic_record
 
+__all__ = ["HIGH_PASS_ORDER", "MAX_GAMMA", "PULSE_PERIOD_RANGE", "synthetic_near_fault"]
+
 #: Order of the Butterworth high-pass that keeps the stochastic part out of the pulse's band.
 HIGH_PASS_ORDER = 4
 #: Pulse periods T_p [s] taken: near-fault velocity pulses last 0.3 to about 15 s (the

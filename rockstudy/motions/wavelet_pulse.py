@@ -45,6 +45,18 @@ import numpy as np
 from .intensity import ground_velocity, pseudo_velocity_peak_period, uniform_samples
 from .pulse_extraction import PULSE_LIKE_INDICATOR, baker_indicator
 
+__all__ = [
+    "DAMPING",
+    "extract_wavelet_pulse",
+    "LEVEL",
+    "NEIGHBOURHOOD",
+    "PERIOD_RANGE",
+    "SCALE_RATIO",
+    "SMALLEST_SCALE",
+    "WaveletPulse",
+    "WAVELETS",
+]
+
 #: Pulse periods scanned [s] (Shahi & Baker 2014: 0.25-15 s).
 PERIOD_RANGE = (0.25, 15.0)
 #: The scan's ladder of scales [samples]: SMALLEST_SCALE x SCALE_RATIO^k.

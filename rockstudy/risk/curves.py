@@ -17,6 +17,18 @@ from ..warnings import UnitsWarning
 from .readers import read_curve
 from .units import to_si, units_for
 
+__all__ = [
+    "DESIGN_LEVEL_BOUNDS",
+    "DESIGN_RATE",
+    "HazardCurve",
+    "IMPOSSIBLE_LEVELS",
+    "level_at_rate",
+    "LOG_HUGE",
+    "LOG_TINY",
+    "RECORD_RATES",
+    "suite_off_curve",
+]
+
 
 def _positive_increasing(name, values) -> np.ndarray:
     """``values`` as a 1-D float array of at least two finite numbers > 0, or a ValueError

@@ -11,6 +11,8 @@ from .. import _validate
 from .curves import LOG_HUGE, HazardCurve, _slopes
 from .units import to_si, units_for
 
+__all__ = ["annual_rate", "MAX_DISPERSION", "MAX_YEARS", "probability_in", "rate_deaggregation"]
+
 #: The largest dispersion beta of a fragility: ln C of a capacity C spread by more than 10
 #: (its 16-84 % range a factor e^20, about 5e8) says nothing of an object, and beyond it
 #: Cornell's exp(k^2 beta^2 / 2) leaves floating point for any hazard slope k above 3.8.

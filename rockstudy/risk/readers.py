@@ -19,6 +19,8 @@ from .. import _validate
 from ..motions import measures
 from ..motions.records import read_text_file
 
+__all__ = ["OPENQUAKE_IMTS", "read_curve"]
+
 #: OpenQuake's IMT names -> (rockstudy IM, the unit OpenQuake gives its levels in).
 OPENQUAKE_IMTS = {
     "PGA": ("pga", "g"),

@@ -10,6 +10,20 @@ import numpy as np
 from .. import _validate
 from ..constants import G
 
+__all__ = [
+    "Block",
+    "block_parameters",
+    "check_half_diagonal",
+    "check_slenderness",
+    "frequency_parameter",
+    "FREQUENCY_PARAMETER_RANGE",
+    "HALF_DIAGONAL_RANGE",
+    "MIN_SLENDERNESS",
+    "restitution_housner",
+    "uplift_acceleration",
+    "uplift_acceleration_block",
+]
+
 #: Half-diagonals R [m] taken: a micrometre to a thousand kilometres, beyond any rocking
 #: object at both ends (the kernels divide by powers of p = sqrt(3 g / 4 R)).
 HALF_DIAGONAL_RANGE = (1e-6, 1e6)

@@ -24,6 +24,18 @@ from ..constants import G
 from . import _jet as jt
 from .mechanism import Mechanism, RockingParameters
 
+__all__ = [
+    "Arch",
+    "AsymmetricFrame",
+    "ConicalShell",
+    "four_bar_mechanism",
+    "HINGE_TOLERANCE",
+    "PointMassStrut",
+    "restitution_symmetric_body",
+    "RockingWall",
+    "SymmetricFrame",
+]
+
 
 def _leaning(R, alpha, phi):
     """Centre of a body of half-diagonal R leaning over a pivot at the origin: (x, y)."""

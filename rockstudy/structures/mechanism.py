@@ -27,6 +27,15 @@ from .. import _validate
 from ..constants import G
 from ._jet import Jet
 
+__all__ = [
+    "CRITICAL_MAX_ITER",
+    "CRITICAL_ROTATION_TOL",
+    "EquivalentBlock",
+    "Mechanism",
+    "Pose",
+    "RockingParameters",
+]
+
 # phi_cr to rounding [rad]: every rocking parameter of the equivalent block is read at it.
 CRITICAL_ROTATION_TOL = 1e-15
 # The bracket is one step of a 2001-point grid; Newton converges in about 5 evaluations of the

@@ -10,17 +10,26 @@ from .analysis.record_fragility import ida_fragility, im_efficiency, stripe_frag
 from .analysis.risk import object_risk
 from .designs.records import cloud, incremental_dynamic_analysis, multiple_stripes
 from .designs.sampling import make_design
-from .running.runner import FailedSamplesError, RunReport, SchedulerError, run_study
-from .running.store import StoreError, export_netcdf, open_result
+from .running.runner import (
+    FailedSamplesError,
+    ResourceError,
+    RunReport,
+    SchedulerError,
+    run_study,
+)
+from .running.store import DamagedCube, StoreError, export_netcdf, open_result
 from .spec.ida_options import IdaOptionError
 from .spec.samplers import salib_problem
 from .spec.schema import Study, StudyError, json_schema, load_study, validate_text
-from .spec.structures import FieldError
+from .spec.structures import FieldError, FieldErrors
 
 __all__ = [
+    "DamagedCube",
     "FailedSamplesError",
     "FieldError",
+    "FieldErrors",
     "IdaOptionError",
+    "ResourceError",
     "RockingAccessor",
     "SchedulerError",
     "StoreError",

@@ -25,6 +25,21 @@ from ..constants import G
 from ..dynamics import _auto
 from ..dynamics.batch import simulate_batch
 
+__all__ = [
+    "bound_table",
+    "cell_maximum",
+    "GRID_FREQUENCY",
+    "linearization_error_map",
+    "main",
+    "neighbourhood_maximum",
+    "overturning_nearby",
+    "pulse_grid_batch",
+    "REFERENCE_RTOL",
+    "relative_max_rotation_error",
+    "robust_decision",
+    "tolerance_error_map",
+]
+
 GRID_FREQUENCY = 2.0  # p [rad/s] of the maps: they are in (psi, omega), any p will do
 REFERENCE_RTOL = 1e-11
 

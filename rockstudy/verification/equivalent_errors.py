@@ -23,6 +23,8 @@ from scipy.integrate import quad
 from ..closedform.free import free_rocking_period, overturning_time_constant_acceleration
 from ..constants import G
 
+__all__ = ["Direction", "error_map"]
+
 
 def _quarter_period(mech, phi0):
     t0 = mech.terms(np.array([phi0]))

@@ -30,6 +30,8 @@ from ..closedform import sine
 from ..constants import G
 from ..dynamics.batch import simulate_batch
 
+__all__ = ["linear_outcomes", "validity_map"]
+
 _P = 1.0  # the map is in (a, omega): any p will do; p = 1 makes t = tau
 _LIN_ALPHA = 0.05  # the linear model is scale-free in (a, omega, eta): any alpha will do
 _R = 3.0 * G / (4.0 * _P * _P)

@@ -22,13 +22,14 @@ import xarray as xr
 
 from ... import _validate
 from ..designs.record_rows import design_dataset
+from ..spec.design_kinds import DESIGN_KINDS, design_kind
 from ..spec.schema import Study
 from . import contact, record_fragility, record_similarity, risk, sampled
 
 __all__ = ["RECORD_DESIGNS", "RockingAccessor"]
 
-#: The kinds of record designs (``attrs["design"]`` of their datasets).
-RECORD_DESIGNS = ("cloud", "stripes", "ida")
+#: The kinds of record designs (``attrs["design"]`` of their datasets): the registry's.
+RECORD_DESIGNS = tuple(DESIGN_KINDS)
 
 
 def _takes(function, renamed=(), leave=()) -> list[str]:
@@ -140,9 +141,7 @@ class RockingAccessor:
     @property
     def _record_fit(self):
         """The fragility fit of a record design: of IDA capacities, or of stripes' points."""
-        if self.kind == "ida":
-            return record_fragility.ida_fragility
-        return record_fragility.stripe_fragility
+        return getattr(record_fragility, design_kind(self.kind).fragility)
 
     def _sampled(self, method: str, record_analysis: str) -> str:
         """The sampler kind of a sampled cube, or a ValueError naming ``method``."""

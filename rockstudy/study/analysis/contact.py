@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+__all__ = ["friction_array", "outside_model", "summary_line"]
+
 
 def friction_array(ds: xr.Dataset, friction) -> xr.DataArray:
     """The friction coefficient of each scene of ``ds``: a number, or one per structure (on

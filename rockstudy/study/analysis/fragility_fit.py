@@ -47,11 +47,47 @@ from scipy import optimize, special, stats
 from ... import _validate
 from ..._warnings import SeparationWarning
 
+__all__ = [
+    "BAND_COLUMNS",
+    "BAND_METHODS",
+    "binned_outcomes",
+    "binomial_covariance",
+    "bootstrap_rng",
+    "capacities_covariance",
+    "check_conf_level",
+    "check_n_boot",
+    "CONF_LEVEL",
+    "fit_binomial",
+    "fit_binomial_limit",
+    "fit_capacities",
+    "fragility_row",
+    "lack_of_fit",
+    "LACK_OF_FIT_LEVEL",
+    "MAX_BOOT",
+    "MIN_EXPECTED",
+    "N_BOOT",
+    "NO_MAXIMUM",
+    "no_maximum_row",
+    "percentile_intervals",
+    "probability_band",
+    "SEED",
+    "SEPARATED",
+    "separation",
+    "separation_message",
+    "SEPARATIONS",
+    "wald_intervals",
+    "warn_if_separated",
+]
+
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 #: how the pointwise band of P(x) of a fitted row is formed (see the module docstring).
 #: Resamples (of records, or of samples) behind every bootstrapped band, unless a call gives
 #: ``n_boot``: the fitting functions, the reports and the risk integral share it.
 N_BOOT = 200
+#: The confidence level of every band, unless a call gives ``conf_level``.
+CONF_LEVEL = 0.9
+#: The seed of every bootstrap, unless a call gives ``seed``.
+SEED = 0
 
 BAND_METHODS = ("likelihood", "record_bootstrap", "noncentral_t", "none")
 

@@ -29,9 +29,12 @@ from scipy import stats
 
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
+from ..spec.design_kinds import DESIGN_KINDS, kind_of
 from .fragility_fit import (
+    CONF_LEVEL,
     N_BOOT,
     NO_MAXIMUM,
+    SEED,
     binomial_covariance,
     bootstrap_rng,
     capacities_covariance,
@@ -52,6 +55,7 @@ __all__ = [
     "default_candidates",
     "fit_binomial",
     "fit_capacities",
+    "fragility_of",
     "ida_fragility",
     "im_efficiency",
     "intensity",
@@ -200,21 +204,29 @@ def _row(label, theta, beta, band, n, x, unit, by, cov, method, conf_level):
     return {**row, "unit": unit}
 
 
-def _check(ds, design, conf_level, n_boot):
-    """Validated (conf_level, n_boot); a ValueError if ``ds`` is not of the ``design`` kind."""
+def _check(ds, fitter, conf_level, n_boot):
+    """Validated (conf_level, n_boot); a ValueError if the fragility of ``ds``'s design kind
+    (:mod:`rockstudy.study.spec.design_kinds`) is not ``fitter``. A dataset of no design
+    kind with the outcomes of its points (``overturned``) is fitted as stripes."""
     conf_level, n_boot = check_conf_level(conf_level), check_n_boot(n_boot)
-    kind = ds.attrs.get("design")
-    if design == "ida" and kind != "ida":
+    name = ds.attrs.get("design")
+    kind = DESIGN_KINDS.get(name) if isinstance(name, str) else None
+    if kind is None and "overturned" in ds:
+        kind = DESIGN_KINDS["stripes"]
+    if kind is None or kind.fragility != fitter:
+        fits = [k.name for k in DESIGN_KINDS.values() if k.fragility == fitter]
+        other = f"; use {kind.fragility} for a {name!r} design" if kind is not None else ""
         raise ValueError(
-            f"ds: ida_fragility needs an IDA dataset (design 'ida'), got design {kind!r}; "
-            "use stripe_fragility for stripes and clouds"
-        )
-    if design != "ida" and (kind == "ida" or "overturned" not in ds):
-        raise ValueError(
-            f"ds: stripe_fragility needs a stripes or cloud dataset (with 'overturned'), got "
-            f"design {kind!r}; use ida_fragility for an IDA"
+            f"ds: {fitter} needs a dataset of design {' or '.join(map(repr, fits))}, got "
+            f"design {name!r}{other}"
         )
     return conf_level, n_boot
+
+
+def fragility_of(ds):
+    """The fragility fitter of a record design's Dataset: its design kind's
+    (:func:`stripe_fragility` or :func:`ida_fragility`)."""
+    return globals()[kind_of(ds).fragility]
 
 
 def _measure(ds, im, period):
@@ -230,9 +242,10 @@ def stripe_fragility(
     period=None,
     by=None,
     bins=None,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> pd.DataFrame:
     """Lognormal fragility of a stripe (or cloud) design by the binomial MLE (Baker 2015).
 
@@ -256,6 +269,8 @@ def stripe_fragility(
     n_boot, conf_level, seed
         Intervals of theta and beta by resampling records (with replacement) and refitting
         both; ``n_boot=0`` gives their Wald intervals instead. ``conf_level`` in (0, 1).
+        Keywords only, in this order in every function that takes them (defaults
+        :data:`~rockstudy.study.analysis.fragility_fit.N_BOOT`, ``CONF_LEVEL`` and ``SEED``).
 
     Returns
     -------
@@ -274,7 +289,7 @@ def stripe_fragility(
         their band NaN). Such bootstrap resamples enter at their limit
         (:func:`~rockstudy.study.analysis.fragility_fit.fit_binomial_limit`).
     """
-    conf_level, n_boot = _check(ds, "stripes", conf_level, n_boot)
+    conf_level, n_boot = _check(ds, "stripe_fragility", conf_level, n_boot)
     im, period = _measure(ds, im, period)
     x_all, y_all, ok = stripe_arrays(ds, im, period)
     y_all = y_all.astype(float)
@@ -344,9 +359,10 @@ def ida_fragility(
     period=None,
     by=None,
     bins=None,
-    conf_level: float = 0.9,
+    *,
     n_boot: int = N_BOOT,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> pd.DataFrame:
     """Lognormal fit of IDA capacities (first overturning levels) in any stored measure.
 
@@ -370,7 +386,7 @@ def ida_fragility(
     (:func:`capacities_lack_of_fit`) for a group of one structure without censored
     capacities, NaN otherwise; below 0.01 the capacities do not look lognormal.
     """
-    conf_level, n_boot = _check(ds, "ida", conf_level, n_boot)
+    conf_level, n_boot = _check(ds, "ida_fragility", conf_level, n_boot)
     im, period = _measure(ds, im, period)
     cap, top, cens_all, ok = ida_arrays(ds, im, period)
     unit = quoted(im)[0]
@@ -458,7 +474,7 @@ def _specs(ds, candidates):
 
 
 def im_efficiency(
-    ds: xr.Dataset, candidates=None, by=None, bins=None, n_boot: int = N_BOOT, **kw
+    ds: xr.Dataset, candidates=None, by=None, bins=None, *, n_boot: int = N_BOOT, **kw
 ) -> pd.DataFrame:
     """Which intensity measure predicts overturning best: the dispersion of each, per power.
 
@@ -492,7 +508,7 @@ def im_efficiency(
         not rise (``no_rise``) has no beta (NaN, sorted last: not ranked), and warns
         (:class:`~rockstudy.SeparationWarning`).
     """
-    fit = ida_fragility if ds.attrs.get("design") == "ida" else stripe_fragility
+    fit = fragility_of(ds)
     candidates = default_candidates(ds) if candidates is None else candidates
     frames = []
     for name, period in _specs(ds, candidates):

@@ -25,8 +25,11 @@ import pandas as pd
 import xarray as xr
 
 from ...motions import measures
-from .fragility_fit import N_BOOT, NO_MAXIMUM, fit_binomial_limit, separation
+from ..spec.design_kinds import kind_of
+from .fragility_fit import CONF_LEVEL, N_BOOT, NO_MAXIMUM, SEED, fit_binomial_limit, separation
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
+
+__all__ = ["FREQUENCY_GROUP", "size_class_medians", "size_classes", "size_edges", "size_label"]
 
 #: Variable on (record, structure) whose bins condition the collapse (omega_p / p).
 FREQUENCY_GROUP = "pulse_frequency_ratio"
@@ -120,7 +123,7 @@ def _median_fitter(ds, im, period):
     needs_period = im in measures.MEASURES and measures.MEASURES[im].needs_period
     if needs_period and period is None and np.isfinite(ds.attrs.get("im_period", np.nan)):
         period = ds.attrs["im_period"]
-    if ds.attrs.get("design") == "ida":
+    if kind_of(ds, default="stripes").capacities:
         cap, top, cens, ok = ida_arrays(ds, im, period)
         x = np.where(cens, top, cap)  # capacities, and the censoring levels
 
@@ -152,9 +155,10 @@ def size_class_medians(
     period=None,
     size_bins=3,
     frequency_bins=None,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Median overturning intensity theta of each size class, and its spread across classes.
 

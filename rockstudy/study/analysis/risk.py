@@ -59,10 +59,13 @@ from ... import _validate, risk
 from ...constants import G
 from ...risk.units import to_si
 from ...warnings import UnitsWarning
+from ..spec.design_kinds import design_kind, kind_of
 from . import record_fragility as rf
 from .fragility_fit import (
+    CONF_LEVEL,
     N_BOOT,
     NO_MAXIMUM,
+    SEED,
     bootstrap_rng,
     check_conf_level,
     check_n_boot,
@@ -93,7 +96,7 @@ def _check_hazard(ds, hazard):
     return hazard.im, hazard.period
 
 
-def _ida_fitter(ds, im, period):
+def ida_fitter(ds, im, period):
     """(fit(j, rows) -> (theta, beta), count(j, rows) -> overturning records, lowest censoring
     level per object, no_maximum(j) -> None, lowest capacity per object) of an IDA, in quoted
     units."""
@@ -114,8 +117,8 @@ def _ida_fitter(ds, im, period):
     return fit, count, lowest, lambda j: None, first
 
 
-def _stripe_fitter(ds, im, period):
-    """As :func:`_ida_fitter` for stripes and clouds (binomial fit of the points, a separated
+def stripe_fitter(ds, im, period):
+    """As :func:`ida_fitter` for stripes and clouds (binomial fit of the points, a separated
     resample at its limit); the third item is the lowest intensity simulated per object, the
     fourth the kind of :data:`.fragility_fit.NO_MAXIMUM` of all its points (None if they
     have a fit), the fifth the lowest intensity at which it overturned."""
@@ -235,15 +238,15 @@ def records_measure(ds, hazard) -> np.ndarray:
     return np.asarray(values.values, float)
 
 
-def _status(ida, theta, beta, n_over, min_overturning, no_maximum):
+def _status(capacities, theta, beta, n_over, min_overturning, no_maximum):
     if n_over == 0:
         return "none"
-    if not ida and theta == 0.0 and beta != np.inf:
+    if not capacities and theta == 0.0 and beta != np.inf:
         return "all"
     if no_maximum is not None:
         return "no rise" if no_maximum == "no rise" else "separated"
     if not (np.isfinite(theta) and theta > 0 and 0 <= beta <= risk.MAX_DISPERSION):
-        return "no fit" if n_over >= (2 if ida else 1) else "few"
+        return "no fit" if n_over >= (2 if capacities else 1) else "few"
     return "ok" if n_over >= min_overturning else "few"
 
 
@@ -252,7 +255,7 @@ def _probability(years, rate):
     return np.where(np.isfinite(rate), risk.probability_in(years, np.nan_to_num(rate)), np.nan)
 
 
-def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning, cut):
+def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, capacities, min_overturning, cut):
     """The point estimate, the bootstrap rates and the status of object ``j`` (its fragility
     0 below ``cut``, in ``unit``; None: the whole lognormal); and the rate of the whole
     lognormal."""
@@ -260,7 +263,7 @@ def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, ida, min_overturning,
     every = np.arange(n_rec)
     theta, beta = fit(j, every)
     n_over = count(j, every)
-    status = _status(ida, theta, beta, n_over, min_overturning, no_maximum(j))
+    status = _status(capacities, theta, beta, n_over, min_overturning, no_maximum(j))
     if status in ("separated", "no rise"):  # the limit of the fit is no estimate
         theta, beta = np.nan, np.nan
     whole = _rate(theta, beta, hazard, unit) if status in ("ok", "few") else np.nan
@@ -275,9 +278,10 @@ def object_risk(
     ds: xr.Dataset,
     hazard: risk.HazardCurve,
     years: float = 50.0,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
     min_overturning: int = 5,
 ) -> xr.Dataset:
     """Per object: the fragility in the hazard's IM, lambda_OT, P(OT in ``years``) and bands.
@@ -347,16 +351,13 @@ def object_risk(
     )
     n_boot, conf_level = check_n_boot(n_boot), check_conf_level(conf_level)
     min_overturning = _validate.count("min_overturning", min_overturning, 1)
-    design = ds.attrs.get("design")
-    if design not in ("ida", "stripes", "cloud"):
-        raise ValueError(f"ds: attrs['design'] must be 'ida', 'stripes' or 'cloud', got {design!r}")
+    kind = kind_of(ds)
     im, period = _check_hazard(ds, hazard)
     off = risk.suite_off_curve(hazard, records_measure(ds, hazard))
     if off is not None:
         warnings.warn(f"hazard: {off}; check the units of both", UnitsWarning, stacklevel=2)
     unit = rf.quoted(im)[0]
-    ida = design == "ida"
-    fitter = (_ida_fitter if ida else _stripe_fitter)(ds, im, period)
+    fitter = globals()[kind.risk_fitter](ds, im, period)
     n_rec = ds.sizes["record"]
     rng = bootstrap_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]
@@ -376,13 +377,13 @@ def object_risk(
             boot_rows,
             hazard,
             unit,
-            ida,
+            kind.capacities,
             min_overturning,
             cuts[j] if np.isfinite(cuts[j]) else None,
         )
         for j in range(ds.sizes["structure"])
     ]
-    attrs = {"design": design, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
+    attrs = {"design": kind.name, "n_boot": n_boot, "conf_level": conf_level, "seed": int(seed)}
     levels = (uplift, cut, refused)
     return _risk_dataset(ds, rows, fitter[2] * to_hazard, hazard, years, to_hazard, attrs, levels)
 
@@ -399,7 +400,7 @@ def _bands(boot, conf_level):
     return lo, hi, valid
 
 
-def _bounds(status, lowest, hazard, ida, cut):
+def _bounds(status, lowest, hazard, capacities, cut):
     """``rate_upper_bound`` (an IDA's "none"; stripes' "all" where the fragility is cut: P(OT)
     <= 1 from the cut on and 0 below it, so lambda_OT <= lambda(cut)) and ``rate_lower_bound``
     (stripes' "all")."""
@@ -407,9 +408,9 @@ def _bounds(status, lowest, hazard, ida, cut):
     ok = np.isfinite(lowest) & (lowest > 0)
     cut_ok = np.isfinite(cut) & (cut > 0)
     at_cut = hazard.rate(np.where(cut_ok, cut, 1.0))
-    everywhere = ~ida & (status == "all")
+    everywhere = (not capacities) & (status == "all")
     upper = np.where(
-        ida & (status == "none") & ok, at, np.where(everywhere & cut_ok, at_cut, np.nan)
+        capacities & (status == "none") & ok, at, np.where(everywhere & cut_ok, at_cut, np.nan)
     )
     lower = np.where(everywhere & ok, at, np.nan)
     return upper, lower
@@ -438,7 +439,8 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs, levels):
         )[2]
     parts = np.where(fitted[:, None], parts, np.nan)
     status = np.array(status, dtype=object)
-    upper, lower = _bounds(status, lowest, hazard, attrs["design"] == "ida", cut)
+    capacities = design_kind(attrs["design"]).capacities
+    upper, lower = _bounds(status, lowest, hazard, capacities, cut)
     v = {
         "theta": np.where(np.isfinite(theta), theta * to_hazard, theta),
         "beta": beta,

@@ -27,8 +27,10 @@ from scipy.spatial import cKDTree
 from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
+    CONF_LEVEL,
     N_BOOT,
     NO_MAXIMUM,
+    SEED,
     binomial_covariance,
     bootstrap_rng,
     check_conf_level,
@@ -43,6 +45,23 @@ from .fragility_fit import (
     wald_intervals,
     warn_if_separated,
 )
+
+__all__ = [
+    "check_variables",
+    "collapse_metric",
+    "FailedPolicy",
+    "first_order_given_data",
+    "fragility",
+    "fragility_curve",
+    "fragility_samples",
+    "ROTATION_OUTPUTS",
+    "sobol_convergence",
+    "sobol_indices",
+    "study_of",
+    "unexplained_share",
+    "UnexplainedShare",
+    "warn_if_rotation_of_overturned",
+]
 
 FailedPolicy = Literal["error", "drop", "impute"]
 
@@ -227,9 +246,10 @@ def fragility(
     outcome: str = "overturned",
     by=None,
     bins=None,
+    *,
     n_boot: int = N_BOOT,
-    conf_level: float = 0.9,
-    seed: int = 0,
+    conf_level: float = CONF_LEVEL,
+    seed: int = SEED,
     failed: FailedPolicy = "drop",
 ) -> pd.DataFrame:
     """Lognormal fragility curves P(outcome | intensity) fitted by maximum likelihood.

@@ -29,8 +29,29 @@ from ..._warnings import UpliftWarning
 from ...motions import measures
 from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
+from ..spec.design_kinds import design_kind
 from ..spec.feasibility import record_pairs
 from . import records as rd
+
+__all__ = [
+    "CONTACT_VARIABLES",
+    "design_dataset",
+    "design_rows",
+    "empty_rows",
+    "evaluate_rows",
+    "GROUP_VARIABLES",
+    "ida_steps",
+    "load_record",
+    "outputs",
+    "PULSE_VARIABLES",
+    "record_variables",
+    "sample_measures",
+    "sample_outputs",
+    "scale_factors",
+    "stored_periods",
+    "STRUCTURE_VARIABLES",
+    "uplift_column",
+]
 
 #: Per-record variables of the pulse in the design Dataset: (long_name, units).
 PULSE_VARIABLES = {
@@ -136,12 +157,13 @@ def outputs(study) -> dict:
     """The per-row outputs of a design study: name -> (long_name, units, dtype, fill, extra
     dimension or None). ``kernel_status`` is the design's ``status`` (0 ok)."""
     de = study.design
+    kind = design_kind(de.kind)
     out = {k: (*_float(*v), None) for k, v in record_variables().items()}
     for k in measures.listed(True):
         m = measures.MEASURES[k]
         out[k] = (f"{m.label}(T) of the unscaled record", m.unit, "f8", np.nan, "period")
     out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
-    if de.kind == "ida":
+    if kind.capacities:
         out.update({k: (*v, None) for k, v in _IDA.items()})
         im = de.ida().im
         unit = "1" if im in measures.RATIOS else measures.measure(im).unit
@@ -150,7 +172,7 @@ def outputs(study) -> dict:
             out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
     else:
         out.update({k: (*v, None) for k, v in _RUN.items()})
-        if de.kind == "stripes":
+        if kind.levels:
             out["scale"] = ("factor applied to the record", "1", "f8", np.nan, None)
         out["censored"] = (
             "1 if not run: the scaled vertical reaches -g (free fall; kernel_status 2)",
@@ -197,7 +219,8 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     data = {k: ("sample", np.asarray(v)[st]) for k, v in structures.items()}
     data.update(record=("sample", rec), structure=("sample", st), level_index=("sample", lev))
     coords = {"sample": np.arange(rec.size)}
-    if study.design.kind == "stripes":
+    kind = design_kind(study.design.kind)
+    if kind.levels:
         coords["level"] = ("level", study.motion.scale_to.levels())
     coords["period"] = ("period", stored_periods(study))
     ds = xr.Dataset(data, coords=coords)
@@ -210,7 +233,7 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     )
     if study.structure.kind == "objects":
         ds.attrs["structure_names"] = json.dumps([o.name for o in study.structure.objects])
-    if study.design.kind == "ida":
+    if kind.capacities:
         ds.attrs["ida_steps"] = ida_steps(study)
     return ds
 
@@ -236,17 +259,18 @@ def stored_periods(study) -> np.ndarray:
     """Periods [s] of the stored ``sa``: ``design.periods`` and the period of a spectral target
     (as :mod:`.records` stores them), sorted."""
     de, periods = study.design, set(study.design.periods)
-    if de.kind == "stripes" and study.motion.scale_to.period is not None:
+    kind = design_kind(de.kind)
+    if kind.levels and study.motion.scale_to.period is not None:
         periods.add(study.motion.scale_to.period)
-    if de.kind == "ida" and de.period is not None:
+    if kind.capacities and de.period is not None:
         periods.add(de.period)
     return np.array(sorted(periods), float)
 
 
 def _widths(study) -> dict:
     """Sizes of the extra dimensions of the outputs."""
-    ida = study.design.kind == "ida"
-    return {"period": stored_periods(study).size, "step": ida_steps(study) if ida else 0}
+    steps = design_kind(study.design.kind).capacities
+    return {"period": stored_periods(study).size, "step": ida_steps(study) if steps else 0}
 
 
 def empty_rows(study, n: int) -> dict:
@@ -258,23 +282,25 @@ def empty_rows(study, n: int) -> dict:
     }
 
 
-def _run_design(study, record, structures, levels):
-    """The design function of :mod:`.records` on one record."""
+def _run_design(study, record, structures, levels, friction):
+    """The design function of :mod:`.records` on one record (its kind's ``run``), with the
+    friction coefficients of its structures (None: no friction check)."""
     de, run = study.design, study.run
-    common = dict(
+    kind = design_kind(de.kind)
+    kw = dict(
         periods=de.periods,
         damping=de.damping,
         method=run.method,
         rtol=run.rtol,
         max_steps=run.max_steps,
     )
-    common["contact"] = study.friction_coefficients() is not None
-    if de.kind == "cloud":
-        return rd.cloud([record], structures, **common)
-    if de.kind == "stripes":
+    kw["friction"] = friction
+    if kind.levels:
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
-        return rd.multiple_stripes([record], structures, levels, im=t.im, period=t.period, **common)
-    return rd.incremental_dynamic_analysis([record], structures, **de.ida_options(), **common)
+        kw.update(levels=levels, im=t.im, period=t.period)
+    if kind.capacities:
+        kw.update(de.ida_options())
+    return getattr(rd, kind.run)([record], structures, **kw)
 
 
 def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
@@ -284,7 +310,9 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     width = _widths(study)
     result = empty_rows(study, cols["sample"].size)
     motion_json = study.motion.model_dump_json()
-    levels_all = study.motion.scale_to.levels() if study.design.kind == "stripes" else np.ones(1)
+    on_levels = design_kind(study.design.kind).levels
+    levels_all = study.motion.scale_to.levels() if on_levels else np.ones(1)
+    friction = study.friction_coefficients()
     for r in np.unique(cols["record"]):
         rows = np.flatnonzero(cols["record"] == r)
         rec = load_record(motion_json, base_dir, int(r))
@@ -297,7 +325,9 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "uplift_acceleration": uplift_column(study, cols, first),
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
-        ds = _run_design(study, rec, structures, levels_all[lev_ids])
+        mu = friction if friction is None or friction.size > 1 else float(friction[0])
+        mu = mu[st_ids] if isinstance(mu, np.ndarray) else mu
+        ds = _run_design(study, rec, structures, levels_all[lev_ids], mu)
         _fill(result, outs, ds, rows, st_pos, lev_pos, width)
     return result
 
@@ -332,10 +362,10 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     """Fold a design study's rows (the store's cube) into the layout of :mod:`.records`:
     ``record`` x ``structure`` [x ``level``], per-record and per-structure tables, attributes.
     """
-    kind = cube.attrs["record_design"]
+    kind = design_kind(cube.attrs["record_design"])
     names = json.loads(cube.attrs["record_names"])
     n_rec, n_st = len(names), int(cube.attrs["structures"])
-    n_lev = cube.sizes.get("level", 1) if kind == "stripes" else 1
+    n_lev = cube.sizes.get("level", 1) if kind.levels else 1
     shape = (n_rec, n_st, n_lev)
     study = json.loads(cube.attrs["study"])
     out = {}
@@ -349,7 +379,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             out[new] = (("structure",), values[0, :, 0], var.attrs)
         elif name in record_variables() or name in measures.listed(True):
             out[new] = (("record",) + extra, values[:, 0, 0], var.attrs)
-        elif name in GROUP_VARIABLES or kind != "stripes":
+        elif name in GROUP_VARIABLES or not kind.levels:
             out[new] = (("record", "structure") + extra, values[:, :, 0], var.attrs)
         else:
             out[new] = (("record", "structure", "level"), values, var.attrs)
@@ -363,7 +393,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         "period": cube["period"].values,
         "record_name": ("record", np.array(names, dtype=object)),
     }
-    if kind == "stripes":
+    if kind.levels:
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)
     if "error" in ds:  # zarr reads the empty message (its fill value) back as NaN
@@ -381,13 +411,15 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
     de = study["design"]
     attrs.update(
-        design=kind, method=study["run"]["method"], rtol=study["run"]["rtol"], damping=de["damping"]
+        design=kind.name,
+        method=study["run"]["method"],
+        rtol=study["run"]["rtol"],
+        damping=de["damping"],
     )
-    if kind == "stripes":
+    if kind.levels:
         t = study["motion"]["scale_to"]
         attrs.update(im=t["im"], im_period=np.nan if t["period"] is None else t["period"])
-        attrs["n_simulations"] = n_rec * n_st * n_lev
-    elif kind == "ida":
+    if kind.capacities:
         attrs.update(rd.IdaOptions.given(de).attrs())
         attrs["n_simulations"] = int(
             np.nansum(np.where(ds["simulations"] >= 0, ds["simulations"], 0))
@@ -396,9 +428,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
             ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
         used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
         ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
-    else:
-        attrs["n_simulations"] = n_rec * n_st
-    if kind != "ida":  # as the API: bool, and the points not run are not simulations
+    else:  # as the API: bool, and the points not run are not simulations
         ds["censored"] = ds["censored"] == 1
         attrs["n_simulations"] = int((~ds["censored"]).sum())
     ds.attrs = attrs

@@ -21,6 +21,7 @@ bisection) and the switch band above it, where the block is seen to survive agai
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import xarray as xr
@@ -31,6 +32,7 @@ from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
 from ...dynamics.batch import CONTACT_OUTPUTS
 from ...dynamics.methods import MAX_STEPS
+from ...dynamics.simulate import check_friction
 from ...motions import Record
 from ...motions import intensity as _im
 from ...motions import measures as _ms
@@ -43,6 +45,18 @@ from ...structures.block import (
 )
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
+
+__all__ = [
+    "CENSORED_REASONS",
+    "cf_flags",
+    "cloud",
+    "incremental_dynamic_analysis",
+    "multiple_stripes",
+    "record_labels",
+    "STATUS_FREE_FALL",
+    "STEP_KINDS",
+    "STEP_VARIABLES",
+]
 
 _STRUCTURE_KEYS = (
     "half_diagonal",
@@ -158,6 +172,35 @@ def _check(name, arr, low, high):
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"{name}[{i}] = {arr[i]!r} is outside ({low:g}, {high:g})")
+
+
+def _friction_check(friction, contact, n: int) -> bool:
+    """Whether the design computes the friction check (``friction_demand``, ``lift_off``):
+    ``friction`` is the friction coefficient mu in (0, 10]
+    (:data:`~rockstudy.dynamics.simulate.MAX_FRICTION`), one number or one per structure
+    (``n``; NaN: none for that structure), or None. ``contact`` is its deprecated spelling
+    (True or False, with a FutureWarning). A ValueError or TypeError names ``friction`` (or
+    ``contact``) otherwise."""
+    if contact is not None:
+        contact = _validate.flag("contact", contact)
+        warnings.warn(
+            "contact= of the record designs is deprecated: give friction=mu, the friction "
+            "coefficient of the contact check (as simulate(friction=) and a study's friction)",
+            FutureWarning,
+            stacklevel=3,
+        )
+    if friction is None:
+        return bool(contact)
+    if np.ndim(friction) == 0:
+        check_friction(friction)
+        return True
+    mu = np.asarray(friction, dtype=object)
+    if mu.ndim != 1 or mu.size != n:
+        raise ValueError(f"friction: give one number or one per structure ({n}), got {friction!r}")
+    for m in mu:  # NaN: no coefficient for that structure
+        if not (isinstance(m, float) and math.isnan(m)):
+            check_friction(m)
+    return True
 
 
 def _target(im, period, periods):
@@ -288,10 +331,10 @@ _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
 STATUS_FREE_FALL = 2
 
 
-def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps, contact=False):
+def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps, contact):
     """:func:`_run` on the points whose |scale| stays below the record's free-fall scale;
     the others get ``status`` :data:`STATUS_FREE_FALL`, NaN rotation and time, no overturning
-    and -1 impacts. With ``contact``, also ``friction_demand`` (NaN where not run) and
+    and -1 impacts. With ``contact`` (True), also ``friction_demand`` (NaN where not run) and
     ``lift_off`` (see :func:`rockstudy.simulate_batch`)."""
     ok = np.abs(scales) < free_fall_scale(record)
     out = {
@@ -325,7 +368,8 @@ def cloud(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
-    contact: bool = False,
+    friction=None,
+    contact: bool | None = None,
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -351,11 +395,17 @@ def cloud(
         Damping ratio of ``sa`` and the spectrum intensity.
     method, rtol, max_steps
         As in :func:`rockstudy.simulate_batch`.
-    contact : bool
-        Also ``friction_demand`` (max abs(F_h / F_v) at the contact; below uplift
+    friction : float or array_like, optional
+        The friction coefficient mu in (0, 10] (one, or one per structure; NaN: none for that
+        structure), as ``simulate(friction=)`` and a study's ``friction``: the design then
+        also gives ``friction_demand`` (max abs(F_h / F_v) at the contact; below uplift
         max abs(u_h'') / g) and ``lift_off`` of every point, as
         :attr:`rockstudy.RockingResult.friction_demand` (each point that lifts is run again
-        with a history: 1-40 ms a point).
+        with a history: 1-40 ms a point), for the friction check of the report
+        (:func:`~rockstudy.study.report.records.record_report` with the same ``friction``).
+    contact : bool, optional
+        Deprecated spelling of the friction check without a coefficient (FutureWarning):
+        give ``friction`` instead.
 
     Returns
     -------
@@ -365,9 +415,9 @@ def cloud(
         whose vertical component reaches -g is not run (free fall): ``censored`` and
         ``status`` :data:`STATUS_FREE_FALL` on its points.
     """
-    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
+    contact = _friction_check(friction, contact, st["critical_rotation"].size)
     _, periods = _target("pga", None, periods)
     ds = _record_dataset(records, st, periods, damping)
     idx = np.arange(st["critical_rotation"].size)
@@ -397,7 +447,8 @@ def multiple_stripes(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
-    contact: bool = False,
+    friction=None,
+    contact: bool | None = None,
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -414,7 +465,7 @@ def multiple_stripes(
         ``pga_ratio`` or ``pgv_ratio``.
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
-    records, structures, periods, damping, method, rtol, max_steps, contact
+    records, structures, periods, damping, method, rtol, max_steps, friction, contact
         As in :func:`cloud`.
 
     Returns
@@ -427,9 +478,9 @@ def multiple_stripes(
         :data:`STATUS_FREE_FALL` (2), which the fragility fits leave out; the record's
         other points run.
     """
-    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
+    contact = _friction_check(friction, contact, st["critical_rotation"].size)
     period, periods = _target(im, period, periods)
     levels = np.atleast_1d(np.asarray(levels, float))
     if levels.ndim != 1 or not levels.size or not np.all(np.isfinite(levels) & (levels > 0)):
@@ -494,7 +545,8 @@ def incremental_dynamic_analysis(
     method: str = "nonlinear",
     rtol: float = 1e-8,
     max_steps: int = MAX_STEPS,
-    contact: bool = False,
+    friction=None,
+    contact: bool | None = None,
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -540,8 +592,9 @@ def incremental_dynamic_analysis(
     step, tolerance, max_pga_ratio, scan
         See :class:`IdaOptions` (ranges checked; a ValueError names the option).
     records, structures, period, periods, damping, method, rtol, max_steps
-        As in :func:`multiple_stripes`. ``contact``: also ``friction_demand`` and ``lift_off``
-        (see :func:`cloud`) at ``capacity_scale_lower``, the highest scale simulated below
+        As in :func:`multiple_stripes`. ``friction`` (and its deprecated spelling
+        ``contact``): also ``friction_demand`` and ``lift_off`` (see :func:`cloud`) at
+        ``capacity_scale_lower``, the highest scale simulated below
         the first overturning (of a censored block: the highest it stood at).
         ``method="linear"`` runs the exact piecewise solution of the linearized model for
         records without a vertical component.
@@ -562,9 +615,9 @@ def incremental_dynamic_analysis(
         (:data:`STEP_KINDS`): the IDA curves. Attributes: the options and ``n_simulations``.
     """
     options = IdaOptions(im, period, step, tolerance, max_pga_ratio, scan)
-    contact = _validate.flag("contact", contact)
     records = _records(records)
     st = _structures(structures)
+    contact = _friction_check(friction, contact, st["critical_rotation"].size)
     period, periods = _target(im, period, periods)
     ds = _record_dataset(records, st, periods, damping)
     measure = np.array([_record_measure(r, im, period, damping, st) for r in records])

@@ -17,6 +17,8 @@ from ..spec.samplers import SAMPLERS
 from ..spec.schema import Study
 from ..spec.structures import KINDS
 
+__all__ = ["make_design", "target_attributes", "unit_samples", "VARIABLES"]
+
 #: CF-style attributes of every design variable.
 VARIABLES = {
     "half_diagonal": ("half-diagonal R of the block", "m"),

@@ -12,8 +12,25 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import xarray as xr
 
 from ..._warnings import SeparationWarning
+from ..running.store import open_result
+
+
+def dataset_of(data, what: str, verify: bool = True) -> tuple[xr.Dataset, str | None]:
+    """(the Dataset, the name of its file or None) of a report's input ``data``: an
+    :class:`xarray.Dataset` as it is, or the path of a result cube, read with
+    :func:`~rockstudy.study.running.store.open_result` (``verify`` its checksums); a
+    TypeError naming ``what`` otherwise."""
+    if isinstance(data, xr.Dataset):
+        return data, None
+    if isinstance(data, (str, Path)) or hasattr(data, "__fspath__"):
+        path = Path(data)
+        return open_result(path, verify=verify).load(), path.stem  # a missing cube: no folder
+    raise TypeError(
+        f"{what} must be an xarray.Dataset or the path of a result cube, got {type(data).__name__}"
+    )
 
 
 def _plt():

@@ -25,6 +25,7 @@ from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL, N_BOOT
 from ..analysis.risk import cut_levels, horizontal
 from ..analysis.sampled import fragility_curve
+from ..spec.design_kinds import DesignKind, design_kind
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from ._page import (
     _log_ticks,
@@ -35,6 +36,21 @@ from ._page import (
     separation_note,
     shown_separation,
 )
+
+__all__ = [
+    "FONT",
+    "friction_check",
+    "ida_axis",
+    "IDA_AXIS_MARGIN",
+    "object_capacity",
+    "object_curves",
+    "object_fragility",
+    "outcome",
+    "quoted_to_report",
+    "ReportContext",
+    "scale_factors",
+    "si_to_report",
+]
 
 #: Font size of legends and tick labels of the per-object figures [pt] (print: >= 8).
 FONT = 8
@@ -84,6 +100,11 @@ class ReportContext:
         return self.ds.attrs["design"]
 
     @property
+    def kind(self) -> DesignKind:
+        """The design's entry in the registry of design kinds."""
+        return design_kind(self.design)
+
+    @property
     def objects(self) -> bool:
         """Named objects (the ``structure`` coordinate holds names), not sampled structures."""
         return self.ds["structure"].dtype.kind in "OUS"
@@ -96,14 +117,14 @@ class ReportContext:
     @property
     def overturned(self) -> bool:
         """Whether any point of the design overturned."""
-        if self.design == "ida":
+        if self.kind.capacities:
             return bool((self.ds["censored"].values == 0).any())
         return bool((self.ds["overturned"].values == 1).any())
 
     @property
     def rocked(self) -> bool:
         """Whether any simulated point left rest."""
-        name = "step_max_rotation" if self.design == "ida" else "max_rotation"
+        name = "step_max_rotation" if self.kind.capacities else "max_rotation"
         return bool((np.nan_to_num(self.ds[name].values) > 0).any()) or self.overturned
 
     @property
@@ -201,16 +222,16 @@ def outcome(page, ctx):
 
 def scale_factors(page, ctx):
     """A warning box where records are scaled beyond ``max_scale_factor``."""
-    if ctx.design == "cloud":
+    if ctx.kind.scale_variable is None:
         return
-    scale = ctx.ds["scale" if ctx.design == "stripes" else "capacity_scale"].values
+    scale = ctx.ds[ctx.kind.scale_variable].values
     limit = ctx.max_scale_factor
     beyond = np.abs(np.nan_to_num(scale)) > limit
     if not beyond.any():
         return
     names = ctx.record_names()
     worst = np.unravel_index(int(np.nanargmax(np.abs(scale))), scale.shape)
-    what = "stripe points" if ctx.design == "stripes" else "capacities (first overturnings)"
+    what = ctx.kind.text["scaled"]
     page.warning(
         f"{int(beyond.sum())} of {scale.size} {what} scale a record by more than "
         f"max_scale_factor = {limit:g} (largest {float(np.nanmax(np.abs(scale))):.3g} x, record "
@@ -249,7 +270,7 @@ def si_to_report(units, im) -> float:
 
 def _object_fit(ctx, im, period):
     """The fragility of each object against ``im`` (rows by name), in the report's units."""
-    fit = rf.ida_fragility if ctx.design == "ida" else rf.stripe_fragility
+    fit = getattr(rf, ctx.kind.fragility)
     with shown_separation():  # said on the page (separation_note)
         table = fit(ctx.ds, im=im, period=period, by="structure", n_boot=ctx.n_boot)
     f = quoted_to_report(ctx.units, im)
@@ -313,11 +334,7 @@ def object_fragility(page, ctx):
         "wall, frame or arch: the structure's own, not its equivalent block's), drawn where "
         "the measure has one (PGA, PGA / uplift level); open circles, in the object's "
         "colour: "
-        + {
-            "ida": "its capacities at the plotting positions (k - 1/2) / n of their ranks",
-            "stripes": "the share of its records that overturned at each stripe level",
-            "cloud": "each record's outcome (0 stood, 1 overturned)",
-        }[ctx.design]
+        + ctx.kind.text["observed"]
         + (
             "; under these horizontal records nothing can overturn below it, so the fragility "
             "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "
@@ -391,13 +408,13 @@ def _observed(ctx, im, period, j) -> tuple[np.ndarray, np.ndarray]:
     geometric mean of the points' intensities there); for a cloud each record's outcome (0
     stood, 1 overturned) at its intensity."""
     f = quoted_to_report(ctx.units, im)
-    if ctx.design == "ida":
+    if ctx.kind.capacities:
         cap, _, cens, ok = rf.ida_arrays(ctx.ds, im, period)
         n = int(ok[:, j].sum())
         x = np.sort(cap[:, j][ok[:, j] & ~cens[:, j]]) * f
         return x, (np.arange(1, x.size + 1) - 0.5) / max(n, 1)
     x, y, ok = rf.stripe_arrays(ctx.ds, im, period)
-    if ctx.design == "cloud":
+    if not ctx.kind.levels:  # one point of each record
         return x[ok[:, j], j] * f, (y[ok[:, j], j] == 1).astype(float)
     x, y, ok = (a[:, j].reshape(a.shape[0], -1) for a in (x, y, ok))  # (record, level)
     xs, ys = [], []
@@ -455,8 +472,8 @@ def _plot_objects(ax, ctx, t, im, period) -> bool:
 
 
 def _ida_capacity(ctx):
-    """(cells, values): the PGA at first overturning of each object (rows) under each record
-    (columns); censored: 'above' the highest scale seen to stand."""
+    """(cells, values, what): the PGA at first overturning of each object (rows) under each
+    record (columns); censored: 'above' the highest scale seen to stand."""
     ds, f = ctx.ds, 1.0 / _unit(ctx)
     pga = ds["pga"].values[:, None] * f
     cap = ds["capacity_scale"].values * pga
@@ -465,12 +482,23 @@ def _ida_capacity(ctx):
     cells = np.empty(value.shape, object)  # numbers, or text where censored
     for k, v in np.ndenumerate(value):
         cells[k] = float(v) if np.isfinite(v) else f"above {lower[k]:.3g}"
-    return cells, value
+    what = (
+        f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
+        "(the IDA capacity; 'above': censored, standing at the highest scale reached"
+        + (
+            f", the ladder's top at {ds.attrs['max_pga_ratio']:g} times the object's "
+            "uplift PGA, unless the record's free fall stopped it lower"
+            if "max_pga_ratio" in ds.attrs
+            else ""
+        )
+        + ")"
+    )
+    return cells, value, what
 
 
 def _stripe_capacity(ctx):
-    """(cells, values): the bracket of levels in which each object first overturned under
-    each record (the lowest overturning level, in the stripes' measure)."""
+    """(cells, values, what): the bracket of levels in which each object first overturned
+    under each record (the lowest overturning level, in the stripes' measure)."""
     ds = ctx.ds
     im = ds.attrs.get("im", "pga")
     levels = ds["level"].values * si_to_report(ctx.units, im)
@@ -484,16 +512,24 @@ def _stripe_capacity(ctx):
             cells[j, i] = f"at or below {levels[0]:.3g}"
         else:
             cells[j, i] = f"{levels[k - 1]:.3g} to {levels[k]:.3g}"
-    return cells, np.where(first >= 0, levels[np.maximum(first, 0)], np.nan)
+    what = (
+        f"the stripe levels, {ctx.stripe_label()}, between which the object first "
+        "overturned (the highest level below that it stood at, the lowest it overturned at)"
+    )
+    return cells, np.where(first >= 0, levels[np.maximum(first, 0)], np.nan), what
 
 
 def _cloud_capacity(ctx):
-    """(cells, values): under the unscaled records, whether each object overturned."""
+    """(cells, values, what): under the unscaled records, whether each object overturned."""
     ds, f = ctx.ds, 1.0 / _unit(ctx)
     over = (ds["overturned"].values == 1).T
     pga = np.broadcast_to(ds["pga"].values * f, over.shape)
     cells = np.where(over, "overturned", "stands").astype(object)
-    return cells, np.where(over, pga, np.nan)
+    what = (
+        "whether the object overturned under the unscaled record (the governing "
+        f"capacity: the lowest PGA [{ctx.units}] of a record that overturned it)"
+    )
+    return cells, np.where(over, pga, np.nan), what
 
 
 def object_capacity(page, ctx):
@@ -501,8 +537,7 @@ def object_capacity(page, ctx):
     if not ctx.objects:
         return
     page.heading("Capacity of each object under each record")
-    how = {"ida": _ida_capacity, "stripes": _stripe_capacity, "cloud": _cloud_capacity}
-    cells, values = how[ctx.design](ctx)
+    cells, values, what = globals()[ctx.kind.capacity](ctx)
     records = ctx.record_names()
     table = pd.DataFrame(cells, index=list(map(str, ctx.ds["structure"].values)), columns=records)
     table.index.name = "object"
@@ -515,21 +550,6 @@ def object_capacity(page, ctx):
     # first: a wide table scrolls, and these are what the table is read for
     table.insert(0, "governing capacity", [v for _, v in govern])
     table.insert(0, "governing record(s) (lowest capacity)", [g for g, _ in govern])
-    what = {
-        "ida": f"the PGA [{ctx.units}] of the scaled record at the object's first overturning "
-        "(the IDA capacity; 'above': censored, standing at the highest scale reached"
-        + (
-            f", the ladder's top at {ctx.ds.attrs['max_pga_ratio']:g} times the object's "
-            "uplift PGA, unless the record's free fall stopped it lower"
-            if "max_pga_ratio" in ctx.ds.attrs
-            else ""
-        )
-        + ")",
-        "stripes": f"the stripe levels, {ctx.stripe_label()}, between which the object first "
-        "overturned (the highest level below that it stood at, the lowest it overturned at)",
-        "cloud": f"whether the object overturned under the unscaled record (the governing "
-        f"capacity: the lowest PGA [{ctx.units}] of a record that overturned it)",
-    }[ctx.design]
     page.table(table, "object_capacity", f"Capacity of each object under each record: {what}")
     if not np.isfinite(values).any():
         page.text("No object overturned under any record: no record governs.")
@@ -598,9 +618,10 @@ def ida_axis(ctx, j) -> tuple[float, float] | None:
 
 def object_curves(page, ctx):
     """Per object: the IDA curves (or the stripe points) of every record, in order of scale."""
-    if not ctx.objects or ctx.design == "cloud":
+    if not ctx.objects or not ctx.kind.text["objects"]:
         return
-    page.heading("IDA curves of each object" if ctx.design == "ida" else "Stripes of each object")
+    page.heading(ctx.kind.text["objects"])
+    draw = globals()[ctx.kind.draw]
     names = list(map(str, ctx.ds["structure"].values))
     records = ctx.record_names()
     fig, axes = _panels(len(names))
@@ -608,14 +629,11 @@ def object_curves(page, ctx):
     uplift = _uplift(ctx, "pga")
     for j, ax in enumerate(axes):
         for i in range(len(records)):
-            if ctx.design == "ida":
-                _ida_curve(ax, ctx, i, j, spread[i])
-            else:
-                _stripe_points(ax, ctx, i, j, spread[i])
+            draw(ax, ctx, i, j, spread[i])
         if np.isfinite(uplift[j]):  # NaN: a cube that does not say it
             ax.axhline(uplift[j], ls=":", lw=1.2, color="0.3")
         ax.set_yscale("log")
-        if ctx.design == "ida" and (span := ida_axis(ctx, j)) is not None:
+        if ctx.kind.capacities and (span := ida_axis(ctx, j)) is not None:
             ax.set_ylim(*span)
         ax.set_xlim(-0.04, 1.08)
         ax.set_title(ctx.text(ctx.structure_title(j)), fontsize=FONT + 1)
@@ -628,22 +646,21 @@ def object_curves(page, ctx):
         fig,
         f"object_{ctx.design}",
         "Every object under every record: "
-        + (
-            "the IDA curves, each record's simulated scales in increasing order up to the "
-            "first overturning (the line ends there); crosses: the first overturning (drawn "
-            "at theta_max / alpha = 1), faint: the scales of the scan above it that "
-            "overturned too; open circles: scales above the first overturning at "
-            "which the object stood; shaded: the switch band from the first overturning to "
-            "the highest scale at which it stood; the axis spans the capacities "
-            "and uplift level (the scan and switch bands above them run off the top)"
-            if ctx.design == "ida"
-            else "the stripe points (open circles: stood; crosses: overturned, drawn at "
-            "theta_max / alpha = 1)"
-        )
+        + ctx.kind.text["objects_note"]
         + "; dotted: the object's uplift level (g tan alpha of a block, g lambda of another "
         "structure); markers of the records are offset "
         "slightly in x so that none hides another",
     )
+
+
+def _cloud_point(ax, ctx, i, j, offset):
+    """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
+    ds = ctx.ds
+    y = ds["pga"].values[i] / _unit(ctx)
+    over = bool(ds["overturned"].values[i, j] == 1)
+    x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
+    style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
+    ax.plot([x + offset], [y], ls="none", label=_mpl_text(ctx.record_names()[i]), **style)
 
 
 def _shared_legend(fig, ax, n):
@@ -673,7 +690,7 @@ def _stripe_points(ax, ctx, i, j, offset):
 def _ida_scenes(ctx) -> str:
     """What the scenes of an IDA's contact check are, with their PGA range; '' otherwise."""
     ds = ctx.ds
-    if ctx.design != "ida" or "capacity_scale_lower" not in ds:
+    if not ctx.kind.capacities or "capacity_scale_lower" not in ds:
         return ""
     pga = (ds["capacity_scale_lower"] * ds["pga"]).values / _unit(ctx)
     pga = pga[np.isfinite(pga) & np.isfinite(ds["friction_demand"].values)]
@@ -729,11 +746,10 @@ def friction_check(page, ctx):
         page.warning(summary_line(ds, ctx.friction) + _ida_scenes(ctx))
     elif flags is not None:
         page.text("No scene needs more friction than mu or lifts off: the block model holds.")
-    design = {"ida": " (IDA: at the highest scale below the first overturning)"}
     page.table(
         frame,
         "friction_check",
         "The contact check of each scene: the friction demand max |F_h / F_v| (below uplift "
         "it is max |a_g| / g), the lift-offs and the scenes outside the rocking-block model"
-        + design.get(ctx.design, ""),
+        + ctx.kind.text["friction"],
     )

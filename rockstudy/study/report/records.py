@@ -15,23 +15,23 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import xarray as xr
 
 from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
+from ..spec.design_kinds import DESIGN_KINDS, design_kind, kind_of
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from . import objects as ro
 from ._page import (
     _FRAGILITY_NAMES,
     _capacities_as_measured,
     _log_ticks,
-    _mpl_text,
     _names,
     _Page,
     _plt,
+    dataset_of,
     draw_fits,
     object_colors,
     separation_note,
@@ -40,17 +40,23 @@ from ._page import (
 from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
 
-#: Designs this report reads (``ds.attrs["design"]``).
-DESIGNS = ("cloud", "stripes", "ida")
+__all__ = [
+    "DESIGNS",
+    "FREQUENCY_BINS",
+    "GROUP_NAMES",
+    "im_label",
+    "record_report",
+    "REPORT_UNITS",
+    "SECTIONS",
+    "UPLIFT_NOTE",
+]
+
+#: Designs this report reads (``ds.attrs["design"]``): every kind of the registry.
+DESIGNS = tuple(DESIGN_KINDS)
 
 #: The dimensionless group of the pulse in words (the measures' and ratios' labels are those of
 #: the registry, :func:`rockstudy.motions.measures.label`).
 GROUP_NAMES = {"pulse_amplitude_ratio": "pulse amplitude omega_p A_p / a_up [-]"}
-_DESIGN_NAMES = {
-    "cloud": "cloud (records unscaled)",
-    "stripes": "multiple-stripe analysis",
-    "ida": "incremental dynamic analysis (a ladder of rungs, refined by bisection)",
-}
 #: Units of the report's accelerations: as given (a study's scale_to.units) -> as shown.
 REPORT_UNITS = {"g": "g", "m/s^2": "m/s^2", "m/s2": "m/s^2"}
 #: What the page's ratios divide by, said once at its top.
@@ -92,7 +98,7 @@ def _measures(ds) -> list[tuple[str, float | None]]:
 def _fit(ds, im, period, edges, n_boot, by=None):
     """The design's fragility table against ``im``, by size class when there are sizes (or
     ``by`` a coordinate, e.g. ``"structure"`` for named objects)."""
-    fit = rf.ida_fragility if ds.attrs.get("design") == "ida" else rf.stripe_fragility
+    fit = rf.fragility_of(ds)
     by = by if edges is None else "half_diagonal"
     with shown_separation():  # said on the page (separation_note)
         table = fit(ds, im=im, period=period, by=by, bins=edges, n_boot=n_boot)
@@ -109,24 +115,24 @@ def _fit(ds, im, period, edges, n_boot, by=None):
 
 
 def _summary(page, ds, relabel=str):
-    design = ds.attrs.get("design")
+    kind = kind_of(ds)
     rows = {
-        "design": _DESIGN_NAMES.get(design, str(design)),
+        "design": kind.description,
         "records": int(ds.sizes["record"]),
         "structures": int(ds.sizes["structure"]),
         "simulations": int(ds.attrs.get("n_simulations", 0)),
         "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
-    if design in ("stripes", "ida"):
+    if kind.scaled:
         rows["scaling measure"] = relabel(
             im_label(
                 ds.attrs.get("im", "pga"),
                 ds.attrs["im_period"] if np.isfinite(ds.attrs.get("im_period", np.nan)) else None,
             )
         )
-    if design == "stripes":
+    if kind.levels:
         rows["levels"] = int(ds.sizes["level"])
-    if design == "ida":
+    if kind.capacities:
         rows["ladder step (relative)"] = float(ds.attrs.get("step", np.nan))
         rows["bisection tolerance (relative)"] = float(ds.attrs.get("tolerance", np.nan))
         reason = ds["censored_reason"].values
@@ -209,11 +215,7 @@ def _record_fragility_figure(page, fig, ds, edges):
         "Lognormal fragility curves with 90 % pointwise bands of the probability over both "
         "the median and beta"
         + (" by block size" if edges is not None else "")
-        + (
-            ": the fit of the IDA capacities (first overturning levels)"
-            if ds.attrs.get("design") == "ida"
-            else ": the binomial maximum-likelihood fit (Baker 2015)"
-        )
+        + f": {kind_of(ds).text['fit']}"
         + "; dashed: the median lies outside the observed intensities",
     )
 
@@ -302,8 +304,8 @@ def _representatives(ds, k=3) -> list[int]:
 def _responses(page, ctx):
     """IDA curves, stripe points or the cloud, for up to three blocks spanning the sizes (the
     per-object panels' drawing; markers of the records offset in x, survivors hollow)."""
-    ds = ctx.ds
-    design = ds.attrs.get("design")
+    ds, kind = ctx.ds, ctx.kind
+    draw = getattr(ro, kind.draw)
     names = _names(ds)
     picks = _representatives(ds)
     plt = _plt()
@@ -311,12 +313,7 @@ def _responses(page, ctx):
     spread = 0.015 * (np.arange(len(names)) - (len(names) - 1) / 2)
     for ax, j in zip(axes[0], picks, strict=True):
         for i in range(len(names)):
-            if design == "ida":
-                ro._ida_curve(ax, ctx, i, j, spread[i])
-            elif design == "stripes":
-                ro._stripe_points(ax, ctx, i, j, spread[i])
-            else:
-                _cloud_point(ax, ctx, i, j, spread[i])
+            draw(ax, ctx, i, j, spread[i])
         ax.set(
             xlabel="peak rotation / slenderness, theta_max / alpha [-]",
             ylabel=f"PGA of the scaled record [{ctx.units}]",
@@ -324,52 +321,30 @@ def _responses(page, ctx):
             xlim=(-0.04, 1.08),
             title=_structure_title(ds, j),
         )
-        if design == "ida" and (span := ro.ida_axis(ctx, j)) is not None:
+        if kind.capacities and (span := ro.ida_axis(ctx, j)) is not None:
             ax.set_ylim(*span)
         _log_ticks(ax, "y")
     if len(names) <= 15:
         ro._shared_legend(fig, axes[0][0], len(names))
     else:
         fig.tight_layout()
-    what = {
-        "ida": "IDA curves: every simulated scale of each record, in the order of intensity",
-        "stripes": "Stripe points: each record scaled to each level",
-        "cloud": "The cloud: each record unscaled",
-    }.get(design, "Responses")
     page.figure(
         fig,
-        f"{design}_points",
-        f"{what}, for blocks spanning the design's sizes; crosses: overturned (drawn at "
-        "theta_max / alpha = 1)"
-        + (
-            "; the line ends at the first overturning, open circles mark the scales above it "
-            "at which the block was seen to survive, shaded: the switch band; the axis spans "
-            "the capacities and the uplift level (the scan and switch bands above them run "
-            "off the top, the scan's crosses faint)"
-            if design == "ida"
-            else "; open circles: stood"
-        )
+        f"{kind.name}_points",
+        f"{kind.text['points']}, for blocks spanning the design's sizes; crosses: overturned "
+        "(drawn at theta_max / alpha = 1)"
+        + kind.text["points_note"]
         + "; markers of the records offset slightly in x so that none hides another",
     )
 
 
-def _cloud_point(ax, ctx, i, j, offset):
-    """Record i's point of block j in a cloud: hollow circle (stood) or cross (overturned)."""
-    ds = ctx.ds
-    y = ds["pga"].values[i] / ro._unit(ctx)
-    over = bool(ds["overturned"].values[i, j] == 1)
-    x = 1.0 if over else min(ds["max_rotation"].values[i, j] / ds["slenderness"].values[j], 1.0)
-    style = {"marker": "x", "ms": 6} if over else {"marker": "o", "mfc": "none", "ms": 5}
-    ax.plot([x + offset], [y], ls="none", label=_mpl_text(ctx.record_names()[i]), **style)
-
-
 def _per_record(page, ds):
     names = _names(ds)
-    design = ds.attrs.get("design")
+    capacities = kind_of(ds).capacities
     rows = {}
     for i, name in enumerate(names):
         row = {"simulations": None, "failed points": int((ds["status"].values[i] != 0).sum())}
-        if design == "ida":
+        if capacities:
             cap = rf.intensity(ds.isel(record=[i]), "pga", scale="capacity_scale").values[0]
             ratio = rf.intensity(ds.isel(record=[i]), "pga_ratio", scale="capacity_scale")
             ratio = ratio.values[0]
@@ -614,14 +589,14 @@ SECTIONS = [
     ro.object_capacity,
     ro.object_curves,
     _section(
-        lambda ctx: {"ida": "IDA curves", "stripes": "Stripes", "cloud": "Cloud"}[ctx.design],
+        lambda ctx: ctx.kind.text["heading"],
         lambda page, ctx: _responses(page, ctx),
-        when=lambda ctx: not ctx.objects or ctx.design == "cloud",
+        when=lambda ctx: not ctx.objects or not ctx.kind.text["objects"],
     ),
     _section(
         "Switch band",
         lambda page, ctx: _switch_band(page, ctx.ds),
-        when=lambda ctx: ctx.design == "ida",
+        when=lambda ctx: "Switch band" in ctx.kind.sections,
     ),
     _section(
         "Stripes and IDA side by side",
@@ -639,19 +614,30 @@ SECTIONS = [
 
 
 def _compare(page, ctx):
-    ida, stripes = (ctx.ds, ctx.compare) if ctx.design == "ida" else (ctx.compare, ctx.ds)
+    ida, stripes = (ctx.ds, ctx.compare) if ctx.kind.capacities else (ctx.compare, ctx.ds)
     by = "structure" if ctx.objects else None
     _side_by_side(page, ida, stripes, ctx.edges, ctx.n_boot, by)
 
 
+def _comparable(kind, compare) -> bool:
+    """Whether ``compare`` can be shown beside a design of ``kind``: one of the two gives
+    capacities (an IDA), the other the outcomes at levels (stripes)."""
+    other = compare.attrs.get("design")
+    if other not in DESIGN_KINDS:
+        return False
+    pair = (kind, design_kind(other))
+    return any(a.capacities and not b.capacities and b.levels for a, b in (pair, pair[::-1]))
+
+
 def record_report(
-    ds: xr.Dataset,
+    ds,
     out,
     title: str = "Record design",
     description: str = "",
+    *,
     n_boot: int = N_BOOT,
     appendix=None,
-    compare: xr.Dataset | None = None,
+    compare=None,
     units: str = "g",
     max_scale_factor: float = DEFAULT_MAX_SCALE_FACTOR,
     friction=None,
@@ -668,11 +654,13 @@ def record_report(
 
     Parameters
     ----------
-    ds : xarray.Dataset
+    ds : xarray.Dataset or path-like
         From :func:`~rockstudy.study.designs.records.cloud`,
         :func:`~rockstudy.study.designs.records.multiple_stripes` or
         :func:`~rockstudy.study.designs.records.incremental_dynamic_analysis` (``design`` in its
-        attributes), or a result cube of the same layout.
+        attributes), or a result cube of the same layout, or the path of one (read with
+        :func:`~rockstudy.study.running.store.open_result`; as
+        :func:`~rockstudy.study.report.sampled.make_report` takes either).
     out : path-like
         Folder of the page, its PNG figures and CSV tables (created if missing).
     title, description : str
@@ -684,7 +672,7 @@ def record_report(
         intervals and rates without bands.
     appendix : callable, optional
         Called with the page last, to add sections (a study's report adds its study file).
-    compare : xarray.Dataset, optional
+    compare : xarray.Dataset or path-like, optional
         The other of an IDA and a stripes design on the same records and structures: the
         page then shows both fragilities side by side and warns where their median bands
         do not overlap.
@@ -698,7 +686,7 @@ def record_report(
         more than this (> 1; a study's ``design.max_scale_factor``).
     friction : float or array_like, optional
         The friction coefficient mu (one, or one per structure): with ``friction_demand`` in
-        ``ds`` (``contact=True`` of the design functions, or a study's ``friction``) the page
+        ``ds`` (``friction=`` of the design functions, or a study's ``friction``) the page
         counts the scenes whose demand exceeds it or that lift off, with a warning box.
     study : rockstudy.study.spec.Study, optional
         The study the dataset was run from, for the sections that read its settings
@@ -708,15 +696,15 @@ def record_report(
         overturning, with the probability in ``years`` [yr] (default 50) and a deaggregation
         figure (:func:`~rockstudy.study.analysis.risk.object_risk`).
     """
-    design = ds.attrs.get("design")
-    if design not in DESIGNS:
-        raise ValueError(f"ds: attrs['design'] must be one of {DESIGNS}, got {design!r}")
+    ds = dataset_of(ds, "ds")[0]
+    compare = None if compare is None else dataset_of(compare, "compare")[0]
+    kind = kind_of(ds)
     if units not in REPORT_UNITS:
         raise ValueError(f"units: must be one of {list(REPORT_UNITS)}, got {units!r}")
     if not (isinstance(max_scale_factor, (int, float)) and max_scale_factor > 1):
         raise ValueError(f"max_scale_factor: must be a number > 1, got {max_scale_factor!r}")
-    if compare is not None and {design, compare.attrs.get("design")} != {"ida", "stripes"}:
-        kinds = {design, compare.attrs.get("design")}
+    if compare is not None and not _comparable(kind, compare):
+        kinds = {kind.name, compare.attrs.get("design")}
         raise ValueError(
             f"compare: give a stripes design beside an IDA (or the reverse), got {kinds}"
         )

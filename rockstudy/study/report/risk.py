@@ -13,6 +13,8 @@ from ...motions import measures
 from ..analysis.risk import object_risk, records_measure
 from ._page import _log_ticks, _mpl_text, _plt, object_colors
 
+__all__ = ["EXTRAPOLATED_SHARE", "MAX_DEAGGREGATION_LINES", "section"]
+
 
 def section(page, ctx):
     """The annual probability of overturning of each object, when the report has a hazard."""

@@ -17,13 +17,15 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import xarray as xr
 
 from ...constants import STANDARD_GRAVITY, G
 from ...motions import measures
 from ..analysis import sampled as analysis
-from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, binned_outcomes
+from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, N_BOOT, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
 from ..running.store import open_result
+from ..spec.design_kinds import DESIGN_KINDS
 from ..spec.sampler_spec import SAMPLER_LAYOUTS
 from ._page import (
     _FRAGILITY_NAMES,
@@ -32,10 +34,13 @@ from ._page import (
     _Page,
     _plt,
     _shown,
+    dataset_of,
     draw_fits,
     separation_note,
     shown_separation,
 )
+
+__all__ = ["make_report", "SLENDER_LIMIT"]
 
 
 def _summary(page, ds):
@@ -171,7 +176,7 @@ def _fragility_view(page, ax, d, bins, im, band, label):
     sub = d.isel(sample=np.flatnonzero(_middle_third(d[band].values)))
     try:
         with shown_separation():  # said on the page (separation_note)
-            t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=100)
+            t = analysis.fragility(sub, im, by="half_diagonal", bins=bins, n_boot=N_BOOT)
     except ValueError as err:  # no block size saw both outcomes
         page.text(f"Fragility against {im}: {err}")
         return None
@@ -728,17 +733,21 @@ _SECTIONS = (
 def make_report(result, out=None, verify: bool = True) -> Path:
     """Write the report of a result cube into ``out`` (default: RESULT's name + '_report').
 
-    ``verify=False`` reads the cube without checking it against the checksums of its run
-    (see :func:`~rockstudy.study.running.store.open_result`): a cube whose metadata was edited."""
-    result = Path(result)
-    out = Path(out) if out is not None else result.with_name(result.stem + "_report")
-    ds = open_result(result, verify=verify).load()  # a missing cube leaves no report folder
+    ``result`` is the path of the cube or the cube itself, an :class:`xarray.Dataset` (as
+    :func:`~rockstudy.study.report.records.record_report` takes either; then ``out`` is
+    required). ``verify=False`` reads a cube's path without checking it against the
+    checksums of its run (see :func:`~rockstudy.study.running.store.open_result`): a cube
+    whose metadata was edited."""
+    if isinstance(result, xr.Dataset) and out is None:
+        raise ValueError("out: give the report's folder when result is a Dataset")
+    ds, name = dataset_of(result, "result", verify)
+    out = Path(out) if out is not None else Path(result).with_name(name + "_report")
     out.mkdir(parents=True, exist_ok=True)
-    if ds.attrs.get("design") in ("cloud", "stripes", "ida"):  # a record design
+    if ds.attrs.get("design") in DESIGN_KINDS:  # a record design
         from .records import record_report
 
         if "study" not in ds.attrs:  # a design run from Python and saved: no study file
-            return record_report(ds, out, title=result.stem)
+            return record_report(ds, out, title=name or "Record design")
         study = analysis.study_of(ds)
 
         def study_section(page):

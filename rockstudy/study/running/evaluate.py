@@ -21,6 +21,16 @@ from ..designs import record_rows
 from ..spec.feasibility import record_path
 from ..spec.schema import Study
 
+__all__ = [
+    "engine_outputs",
+    "evaluate_chunk",
+    "OUTPUTS",
+    "resolve_file",
+    "STATUS_FAILED",
+    "STATUS_OK",
+    "STATUS_PENDING",
+]
+
 STATUS_PENDING, STATUS_OK, STATUS_FAILED = 0, 1, 2
 
 

@@ -13,6 +13,8 @@ import xarray as xr
 
 from ._files import StoreError
 
+__all__ = ["check_export_target", "export_netcdf"]
+
 _INT32 = np.iinfo(np.int32)
 
 

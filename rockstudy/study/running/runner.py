@@ -29,6 +29,18 @@ from . import store
 from ._warmup import prime_study
 from .evaluate import STATUS_FAILED, evaluate_chunk
 
+__all__ = [
+    "error_summary",
+    "FailedSamplesError",
+    "MAX_SCHEDULER_FILE_BYTES",
+    "MAX_SCRIPT_BYTES",
+    "out_of_memory",
+    "ResourceError",
+    "run_study",
+    "RunReport",
+    "SchedulerError",
+]
+
 
 @dataclass
 class RunReport:

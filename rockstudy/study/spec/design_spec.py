@@ -12,6 +12,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
+from .design_kinds import DESIGN_KINDS, design_kind
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR
 from .ida_options import IdaOptionError, IdaOptions
 from .motion_spec import ScaleIM, _check_period
@@ -31,7 +32,7 @@ class DesignSpec(_Model):
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio."""
 
-    kind: Literal["cloud", "stripes", "ida"]
+    kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
     damping: _Damping = 0.05
     im: ScaleIM | None = None
@@ -54,7 +55,7 @@ class DesignSpec(_Model):
                 "is no longer an option: the IDA climbs a ladder of rungs; give step (the "
                 "relative step between rungs, default 0.01) instead",
             )
-        if self.kind != "ida":
+        if not design_kind(self.kind).capacities:
             for name in ida:
                 if getattr(self, name) is not None:
                     raise FieldError(name, f"applies to kind = 'ida' only, not {self.kind!r}")

@@ -16,6 +16,18 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from scipy import stats
 
+__all__ = [
+    "Choice",
+    "Distribution",
+    "Grid",
+    "LogNormal",
+    "LogUniform",
+    "Normal",
+    "Triangular",
+    "TruncNormal",
+    "Uniform",
+]
+
 #: The extreme probabilities a sampler can draw (Monte Carlo draws in [0, 1), Sobol' is clipped
 #: below 1): the values there must be finite.
 _U_EXTREMES = np.array([2.0**-53, 0.5, 1.0 - 2.0**-53])

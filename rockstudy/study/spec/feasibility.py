@@ -19,7 +19,27 @@ from ...motions import measures
 from ...motions.suites import read_pair, suite_pairs, units_refusal
 from ...risk import suite_off_curve
 from ...structures.block import uplift_acceleration_block
+from .design_kinds import design_kind
 from .structures import KINDS
+
+__all__ = [
+    "DEFAULT_MAX_SCALE_FACTOR",
+    "design_bytes",
+    "draw_span",
+    "free_fall_scale",
+    "hazard_notes",
+    "LARGE_OBJECT",
+    "MAX_CHUNK_ROWS",
+    "notes",
+    "problems",
+    "read_problems",
+    "record_pairs",
+    "record_path",
+    "size_notes",
+    "UPLIFT_NOTE_GAP",
+    "uplift_notes",
+    "vertical_refusal",
+]
 
 #: Most rows of one chunk (one dask task): 10^7 rows hold about 3 GB.
 MAX_CHUNK_ROWS = 10**7
@@ -209,8 +229,9 @@ def _scaling_notes(study, base_dir) -> list[str]:
     a block, g lambda of another structure, eq. 10 of [003]), that nothing can rock (no
     structure leaves rest)."""
     de = study.design
-    cloud = de is not None and de.kind == "cloud"  # the records as recorded: scale 1
-    if not cloud and (study.motion.target() is None or (de is not None and de.kind != "stripes")):
+    kind = None if de is None else design_kind(de.kind)
+    cloud = kind is not None and not kind.scaled  # the records as recorded: scale 1
+    if not cloud and (study.motion.target() is None or (kind is not None and not kind.levels)):
         return []
     limit = DEFAULT_MAX_SCALE_FACTOR if de is None else de.max_scale_factor
     found, top_pga, horizontal = [], 0.0, True
@@ -345,7 +366,7 @@ def _largest_scaled_peak(study, rec) -> tuple[str, float] | None:
     if rec.vertical is not None:
         peak = max(peak, float(np.max(np.abs(rec.vertical))))
     uplift = study.uplift_span()[1]
-    if de is not None and de.kind == "ida":  # the top of its ladder, PGA = max_pga_ratio a_up
+    if de is not None and design_kind(de.kind).capacities:  # its ladder's top: max_pga_ratio a_up
         top = de.ida_options()["max_pga_ratio"] * uplift
         return "design.max_pga_ratio", top * peak / rec.peak if rec.peak > 0 else 0.0
     if mo.scale is not None:
@@ -401,7 +422,7 @@ def vertical_refusal() -> str | None:
 def _scaled_measures(study) -> list[tuple]:
     """(im, period, damping) of every measure a study scales its records by."""
     target, de = study.motion.target(), study.design
-    if de is not None and de.kind == "ida":  # brackets by PGA, reports in im
+    if de is not None and design_kind(de.kind).capacities:  # brackets by PGA, reports in im
         return [("pga", None, de.damping), (de.ida_options()["im"], de.period, de.damping)]
     return [] if target is None else [(target.im, target.period, target.damping)]
 

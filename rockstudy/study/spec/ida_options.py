@@ -10,6 +10,8 @@ from typing import ClassVar
 
 import numpy as np
 
+__all__ = ["IdaOptionError", "IdaOptions"]
+
 
 @dataclass(frozen=True)
 class IdaOptions:

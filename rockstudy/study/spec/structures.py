@@ -38,6 +38,18 @@ from ...structures import (
 )
 from ...structures.block import HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 
+__all__ = [
+    "check_all",
+    "check_object",
+    "FieldError",
+    "FieldErrors",
+    "FieldRange",
+    "KINDS",
+    "object_fields",
+    "SAMPLED_KINDS",
+    "StructureKind",
+]
+
 
 class FieldError(ValueError):
     """A problem of one field of a table, raised by a table's checks (so the message can

@@ -23,6 +23,7 @@ from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
 from ...motions.pulses import PERIOD_RANGE
 from ...structures.block import uplift_acceleration_block
+from .design_kinds import design_kind
 from .design_spec import DesignSpec
 from .distributions import Distribution
 from .feasibility import draw_span as _draw_span
@@ -163,11 +164,11 @@ class Study(_Model):
                 f"does not apply to a [design] (kind = {de.kind!r}); "
                 + (
                     "give motion.scale_to with a grid of levels"
-                    if de.kind == "stripes"
+                    if design_kind(de.kind).levels
                     else "remove it"
                 ),
             )
-        if de.kind == "stripes":
+        if design_kind(de.kind).levels:
             if mo.scale_to is not None and mo.scale_to.damping != de.damping:
                 raise FieldError(
                     "motion.scale_to.damping",
@@ -185,7 +186,11 @@ class Study(_Model):
             raise FieldError(
                 "motion.scale_to",
                 f"does not apply to a {de.kind!r} design"
-                + ("; give the IDA's measure as design.im" if de.kind == "ida" else ""),
+                + (
+                    "; give the IDA's measure as design.im"
+                    if design_kind(de.kind).capacities
+                    else ""
+                ),
             )
         if self.sampler.replicates > 1:
             raise FieldError("sampler.replicates", "does not apply to a [design]")
@@ -364,7 +369,7 @@ class Study(_Model):
 
     def levels(self) -> int:
         """Intensity levels of each record and structure of a design (1 but for stripes)."""
-        if self.design is not None and self.design.kind == "stripes":
+        if self.design is not None and design_kind(self.design.kind).levels:
             return self.motion.scale_to.value.size()
         return 1
 
