@@ -350,6 +350,15 @@ _RUNNERS = {
 }
 
 
+def check_friction(value) -> float:
+    """The friction coefficient mu in (0, :data:`MAX_FRICTION`] as a float, or a ValueError
+    naming ``friction``."""
+    value = _validate.number("friction", value)
+    if not (math.isfinite(value) and 0.0 < value <= MAX_FRICTION):
+        raise ValueError(f"friction must lie in (0, {MAX_FRICTION:g}], got {value!r}")
+    return value
+
+
 def simulate(
     structure,
     motion: Motion,

@@ -57,7 +57,6 @@ __all__ = [
     "scale_targets",
     "set_probe",
     "target",
-    "UNIT_ALIASES",
     "unregister_measure",
 ]
 

@@ -24,7 +24,6 @@ from ...motions import measures
 from ..analysis import sampled as analysis
 from ..analysis.fragility_fit import BAND_COLUMNS, LACK_OF_FIT_LEVEL, N_BOOT, binned_outcomes
 from ..designs.sampling import VARIABLES, target_attributes
-from ..running.store import open_result
 from ..spec.design_kinds import DESIGN_KINDS
 from ..spec.sampler_spec import SAMPLER_LAYOUTS
 from ._page import (

@@ -60,10 +60,10 @@ from .messages import _format_errors
 from .motion_spec import (
     MAX_SCALE,
     MIN_SCALE,
+    RECORD_UNITS,
     HVPair,
     MotionSpec,
     PulseSpec,
-    RECORD_UNITS,
     RecordSpec,
     ScaleIM,
     ScaleTo,
