@@ -17,6 +17,16 @@ from .result import RockingResult
 from .slide_rock import REGIMES
 from .slide_rock_reference import simulate_contact_reference
 
+__all__ = [
+    "CONTACT_METHODS",
+    "SLIDING",
+    "SOLVER",
+    "friction_pair",
+    "refuse_options",
+    "slides_only",
+    "simulate_contact",
+]
+
 #: The methods that run the contact model (its scipy reference is, for now, its only solver).
 CONTACT_METHODS = ("nonlinear", "scipy", "auto")
 

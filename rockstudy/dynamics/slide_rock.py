@@ -43,6 +43,27 @@ import math
 
 from ..constants import G
 
+__all__ = [
+    "REGIMES",
+    "inertia_ratio",
+    "sliding_acceleration",
+    "rocking_acceleration",
+    "contact_forces",
+    "slide_rock_denominator",
+    "slide_rock_accelerations",
+    "uplift_force_ratio",
+    "slide_rock_threshold",
+    "leaves_rest",
+    "initiation_regime",
+    "corner_offset",
+    "corner_velocity",
+    "apply_impulse",
+    "corner_impact",
+    "rocking_impact",
+    "centre_velocity",
+    "kinetic_energy",
+]
+
 #: The regimes, in the order of ``regime`` codes.
 REGIMES = ("rest", "slide", "rock", "slide_rock", "flight")
 REST, SLIDE, ROCK, SLIDE_ROCK, FLIGHT = range(5)

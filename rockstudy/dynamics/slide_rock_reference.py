@@ -27,6 +27,11 @@ from . import slide_rock as sr
 from .constants import REST_FRACTION
 from .reference import _grids, _ground, _uplift_time
 
+__all__ = [
+    "HOP_POINTS",
+    "simulate_contact_reference",
+]
+
 
 class _Scene:
     """The block, the friction, the ground and the run's controls."""
