@@ -46,6 +46,10 @@ class _Scene:
         self.rtol = rtol
         self.t_end = math.inf if t_max is None else float(t_max)
         self.omega_rest = REST_FRACTION * self.p * alpha
+        #: the slip speed the solver resolves [m/s]: rtol of the largest speed the ground can
+        #: give (its peak acceleration over the motion's duration)
+        peak = max(abs(float(self.acc(t))) for t in self.grid[:: max(1, self.grid.size // 4097)])
+        self.slip_rest = rtol * peak * self.dur
 
     def ground(self, t):
         """(u_h'', u_v'') [m/s^2] at t (0 after the motion)."""
@@ -314,9 +318,36 @@ def _leave_rest(scene, log, st):
     return True
 
 
+def _slide_to_rest(scene, log, st):
+    """A slide on still ground (after the motion) ends in closed form: the slip velocity v
+    falls at mu_k g, so the block stops after ``|v| / (mu_k g)`` having slid ``v |v| /
+    (2 mu_k g)``, friction taking its kinetic energy v^2 / 2 [J/kg] (Coulomb's law with N =
+    m g). A slip speed below the solver's resolution (:attr:`_Scene.slip_rest`) is taken as
+    0: it would carry a slide of ``v^2 / (2 mu_k g)`` made of the integration's error alone.
+    True where it stops before the end of the run (st is then at rest), else False."""
+    v = float(st.y[2])
+    if abs(v) <= scene.slip_rest:
+        v = 0.0
+    elif scene.kinetic == 0.0:  # a frictionless base: it slides on to the end of the run
+        return False
+    t_stop = abs(v) / (scene.kinetic * G) if v != 0.0 else 0.0
+    if st.t + t_stop > scene.t_end:
+        return False
+    log.spent(sr.SLIDE, st.t, st.t + t_stop)
+    st.t += t_stop
+    st.y[0] += 0.5 * v * t_stop
+    st.y[5] += 0.5 * v * v
+    st.y[1:4] = 0.0
+    st.regime = sr.REST
+    log.row(st.t, 0.0, 0.0, float(st.y[0]))
+    return True
+
+
 def _contact_phase(scene, log, st):
     """One contact phase (slide, rock or slide-rock) from st to its first event or the next
     stop; returns "end" (the run's end reached), "fall" or "on"."""
+    if st.regime == sr.SLIDE and st.t >= scene.dur and _slide_to_rest(scene, log, st):
+        return "on"
     stop = scene.stop(st.t)
     if st.t >= stop:
         return "end"
