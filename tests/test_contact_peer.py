@@ -1,5 +1,5 @@
 """The contact model's pure sliding (mu < tan alpha) against a peer library: pySLAMMER's rigid
-(Newmark) sliding-block analysis, which its authors verified against USGS SLAMMER.
+(Newmark) sliding-block analysis (pySLAMMER is based on the USGS tool SLAMMER).
 
 Where the definitions agree. pySLAMMER's rigid analysis is one-way: the block slips only in
 the direction of positive ground acceleration, at u_rel'' = a_g - k_y g, and never back. A
