@@ -264,12 +264,14 @@ outputs = ["max_rotation", "overturned"]
 """
 
 
-def test_a_study_with_model_auto_stores_the_slide_outputs(tmp_path):
+def test_a_study_with_model_auto_stores_the_slide_outputs(tmp_path, capsys):
     """[run] model = "auto" with friction: every scene's row equals simulate_batch's under
-    the same model, the slide outputs stored with their units."""
+    the same model, the slide outputs stored with their units; the end of the run warns of
+    no scene outside the model (the contact model ran them)."""
     import xarray as xr
     from distributed import Client
 
+    from rockstudy.cli import _contact_warning
     from rockstudy.study import run_study
 
     study = validate_text(STUDY.format(friction="friction = 0.2", model="auto"))
@@ -293,6 +295,8 @@ def test_a_study_with_model_auto_stores_the_slide_outputs(tmp_path):
     for name in ("max_rotation", "max_slide", "residual_slide", "regime"):
         np.testing.assert_array_equal(ds[name].values, expected[name], err_msg=name)
     assert (expected["model"] == 3).any()  # some scene needed the contact model
+    _contact_warning(study, cube)
+    assert "outside" not in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -316,3 +320,119 @@ def test_a_study_refuses_slide_outputs_under_the_rocking_model():
     with pytest.raises(ValueError) as err:
         validate_text(text)
     assert "run.outputs" in str(err.value) and "contact model" in str(err.value)
+
+
+# ---------------------------------------------------------------- a record design
+
+
+def _write_at2(path, record):
+    """A PEER .AT2 file of ``record`` (in g)."""
+    values = record.acceleration / G
+    lines = [
+        "PEER STRONG MOTION DATABASE RECORD",
+        "synthetic near-fault record for the contact tests",
+        "ACCELERATION TIME SERIES IN UNITS OF G",
+        f"NPTS= {values.size}, DT= {record.dt:.4f} SEC",
+    ]
+    lines += [" ".join(f"{v:.9e}" for v in values[i : i + 5]) for i in range(0, values.size, 5)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+OBJECTS_STUDY = """
+name = "museum_contact"
+seed = 1
+friction = 0.8
+[structure]
+kind = "objects"
+file = "objects.csv"
+[motion]
+kind = "record"
+files = "{folder}"
+[design]
+kind = "cloud"
+slide_limits = [0.01, 0.05]
+[run]
+model = "auto"
+"""
+#: A stocky bronze on a smooth base (mu 0.2 < tan 0.35: it slides) and a slender statue on
+#: the study's mu 0.8 (it rocks).
+OBJECTS_CSV = """name,half_diagonal,slenderness,friction
+Bronze,0.5,0.35,0.2
+Statue,1.0,0.15,
+"""
+
+
+def test_a_cloud_of_objects_under_auto_stores_each_objects_slide(tmp_path):
+    """[run] model = "auto" in a cloud design with a friction column: each (record, object)
+    point is simulate(friction=the object's mu)'s answer where simulate's friction demand
+    exceeds it, Housner's (no slip) elsewhere; max_slide stored in metres."""
+    from distributed import Client
+
+    from rockstudy.motions import load_suite, synthetic_near_fault
+    from rockstudy.study import load_study, run_study
+    from rockstudy.study.running.store import open_result
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for i, tp in enumerate((0.4, 0.9)):
+        rec = synthetic_near_fault(pulse_period=tp, pga=2.5, seed=40 + i, duration=3.0)
+        _write_at2(folder / f"r{i}.AT2", rec)
+    (tmp_path / "objects.csv").write_text(OBJECTS_CSV)
+    path = tmp_path / "museum.toml"
+    path.write_text(OBJECTS_STUDY.format(folder=folder))
+    study = load_study(path)
+    assert study.design.slide_limits == [0.01, 0.05]
+    cube = tmp_path / "cube.zarr"
+    with Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as c:
+        run_study(study, cube, client=c, base_dir=tmp_path, progress=False, netcdf=False)
+    ds = open_result(cube).load()
+    assert ds["max_slide"].attrs["units"] == "m"
+    records = load_suite(str(folder))
+    blocks = {"Bronze": (0.5, 0.35, 0.2), "Statue": (1.0, 0.15, 0.8)}
+    slid = 0
+    for r, rec in enumerate(records):
+        for s, (name, (R, alpha, mu)) in enumerate(blocks.items()):
+            point = ds.isel(record=r, structure=s)
+            block = rs.Block(half_diagonal=R, slenderness=alpha)
+            housner = rs.simulate(block, rec)
+            if housner.friction_demand > mu or housner.lift_off:
+                expected = rs.simulate(block, rec, friction=mu)
+                assert int(point["model"]) == 3, (r, name)
+                assert float(point["max_slide"]) == pytest.approx(expected.max_slide, rel=1e-12)
+                assert int(point["regime"]) >= 1
+                slid += expected.max_slide > 0
+            else:
+                assert int(point["model"]) != 3, (r, name)
+                assert float(point["max_slide"]) == 0.0
+                assert float(point["max_rotation"]) == pytest.approx(housner.max_rotation, rel=1e-6)
+    assert slid >= 2  # the bronze slid under both records
+
+
+@pytest.mark.parametrize(
+    "old, new, field, words",
+    [
+        ("[0.01, 0.05]", "[0.05, 0.01]", "design.slide_limits", "increasing"),
+        ("[0.01, 0.05]", "[0.0, 0.05]", "design.slide_limits", "must be > 0"),
+        ('"auto"', '"rocking"', "design.slide_limits", "contact model"),
+        ('"cloud"', '"ida"', "run.model", "IDA"),
+        ("friction = 0.8", "", "run.model", "needs the friction coefficient"),
+    ],
+)
+def test_a_design_refuses_bad_slide_limits_and_the_contact_model_in_an_ida(
+    tmp_path, old, new, field, words
+):
+    """slide_limits: > 0 m, increasing, with the contact model; the contact model: not in an
+    IDA, and with every object's friction (the statue has none without the study's)."""
+    folder = tmp_path / "records"
+    folder.mkdir()
+    rec = rs.motions.synthetic_near_fault(pulse_period=0.5, pga=2.5, seed=1, duration=2.0)
+    _write_at2(folder / "r0.AT2", rec)
+    (tmp_path / "objects.csv").write_text(OBJECTS_CSV)
+    text = OBJECTS_STUDY.format(folder=folder).replace(old, new)
+    path = tmp_path / "museum.toml"
+    path.write_text(text)
+    from rockstudy.study import load_study
+
+    with pytest.raises(ValueError) as err:
+        load_study(path)
+    assert field in str(err.value) and words in str(err.value), str(err.value)

@@ -26,6 +26,7 @@ import numpy as np
 import xarray as xr
 
 from ..._warnings import UpliftWarning
+from ...dynamics import outputs as _outputs
 from ...motions import measures
 from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
@@ -162,6 +163,10 @@ def outputs(study) -> dict:
     if study.friction_coefficients() is not None:  # the contact check (spec.Study.friction)
         for name in ("friction_demand", "lift_off"):
             out[name] = (*CONTACT_VARIABLES[name], None)
+    if study.run.model != "rocking":  # the contact model's (rockstudy.dynamics.outputs)
+        for name in rd.MODEL_KEYS:
+            o = _outputs.OUTPUTS[name]
+            out[name] = (o.long_name, o.units, o.store_dtype, o.fill, None)
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
         "1",
@@ -258,8 +263,9 @@ def empty_rows(study, n: int) -> dict:
     }
 
 
-def _run_design(study, record, structures, levels):
-    """The design function of :mod:`.records` on one record."""
+def _run_design(study, record, structures, levels, structure_ids):
+    """The design function of :mod:`.records` on one record (``structure_ids``: the
+    structures' indices in the study, for each object's friction)."""
     de, run = study.design, study.run
     common = dict(
         periods=de.periods,
@@ -269,6 +275,9 @@ def _run_design(study, record, structures, levels):
         max_steps=run.max_steps,
     )
     common["contact"] = study.friction_coefficients() is not None
+    if run.model != "rocking":  # spec.Study._contact_model: every structure has its mu
+        mu = study.friction_coefficients()
+        common.update(model=run.model, friction=mu[structure_ids] if mu.size > 1 else mu[0])
     if de.kind == "cloud":
         return rd.cloud([record], structures, **common)
     if de.kind == "stripes":
@@ -297,7 +306,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "uplift_acceleration": uplift_column(study, cols, first),
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
-        ds = _run_design(study, rec, structures, levels_all[lev_ids])
+        ds = _run_design(study, rec, structures, levels_all[lev_ids], cols["structure"][first])
         _fill(result, outs, ds, rows, st_pos, lev_pos, width)
     return result
 

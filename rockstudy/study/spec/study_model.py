@@ -113,8 +113,9 @@ class Study(_Model):
     @model_validator(mode="after")
     def _contact_model(self):
         """``run.model = "contact"`` or ``"auto"`` needs the friction of every scene (the
-        study's ``friction``, or each object's), and runs in a Monte Carlo study (a record
-        design runs Housner's model with the friction check)."""
+        study's ``friction``, or each object's), and runs in a Monte Carlo study or a cloud
+        or stripes design (an IDA runs Housner's model with the friction check);
+        ``design.slide_limits`` needs it."""
         model = self.run.model
         if model == "rocking":
             if self.design is not None and self.design.slide_limits:
@@ -131,12 +132,11 @@ class Study(_Model):
                 f"{model!r} runs the contact model, which needs the friction coefficient mu of "
                 "every scene: give friction (top level, or per object), or model = 'rocking'",
             )
-        if self.design is not None:
+        if self.design is not None and self.design.kind == "ida":
             raise FieldError(
                 "run.model",
-                f"{model!r} is not available in a record design ([design] kind = "
-                f"{self.design.kind!r}) yet: record designs run Housner's model with the "
-                "friction check; give model = 'rocking' or run a Monte Carlo study",
+                f"{model!r} is not available in an IDA yet (its ladder runs Housner's model "
+                "with the friction check): give model = 'rocking', or a cloud or stripes design",
             )
         return self
 
