@@ -436,3 +436,25 @@ def test_a_design_refuses_bad_slide_limits_and_the_contact_model_in_an_ida(
     with pytest.raises(ValueError) as err:
         load_study(path)
     assert field in str(err.value) and words in str(err.value), str(err.value)
+
+
+def test_stripes_of_a_stocky_block_slide_as_newmarks_block_at_each_level():
+    """multiple_stripes(..., friction=, model="contact") under a rectangular pulse scaled to
+    each PGA level: the stocky block never rotates, and slides the Newmark closed form of
+    that level (mu 0.1 for the first block, 0.15 for the second)."""
+    dur, levels, mu = 0.3, np.array([0.3, 0.6]) * G, np.array([0.1, 0.15])
+    ds = rs.study.multiple_stripes(
+        [step(G, dur)],
+        {"half_diagonal": [0.8, 0.6], "slenderness": [0.35, 0.4]},
+        levels,
+        im="pga",
+        friction=mu,
+        model="contact",
+    )
+    a = levels[None, :]
+    newmark = (a - mu[:, None] * G) * a * dur**2 / (2 * mu[:, None] * G)
+    np.testing.assert_allclose(ds["max_slide"].isel(record=0).values, newmark, rtol=1e-9)
+    assert np.all(ds["max_rotation"].values == 0.0) and np.all(ds["model"].values == 3)
+    assert ds["max_slide"].dims == ("record", "structure", "level")
+    with pytest.raises(ValueError, match="needs friction="):
+        rs.study.cloud([step(G, dur)], {"half_diagonal": 0.8, "slenderness": 0.35}, model="auto")
