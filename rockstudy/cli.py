@@ -373,9 +373,11 @@ def _run(args) -> int:
 
 
 def _contact_warning(study, path) -> None:
-    """A warning on stderr when scenes lie outside the block model (a study's friction)."""
+    """A warning on stderr when scenes lie outside the block model (a study's friction,
+    under Housner's model: the contact model runs them under ``run.model`` "contact" or
+    "auto")."""
     mu = study.friction_coefficients()
-    if mu is None:
+    if mu is None or study.run.model != "rocking":
         return
     from .study.analysis.contact import summary_line
     from .study.running.store import open_result

@@ -17,13 +17,19 @@ from ..motions import Record
 from ..motions import _kernels as mk
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
-from . import _auto, _linear, _linear_record, _rocking, conditioning, outputs
+from . import _auto, _linear, _linear_record, _rocking, conditioning, contact_model, outputs
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
+from .simulate import MAX_FRICTION
 
 __all__ = ["CONDITIONING_OUTPUTS", "CONTACT_OUTPUTS", "OUTPUTS", "PulseName", "simulate_batch"]
 
 PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
+#: The models :func:`simulate_batch` runs a scene under (its ``model``): Housner's no-slip
+#: block, the planar contact model, or Housner's with the contact model where it fails.
+CONTACT_CHOICES = ("rocking", "contact", "auto")
+#: The ``model`` output of a row the contact model answered (0-2: :mod:`._auto`).
+MODEL_CONTACT = 3
 #: batch method -> kernel model (None: chosen row by row); what each method can run is in
 #: :data:`rockstudy.dynamics.methods.METHODS`
 _MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR, "auto": None}
@@ -40,6 +46,9 @@ CONTACT_OUTPUTS = outputs.names("contact")
 #: Returned only when ``outputs`` names it: every row is run again with its amplitude times
 #: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
 CONDITIONING_OUTPUTS = outputs.names("conditioning")
+#: Returned by default with ``model="contact"`` or ``"auto"`` (and only then): the slip and
+#: the regimes, by the contact model (:func:`.contact_model.contact_outputs`).
+SLIDE_OUTPUTS = outputs.names("contact_model")
 # (trig-only, one thread) -> batch kernel: on one thread (a study's workers) the serial
 # variants, which compile without the parallel loop's cost
 _BATCH_KERNELS = {
@@ -206,6 +215,8 @@ def simulate_batch(
     max_steps: int = MAX_STEPS,
     outputs=None,
     as_dataset: bool = False,
+    friction=None,
+    model: Literal["rocking", "contact", "auto"] = "rocking",
 ):
     """Rock many blocks through many pulses (or scaled copies of one record) in one call.
 
@@ -280,8 +291,36 @@ def simulate_batch(
         Return an :class:`xarray.Dataset` on a ``scene`` dimension instead: the inputs
         (``frequency_parameter`` p [rad/s], ``critical_rotation`` or ``slenderness`` under
         the name it was given, ``restitution``, and ``amplitude``, ``period``, ``cycles`` of
-        the pulse or the record's ``scale``; with ``half_diagonal`` if given) as coordinates
-        with units, the outputs as variables.
+        the pulse or the record's ``scale``; with ``half_diagonal`` if given; with
+        ``friction``, ``friction_static`` and ``friction_kinetic``) as coordinates with units,
+        the outputs as variables.
+    friction : float, array_like or tuple, optional
+        The friction coefficient of the base, in (0, 10] (:data:`.simulate.MAX_FRICTION`):
+        mu (a scalar or one per row: mu_s = mu_k), or a tuple (mu_s, mu_k) (each a scalar or
+        one per row) with mu_s >= mu_k, as :func:`rockstudy.simulate`'s ``friction``.
+    model : {"rocking", "contact", "auto"}
+        The model of every scene. ``"rocking"`` (default): Housner's no-slip model, as
+        without ``friction``; with ``friction``, ``friction_demand`` and ``lift_off`` (the
+        friction check) are returned by default too. ``"contact"`` (needs ``friction``): the
+        planar contact model (:func:`rockstudy.dynamics.contact_model.contact_outputs`: the
+        exact sliding kernel where the block cannot rock, mu_s < tan(alpha) under a record,
+        else the ``solve_ivp`` reference at ``rtol``; milliseconds to seconds a row, one row
+        at a time) on every row; ``method`` "linear" is refused. ``"auto"`` (needs
+        ``friction``): Housner's model with the friction check on every row, then the
+        contact model on the rows whose friction demand exceeded mu_s or that lifted off;
+        the other rows keep Housner's answer, which the contact model would give too (no
+        slip, no flight). The output ``model`` says which answered each row (3: the contact
+        model). With ``"contact"`` or ``"auto"`` the outputs also hold (by default)
+        ``max_slide`` [m], ``residual_slide`` [m], ``first_slip_time`` [s], ``time_slide``,
+        ``time_slide_rock``, ``time_flight`` [s] and ``regime`` (the most involved regime
+        entered: 0 rest, 1 slide, 2 rock, 3 slide-rock, 4 flight), as
+        :func:`rockstudy.simulate` with ``friction`` names them; ``lift_off`` is the contact
+        model's (the block flew) on its rows. Rows the contact model answered have
+        ``steps`` -1 and ``peak_time`` NaN (it counts no steps and times no peak), and
+        ``status`` 1 where its reference stopped at its cap of phases. Rows Housner's model
+        answered have no slip (0; NaN, with ``first_slip_time``, where the block overturned:
+        the fall's slip lies outside that model) and ``regime`` 0 or 2. ``conditioning`` is
+        refused with these models.
 
     Returns
     -------
@@ -297,15 +336,16 @@ def simulate_batch(
         integration, 1 linear, 2 nonlinear: what each row ran); only those of ``outputs`` (and
         ``status``) if given.
     """
-    wanted = _requested_outputs(outputs)
+    _check_model(model, friction, method)
+    wanted = _requested_outputs(outputs, model, friction is not None)
     method_for(
         method,
         batch=True,
         record=record is not None,
         vertical=getattr(record, "vertical", None) is not None,
-        friction_demand=bool(set(CONTACT_OUTPUTS) & set(wanted)),
+        friction_demand=bool(set(CONTACT_OUTPUTS) & set(wanted)) or model != "rocking",
     )
-    model = _MODELS[method]
+    kernel_model = _MODELS[method]
     theta_cr = _critical_rotation(critical_rotation, slenderness)
     rtol = _validate.rtol(rtol)
     max_steps = _validate.max_steps(max_steps)
@@ -322,7 +362,9 @@ def simulate_batch(
         period=period,
         scale=scale,
         cycles=cycles,
+        **_friction_arguments(friction),
     )
+    mu = None if friction is None else _friction_columns(friction, n)
     R, p, alpha, eta = _blocks(half_diagonal, frequency_parameter, theta_cr, restitution, n)
     kind, mp, times, samples, vsamples = _motions(
         pulse, record, scale, amplitude, period, cycles, n
@@ -333,49 +375,167 @@ def simulate_batch(
     linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
 
     def solve(rows):
-        if model is not None:
-            return _run(rows, np.arange(n), model, rtol, max_steps), np.full(
-                n, _CODES[model], np.int8
+        if kernel_model is not None:
+            return _run(rows, np.arange(n), kernel_model, rtol, max_steps), np.full(
+                n, _CODES[kernel_model], np.int8
             )
         return _auto_rows(
             rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
         )
 
     out, codes = solve(rows)
-    result = _outputs(out, codes, wanted)
+    cols = _columns(out, codes)
     if "conditioning" in wanted:
-        result["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
-    if set(CONTACT_OUTPUTS) & set(wanted):
-        _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps)
+        cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
+    if _needs_check(wanted, model):
+        _add_contact_outputs(cols, rows, codes, method, rtol, max_steps)
+    if model != "rocking":
+        motions = _RowMotions(pulse, record, mp, amplitude, period, cycles, n)
+        _add_contact_model(cols, rows, mu, model, motions, rtol)
+    result = {name: cols[name] for name in wanted}
     if not as_dataset:
         return result
     inputs = {"frequency_parameter": p, theta_cr[0]: alpha, "restitution": eta}
     if half_diagonal is not None:
         inputs["half_diagonal"] = R
+    if mu is not None:
+        inputs.update(friction_static=mu[0], friction_kinetic=mu[1])
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
     return _as_dataset(
         result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
     )
 
 
-def _outputs(out, codes, wanted) -> dict:
-    """The kernels' rows ``out`` (:data:`.outputs.KERNEL_ROW`) and the model ``codes`` as the
-    output arrays named in ``wanted`` (the contact outputs apart)."""
-    cols = {name: np.ascontiguousarray(out[name]) for name in out.dtype.names}
-    cols["model"] = codes
-    return {name: cols[name] for name in wanted if name in cols}
+def _columns(out, codes) -> dict:
+    """The kernels' rows ``out`` (:data:`.outputs.KERNEL_ROW`) and the model ``codes`` as
+    output arrays (copies: the contact model's pass overwrites rows)."""
+    cols = {name: np.array(out[name]) for name in out.dtype.names}
+    cols["model"] = codes.copy()
+    return cols
 
 
-def _add_contact_outputs(result, wanted, rows, codes, method, rtol, max_steps):
-    """Add the friction demand and lift-off of each scene to ``result`` (a scene whose contact
+def _add_contact_outputs(cols, rows, codes, method, rtol, max_steps):
+    """Add the friction demand and lift-off of each scene to ``cols`` (a scene whose contact
     pass reached the step limit gets that status)."""
     from ._batch_contact import contact_rows
 
     demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
-    result["status"] = np.where(limited, STATUS_STEP_LIMIT, result["status"])
-    for name, values in zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True):
-        if name in wanted:
-            result[name] = values
+    cols["status"] = np.where(limited, STATUS_STEP_LIMIT, cols["status"])
+    cols.update(zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True))
+
+
+def _needs_check(wanted, model) -> bool:
+    """Whether the friction check of Housner's model (:func:`_add_contact_outputs`) runs:
+    ``"auto"`` decides by it; under ``"contact"`` only ``friction_demand`` needs it (the
+    contact model gives its own ``lift_off``)."""
+    asked = set(CONTACT_OUTPUTS) & set(wanted)
+    return model == "auto" or "friction_demand" in asked or (model == "rocking" and bool(asked))
+
+
+def _check_model(model, friction, method):
+    """A ValueError naming ``model`` for a value outside :data:`CONTACT_CHOICES`, the contact
+    model without ``friction``, or ``"contact"`` with the linear method."""
+    if model not in CONTACT_CHOICES:
+        raise ValueError(f"model must be one of {list(CONTACT_CHOICES)}, got {model!r}")
+    if model != "rocking" and friction is None:
+        raise ValueError(
+            f"model={model!r} runs the contact model, which needs friction= (mu, or "
+            "(mu_s, mu_k)); give it, or model='rocking'"
+        )
+    if model == "contact" and method == "linear":
+        raise ValueError(
+            "model='contact' runs the contact model on every row (a nonlinear model): "
+            "method='linear' does not apply; give method='nonlinear' or 'auto'"
+        )
+
+
+def _friction_arguments(friction) -> dict:
+    """The friction columns of :func:`simulate_batch` by name, for the common length."""
+    if friction is None:
+        return {}
+    if isinstance(friction, tuple):
+        if len(friction) != 2:
+            raise ValueError(f"friction: a tuple is (mu_s, mu_k), got {len(friction)} values")
+        return {"friction[0]": friction[0], "friction[1]": friction[1]}
+    return {"friction": friction}
+
+
+def _friction_columns(friction, n) -> tuple:
+    """(mu_s, mu_k), each of length n, from ``friction`` (:func:`simulate_batch`): in
+    (0, MAX_FRICTION], mu_k <= mu_s; a ValueError naming the argument otherwise."""
+    pair = friction if isinstance(friction, tuple) else (friction, friction)
+    names = ("friction[0]", "friction[1]") if isinstance(friction, tuple) else ("friction",) * 2
+    static, kinetic = (
+        _column(name, value, n, 0.0, MAX_FRICTION, high_open=False)
+        for name, value in zip(names, pair, strict=True)
+    )
+    if np.any(kinetic > static):
+        i = int(np.flatnonzero(kinetic > static)[0])
+        raise ValueError(
+            f"friction: row {i}: the kinetic coefficient {float(kinetic[i])!r} exceeds the static "
+            f"{float(static[i])!r} (give (mu_s, mu_k) with mu_s >= mu_k)"
+        )
+    return static, kinetic
+
+
+class _RowMotions:
+    """The Motion of each row of :func:`simulate_batch` (the record scaled by the row's
+    scale, or the row's pulse), built on demand for the contact model."""
+
+    def __init__(self, pulse, record, mp, amplitude, period, cycles, n):
+        self.record, self.scale = record, mp[:, 0]
+        if record is None:
+            self.pulse = PULSES[pulse]
+            columns = (amplitude, period, cycles)
+            self.amplitude, self.period, self.cycles = (
+                np.broadcast_to(np.asarray(x, dtype=float), (n,)) for x in columns
+            )
+            self.counted = pulse in ("sine", "cosine")  # the others take no cycles
+
+    def __getitem__(self, i):
+        if self.record is not None:
+            return self.record.scaled(float(self.scale[i]))
+        extra = {"cycles": int(self.cycles[i])} if self.counted else {}
+        return self.pulse(amplitude=float(self.amplitude[i]), period=float(self.period[i]), **extra)
+
+
+def _add_contact_model(cols, rows, mu, model, motions, rtol):
+    """Run the contact model (:func:`.contact_model.contact_outputs`) on the rows of
+    ``cols`` that ``model`` gives it (all of them, or under ``"auto"`` those whose friction
+    demand exceeded mu_s or that lifted off), writing its outputs over Housner's there; the
+    other rows get the slide outputs of a block that did not slip (:func:`_no_slip`)."""
+    p, alpha, eta = rows[:3]
+    n = p.size
+    if model == "auto":
+        chosen = (cols["friction_demand"] > mu[0]) | (cols["lift_off"] != 0)
+    else:
+        chosen = np.ones(n, bool)
+    cols.update(_no_slip(cols))
+    untimed = [
+        name for name in outputs.KERNEL_ROW.names if "contact" not in outputs.OUTPUTS[name].models
+    ]
+    for i in np.flatnonzero(chosen):
+        one = contact_model.contact_outputs(
+            p[i], alpha[i], eta[i], motions[i], (mu[0][i], mu[1][i]), rtol
+        )
+        for name, value in one.items():
+            cols.setdefault(name, np.zeros(n, np.asarray(value).dtype))[i] = value
+    for name in untimed:  # the kernel outputs the contact model leaves out
+        cols[name][chosen] = outputs.OUTPUTS[name].fill
+    cols["model"][chosen] = MODEL_CONTACT
+
+
+def _no_slip(cols) -> dict:
+    """The slide outputs (:data:`SLIDE_OUTPUTS`) of rows Housner's model answers: no slip
+    and no flight, regime 0 (never lifted) or 2 (rocked); NaN where the block overturned
+    (the fall unloads the base, whose slip lies outside that model) or the row failed."""
+    lifted = (cols["max_rotation"] > 0.0) | (cols["n_impacts"] > 0)
+    unknown = cols["overturned"].astype(bool) | (cols["status"] != 0)
+    zero = np.where(unknown, np.nan, 0.0)
+    out = {name: zero.copy() for name in SLIDE_OUTPUTS if name != "regime"}
+    out["first_slip_time"] = np.full(zero.size, np.nan)
+    out["regime"] = np.where(lifted, 2, 0).astype(np.int8)
+    return out
 
 
 def _perturbed_rows(rows):
@@ -411,6 +571,8 @@ _BATCH_UNITS = {
     "period": ("pulse period T_p", "s"),
     "cycles": ("pulse cycles", "1"),
     "scale": ("factor on the record", "1"),
+    "friction_static": ("static friction coefficient mu_s", "1"),
+    "friction_kinetic": ("kinetic friction coefficient mu_k", "1"),
 }
 
 
@@ -433,15 +595,30 @@ def _as_dataset(result, inputs, method, rtol, motion):
     )
 
 
-def _requested_outputs(outputs):
-    """The output names to return, in the order of :data:`OUTPUTS`, ``status`` included."""
+def _requested_outputs(outputs, model="rocking", friction=False):
+    """The output names to return, in the order of :data:`OUTPUTS`, ``status`` included: by
+    default :data:`OUTPUTS`, with ``friction`` the friction check (:data:`CONTACT_OUTPUTS`;
+    under ``model="contact"`` its ``lift_off`` only: the demand needs Housner's model run
+    with a history), and under the contact model :data:`SLIDE_OUTPUTS`."""
+    allowed = OUTPUTS + CONTACT_OUTPUTS + SLIDE_OUTPUTS + CONDITIONING_OUTPUTS
     if outputs is None:
-        return OUTPUTS
-    names = [outputs] if isinstance(outputs, str) else list(outputs)
-    allowed = OUTPUTS + CONTACT_OUTPUTS + CONDITIONING_OUTPUTS
+        check = ("lift_off",) if model == "contact" else CONTACT_OUTPUTS
+        slides = SLIDE_OUTPUTS if model != "rocking" else ()
+        names = OUTPUTS + (check if friction else ()) + slides
+    else:
+        names = [outputs] if isinstance(outputs, str) else list(outputs)
     unknown = sorted(set(names) - set(allowed))
     if unknown:
         raise ValueError(f"outputs: unknown name(s) {unknown}; allowed: {list(allowed)}")
+    if model == "rocking" and set(names) & set(SLIDE_OUTPUTS):
+        raise ValueError(
+            f"outputs: {sorted(set(names) & set(SLIDE_OUTPUTS))} come from the contact model: "
+            "give friction= and model='contact' or 'auto'"
+        )
+    if model != "rocking" and "conditioning" in names:
+        raise ValueError(
+            f"outputs: conditioning is computed for Housner's model only, not model={model!r}"
+        )
     return tuple(name for name in allowed if name in names or name == "status")
 
 

@@ -5,14 +5,18 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 
 import numpy as np
 
 from .. import _validate
+from .._warnings import IncompleteReferenceWarning
 from ..constants import G
 from ..motions import _kernels as mk
 from ._sliding import slide_record
 from .contact import ContactCheck, check_contact
+from .methods import STATUS_STEP_LIMIT
+from .outputs import TIMED_REGIMES
 from .result import RockingResult
 from .slide_rock import REGIMES
 from .slide_rock_reference import simulate_contact_reference
@@ -119,19 +123,87 @@ def _sliding_kernel(motion, friction):
     }
 
 
+def contact_history(p, alpha, eta, motion, friction, method, rtol, t_max) -> dict:
+    """One scene of the contact model: the dict of
+    :func:`~.slide_rock_reference.simulate_contact_reference` (``"energy"`` and
+    ``"regime_sequence"`` from the reference only), from the exact sliding kernel where
+    :func:`slides_only` allows it, else from the reference; ``"solver"`` says which ran
+    (:data:`SLIDING` or :data:`SOLVER`)."""
+    if slides_only(motion, friction, alpha, method, t_max):
+        return {**_sliding_kernel(motion, friction), "solver": SLIDING}
+    radius = 0.75 * G / (p * p)
+    r = simulate_contact_reference(radius, alpha, eta, motion, *friction, rtol=rtol, t_max=t_max)
+    return {**r, "solver": SOLVER}
+
+
+def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
+    """The batch outputs of one scene under the contact model (what
+    :func:`rockstudy.simulate_batch` stores for a row its ``model`` runs the contact model on).
+
+    Parameters
+    ----------
+    p, alpha, eta : float
+        Frequency parameter [rad/s], slenderness [rad] and restitution of the block.
+    motion : Motion
+        The ground motion of the scene (a pulse, or a scaled record).
+    friction : (float, float)
+        (mu_s, mu_k), checked (:func:`friction_pair`).
+    rtol : float
+        Relative tolerance of the reference (the sliding kernel is exact).
+    t_max : float, optional
+        End of the history [s]; by default until the block rests after the motion.
+
+    Returns
+    -------
+    dict
+        Scalars named as the outputs of :mod:`.outputs` that the contact model computes:
+        ``status`` (0, or 1 where the reference stopped at its cap of phases: an
+        :class:`~rockstudy.IncompleteReferenceWarning` caught here), ``max_rotation``,
+        ``overturned``, ``n_impacts``, ``overturn_time``, ``first_impact_time``,
+        ``lift_off``, ``max_slide``, ``residual_slide``, ``first_slip_time``, the seconds in
+        the regimes Housner's model has not (``time_slide``, ``time_slide_rock``,
+        ``time_flight``) and ``regime`` (:func:`regime_code`).
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", IncompleteReferenceWarning)
+        r = contact_history(p, alpha, eta, motion, friction, "auto", rtol, t_max)
+    incomplete = any(issubclass(w.category, IncompleteReferenceWarning) for w in caught)
+    impacts = np.asarray(r["impact_times"], float)
+    times = r["regime_times"]
+    return {
+        "status": STATUS_STEP_LIMIT if incomplete else 0,
+        "max_rotation": float(r["max_rotation"]),
+        "overturned": bool(r["overturned"]),
+        "n_impacts": impacts.size,
+        "overturn_time": float(r["overturn_time"]),
+        "first_impact_time": float(impacts[0]) if impacts.size else math.nan,
+        "lift_off": bool(r["lift_off"]),
+        "max_slide": float(r["max_slide"]),
+        "residual_slide": float(r["residual_slide"]),
+        "first_slip_time": float(r["first_slip_time"]),
+        **{f"time_{name}": float(times[name]) for name in TIMED_REGIMES},
+        "regime": regime_code(times),
+    }
+
+
+def regime_code(regime_times) -> int:
+    """The most involved regime a block entered, as its index in
+    :data:`~.slide_rock.REGIMES` (0 rest, 1 slide, 2 rock, 3 slide-rock, 4 flight): the last
+    one of that order with time spent in it (``regime_times``: seconds by regime name)."""
+    moving = enumerate(REGIMES[1:], start=1)
+    return max((i for i, name in moving if regime_times.get(name, 0.0) > 0.0), default=0)
+
+
 def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocking):
     """The contact model of the block (p, alpha, eta) under ``motion`` with ``friction`` =
     (mu_s, mu_k), as a :class:`~rockstudy.RockingResult`: its ``friction_demand`` is that of
     Housner's no-slip model on the same scene (``rocking()`` runs it, on first use), its
     ``lift_off`` the contact model's own. The exact sliding kernel runs the scenes of
     :func:`slides_only`, the ``solve_ivp`` reference the others."""
-    radius = 0.75 * G / (p * p)
-    if slides_only(motion, friction, alpha, method, t_max):
-        r, info = _sliding_kernel(motion, friction), {"solver": SLIDING}
+    r = contact_history(p, alpha, eta, motion, friction, method, rtol, t_max)
+    if r["solver"] == SLIDING:
+        info = {"solver": SLIDING}
     else:
-        r = simulate_contact_reference(
-            radius, alpha, eta, motion, *friction, rtol=rtol, t_max=t_max
-        )
         info = {
             "solver": SOLVER,
             "energy": {k: v for k, v in r["energy"].items() if k != "each_impact_loss"},

@@ -26,6 +26,7 @@ __all__ = [
     "OUTPUTS",
     "STAGES",
     "STUDY_OUTPUTS",
+    "TIMED_REGIMES",
     "Output",
     "names",
 ]
@@ -33,14 +34,18 @@ __all__ = [
 #: The models a batch runs (:func:`rockstudy.simulate_batch`): Housner's block by the
 #: Taylor/DOP853 kernel, the linearized block by the same kernel (a record with a vertical
 #: component), the exact piecewise linear solution under a trigonometric pulse and under a
-#: record, and the rest of ``method="auto"`` (no uplift, nothing integrated).
-MODELS = ("nonlinear", "linear", "exact_linear", "exact_linear_record", "rest")
+#: record, the rest of ``method="auto"`` (no uplift, nothing integrated), and the planar
+#: contact model (:func:`rockstudy.dynamics.contact_model.contact_outputs`: rest, slide, rock,
+#: slide-rock, flight) of ``model="contact"`` or ``"auto"``.
+MODELS = ("nonlinear", "linear", "exact_linear", "exact_linear_record", "rest", "contact")
 #: The models whose kernel writes a row of :data:`KERNEL_ROW`.
 KERNEL_MODELS = MODELS[:4]
 #: Where an output is computed: in every batch kernel's row (``kernel``), by
-#: :func:`simulate_batch` around the kernels (``batch``), by its contact pass (``contact``) or
-#: its conditioning pass (``conditioning``), or by a study from another output (``study``).
-STAGES = ("kernel", "batch", "contact", "conditioning", "study")
+#: :func:`simulate_batch` around the kernels (``batch``), by its contact pass (``contact``: the
+#: friction check of Housner's model), by the contact model (``contact_model``: with
+#: ``model="contact"`` or ``"auto"``) or by its conditioning pass (``conditioning``), or by a
+#: study from another output (``study``).
+STAGES = ("kernel", "batch", "contact", "contact_model", "conditioning", "study")
 
 
 @dataclass(frozen=True)
@@ -90,8 +95,18 @@ class Output:
             raise ValueError(f"{self.name}: models must be among {MODELS}, got {self.models}")
 
 
+#: The regimes of the contact model (:data:`rockstudy.dynamics.slide_rock.REGIMES`) whose
+#: seconds are batch outputs (``time_<regime>``): those outside Housner's model, 0 for every
+#: scene it answers.
+TIMED_REGIMES = ("slide", "slide_rock", "flight")
+
 _NAN = float("nan")
 _BLOCK_MODELS = ("nonlinear", "linear")
+#: The models of the outputs that the contact model computes too.
+_WITH_CONTACT = (*KERNEL_MODELS, "contact")
+#: The models of the contact model's outputs: the contact model, and Housner's wherever
+#: ``model="auto"`` keeps its answer (the friction held and the block never flew: no slip).
+_SLIDING_MODELS = (*_BLOCK_MODELS, "rest", "contact")
 
 
 def _f8(name, units, long_name, **where):
@@ -109,48 +124,116 @@ def _int(name, dtype, long_name, store_dtype="i8", **where):
 OUTPUTS = {
     o.name: o
     for o in (
-        _int("status", "i8", "0 ok, 1 step limit reached", in_study=False),
-        _f8("max_rotation", "rad", "max |theta| (pi/2 if overturned)"),
-        _int("overturned", "bool", "overturned (1) or survived (0)", "i1"),
-        _int("n_impacts", "i8", "impacts until rest"),
+        _int(
+            "status",
+            "i8",
+            "0 ok, 1 step limit reached (the contact model: its cap of phases)",
+            in_study=False,
+            models=_WITH_CONTACT,
+        ),
+        _f8("max_rotation", "rad", "max |theta| (pi/2 if overturned)", models=_WITH_CONTACT),
+        _int("overturned", "bool", "overturned (1) or survived (0)", "i1", models=_WITH_CONTACT),
+        _int("n_impacts", "i8", "impacts until rest", models=_WITH_CONTACT),
         _f8(
             "overturn_time",
             "s",
             "time at which |theta| reached pi/2 (NaN if it survived)",
             at_rest=_NAN,
+            models=_WITH_CONTACT,
         ),
-        _int("steps", "i8", "integrator steps (DOP853 or Taylor; 0 for the exact solvers)"),
-        _f8("first_impact_time", "s", "time of the first impact (NaN if none)", at_rest=_NAN),
+        _int(
+            "steps",
+            "i8",
+            "integrator steps (DOP853 or Taylor; 0 for the exact solvers, -1 for the contact "
+            "model, which does not count them)",
+        ),
+        _f8(
+            "first_impact_time",
+            "s",
+            "time of the first impact (NaN if none)",
+            at_rest=_NAN,
+            models=_WITH_CONTACT,
+        ),
         _f8(
             "peak_time",
             "s",
             "time at which |theta| reached max_rotation (the overturning time if overturned; "
-            "NaN if it never rocked)",
+            "NaN if it never rocked, and under the contact model, which does not time it)",
             at_rest=_NAN,
         ),
         _int(
             "model",
             "i1",
-            "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear",
+            "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear, 3 contact model",
             "i1",
             models=MODELS,
             stage="batch",
         ),
-        _f8("max_rotation_ratio", "1", "max |theta| / theta_cr", stage="study"),
+        _f8(
+            "max_rotation_ratio",
+            "1",
+            "max |theta| / theta_cr",
+            stage="study",
+            models=_WITH_CONTACT,
+        ),
         _f8(
             "friction_demand",
             "1",
-            "friction demand max |F_h / F_v| at the contact (inf with a lift-off)",
+            "friction demand max |F_h / F_v| at the contact of Housner's no-slip model (inf "
+            "with a lift-off)",
             models=_BLOCK_MODELS,
             stage="contact",
         ),
         _int(
             "lift_off",
             "i1",
-            "1 if the vertical contact force was not compressive somewhere",
+            "1 if the vertical contact force was not compressive somewhere (the contact "
+            "model: the block flew)",
             "i1",
-            models=_BLOCK_MODELS,
+            models=(*_BLOCK_MODELS, "contact"),
             stage="contact",
+        ),
+        _f8(
+            "max_slide",
+            "m",
+            "max |slip| of the base relative to the ground (NaN if Housner's model answered "
+            "and the block overturned)",
+            models=_SLIDING_MODELS,
+            stage="contact_model",
+        ),
+        _f8(
+            "residual_slide",
+            "m",
+            "slip of the base relative to the ground at the end (NaN if overturned)",
+            models=_SLIDING_MODELS,
+            stage="contact_model",
+        ),
+        _f8(
+            "first_slip_time",
+            "s",
+            "time at which the base first slipped (NaN if it never did, or if Housner's "
+            "model answered and the block overturned)",
+            models=_SLIDING_MODELS,
+            stage="contact_model",
+        ),
+        *(
+            _f8(
+                f"time_{regime}",
+                "s",
+                f"seconds in the {label} regime (NaN if Housner's model answered and the "
+                "block overturned)",
+                models=_SLIDING_MODELS,
+                stage="contact_model",
+            )
+            for regime, label in ((r, r.replace("_", "-")) for r in TIMED_REGIMES)
+        ),
+        _int(
+            "regime",
+            "i1",
+            "most involved regime entered: 0 rest, 1 slide, 2 rock, 3 slide-rock, 4 flight",
+            "i1",
+            models=_SLIDING_MODELS,
+            stage="contact_model",
         ),
         _f8(
             "conditioning",

@@ -26,6 +26,7 @@ import numpy as np
 import xarray as xr
 
 from ..._warnings import UpliftWarning
+from ...dynamics import outputs as _outputs
 from ...motions import measures
 from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
@@ -184,6 +185,10 @@ def outputs(study) -> dict:
     if study.friction_coefficients() is not None:  # the contact check (spec.Study.friction)
         for name in ("friction_demand", "lift_off"):
             out[name] = (*CONTACT_VARIABLES[name], None)
+    if study.run.model != "rocking":  # the contact model's (rockstudy.dynamics.outputs)
+        for name in rd.MODEL_KEYS:
+            o = _outputs.OUTPUTS[name]
+            out[name] = (o.long_name, o.units, o.store_dtype, o.fill, None)
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
         "1",
@@ -284,7 +289,7 @@ def empty_rows(study, n: int) -> dict:
 
 def _run_design(study, record, structures, levels, friction):
     """The design function of :mod:`.records` on one record (its kind's ``run``), with the
-    friction coefficients of its structures (None: no friction check)."""
+    friction coefficients of its structures (None: no friction check); under the study's contact model (``[run] model``) it runs that model."""
     de, run = study.design, study.run
     kind = design_kind(de.kind)
     kw = dict(
@@ -295,6 +300,8 @@ def _run_design(study, record, structures, levels, friction):
         max_steps=run.max_steps,
     )
     kw["friction"] = friction
+    if run.model != "rocking":  # spec.Study._contact_model: every structure has its mu
+        kw["model"] = run.model
     if kind.levels:
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
         kw.update(levels=levels, im=t.im, period=t.period)

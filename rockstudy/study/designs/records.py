@@ -28,9 +28,10 @@ import xarray as xr
 
 from ... import _validate
 from ...constants import G
+from ...dynamics import outputs as _outputs
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
-from ...dynamics.batch import CONTACT_OUTPUTS
+from ...dynamics.batch import CONTACT_OUTPUTS, SLIDE_OUTPUTS
 from ...dynamics.methods import MAX_STEPS
 from ...dynamics.simulate import check_friction
 from ...motions import Record
@@ -310,8 +311,11 @@ def record_labels(names) -> np.ndarray:
     return np.array(labels, dtype=object)
 
 
-def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None):
-    """simulate_batch on the structures ``idx`` (array) at ``scales`` (same length)."""
+def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None, model=None):
+    """simulate_batch on the structures ``idx`` (array) at ``scales`` (same length);
+    ``model`` = (model, friction of each structure) runs the contact model
+    (:func:`rockstudy.simulate_batch`'s ``model`` and ``friction``)."""
+    contact_model = {} if model is None else {"model": model[0], "friction": model[1][idx]}
     return simulate_batch(
         frequency_parameter=structures["frequency_parameter"][idx],
         critical_rotation=structures["critical_rotation"][idx],
@@ -322,7 +326,36 @@ def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None)
         rtol=rtol,
         max_steps=max_steps,
         outputs=outputs,
+        **contact_model,
     )
+
+
+def _contact_model(model, friction, n):
+    """(model, friction of each of the n structures) for :func:`_run`, or None under
+    Housner's model (``model="rocking"``, where ``friction`` gives the friction check only);
+    a ValueError naming the argument otherwise (the contact model needs every mu)."""
+    if model == "rocking":
+        return None
+    if model not in ("contact", "auto"):
+        raise ValueError(f"model must be 'rocking', 'contact' or 'auto', got {model!r}")
+    if friction is None:
+        raise ValueError(f"model={model!r} runs the contact model, which needs friction=")
+    mu = np.asarray(friction, dtype=float)
+    if mu.ndim > 1 or mu.size not in (1, n):
+        raise ValueError(f"friction: give one coefficient or one per structure ({n})")
+    if np.isnan(mu).any():
+        raise ValueError(f"friction: model={model!r} needs a coefficient for every structure")
+    return model, np.broadcast_to(mu.ravel(), (n,))
+
+
+#: What a design keeps of the contact model: the model of each point, its slip and regimes.
+MODEL_KEYS = ("model", *SLIDE_OUTPUTS)
+
+
+def _keys(contact, model):
+    """The outputs a design keeps: :data:`_OUT`, the friction check with ``contact``, and
+    :data:`MODEL_KEYS` under the contact model (``model`` not None)."""
+    return _OUT + (CONTACT_OUTPUTS if contact else ()) + (() if model is None else MODEL_KEYS)
 
 
 _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
@@ -331,11 +364,14 @@ _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
 STATUS_FREE_FALL = 2
 
 
-def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps, contact):
+def _run_below_free_fall(
+    record, st, idx, scales, method, rtol, max_steps, contact=False, model=None
+):
     """:func:`_run` on the points whose |scale| stays below the record's free-fall scale;
     the others get ``status`` :data:`STATUS_FREE_FALL`, NaN rotation and time, no overturning
-    and -1 impacts. With ``contact`` (True), also ``friction_demand`` (NaN where not run) and
-    ``lift_off`` (see :func:`rockstudy.simulate_batch`)."""
+    and -1 impacts. With ``contact``, also ``friction_demand`` (NaN where not run) and
+    ``lift_off`` (see :func:`rockstudy.simulate_batch`); with ``model`` (:func:`_contact_model`)
+    the contact model's outputs (their failed-row fill where not run)."""
     ok = np.abs(scales) < free_fall_scale(record)
     out = {
         "max_rotation": np.full(scales.size, np.nan),
@@ -344,14 +380,17 @@ def _run_below_free_fall(record, st, idx, scales, method, rtol, max_steps, conta
         "overturn_time": np.full(scales.size, np.nan),
         "status": np.full(scales.size, STATUS_FREE_FALL, np.int64),
     }
-    keys = _OUT + (CONTACT_OUTPUTS if contact else ())
+    keys = _keys(contact, model)
     if contact:
         out.update(
             friction_demand=np.full(scales.size, np.nan), lift_off=np.zeros(scales.size, bool)
         )
+    for name in MODEL_KEYS if model is not None else ():
+        entry = _outputs.OUTPUTS[name]
+        out[name] = np.full(scales.size, entry.fill, entry.store_dtype)
     if ok.any():
-        wanted = keys if contact else None
-        run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps, wanted)
+        wanted = keys if contact or model is not None else None
+        run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps, wanted, model)
         for k in keys:
             out[k][ok] = run[k]
     return out
@@ -370,6 +409,7 @@ def cloud(
     max_steps: int = MAX_STEPS,
     friction=None,
     contact: bool | None = None,
+    model: str = "rocking",
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -406,6 +446,12 @@ def cloud(
     contact : bool, optional
         Deprecated spelling of the friction check without a coefficient (FutureWarning):
         give ``friction`` instead.
+    model : {"rocking", "contact", "auto"}
+        "contact" or "auto" with ``friction`` (one mu or one per structure, none NaN) runs
+        the contact model as :func:`rockstudy.simulate_batch` does, and keeps ``model``,
+        ``max_slide``, ``residual_slide``, ``first_slip_time``, ``time_slide``,
+        ``time_slide_rock``, ``time_flight`` and ``regime`` of every point; "rocking"
+        (default): Housner's model (with the friction check where ``friction`` is given).
 
     Returns
     -------
@@ -422,10 +468,12 @@ def cloud(
     ds = _record_dataset(records, st, periods, damping)
     idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
+    model = _contact_model(model, friction, idx.size)
     outs = [
-        _run_below_free_fall(r, st, idx, ones, method, rtol, max_steps, contact) for r in records
+        _run_below_free_fall(r, st, idx, ones, method, rtol, max_steps, contact, model)
+        for r in records
     ]
-    for k in _OUT + (CONTACT_OUTPUTS if contact else ()):
+    for k in _keys(contact, model):
         ds[k] = (("record", "structure"), np.array([o[k] for o in outs]))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     n_run = int((~ds["censored"]).sum())
@@ -449,6 +497,7 @@ def multiple_stripes(
     max_steps: int = MAX_STEPS,
     friction=None,
     contact: bool | None = None,
+    model: str = "rocking",
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -465,7 +514,7 @@ def multiple_stripes(
         ``pga_ratio`` or ``pgv_ratio``.
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
-    records, structures, periods, damping, method, rtol, max_steps, friction, contact
+    records, structures, periods, damping, method, rtol, max_steps, friction, contact, model
         As in :func:`cloud`.
 
     Returns
@@ -488,15 +537,17 @@ def multiple_stripes(
     ds = _record_dataset(records, st, periods, damping)
     n = st["critical_rotation"].size
     idx = np.repeat(np.arange(n), levels.size)
+    model = _contact_model(model, friction, n)
     scales, outs = [], []
     for r in records:
         s = _scale_for(levels[None, :], _record_measure(r, im, period, damping, st)[:, None], im)
         scales.append(s)
-        outs.append(_run_below_free_fall(r, st, idx, s.ravel(), method, rtol, max_steps, contact))
+        args = (method, rtol, max_steps, contact, model)
+        outs.append(_run_below_free_fall(r, st, idx, s.ravel(), *args))
     dims = ("record", "structure", "level")
     ds = ds.assign_coords(level=levels)
     ds["scale"] = (dims, np.array(scales))
-    for k in _OUT + (CONTACT_OUTPUTS if contact else ()):
+    for k in _keys(contact, model):
         ds[k] = (dims, np.array([o[k] for o in outs]).reshape(len(records), n, levels.size))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     ds.attrs.update(

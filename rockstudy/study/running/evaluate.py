@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ...dynamics import outputs as _outputs
-from ...dynamics.batch import CONTACT_OUTPUTS, simulate_batch
+from ...dynamics.batch import CONTACT_OUTPUTS, SLIDE_OUTPUTS, simulate_batch
 from ...dynamics.batch import OUTPUTS as BATCH_OUTPUTS
 from ...motions import stochastic_record
 from ..designs import record_rows
@@ -56,7 +56,17 @@ def engine_outputs(study: Study) -> tuple:
     """The outputs of :func:`simulate_batch` that the study's outputs need (``auto`` runs the
     linear model only where no output outside its bound is asked for)."""
     names = {"max_rotation" if n == "max_rotation_ratio" else n for n in study.run.outputs}
-    return tuple(n for n in BATCH_OUTPUTS + CONTACT_OUTPUTS if n in names or n == "status")
+    engine = BATCH_OUTPUTS + CONTACT_OUTPUTS + SLIDE_OUTPUTS
+    return tuple(n for n in engine if n in names or n == "status")
+
+
+def _model_arguments(study: Study) -> dict:
+    """The contact model's arguments of :func:`simulate_batch` (``run.model`` and the
+    study's ``friction``); none under ``"rocking"``, whose friction check the outputs ask
+    for."""
+    if study.run.model == "rocking":
+        return {}
+    return {"model": study.run.model, "friction": study.friction}
 
 
 def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
@@ -70,6 +80,7 @@ def _run_rows(study: Study, cols: dict, idx: np.ndarray, base_dir) -> dict:
         rtol=study.run.rtol,
         max_steps=study.run.max_steps,
         outputs=engine_outputs(study),
+        **_model_arguments(study),
     )
     if mo.kind == "pulse":
         return simulate_batch(

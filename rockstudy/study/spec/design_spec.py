@@ -8,7 +8,7 @@ fit with the motion and the sampler is checked by the whole study
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
@@ -21,6 +21,11 @@ from .structures import FieldError
 
 __all__ = ["DesignSpec"]
 
+#: Largest slide limit taken [m] (``design.slide_limits``).
+MAX_SLIDE_LIMIT = 100.0
+#: A slide limit d [m] of ``design.slide_limits``.
+_SlideLimit = Annotated[float, Field(gt=0.0, le=MAX_SLIDE_LIMIT)]
+
 
 class DesignSpec(_Model):
     """A record design over records x structures (``sampler.n`` structures drawn by the
@@ -30,7 +35,9 @@ class DesignSpec(_Model):
     by bisection to ``tolerance``; ``max_pga_ratio`` and ``scan`` as in
     :class:`rockstudy.study.spec.ida_options.IdaOptions`, which holds their defaults and
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
-    record, ``damping`` their damping ratio."""
+    record, ``damping`` their damping ratio. ``slide_limits`` [m] are the slides d of the
+    fragility of sliding, P(max_slide > d) (the contact model's ``max_slide``: with
+    ``run.model`` "contact" or "auto"), distinct and increasing."""
 
     kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
@@ -45,6 +52,14 @@ class DesignSpec(_Model):
     #: Scale factors above this are noted by validate (records scaled far from what they
     #: recorded; cloud and stripes designs).
     max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
+    slide_limits: list[_SlideLimit] = Field(default=[], max_length=100)
+
+    @model_validator(mode="after")
+    def _increasing_slide_limits(self):
+        d = self.slide_limits
+        if any(b <= a for a, b in zip(d[:-1], d[1:], strict=True)):
+            raise FieldError("slide_limits", f"must be distinct and increasing [m], got {d}")
+        return self
 
     @model_validator(mode="after")
     def _ida_keys(self):

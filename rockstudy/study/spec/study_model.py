@@ -30,7 +30,7 @@ from .feasibility import draw_span as _draw_span
 from .hazard_spec import HazardSpec
 from .motion_spec import MotionSpec
 from .parameters import _a_name, _largest, _Model, _smallest
-from .run_spec import CONTACT_OUTPUTS, STEPS_PER_CYCLE, RunSpec
+from .run_spec import CONTACT_OUTPUTS, SLIDE_OUTPUTS, STEPS_PER_CYCLE, RunSpec
 from .sampler_spec import SAMPLER_LAYOUTS, SamplerSpec, samplers_laid_out
 from .structure_spec import Structure
 from .structures import KINDS, FieldError
@@ -96,7 +96,9 @@ class Study(_Model):
     @classmethod
     def _contact_outputs(cls, data):
         """A Monte Carlo study that gives ``friction`` stores the contact check of every scene
-        (``friction_demand`` and ``lift_off`` join ``run.outputs``)."""
+        (``friction_demand`` and ``lift_off`` join ``run.outputs``), and with
+        ``run.model = "contact"`` or ``"auto"`` the contact model's slip and regimes
+        (:data:`.run_spec.SLIDE_OUTPUTS`)."""
         if not (isinstance(data, dict) and data.get("friction") is not None):
             return data
         run = data.get("run", {})
@@ -105,8 +107,39 @@ class Study(_Model):
         outputs = run.get("outputs", RunSpec.model_fields["outputs"].default)
         if not isinstance(outputs, list):
             return data  # the schema names the problem
-        missing = [n for n in CONTACT_OUTPUTS if n not in outputs]
+        added = CONTACT_OUTPUTS + (SLIDE_OUTPUTS if run.get("model") in ("contact", "auto") else ())
+        missing = [n for n in added if n not in outputs]
         return {**data, "run": {**run, "outputs": list(outputs) + missing}}
+
+    @model_validator(mode="after")
+    def _contact_model(self):
+        """``run.model = "contact"`` or ``"auto"`` needs the friction of every scene (the
+        study's ``friction``, or each object's), and runs in a Monte Carlo study or a cloud
+        or stripes design (an IDA runs Housner's model with the friction check);
+        ``design.slide_limits`` needs it."""
+        model = self.run.model
+        if model == "rocking":
+            if self.design is not None and self.design.slide_limits:
+                raise FieldError(
+                    "design.slide_limits",
+                    "needs the contact model's max_slide: give [run] model = 'contact' or "
+                    "'auto' (with friction)",
+                )
+            return self
+        mu = self.friction_coefficients()
+        if mu is None or np.isnan(mu).any():
+            raise FieldError(
+                "run.model",
+                f"{model!r} runs the contact model, which needs the friction coefficient mu of "
+                "every scene: give friction (top level, or per object), or model = 'rocking'",
+            )
+        if self.design is not None and self.design.kind == "ida":
+            raise FieldError(
+                "run.model",
+                f"{model!r} is not available in an IDA yet (its ladder runs Housner's model "
+                "with the friction check): give model = 'rocking', or a cloud or stripes design",
+            )
+        return self
 
     def friction_coefficients(self) -> np.ndarray | None:
         """The friction coefficient of each object (NaN where none is given), the study's
