@@ -347,12 +347,7 @@ def simulate_batch(
     )
     kernel_model = _MODELS[method]
     theta_cr = _critical_rotation(critical_rotation, slenderness)
-    rtol = _validate.rtol(rtol)
-    max_steps = _validate.max_steps(max_steps)
-    if method == "nonlinear":
-        _auto.warn_loose_tolerance(rtol)
-    if (half_diagonal is None) == (frequency_parameter is None):
-        raise ValueError("give exactly one of half_diagonal or frequency_parameter")
+    rtol, max_steps = _controls(method, rtol, max_steps, half_diagonal, frequency_parameter)
     n = _common_length(
         half_diagonal=half_diagonal,
         frequency_parameter=frequency_parameter,
@@ -396,14 +391,23 @@ def simulate_batch(
     if not as_dataset:
         return result
     inputs = {"frequency_parameter": p, theta_cr[0]: alpha, "restitution": eta}
-    if half_diagonal is not None:
-        inputs["half_diagonal"] = R
-    if mu is not None:
-        inputs.update(friction_static=mu[0], friction_kinetic=mu[1])
+    inputs.update({} if half_diagonal is None else {"half_diagonal": R})
+    inputs.update({} if mu is None else {"friction_static": mu[0], "friction_kinetic": mu[1]})
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
-    return _as_dataset(
-        result, inputs, method, rtol, "record" if record is not None else f"{pulse} pulse"
-    )
+    source = "record" if record is not None else f"{pulse} pulse"
+    return _as_dataset(result, inputs, method, rtol, source)
+
+
+def _controls(method, rtol, max_steps, half_diagonal, frequency_parameter):
+    """(rtol, max_steps) checked, with the loose-tolerance warning of the nonlinear kernel;
+    a ValueError unless exactly one of half_diagonal and frequency_parameter is given."""
+    rtol = _validate.rtol(rtol)
+    max_steps = _validate.max_steps(max_steps)
+    if method == "nonlinear":
+        _auto.warn_loose_tolerance(rtol)
+    if (half_diagonal is None) == (frequency_parameter is None):
+        raise ValueError("give exactly one of half_diagonal or frequency_parameter")
+    return rtol, max_steps
 
 
 def _columns(out, codes) -> dict:

@@ -289,7 +289,8 @@ def empty_rows(study, n: int) -> dict:
 
 def _run_design(study, record, structures, levels, friction):
     """The design function of :mod:`.records` on one record (its kind's ``run``), with the
-    friction coefficients of its structures (None: no friction check); under the study's contact model (``[run] model``) it runs that model."""
+    friction coefficients of its structures (None: no friction check), under the study's
+    ``[run] model``."""
     de, run = study.design, study.run
     kind = design_kind(de.kind)
     kw = dict(

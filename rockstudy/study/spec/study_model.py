@@ -133,10 +133,11 @@ class Study(_Model):
                 f"{model!r} runs the contact model, which needs the friction coefficient mu of "
                 "every scene: give friction (top level, or per object), or model = 'rocking'",
             )
-        if self.design is not None and self.design.kind == "ida":
+        if self.design is not None and design_kind(self.design.kind).capacities:
             raise FieldError(
                 "run.model",
-                f"{model!r} is not available in an IDA yet (its ladder runs Housner's model "
+                f"{model!r} is not available in a {self.design.kind!r} design yet (its ladder "
+                "runs Housner's model "
                 "with the friction check): give model = 'rocking', or a cloud or stripes design",
             )
         return self
