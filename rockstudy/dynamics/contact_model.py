@@ -11,13 +11,16 @@ import numpy as np
 from .. import _validate
 from ..constants import G
 from ..motions import _kernels as mk
+from ._contact_scene import MAX_STEPS, STATUS_NO_SOLUTION, contact_scene
 from ._sliding import slide_record
 from .contact import ContactCheck, check_contact
+from .methods import StepLimitError
 from .result import RockingResult
 from .slide_rock import REGIMES
 from .slide_rock_reference import simulate_contact_reference
 
-#: The methods that run the contact model (its scipy reference is, for now, its only solver).
+#: The methods that run the contact model: its numba kernel ("nonlinear", "auto") or its
+#: scipy reference ("scipy").
 CONTACT_METHODS = ("nonlinear", "scipy", "auto")
 
 SLIDING = (
@@ -27,6 +30,10 @@ SLIDING = (
 SOLVER = (
     "contact model (rest, slide, rock, slide-rock, flight; Shenton & Jones 1991, Shenton "
     "1996) by its solve_ivp reference with events"
+)
+KERNEL = (
+    "contact model (rest, slide, rock, slide-rock, flight; Shenton & Jones 1991, Shenton "
+    "1996) by its event-driven numba kernel (DOP853, events on the dense output)"
 )
 
 
@@ -114,10 +121,16 @@ def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocki
     (mu_s, mu_k), as a :class:`~rockstudy.RockingResult`: its ``friction_demand`` is that of
     Housner's no-slip model on the same scene (``rocking()`` runs it, on first use), its
     ``lift_off`` the contact model's own. The exact sliding kernel runs the scenes of
-    :func:`slides_only`, the ``solve_ivp`` reference the others."""
+    :func:`slides_only`, the ``solve_ivp`` reference those of ``method="scipy"``, the
+    event-driven kernel (:mod:`._contact_scene`) the others; a kernel scene that reaches its
+    step limit raises :class:`~rockstudy.dynamics.methods.StepLimitError`, one without a
+    solution (Painleve's paradox) a ValueError."""
     radius = 0.75 * G / (p * p)
     if slides_only(motion, friction, alpha, method, t_max):
         r, info = _sliding_kernel(motion, friction), {"solver": SLIDING}
+    elif method != "scipy":
+        r = _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max)
+        info = {"solver": KERNEL, "steps": r["steps"]}
     else:
         r = simulate_contact_reference(
             radius, alpha, eta, motion, *friction, rtol=rtol, t_max=t_max
@@ -152,6 +165,22 @@ def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocki
         first_slip_time=float(r["first_slip_time"]),
         regime_times=r["regime_times"],
     )
+
+
+def _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max, max_steps=MAX_STEPS):
+    """The reference's dict of a scene the event-driven kernel runs
+    (:func:`._contact_scene.contact_scene`, at most ``max_steps`` steps); a scene it does
+    not solve raises."""
+    r = contact_scene(radius, alpha, eta, motion, *friction, rtol, t_max, max_steps)
+    if r["status"] == STATUS_NO_SOLUTION:
+        raise ValueError(
+            f"friction: mu_k = {friction[1]!r} gives the contact model no solution in this "
+            "scene (Painleve's paradox, possible only for mu_k > 4/3)"
+        )
+    if r["status"] != 0:
+        raise StepLimitError(method, max_steps)
+    r["regime_sequence"] = None
+    return r
 
 
 def _housner_demand(rocking, motion, lift_off):
