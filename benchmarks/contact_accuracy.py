@@ -9,9 +9,10 @@ whose scaled vertical would fall below -0.95 g are drawn again). The kernel
 (:func:`rockstudy.dynamics._contact_scene.contact_batch`, exact sliding where mu < tan
 alpha) runs at ``--rtol`` (1e-10), the reference (``solve_ivp`` DOP853 with events) at
 1e-12. Printed: the distribution of the relative errors of max |theta| and max |u| (over
-max(|x|) + 1e-2 alpha, resp. 1e-2 R alpha: see FLOOR), in units of rtol; the scenes whose decisions (overturned, lift-off, slipped, impact count) differ, and
-whether each lies in the threshold band (the reference's decision flips when the amplitude
-moves by 1e-6 of itself); the scenes the kernel flagged (status != 0).
+max(|x|) + 1e-2 alpha, resp. 1e-2 R alpha: see FLOOR), in units of rtol; the scenes whose
+decisions (overturned, lift-off, slipped, impact count) differ, and whether each lies in the
+threshold band (the reference's decision flips when the amplitude moves by 1e-6 of itself);
+the scenes the kernel flagged (status != 0).
 
     python benchmarks/contact_accuracy.py [--scenes 2000] [--rtol 1e-10] [--window 8]
 """

@@ -27,6 +27,7 @@ from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
 from . import slide_rock as sr
+from ._sliding import sliding_scene
 from ._uplift import _next_break, _skip_quiet
 from ._vertical import refuse_free_fall
 from .constants import (
@@ -511,6 +512,20 @@ def _write(out, i, ta, over):
     row.time_flight = ta[T_TIMES + sr.FLIGHT]
 
 
+@njit(cache=True)
+def _sliding_row(out, i, mp, times, samples, vsamples, static, kinetic):
+    """Row i of a contact batch for a block that cannot rock (mu_s < tan alpha) under a
+    record: the exact sliding kernel (:func:`._sliding.sliding_scene`), nothing integrated."""
+    accel, vert = mp[0] * samples, abs(mp[0]) * vsamples
+    buf = np.empty((3 * times.shape[0] + 2, 3))
+    rows, peak, first, slid = sliding_scene(times, accel, vert, static, kinetic, buf)
+    end = max(buf[rows - 1, 0], times[times.shape[0] - 1])
+    ta = _new_tallies()
+    ta[T_MAX_U], ta[T_FIRST_SLIP], ta[T_U_END] = peak, first, buf[rows - 1, 1]
+    ta[T_TIMES + sr.REST], ta[T_TIMES + sr.SLIDE] = end - slid, slid
+    _write(out, i, ta, False)
+
+
 def _make_batch(parallel):
     """:func:`contact_batch_kernel` (parallel over rows) or its one-thread variant."""
 
@@ -518,6 +533,9 @@ def _make_batch(parallel):
     def batch(p, alpha, eta, static, kinetic, kind, mp, times, samples, vsamples, rtol, max_steps):
         out = np.empty(p.shape[0], CONTACT_ROW)
         for i in prange(p.shape[0]):
+            if kind == KIND_RECORD and static[i] < math.tan(alpha[i]):
+                _sliding_row(out, i, mp[i], times, samples, vsamples, static[i], kinetic[i])
+                continue
             blk = Body(0.75 * G / (p[i] * p[i]), alpha[i], eta[i], static[i], kinetic[i])
             mot = (kind, mp[i], times, samples, vsamples)
             ta, over = contact_run(
@@ -580,7 +598,9 @@ def contact_scene(
 def contact_batch(
     p, alpha, eta, static, kinetic, motion_rows, rtol, max_steps=MAX_STEPS, parallel=True
 ):
-    """The contact model over rows of scenes, in parallel (``parallel=False``: one thread).
+    """The contact model over rows of scenes, in parallel (``parallel=False``: one thread):
+    the exact sliding kernel for a block that cannot rock (mu_s < tan alpha) under a record,
+    the event-driven kernel for the others.
 
     Parameters
     ----------
