@@ -27,6 +27,7 @@ from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
 from . import slide_rock as sr
+from ._free_map import _rotation_at, _travel_time, free_peak_time, free_rocking_map
 from ._sliding import sliding_scene
 from ._uplift import _next_break, _skip_quiet
 from ._vertical import refuse_free_fall
@@ -34,6 +35,7 @@ from .constants import (
     ATOL_FRACTION,
     MIN_STEP,
     MODEL_NONLINEAR,
+    NEVER_AT_REST,
     REST_FRACTION,
     STATUS_MAX_STEPS,
     STEP_GROW_LIMIT,
@@ -58,8 +60,9 @@ CONTACT_TOL_FRACTION = 0.1
 (T_FIRST_IMPACT, T_OVER_TIME, T_STATUS, T_N_HIST, T_U_END) = range(7, 12)
 T_TIMES = 12  # seconds in each regime, 5 slots
 N_TALLIES = 17
-# the run's state (one float array): regime, corner, slip direction, time, step, fresh
-S_REG, S_SIDE, S_SLIP, S_T, S_H, S_FRESH = range(6)
+# the run's state (one float array): regime, corner, slip direction, time, step, fresh, and
+# whether the half-cycle under way started at a sticking impact after the motion (clean)
+S_REG, S_SIDE, S_SLIP, S_T, S_H, S_FRESH, S_CLEAN = range(7)
 
 #: The fields of a contact batch row: the rocking kernels' row, then the contact outputs.
 CONTACT_ROW = np.dtype(
@@ -132,7 +135,7 @@ def _log_state(hist, ta, st, blk, z):
 @njit(cache=True)
 def _enter(st, ta, regime, side, slip):
     """Enter ``regime`` on corner ``side`` slipping towards ``slip`` at st[S_T]."""
-    st[S_REG], st[S_SIDE], st[S_SLIP], st[S_FRESH] = regime, side, slip, 1.0
+    st[S_REG], st[S_SIDE], st[S_SLIP], st[S_FRESH], st[S_CLEAN] = regime, side, slip, 1.0, 0.0
     if (regime == sr.SLIDE or regime == sr.SLIDE_ROCK) and math.isnan(ta[T_FIRST_SLIP]):
         ta[T_FIRST_SLIP] = st[S_T]
 
@@ -175,8 +178,9 @@ def _tally_impact(ta, imps, t):
 def _impact(blk, st, ta, z, imps):
     """The block on corner st.side lands on the other corner at theta = 0 (the reference's
     ``_impact``): Housner's restitution where its impulse stays in the friction cone, else
-    :func:`.slide_rock.corner_impulse`; the Zeno rule below the rest speed. False where no
-    impulse exists (Painleve's paradox)."""
+    :func:`.slide_rock.corner_impulse`; the Zeno rule below the rest speed. Returns 2 where
+    Housner's restitution left it rocking, 1 otherwise, 0 where no impulse exists
+    (Painleve's paradox)."""
     R, alpha, side = blk.radius, blk.alpha, st[S_SIDE]
     corner, omega_rest = -side, REST_FRACTION * math.sqrt(0.75 * G / R) * alpha
     u_dot, w = z[3], z[4]
@@ -192,12 +196,13 @@ def _impact(blk, st, ta, z, imps):
         if abs(w_plus) < omega_rest:  # the Zeno rule
             z[4] = 0.0
             _enter(st, ta, sr.REST, corner, st[S_SLIP])
-        return True
+            return 1
+        return 2
     (vx, vy, w_plus), _, stuck = sr.corner_impulse(
         bx, by, w, 0.0, corner, blk.static, blk.kinetic, R, alpha
     )
     if math.isnan(w_plus):
-        return False
+        return 0
     rx, ry = sr.corner_offset(0.0, corner, R, alpha)
     slip_velocity = sr.corner_velocity(vx, vy, w_plus, rx, ry)[0]
     if corner * w_plus > 0.0 and abs(w_plus) >= omega_rest:
@@ -207,7 +212,7 @@ def _impact(blk, st, ta, z, imps):
         _enter(st, ta, regime, corner, math.copysign(1.0, z[3]))
     else:  # lands flat: the rotation stops, the slide goes on
         _start_sliding(blk, st, ta, z, vx)
-    return True
+    return 1
 
 
 @njit(cache=True)
@@ -258,15 +263,60 @@ def _stop_corner(blk, mot, st, ta, z, k):
 
 
 @njit(cache=True)
+def _map_free_rocking(blk, st, ta, z):
+    """Housner's free rocking from the impact at st[S_T] to rest, without integration
+    (:func:`._free_map.free_rocking_map`): its peak (and time), its impacts, its duration
+    (twice the travel time to each peak, :func:`._free_map._travel_time`).
+
+    Exact for the contact model where mu_s >= tan alpha and the half-cycle before this impact
+    ran free (after the motion) in rock without a slip or a lift-off, and this impact stuck
+    under Housner's restitution: at a given theta the contact forces are affine in the
+    energy (theta_dot^2 is, theta_ddot does not depend on it), and every later half-cycle
+    passes each theta with less energy, down to none at its peak, where |F| / N =
+    (3/4) sin phi cos phi / (1 - (3/4) sin^2 phi) < tan phi <= mu_s and N > 0; so no later
+    half-cycle slips or lifts. The impulse ratio of Housner's impact does not depend on the
+    speed, so every later impact sticks too."""
+    R, alpha, eta = blk.radius, blk.alpha, blk.eta
+    p = math.sqrt(0.75 * G / R)
+    w = abs(z[4])
+    over, peak, n_post = free_rocking_map(
+        0.0, w, p, alpha, eta, MODEL_NONLINEAR, REST_FRACTION * p * alpha
+    )
+    if over or n_post >= NEVER_AT_REST:
+        return
+    if peak > ta[T_MAX_THETA]:
+        dt = free_peak_time(0.0, w, p, alpha, eta, MODEL_NONLINEAR)
+        ta[T_MAX_THETA], ta[T_PEAK_TIME] = peak, st[S_T] + dt
+    spent, wk = 0.0, w / p
+    for _ in range(n_post):
+        top = _rotation_at(0.5 * wk * wk, alpha, MODEL_NONLINEAR)
+        spent += 2.0 * _travel_time(0.0, wk, top, 0.0, alpha, MODEL_NONLINEAR) / p
+        wk *= eta
+    ta[T_N_IMPACTS] += n_post
+    ta[T_TIMES + sr.ROCK] += spent
+    st[S_T] += spent
+    z[1], z[4] = 0.0, 0.0
+    _enter(st, ta, sr.REST, st[S_SIDE], st[S_SLIP])
+
+
+@njit(cache=True)
 def _transition(ev, blk, mot, st, ta, z, k, imps):
     """The regime after the event ``ev`` at st[S_T] (the state z at it). Returns 2 (fell),
-    3 (no solution) or 0 (on)."""
-    regime = int(st[S_REG])
+    3 (no solution) or 0 (on). Without a log of impact times (``imps`` empty: a batch), a
+    sticking impact after the motion that ends a clean half-cycle (:func:`_map_free_rocking`)
+    maps the free rocking to its end."""
+    regime, clean = int(st[S_REG]), st[S_CLEAN] > 0.0
+    st[S_CLEAN] = 0.0
     if ev == cs.EV_FALL:
         ta[T_OVER_TIME] = st[S_T]
         return 2
     if ev == cs.EV_IMPACT:
-        return 0 if _impact(blk, st, ta, z, imps) else 3
+        code = _impact(blk, st, ta, z, imps)
+        if code == 2 and regime == sr.ROCK and st[S_T] >= mot[1][3]:
+            st[S_CLEAN] = 1.0
+            if clean and imps.shape[0] == 0 and blk.static >= math.tan(blk.alpha):
+                _map_free_rocking(blk, st, ta, z)
+        return 3 if code == 0 else 0
     if ev == cs.EV_LAND_POS or ev == cs.EV_LAND_NEG:
         corner = 1.0 if ev == cs.EV_LAND_POS else -1.0
         return 0 if _land(blk, st, ta, z, corner, imps) else 3
@@ -354,15 +404,21 @@ def _rest(blk, mot, st, ta, z, hist, t_end, k):
 
 
 @njit(cache=True)
-def _scales(blk, regime):
-    """Absolute error scales of the six states (as fractions of the tolerance)."""
+def _scales(blk):
+    """Absolute error scales of the six states (as fractions of the tolerance): row 0 in
+    contact, row 1 in flight."""
     R, a = blk.radius, blk.alpha
     p = math.sqrt(0.75 * G / R)
-    sc = np.ones(6)
-    if regime == sr.FLIGHT:
-        sc[0], sc[1], sc[2], sc[3], sc[4], sc[5] = R * a, R * a, a, p * R * a, p * R * a, p * a
-    else:
-        sc[0], sc[1], sc[3], sc[4] = R * a, a, p * R * a, p * a
+    sc = np.ones((2, 6))
+    sc[0, 0], sc[0, 1], sc[0, 3], sc[0, 4] = R * a, a, p * R * a, p * a
+    sc[1, 0], sc[1, 1], sc[1, 2], sc[1, 3], sc[1, 4], sc[1, 5] = (
+        R * a,
+        R * a,
+        a,
+        p * R * a,
+        p * R * a,
+        p * a,
+    )
     return sc * ATOL_FRACTION
 
 
@@ -380,7 +436,7 @@ def _next_stop(mot, t, k, t_end):
 @njit(cache=True)
 def _follow_peaks(rk, mode, st, ta, z, K, z1, hs, s_end, work, found, zp):
     """Raise the tallies to the peaks of s theta inside the step, before s_end."""
-    n = cs.peaks(mode, st[S_T], hs, s_end, z, K, z1, work[2], found)
+    n = cs.peaks(mode, st[S_T], hs, s_end, z, K, z1, work[2], work[5], found)
     for i in range(n):
         t_pk = cs.refine(cs.EV_PEAK, rk, mode, st[S_T], z, K, found[i], hs, zp, work)
         _raise_peaks(ta, t_pk, zp[1], zp[0])
@@ -395,7 +451,8 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
     mode = (regime, st[S_SIDE], st[S_SLIP], blk, mot, k)
     events = cs.regime_events(regime)
     fresh = st[S_FRESH] > 0.0
-    ev, s_ev = cs.first_event(events, mode, st[S_T], hs, z, K, z1, fresh, work[2])
+    trace = work[5]
+    ev, s_ev = cs.first_event(events, mode, st[S_T], hs, z, K, z1, fresh, work[2], trace)
     st[S_FRESH] = 0.0
     if regime == sr.ROCK or regime == sr.SLIDE_ROCK:
         _follow_peaks(rk, mode, st, ta, z, K, z1, hs, s_ev, work, found, zp)
@@ -438,7 +495,7 @@ def _attempt(rk, blk, mot, st, ta, z, K, work, log, tol, t_end, k):
     cs.rk_step(rk, mode, st[S_T], z, hs, K, z1, tmp)
     t1 = t_next if last else st[S_T] + hs
     cs.deriv(mode, t1, z1, K[12])
-    err = cs.rk_error(rk, K, hs, z, z1, _scales(blk, regime), tol)
+    err = cs.rk_error(rk, K, hs, z, z1, work[6][1 if regime == sr.FLIGHT else 0], tol)
     if not err <= 1.0:  # rejected (NaN: slide-rock without a solution, or a bad step)
         if hs * p < MIN_STEP:
             return 3 if err != err else 4
@@ -460,11 +517,20 @@ def contact_run(blk, mot, rtol, t_max, max_steps, log):
     for none. Returns (tallies, overturned)."""
     hist = log[0]
     rk = cs.tableau()
-    ta, st, z = _new_tallies(), np.zeros(6), np.zeros(6)
+    ta, st, z = _new_tallies(), np.zeros(7), np.zeros(6)
     st[S_REG], st[S_SIDE], st[S_SLIP] = sr.REST, 1.0, 1.0
     st[S_H] = 0.01 / math.sqrt(0.75 * G / blk.radius)
     K = np.empty((13, 6))
-    work = (np.empty((13, 6)), np.empty(6), np.empty(6), np.empty(cs.EVENT_POINTS), np.empty(6))
+    n_trace = cs.EVENT_POINTS + len(cs.FRESH_POINTS) + 1
+    work = (
+        np.empty((13, 6)),
+        np.empty(6),
+        np.empty(6),
+        np.empty(cs.EVENT_POINTS),
+        np.empty(6),
+        np.empty((n_trace, 2)),
+        _scales(blk),
+    )
     tol, rec, k, code = CONTACT_TOL_FRACTION * TOL_SAFETY * rtol, mot[0] == KIND_RECORD, 0, 0
     _row(hist, ta, 0.0, 0.0, 0.0, 0.0)
     while True:

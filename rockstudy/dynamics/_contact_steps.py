@@ -132,10 +132,25 @@ def dense(s, h, z, K, z1, out):
 
 
 @njit(cache=True)
-def event_value(ev, mode, t, z):
-    """g of event ``ev`` at (t, z): it crosses 0 downwards at the event."""
+def forces(mode, t, z):
+    """(F / m, N / m) of a contact regime at (t, z) (:func:`.slide_rock.contact_forces`, or
+    F = -sigma mu_k N in slide-rock)."""
     regime, side, slip, blk, mot, k = mode
-    radius, alpha, _, static, kinetic = blk
+    radius, alpha, _, _, kinetic = blk
+    a_h, a_v = ground(mot, t, k)
+    if regime == sr.SLIDE_ROCK:
+        normal = sr.slide_rock_accelerations(
+            z[1], z[4], a_h, a_v, side, slip, kinetic, radius, alpha
+        )[2]
+        return -slip * kinetic * normal, normal
+    th_dd = sr.rocking_acceleration(z[1], a_h, a_v, side, radius, alpha)
+    return sr.contact_forces(z[1], z[4], th_dd, 0.0, a_h, a_v, side, radius, alpha)
+
+
+@njit(cache=True)
+def _g(ev, mode, z, f_h, f_v):
+    """g of event ``ev`` at the state z with the contact forces (f_h, f_v) there."""
+    regime, side, slip, blk = mode[0], mode[1], mode[2], mode[3]
     if ev == EV_IMPACT:
         return side * z[1]
     if ev == EV_FALL:
@@ -146,17 +161,19 @@ def event_value(ev, mode, t, z):
         return side * z[4]
     if ev == EV_LAND_POS or ev == EV_LAND_NEG:
         corner = 1.0 if ev == EV_LAND_POS else -1.0
-        return z[1] - radius * math.cos(alpha - corner * z[2])
-    a_h, a_v = ground(mot, t, k)
-    if regime == sr.SLIDE_ROCK:
-        return sr.slide_rock_accelerations(
-            z[1], z[4], a_h, a_v, side, slip, kinetic, radius, alpha
-        )[2]
-    th_dd = sr.rocking_acceleration(z[1], a_h, a_v, side, radius, alpha)
-    f_h, f_v = sr.contact_forces(z[1], z[4], th_dd, 0.0, a_h, a_v, side, radius, alpha)
+        return z[1] - blk[0] * math.cos(blk[1] - corner * z[2])
     if ev == EV_LIFT:
         return f_v
-    return static * f_v - f_h if ev == EV_SLIP_POS else static * f_v + f_h
+    return blk[3] * f_v - f_h if ev == EV_SLIP_POS else blk[3] * f_v + f_h
+
+
+@njit(cache=True)
+def event_value(ev, mode, t, z):
+    """g of event ``ev`` at (t, z): it crosses 0 downwards at the event."""
+    if EV_SLIP_POS <= ev <= EV_LIFT:
+        f_h, f_v = forces(mode, t, z)
+        return _g(ev, mode, z, f_h, f_v)
+    return _g(ev, mode, z, math.nan, math.nan)
 
 
 @njit(cache=True)
@@ -213,25 +230,33 @@ def _sample_point(j, fresh):
 
 
 @njit(cache=True)
-def first_event(events, mode, t, h, z, K, z1, fresh, tmp):
+def first_event(events, mode, t, h, z, K, z1, fresh, tmp, trace):
     """(event, unit step time) of the first terminal event inside the step, or
     (EV_NONE, 1.0): each g sampled at EVENT_POINTS points (g taken positive at the start
     of a regime, ``fresh``, as the reference's events are at a phase's start; there the
     force events also at FRESH_POINTS), then the first interval where one crosses located
-    by bisection."""
+    by bisection. The sampled (s, s theta') go into ``trace`` (for :func:`peaks`) until a
+    row with s = inf."""
     prev, los = np.empty(5), np.zeros(5)
+    with_forces = False
     for e in range(5):
         ev = events[e]
+        with_forces = with_forces or EV_SLIP_POS <= ev <= EV_LIFT
         prev[e] = 1.0 if fresh or ev == EV_NONE else event_value(ev, mode, t, z)
-    for j in range(EVENT_POINTS + (len(FRESH_POINTS) if fresh else 0)):
+    n = EVENT_POINTS + (len(FRESH_POINTS) if fresh else 0)
+    for j in range(n):
         s = _sample_point(j, fresh)
+        dense(s, h, z, K, z1, tmp)
+        f_h = f_v = math.nan
+        if with_forces:
+            f_h, f_v = forces(mode, t + s * h, tmp)
+        trace[j, 0], trace[j, 1], trace[j + 1, 0] = s, mode[1] * tmp[4], math.inf
         best, best_s = EV_NONE, 2.0
         for e in range(5):
             ev = events[e]
-            force = EV_SLIP_POS <= ev <= EV_LIFT
-            if ev == EV_NONE or (s < EARLIEST and not force):
+            if ev == EV_NONE or (s < EARLIEST and not EV_SLIP_POS <= ev <= EV_LIFT):
                 continue
-            g = _value_at(ev, mode, t, h, s, z, K, z1, tmp)
+            g = _g(ev, mode, tmp, f_h, f_v)
             if prev[e] > 0.0 and not g > 0.0:
                 root = _bisect(ev, mode, t, h, los[e], s, z, K, z1, tmp) if g == g else s
                 if root < best_s:
@@ -243,18 +268,20 @@ def first_event(events, mode, t, h, z, K, z1, fresh, tmp):
 
 
 @njit(cache=True)
-def peaks(mode, t, h, s_end, z, K, z1, tmp, found):
-    """The unit step times in (0, s_end] of the peaks of s theta (s theta' down through 0)
-    into ``found``; returns how many."""
+def peaks(mode, t, h, s_end, z, K, z1, tmp, trace, found):
+    """The unit step times in (0, s_end] of the peaks of s theta (s theta' down through 0),
+    from the samples of :func:`first_event` (``trace``), into ``found``; returns how many."""
     n = 0
-    prev = event_value(EV_PEAK, mode, t, z)
-    for i in range(1, EVENT_POINTS + 1):
-        s = min(i / EVENT_POINTS, s_end)
-        g = _value_at(EV_PEAK, mode, t, h, s, z, K, z1, tmp)
+    prev, lo = mode[1] * z[4], 0.0
+    for j in range(trace.shape[0]):
+        s = trace[j, 0]
+        if s > s_end:  # the interval of the event: its end
+            s = s_end
+        g = trace[j, 1] if s == trace[j, 0] else _value_at(EV_PEAK, mode, t, h, s, z, K, z1, tmp)
         if prev > 0.0 and not g > 0.0 and n < found.shape[0]:
-            found[n] = _bisect(EV_PEAK, mode, t, h, (i - 1) / EVENT_POINTS, s, z, K, z1, tmp)
+            found[n] = _bisect(EV_PEAK, mode, t, h, lo, s, z, K, z1, tmp)
             n += 1
-        prev = g
+        prev, lo = g, s
         if s >= s_end:
             break
     return n
