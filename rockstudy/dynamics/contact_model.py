@@ -13,9 +13,10 @@ from .. import _validate
 from .._warnings import IncompleteReferenceWarning
 from ..constants import G
 from ..motions import _kernels as mk
+from ._contact_scene import MAX_STEPS, STATUS_NO_SOLUTION, contact_scene
 from ._sliding import slide_record
 from .contact import ContactCheck, check_contact
-from .methods import STATUS_STEP_LIMIT
+from .methods import STATUS_STEP_LIMIT, StepLimitError
 from .outputs import TIMED_REGIMES
 from .result import RockingResult
 from .slide_rock import REGIMES
@@ -25,13 +26,19 @@ __all__ = [
     "CONTACT_METHODS",
     "SLIDING",
     "SOLVER",
+    "KERNEL",
+    "contact_history",
+    "contact_outputs",
+    "regime_code",
+    "ROW_OUTPUTS",
     "friction_pair",
     "refuse_options",
     "slides_only",
     "simulate_contact",
 ]
 
-#: The methods that run the contact model (its scipy reference is, for now, its only solver).
+#: The methods that run the contact model: its numba kernel ("nonlinear", "auto") or its
+#: scipy reference ("scipy").
 CONTACT_METHODS = ("nonlinear", "scipy", "auto")
 
 SLIDING = (
@@ -41,6 +48,10 @@ SLIDING = (
 SOLVER = (
     "contact model (rest, slide, rock, slide-rock, flight; Shenton & Jones 1991, Shenton "
     "1996) by its solve_ivp reference with events"
+)
+KERNEL = (
+    "contact model (rest, slide, rock, slide-rock, flight; Shenton & Jones 1991, Shenton "
+    "1996) by its event-driven numba kernel (DOP853, events on the dense output)"
 )
 
 
@@ -127,11 +138,15 @@ def contact_history(p, alpha, eta, motion, friction, method, rtol, t_max) -> dic
     """One scene of the contact model: the dict of
     :func:`~.slide_rock_reference.simulate_contact_reference` (``"energy"`` and
     ``"regime_sequence"`` from the reference only), from the exact sliding kernel where
-    :func:`slides_only` allows it, else from the reference; ``"solver"`` says which ran
-    (:data:`SLIDING` or :data:`SOLVER`)."""
+    :func:`slides_only` allows it, from the reference for ``method="scipy"``, else from the
+    event-driven kernel; ``"solver"`` says which ran (:data:`SLIDING`, :data:`SOLVER` or
+    :data:`KERNEL`)."""
     if slides_only(motion, friction, alpha, method, t_max):
         return {**_sliding_kernel(motion, friction), "solver": SLIDING}
     radius = 0.75 * G / (p * p)
+    if method != "scipy":
+        r = _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max)
+        return {**r, "solver": KERNEL}
     r = simulate_contact_reference(radius, alpha, eta, motion, *friction, rtol=rtol, t_max=t_max)
     return {**r, "solver": SOLVER}
 
@@ -166,7 +181,10 @@ def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
     """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", IncompleteReferenceWarning)
-        r = contact_history(p, alpha, eta, motion, friction, "auto", rtol, t_max)
+        try:
+            r = contact_history(p, alpha, eta, motion, friction, "auto", rtol, t_max)
+        except StepLimitError:  # the kernel did not converge: the row's failed fill
+            return _failed_row()
     incomplete = any(issubclass(w.category, IncompleteReferenceWarning) for w in caught)
     impacts = np.asarray(r["impact_times"], float)
     times = r["regime_times"]
@@ -186,6 +204,21 @@ def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
     }
 
 
+#: The outputs :func:`contact_outputs` gives, beside ``status``.
+ROW_OUTPUTS = (
+    "max_rotation", "overturned", "n_impacts", "overturn_time", "first_impact_time",
+    "lift_off", "max_slide", "residual_slide", "first_slip_time",
+    *(f"time_{name}" for name in TIMED_REGIMES), "regime",
+)  # fmt: skip
+
+
+def _failed_row() -> dict:
+    """The outputs of a scene the kernel did not solve within its steps: ``status`` 1, NaN
+    for a float, -1 for a count, False for a flag (no decision is claimed)."""
+    fills = {"overturned": False, "lift_off": False, "n_impacts": -1, "regime": -1}
+    return {"status": STATUS_STEP_LIMIT, **{k: fills.get(k, math.nan) for k in ROW_OUTPUTS}}
+
+
 def regime_code(regime_times) -> int:
     """The most involved regime a block entered, as its index in
     :data:`~.slide_rock.REGIMES` (0 rest, 1 slide, 2 rock, 3 slide-rock, 4 flight): the last
@@ -199,10 +232,15 @@ def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocki
     (mu_s, mu_k), as a :class:`~rockstudy.RockingResult`: its ``friction_demand`` is that of
     Housner's no-slip model on the same scene (``rocking()`` runs it, on first use), its
     ``lift_off`` the contact model's own. The exact sliding kernel runs the scenes of
-    :func:`slides_only`, the ``solve_ivp`` reference the others."""
+    :func:`slides_only`, the ``solve_ivp`` reference those of ``method="scipy"``, the
+    event-driven kernel (:mod:`._contact_scene`) the others; a kernel scene that reaches its
+    step limit raises :class:`~rockstudy.dynamics.methods.StepLimitError`, one without a
+    solution (Painleve's paradox) a ValueError."""
     r = contact_history(p, alpha, eta, motion, friction, method, rtol, t_max)
     if r["solver"] == SLIDING:
         info = {"solver": SLIDING}
+    elif r["solver"] == KERNEL:
+        info = {"solver": KERNEL, "steps": r["steps"]}
     else:
         info = {
             "solver": SOLVER,
@@ -234,6 +272,22 @@ def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocki
         first_slip_time=float(r["first_slip_time"]),
         regime_times=r["regime_times"],
     )
+
+
+def _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max, max_steps=MAX_STEPS):
+    """The reference's dict of a scene the event-driven kernel runs
+    (:func:`._contact_scene.contact_scene`, at most ``max_steps`` steps); a scene it does
+    not solve raises."""
+    r = contact_scene(radius, alpha, eta, motion, *friction, rtol, t_max, max_steps)
+    if r["status"] == STATUS_NO_SOLUTION:
+        raise ValueError(
+            f"friction: mu_k = {friction[1]!r} gives the contact model no solution in this "
+            "scene (Painleve's paradox, possible only for mu_k > 4/3)"
+        )
+    if r["status"] != 0:
+        raise StepLimitError(method, max_steps)
+    r["regime_sequence"] = None
+    return r
 
 
 def _housner_demand(rocking, motion, lift_off):

@@ -59,25 +59,23 @@ def _scalar_acceleration(motion: Motion):
     return ricker
 
 
-#: Most ulps walked from Brent's root of the lift test to the first double at which it holds.
-LIFT_ULP_WALK = 64
-
-
 def _first_lift(lift, lo, hi):
     """The first double in (lo, hi] at which ``lift`` > 0, where it is not > 0 at lo and is
-    at hi: Brent's root, then walked ulp by ulp to where the test switches, the time
-    :func:`._uplift.next_uplift` bisects to."""
+    at hi: Brent's root narrows the bracket, then bisection to adjacent doubles finds where
+    the test switches, the time :func:`._uplift.next_uplift` bisects to."""
     t = brentq(lift, lo, hi, xtol=1e-15)
-    for _ in range(LIFT_ULP_WALK):
-        if lift(t) > 0.0:
-            break
-        t = np.nextafter(t, hi)
-    for _ in range(LIFT_ULP_WALK):
-        before = np.nextafter(t, lo)
-        if before <= lo or not lift(before) > 0.0:
-            break
-        t = before
-    return t if lift(t) > 0.0 else hi
+    if lift(t) > 0.0:
+        hi = t
+    else:
+        lo = t
+    while True:
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            return hi
+        if lift(mid) > 0.0:
+            hi = mid
+        else:
+            lo = mid
 
 
 def _uplift_time(lift, t0, dur, grid):

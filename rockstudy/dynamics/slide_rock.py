@@ -41,6 +41,8 @@ from __future__ import annotations
 
 import math
 
+from numba import njit
+
 from ..constants import G
 
 __all__ = [
@@ -69,11 +71,13 @@ REGIMES = ("rest", "slide", "rock", "slide_rock", "flight")
 REST, SLIDE, ROCK, SLIDE_ROCK, FLIGHT = range(5)
 
 
+@njit(cache=True)
 def inertia_ratio():
     """I_G / (m R^2) of a rectangular block: (b^2 + h^2) / 3 / R^2 = 1/3."""
     return 1.0 / 3.0
 
 
+@njit(cache=True)
 def sliding_acceleration(a_h, a_v, slip, friction):
     """u'' [m/s^2] of a block sliding flat, slip direction ``slip`` = sign(u'):
 
@@ -83,6 +87,7 @@ def sliding_acceleration(a_h, a_v, slip, friction):
     return -a_h - slip * friction * (G + a_v)
 
 
+@njit(cache=True)
 def rocking_acceleration(theta, a_h, a_v, side, radius, slenderness):
     """theta'' [rad/s^2] about the fixed corner ``side``: Housner's eq. (2.2) of [000] with
     gravity g + u_v'' and p^2 = 3 g / (4 R),
@@ -93,6 +98,7 @@ def rocking_acceleration(theta, a_h, a_v, side, radius, slenderness):
     return -0.75 / radius * ((G + a_v) * math.sin(x) + a_h * math.cos(x))
 
 
+@njit(cache=True)
 def contact_forces(theta, theta_dot, theta_ddot, u_ddot, a_h, a_v, side, radius, slenderness):
     """(F / m, N / m) [m/s^2]: the base's force on a block in contact at corner ``side``,
     m times the centre of mass's absolute acceleration plus its weight (Newton):
@@ -112,6 +118,7 @@ def contact_forces(theta, theta_dot, theta_ddot, u_ddot, a_h, a_v, side, radius,
     return f_h, f_v
 
 
+@njit(cache=True)
 def slide_rock_denominator(theta, side, slip, friction, slenderness):
     """1/3 + k s sin(phi), k = s sin(phi) - mu_k sigma cos(phi): the effective inertia of
     slide-rock (:func:`slide_rock_accelerations`). Where it is <= 0 the equations have no
@@ -121,6 +128,7 @@ def slide_rock_denominator(theta, side, slip, friction, slenderness):
     return inertia_ratio() + k * side * math.sin(phi)
 
 
+@njit(cache=True)
 def slide_rock_accelerations(theta, theta_dot, a_h, a_v, side, slip, friction, radius, alpha):
     """(u'', theta'', N / m) of slide-rock: rotation about the corner ``side`` that slips in
     the direction ``slip`` = sign(u'), with F = -sigma mu_k N.
@@ -147,6 +155,7 @@ def slide_rock_accelerations(theta, theta_dot, a_h, a_v, side, slip, friction, r
     return -slip * friction * normal - a_h - tangential, theta_ddot, normal
 
 
+@njit(cache=True)
 def uplift_force_ratio(acceleration, slenderness):
     """``|F| / N`` at the instant a block at rest starts to rock under a step of ground
     acceleration a = ``|u_h''|`` / g >= tan(alpha) (horizontal shaking only), from
@@ -166,6 +175,7 @@ def uplift_force_ratio(acceleration, slenderness):
     return (acceleration - c * excess) / (1.0 + s * excess)
 
 
+@njit(cache=True)
 def slide_rock_threshold(friction, slenderness):
     """a* = ``|u_h''|`` / g above which a block at rest with mu >= tan(alpha) starts in
     slide-rock instead of rock (a step of acceleration, horizontal only): the root of
@@ -187,6 +197,7 @@ def slide_rock_threshold(friction, slenderness):
     return math.inf if den <= 0.0 else (friction * (1.0 + 3.0 * c * c) - 3.0 * s * c) / den
 
 
+@njit(cache=True)
 def leaves_rest(a_h, a_v, static, radius, slenderness):
     """> 0 exactly where a block at rest under the ground (a_h, a_v) [m/s^2] leaves rest:
     ``|a_h|`` - mu_s (g + a_v) where mu_s < tan(alpha) (it slides first), else s theta'' of
@@ -199,6 +210,7 @@ def leaves_rest(a_h, a_v, static, radius, slenderness):
     return side * rocking_acceleration(0.0, a_h, a_v, side, radius, slenderness)
 
 
+@njit(cache=True)
 def initiation_regime(a_h, a_v, static, kinetic, radius, slenderness):
     """The regime a block at rest (or stopping, slip velocity 0, theta = 0) enters under the
     ground (a_h, a_v) [m/s^2] (Shenton 1996): rest while ``|a_h|`` / g_e <= min(mu_s,
@@ -219,18 +231,21 @@ def initiation_regime(a_h, a_v, static, kinetic, radius, slenderness):
     return (SLIDE if kinetic <= tan else SLIDE_ROCK), side
 
 
+@njit(cache=True)
 def corner_offset(theta, corner, radius, slenderness):
     """(r_x, r_y) [m]: the corner ``corner`` (+1 or -1) from the centre of mass."""
     phi = slenderness - corner * theta
     return corner * radius * math.sin(phi), -radius * math.cos(phi)
 
 
+@njit(cache=True)
 def corner_velocity(vx, vy, theta_dot, rx, ry):
     """The velocity [m/s] of the point at (r_x, r_y) from the centre of mass moving at
     (vx, vy) with theta_dot (theta clockwise)."""
     return vx + theta_dot * ry, vy - theta_dot * rx
 
 
+@njit(cache=True)
 def apply_impulse(vx, vy, theta_dot, p_h, p_v, rx, ry, radius):
     """The velocities after the impulse (p_h, p_v) per unit mass [m/s] at (r_x, r_y):
     momentum, and the angular momentum about G, I_G dtheta_dot = -(r x P)."""
@@ -238,7 +253,8 @@ def apply_impulse(vx, vy, theta_dot, p_h, p_v, rx, ry, radius):
     return vx + p_h, vy + p_v, theta_dot - (rx * p_v - ry * p_h) / inertia
 
 
-def corner_impact(vx, vy, theta_dot, theta, corner, static, kinetic, radius, slenderness):
+@njit(cache=True)
+def corner_impulse(vx, vy, theta_dot, theta, corner, static, kinetic, radius, slenderness):
     """A corner strikes the base: the velocities after it, the impulse per unit mass and
     whether the corner sticks.
 
@@ -246,7 +262,8 @@ def corner_impact(vx, vy, theta_dot, theta, corner, static, kinetic, radius, sle
     corner's velocity becomes 0) where the impulse it needs lies in the cone
     ``|P_h|`` <= mu_s P_v; otherwise Coulomb's law on the impulses, P_h = -sign mu_k P_v in
     the direction of the sticking impulse (Brach 1989, eq. 8; see the module docstring for
-    why this never creates energy).
+    why this never creates energy). Where no such impulse exists (Painleve's paradox,
+    possible only for mu_k > 4/3) every returned number is NaN.
 
     Returns
     -------
@@ -255,24 +272,36 @@ def corner_impact(vx, vy, theta_dot, theta, corner, static, kinetic, radius, sle
     rx, ry = corner_offset(theta, corner, radius, slenderness)
     cx, cy = corner_velocity(vx, vy, theta_dot, rx, ry)
     inv = 1.0 / (inertia_ratio() * radius * radius)
-    w = ((1.0 + ry * ry * inv, -rx * ry * inv), (-rx * ry * inv, 1.0 + rx * rx * inv))
-    det = w[0][0] * w[1][1] - w[0][1] * w[1][0]
-    p_h = -(w[1][1] * cx - w[0][1] * cy) / det
-    p_v = -(-w[1][0] * cx + w[0][0] * cy) / det
+    w00, w01, w11 = 1.0 + ry * ry * inv, -rx * ry * inv, 1.0 + rx * rx * inv
+    det = w00 * w11 - w01 * w01
+    p_h = -(w11 * cx - w01 * cy) / det
+    p_v = -(-w01 * cx + w00 * cy) / det
     if abs(p_h) <= static * p_v:
         return apply_impulse(vx, vy, theta_dot, p_h, p_v, rx, ry, radius), (p_h, p_v), True
     ratio = math.copysign(kinetic, p_h)
-    den = w[1][0] * ratio + w[1][1]
+    den = w01 * ratio + w11
     if den <= 0.0:
-        raise ValueError(
-            f"friction: mu_k = {kinetic!r} admits no impact impulse at this corner "
-            "(Painleve's paradox, possible only for mu_k > 4/3)"
-        )
+        return (math.nan, math.nan, math.nan), (math.nan, math.nan), False
     p_v = -cy / den
     p_h = ratio * p_v
     return apply_impulse(vx, vy, theta_dot, p_h, p_v, rx, ry, radius), (p_h, p_v), False
 
 
+def corner_impact(vx, vy, theta_dot, theta, corner, static, kinetic, radius, slenderness):
+    """:func:`corner_impulse`, with a ValueError where no impulse exists (Painleve's
+    paradox, possible only for mu_k > 4/3)."""
+    after, impulse, stuck = corner_impulse(
+        vx, vy, theta_dot, theta, corner, static, kinetic, radius, slenderness
+    )
+    if math.isnan(after[2]):
+        raise ValueError(
+            f"friction: mu_k = {kinetic!r} admits no impact impulse at this corner "
+            "(Painleve's paradox, possible only for mu_k > 4/3)"
+        )
+    return after, impulse, stuck
+
+
+@njit(cache=True)
 def rocking_impact(u_dot, theta_dot, side, restitution, radius, slenderness):
     """theta_dot+ [rad/s] when the block on corner ``side`` lands on the other corner at
     theta = 0 and that corner sticks: Housner's restitution on the rotation (eq. 2.4 of
@@ -286,6 +315,7 @@ def rocking_impact(u_dot, theta_dot, side, restitution, radius, slenderness):
     return restitution * theta_dot + 0.75 * math.cos(slenderness) / radius * u_dot
 
 
+@njit(cache=True)
 def centre_velocity(u_dot, theta, theta_dot, side, radius, slenderness):
     """(vx, vy) [m/s] of the centre of mass of a block in contact at corner ``side``:
     d/dt (x_c - s R sin phi, R cos phi) with x_c' = u'."""
@@ -293,6 +323,7 @@ def centre_velocity(u_dot, theta, theta_dot, side, radius, slenderness):
     return u_dot + radius * math.cos(phi) * theta_dot, side * radius * math.sin(phi) * theta_dot
 
 
+@njit(cache=True)
 def kinetic_energy(vx, vy, theta_dot, radius):
     """Kinetic energy per unit mass [J/kg] relative to the ground: translation plus
     I_G theta_dot^2 / 2."""
