@@ -31,7 +31,7 @@ from ._rocking import (
 )
 from ._vertical import refuse_free_fall
 
-__all__ = ["HOP_POINTS", "LIFT_ULP_WALK", "simulate_reference"]
+__all__ = ["HOP_POINTS", "simulate_reference"]
 
 
 def _scalar_vertical(motion: Motion):
