@@ -457,3 +457,20 @@ def test_result_outputs_and_arguments():
         rs.simulate(BLOCK, pulse, friction=0.3, dt_out=0.1, t_max=1.0)
     with pytest.raises(ValueError, match="the contact model runs a Block, not a SymmetricFrame"):
         rs.simulate(SymmetricFrame(1.0, 0.15, 0.5), pulse, friction=0.3)
+
+
+@pytest.mark.parametrize("friction", [1e-300, 1e-15, (0.5, 1e-12)])
+def test_a_friction_below_the_smallest_the_model_follows_is_refused_by_name(friction):
+    """Below MIN_FRICTION a slide left after the motion lasts |v| / (mu_k g): refused, in
+    simulate and in a batch, before any integration."""
+    from rockstudy.dynamics.contact_model import MIN_FRICTION
+
+    block, pulse = rs.Block(0.8, 0.2), rs.motions.SinePulse(4.0, 0.6)
+    with pytest.raises(ValueError, match="friction must lie in") as err:
+        rs.simulate(block, pulse, friction=friction)
+    assert f"{MIN_FRICTION:g}" in str(err.value)
+    with pytest.raises(ValueError, match="friction"):
+        rs.simulate_batch(
+            half_diagonal=0.8, slenderness=0.2, amplitude=4.0, period=0.6,
+            friction=friction, model="contact",
+        )  # fmt: skip

@@ -27,6 +27,7 @@ __all__ = [
     "SLIDING",
     "SOLVER",
     "KERNEL",
+    "MIN_FRICTION",
     "contact_history",
     "contact_outputs",
     "regime_code",
@@ -55,10 +56,16 @@ KERNEL = (
 )
 
 
+#: The smallest friction coefficient the contact model takes. No base of the field is that
+#: smooth (PTFE on steel is about 0.04), and below it a slide left after the motion, which
+#: lasts |v| / (mu_k g), outlasts what the kernel follows (it stalls near 1e-15).
+MIN_FRICTION = 1e-6
+
+
 def friction_pair(friction, largest) -> tuple[float, float]:
     """(mu_s, mu_k) from ``friction``: one coefficient mu (mu_s = mu_k = mu) or a pair
-    (mu_s, mu_k) with mu_s >= mu_k, each in (0, ``largest``]; a ValueError naming
-    ``friction`` otherwise."""
+    (mu_s, mu_k) with mu_s >= mu_k, each in [:data:`MIN_FRICTION`, ``largest``]; a
+    ValueError naming ``friction`` otherwise."""
     pair = friction if isinstance(friction, (tuple, list)) else (friction, friction)
     if len(pair) != 2:
         raise ValueError(
@@ -66,8 +73,11 @@ def friction_pair(friction, largest) -> tuple[float, float]:
         )
     static, kinetic = (_validate.number("friction", value) for value in pair)
     for value in (static, kinetic):
-        if not (math.isfinite(value) and 0.0 < value <= largest):
-            raise ValueError(f"friction must lie in (0, {largest:g}], got {value!r}")
+        if not (math.isfinite(value) and MIN_FRICTION <= value <= largest):
+            raise ValueError(
+                f"friction must lie in [{MIN_FRICTION:g}, {largest:g}] for the contact model, "
+                f"got {value!r}"
+            )
     if kinetic > static:
         raise ValueError(
             f"friction: the kinetic coefficient {kinetic!r} exceeds the static {static!r} "
@@ -141,6 +151,10 @@ def contact_history(p, alpha, eta, motion, friction, method, rtol, t_max) -> dic
     :func:`slides_only` allows it, from the reference for ``method="scipy"``, else from the
     event-driven kernel; ``"solver"`` says which ran (:data:`SLIDING`, :data:`SOLVER` or
     :data:`KERNEL`)."""
+    if min(friction) < MIN_FRICTION:
+        raise ValueError(
+            f"friction must lie in [{MIN_FRICTION:g}, 10] for the contact model, got {friction!r}"
+        )
     if slides_only(motion, friction, alpha, method, t_max):
         return {**_sliding_kernel(motion, friction), "solver": SLIDING}
     radius = 0.75 * G / (p * p)

@@ -136,9 +136,9 @@ class Study(_Model):
         if self.design is not None and design_kind(self.design.kind).capacities:
             raise FieldError(
                 "run.model",
-                f"{model!r} is not available in a {self.design.kind!r} design yet (its ladder "
-                "runs Housner's model "
-                "with the friction check): give model = 'rocking', or a cloud or stripes design",
+                f"{model!r} is not available in an {self.design.kind.upper()} design yet "
+                "(its ladder runs Housner's model with the friction check): give model = "
+                "'rocking', or a cloud or stripes design",
             )
         return self
 
