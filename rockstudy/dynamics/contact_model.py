@@ -73,7 +73,9 @@ def friction_pair(friction, largest) -> tuple[float, float]:
         )
     static, kinetic = (_validate.number("friction", value) for value in pair)
     for value in (static, kinetic):
-        if not (math.isfinite(value) and MIN_FRICTION <= value <= largest):
+        if not (math.isfinite(value) and 0.0 < value <= largest):
+            raise ValueError(f"friction must lie in (0, {largest:g}], got {value!r}")
+        if value < MIN_FRICTION:
             raise ValueError(
                 f"friction must lie in [{MIN_FRICTION:g}, {largest:g}] for the contact model, "
                 f"got {value!r}"
