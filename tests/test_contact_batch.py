@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from _helpers import write_at2
 
 import rockstudy as rs
 from rockstudy.constants import G
@@ -325,19 +326,6 @@ def test_a_study_refuses_slide_outputs_under_the_rocking_model():
 # ---------------------------------------------------------------- a record design
 
 
-def _write_at2(path, record):
-    """A PEER .AT2 file of ``record`` (in g)."""
-    values = record.acceleration / G
-    lines = [
-        "PEER STRONG MOTION DATABASE RECORD",
-        "synthetic near-fault record for the contact tests",
-        "ACCELERATION TIME SERIES IN UNITS OF G",
-        f"NPTS= {values.size}, DT= {record.dt:.4f} SEC",
-    ]
-    lines += [" ".join(f"{v:.9e}" for v in values[i : i + 5]) for i in range(0, values.size, 5)]
-    path.write_text("\n".join(lines) + "\n")
-
-
 OBJECTS_STUDY = """
 name = "museum_contact"
 seed = 1
@@ -376,7 +364,7 @@ def test_a_cloud_of_objects_under_auto_stores_each_objects_slide(tmp_path):
     folder.mkdir()
     for i, tp in enumerate((0.4, 0.9)):
         rec = synthetic_near_fault(pulse_period=tp, pga=2.5, seed=40 + i, duration=3.0)
-        _write_at2(folder / f"r{i}.AT2", rec)
+        write_at2(folder / f"r{i}.AT2", rec)
     (tmp_path / "objects.csv").write_text(OBJECTS_CSV)
     path = tmp_path / "museum.toml"
     path.write_text(OBJECTS_STUDY.format(folder=folder))
@@ -426,7 +414,7 @@ def test_a_design_refuses_bad_slide_limits_and_the_contact_model_in_an_ida(
     folder = tmp_path / "records"
     folder.mkdir()
     rec = rs.motions.synthetic_near_fault(pulse_period=0.5, pga=2.5, seed=1, duration=2.0)
-    _write_at2(folder / "r0.AT2", rec)
+    write_at2(folder / "r0.AT2", rec)
     (tmp_path / "objects.csv").write_text(OBJECTS_CSV)
     text = OBJECTS_STUDY.format(folder=folder).replace(old, new)
     path = tmp_path / "museum.toml"
