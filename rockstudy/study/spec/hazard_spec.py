@@ -15,7 +15,15 @@ from ...risk import MAX_YEARS
 from .parameters import _describe, _Model, _Period
 from .structures import FieldError
 
-__all__ = ["HazardSpec"]
+__all__ = ["HazardSpec"]  # and HAZARD_MEASURES, read from the registry (__getattr__)
+
+
+def __getattr__(name):
+    """``HAZARD_MEASURES``: the measures a ``[hazard]`` curve may be of, read from the
+    registry when asked (a measure registered after import is one)."""
+    if name == "HAZARD_MEASURES":
+        return tuple(measures.scalable())
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _hazard_im(name: str) -> str:
