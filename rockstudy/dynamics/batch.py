@@ -307,9 +307,10 @@ def simulate_batch(
         else the ``solve_ivp`` reference at ``rtol``; milliseconds to seconds a row, one row
         at a time) on every row; ``method`` "linear" is refused. ``"auto"`` (needs
         ``friction``): Housner's model with the friction check on every row, then the
-        contact model on the rows whose friction demand exceeded mu_s or that lifted off;
-        the other rows keep Housner's answer, which the contact model would give too (no
-        slip, no flight). The output ``model`` says which answered each row (3: the contact
+        contact model on the rows whose friction demand exceeded mu_s, that lifted off or
+        that overturned (the fall unloads the base: it ends in slip or flight); the other
+        rows keep Housner's answer, which the contact model would give too (no slip, no
+        flight). The output ``model`` says which answered each row (3: the contact
         model). With ``"contact"`` or ``"auto"`` the outputs also hold (by default)
         ``max_slide`` [m], ``residual_slide`` [m], ``first_slip_time`` [s], ``time_slide``,
         ``time_slide_rock``, ``time_flight`` [s] and ``regime`` (the most involved regime
@@ -505,13 +506,13 @@ class _RowMotions:
 
 def _add_contact_model(cols, rows, mu, model, motions, rtol):
     """Run the contact model (:func:`.contact_model.contact_outputs`) on the rows of
-    ``cols`` that ``model`` gives it (all of them, or under ``"auto"`` those whose friction
-    demand exceeded mu_s or that lifted off), writing its outputs over Housner's there; the
-    other rows get the slide outputs of a block that did not slip (:func:`_no_slip`)."""
+    ``cols`` that ``model`` gives it (all of them, or under ``"auto"`` those of
+    :func:`_beyond_housner`), writing its outputs over Housner's there; the other rows get
+    the slide outputs of a block that did not slip (:func:`_no_slip`)."""
     p, alpha, eta = rows[:3]
     n = p.size
     if model == "auto":
-        chosen = (cols["friction_demand"] > mu[0]) | (cols["lift_off"] != 0)
+        chosen = _beyond_housner(cols, mu[0])
     else:
         chosen = np.ones(n, bool)
     cols.update(_no_slip(cols))
@@ -527,6 +528,15 @@ def _add_contact_model(cols, rows, mu, model, motions, rtol):
     for name in untimed:  # the kernel outputs the contact model leaves out
         cols[name][chosen] = outputs.OUTPUTS[name].fill
     cols["model"][chosen] = MODEL_CONTACT
+
+
+def _beyond_housner(cols, mu_s):
+    """The rows whose answer ``"auto"`` takes from the contact model: a friction demand
+    above ``mu_s``, a lift-off, or an overturning (the fall of an overturning block unloads
+    the base, so it ends in slip or flight before it lies flat: the contact model times the
+    slip and gives the slide that Housner's model cannot)."""
+    over = cols["overturned"].astype(bool)
+    return (cols["friction_demand"] > mu_s) | (cols["lift_off"] != 0) | over
 
 
 def _no_slip(cols) -> dict:
