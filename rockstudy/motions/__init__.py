@@ -1,6 +1,7 @@
 """Ground motions: analytic pulses, sampled records and stochastic synthesis."""
 
 from .base import Motion
+from .building import Building, floor_motion
 from .mavroeidis import mp_pulse_acceleration, mp_pulse_velocity
 from .measures import register_measure
 from .pulse_extraction import VelocityPulse
@@ -13,6 +14,8 @@ from .wavelet_pulse import WaveletPulse
 
 __all__ = [
     "Motion",
+    "Building",
+    "floor_motion",
     "PULSES",
     "SinePulse",
     "CosinePulse",

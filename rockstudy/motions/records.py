@@ -7,6 +7,7 @@ import os
 import re
 import stat
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -108,6 +109,10 @@ class Record(Motion):
         A label for plots and results.
     vertical : array_like, optional
         Vertical ground acceleration [m/s^2], positive upwards, on the same samples.
+    metadata : mapping, optional
+        What the record is, for the reader (e.g. the building and floor of a floor motion,
+        :func:`rockstudy.motions.floor_motion`); kept by :meth:`scaled`, never read by the
+        motion or its measures.
 
     Intensity measures (:meth:`intensity_measures`, :meth:`response_spectrum`, :meth:`pulse`) are
     computed once and cached; the sample arrays are read-only for that reason.
@@ -118,12 +123,16 @@ class Record(Motion):
     time: np.ndarray | None = None
     name: str = ""
     vertical: np.ndarray | None = None
+    metadata: dict | None = field(default=None, repr=False)
     _times: np.ndarray = field(init=False, repr=False)
     _cache: dict = field(init=False, repr=False)
 
     def __post_init__(self):
         if not isinstance(self.name, str):
             raise ValueError(f"name must be a string, got {type(self.name).__name__}")
+        if not isinstance(self.metadata, Mapping | None):
+            raise TypeError(f"metadata must be a mapping, got {type(self.metadata).__name__}")
+        object.__setattr__(self, "metadata", dict(self.metadata or {}))
         acc = _samples("acceleration", self.acceleration)
         if acc.size < 2:
             raise ValueError("acceleration must hold at least 2 samples")
@@ -191,7 +200,9 @@ class Record(Motion):
             acc = self.acceleration * factor
             vertical = None if self.vertical is None else self.vertical * abs(factor)
         try:
-            return Record(acc, time=self._times, name=self.name, vertical=vertical)
+            return Record(
+                acc, time=self._times, name=self.name, vertical=vertical, metadata=self.metadata
+            )
         except ValueError as exc:
             raise ValueError(f"factor = {factor:g} on the record {self.name!r}: {exc}") from None
 
@@ -342,7 +353,11 @@ class Record(Motion):
                 "its samples"
             )
         return Record(
-            self.acceleration, time=self._times, name=self.name, vertical=vertical.acceleration
+            self.acceleration,
+            time=self._times,
+            name=self.name,
+            vertical=vertical.acceleration,
+            metadata=self.metadata,
         )
 
     def kernel_spec(self):

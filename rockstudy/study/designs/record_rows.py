@@ -252,12 +252,13 @@ def _suite(motion_json: str, base_dir) -> tuple:
 
 @lru_cache(maxsize=32)
 def load_record(motion_json: str, base_dir, index: int):
-    """Record ``index`` of a study's suite (read once per process)."""
+    """Record ``index`` of a study's suite (read once per process), on the motion's floor
+    when it names a building (:meth:`RecordSpec.floor_motion`)."""
     from ..spec.motion_spec import RecordSpec
 
-    units = RecordSpec.model_validate(json.loads(motion_json)).units
+    motion = RecordSpec.model_validate(json.loads(motion_json))
     field, h, v = _suite(motion_json, base_dir)[index]
-    return read_pair(h, v, units, field)
+    return motion.floor_motion(read_pair(h, v, motion.units, field))
 
 
 def stored_periods(study) -> np.ndarray:

@@ -3,8 +3,9 @@
 A pulse is given by its amplitude and period or by their dimensionless groups; a record suite
 by its files (H/V pairs as lists or by a renaming rule) and how each record is scaled
 (``scale``, ``pga_ratio`` or a target :class:`ScaleTo` of an intensity measure, in the units
-of :func:`scale_units`); a stochastic motion by its Kanai-Tajimi filter. :data:`MotionSpec` is
-their union, told apart by ``kind``.
+of :func:`scale_units`), and optionally the floor of a linear building it is felt on
+(:class:`BuildingSpec`, ``floor``); a stochastic motion by its Kanai-Tajimi filter.
+:data:`MotionSpec` is their union, told apart by ``kind``.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from ... import _validate
 from ...motions import measures
+from ...motions.building import MAX_STOREYS, Building, floor_motion
 from ...motions.pulses import MAX_CYCLES, PERIOD_RANGE
 from ...motions.units import acceleration_units
 from .feasibility import draw_span as _draw_span
@@ -35,6 +37,7 @@ from .parameters import (
 from .structures import FieldError
 
 __all__ = [
+    "BuildingSpec",
     "MAX_SCALE",
     "MIN_SCALE",
     "HVPair",
@@ -45,6 +48,7 @@ __all__ = [
     "ScaleIM",
     "ScaleTo",
     "StochasticSpec",
+    "UniformShearSpec",
     "VerticalRule",
     "scale_units",
 ]
@@ -220,6 +224,58 @@ class VerticalRule(_Model):
         return value
 
 
+class UniformShearSpec(_Model):
+    """A shear building of equal storeys (:meth:`rockstudy.motions.Building.uniform_shear`):
+    ``n_storeys``, the first ``period`` [s] and the ``damping`` ratio of every mode."""
+
+    n_storeys: int = Field(ge=1, le=MAX_STOREYS)
+    period: float = Field(gt=0.0, le=100.0)
+    damping: _Damping
+
+
+#: The fields of a modal building (:class:`rockstudy.motions.Building`), in its order.
+_MODAL_FIELDS = ("periods", "mode_shapes", "participation", "damping")
+
+
+class BuildingSpec(_Model):
+    """The linear building whose floor the records are felt on: either ``uniform_shear =
+    { n_storeys, period, damping }`` or its modes, ``periods`` [s], ``mode_shapes`` (one list
+    per mode: its value at floors 1..n), ``participation`` (one factor per mode) and
+    ``damping`` (one ratio, or one per mode); see :class:`rockstudy.motions.Building`."""
+
+    uniform_shear: UniformShearSpec | None = None
+    periods: list[float] | None = None
+    mode_shapes: list[list[float]] | None = None
+    participation: list[float] | None = None
+    damping: float | list[float] | None = None
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        given = [f for f in _MODAL_FIELDS if getattr(self, f) is not None]
+        if self.uniform_shear is not None and given:
+            raise FieldError(given[0], "give either uniform_shear = { ... } or the modes, not both")
+        missing = [f for f in _MODAL_FIELDS if getattr(self, f) is None]
+        if self.uniform_shear is None and missing:
+            raise FieldError(
+                missing[0],
+                "is required: give uniform_shear = { n_storeys, period, damping } or the "
+                f"modes {', '.join(_MODAL_FIELDS)}",
+            )
+        try:
+            self.building()
+        except ValueError as exc:
+            field, _, rest = str(exc).partition(" ")
+            raise FieldError(field, rest) if field in _MODAL_FIELDS else exc from None
+        return self
+
+    def building(self) -> Building:
+        """The :class:`rockstudy.motions.Building` this table describes."""
+        if self.uniform_shear is not None:
+            u = self.uniform_shear
+            return Building.uniform_shear(u.n_storeys, u.period, u.damping)
+        return Building(self.periods, self.mode_shapes, self.participation, self.damping)
+
+
 #: Units of a text record's acceleration column: those of an acceleration in the package's one
 #: table of units (:func:`rockstudy.motions.units.acceleration_units`).
 RECORD_UNITS = tuple(acceleration_units())
@@ -241,6 +297,11 @@ class RecordSpec(_Model):
     ``.AT2`` files are in g (PEER's format), and a
     suite of ``.AT2`` files alone with other units is refused.
 
+    ``building`` (a :class:`BuildingSpec`) and ``floor`` (0 = the ground, to the building's
+    top floor n) put the objects on a floor: every record is replaced by the absolute
+    acceleration of that floor (:func:`rockstudy.motions.floor_motion`) before it is scaled
+    and run. One floor per study (a list of floors is refused).
+
     A path is absolute as written, or relative to the study file's folder (never to the
     working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
     are read. No record is skipped: every file named, matched or found must read.
@@ -253,6 +314,8 @@ class RecordSpec(_Model):
     scale: Param | None = None
     pga_ratio: Param | None = None
     scale_to: ScaleTo | None = None
+    building: BuildingSpec | None = None
+    floor: int | list[int] | None = None
 
     @field_validator("files")
     @classmethod
@@ -296,7 +359,30 @@ class RecordSpec(_Model):
                 )
             if any(isinstance(f, HVPair) for f in self.files):
                 raise FieldError("vertical", "give pairs either in files or in vertical, not both")
+        self._check_floor()
         return self
+
+    def _check_floor(self) -> None:
+        """``building`` and ``floor`` come together; ``floor`` is one floor in 0..n."""
+        if (self.building is None) != (self.floor is None):
+            given, other = ("building", "floor") if self.floor is None else ("floor", "building")
+            raise FieldError(other, f"is required with {given} (the floor of the building)")
+        if isinstance(self.floor, list):
+            raise FieldError(
+                "floor",
+                "must be one floor (a whole number); a list of floors is not a study "
+                "dimension: run one study per floor",
+            )
+        if self.building is not None:
+            top = self.building.building().n_floors
+            if not 0 <= self.floor <= top:
+                raise FieldError("floor", f"must be in 0..{top} (0 = the ground), got {self.floor}")
+
+    def floor_motion(self, record):
+        """``record`` as felt on ``floor`` of ``building`` (the record itself without them)."""
+        if self.building is None:
+            return record
+        return floor_motion(record, self.building.building(), self.floor)
 
     def target(self) -> ScaleTo | None:
         """The scaling target, with ``pga_ratio`` read as ``scale_to = { im = "pga_ratio" }``."""
