@@ -287,3 +287,18 @@ def test_a_study_refuses_a_bad_building_or_floor_by_name(suite, tmp_path, motion
     with pytest.raises(StudyError) as err:
         load_study(write(tmp_path, text))
     assert message in str(err.value)
+
+
+def test_a_study_on_a_floor_refuses_a_ground_hazard_curve(suite, tmp_path):
+    from rockstudy.study import StudyError
+
+    hazard = '[hazard]\nkind = "power_law"\nim = "pga"\nk0 = 1e-4\nk = 2.5\nunits = "g"\n'
+    ground = study_text(suite, "", CLOUD) + hazard
+    assert load_study(write(tmp_path, ground)).hazard is not None
+    for floor in (0, 2):
+        text = study_text(suite, f"{SHEAR}\nfloor = {floor}", CLOUD) + hazard
+        if floor == 0:
+            assert load_study(write(tmp_path, text)).motion.floor == 0
+            continue
+        with pytest.raises(StudyError, match="hazard: is a hazard curve of the ground motion"):
+            load_study(write(tmp_path, text))

@@ -242,6 +242,12 @@ class Study(_Model):
                 "it integrates is fitted per structure over records, which a Monte Carlo "
                 "or Sobol study does not have",
             )
+        if getattr(self.motion, "floor", None):
+            raise FieldError(
+                "hazard",
+                "is a hazard curve of the ground motion, but on motion.floor > 0 the design's "
+                "intensity measures are the floor motion's: leave out [hazard] on a floor",
+            )
         if measures.measure(hz.im).needs_period:
             stored = set(de.periods) | {de.period}
             if self.motion.kind == "record" and self.motion.scale_to is not None:
