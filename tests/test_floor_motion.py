@@ -12,8 +12,9 @@ import math
 import numpy as np
 import pytest
 import scipy.signal
-from _helpers import RECORD_STUDY_HEAD, write_near_fault_pairs
+from _helpers import RECORD_STUDY_HEAD, rows_study, run_rows, write_near_fault_pairs
 
+from rockstudy.constants import G
 from rockstudy.motions import Building, Record, floor_motion, load_suite
 from rockstudy.study import load_study, run_study
 from rockstudy.study.designs import records as rd
@@ -302,3 +303,16 @@ def test_a_study_on_a_floor_refuses_a_ground_hazard_curve(suite, tmp_path):
             continue
         with pytest.raises(StudyError, match="hazard: is a hazard curve of the ground motion"):
             load_study(write(tmp_path, text))
+
+
+def test_monte_carlo_rows_on_a_floor_scale_the_floor_motion(suite, tmp_path):
+    study = rows_study(suite, tmp_path, f"{SHEAR}\nfloor = 3\npga_ratio = 2.5")
+    design, out = run_rows(study, tmp_path)
+    files = sorted(suite.glob("*_H.AT2"))
+    building = Building.uniform_shear(5, 0.5, 0.05)
+    for i, r in enumerate(design["record"].values):
+        ground = Record.from_at2(files[r])
+        floor = lsim_floor(building, 3, ground.time, ground.acceleration)
+        uplift = G * np.tan(design["critical_rotation"].values[i])
+        assert np.max(np.abs(floor)) * out["scale"][i] == pytest.approx(2.5 * uplift, rel=1e-9)
+        assert ground.peak * out["scale"][i] != pytest.approx(2.5 * uplift, rel=1e-2)
