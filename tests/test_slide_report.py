@@ -1,0 +1,128 @@
+"""The record report's sliding sections, from a small museum study of stripes under
+``[run] model = "auto"`` with slide limits and a hazard curve: the slide fragility and annual
+rates per limit, the contact model against the rocking-only model, the regimes; object names
+escaped. Oracles: Housner's model run here by rs.simulate for the rocking-only decision,
+counts of the stored points, and the page's text."""
+
+from __future__ import annotations
+
+import html
+import json
+import time
+
+import numpy as np
+import pytest
+from _helpers import write_at2
+
+import rockstudy as rs
+from rockstudy.motions.suites import read_pair
+from rockstudy.study.analysis import sliding
+
+#: A stocky amphora on a smooth base (mu 0.25 < tan 0.45: it slides), a bronze statue
+#: (tan 0.3 < mu 0.6: it rocks) and a name to escape.
+OBJECTS = """name,half_diagonal,slenderness,friction
+Amphora,0.3,0.45,0.25
+<b>Bronze & Co</b>,0.5,0.3,
+"""
+STUDY = """
+name = "museum <sliding>"
+seed = 1
+friction = 0.6
+[structure]
+kind = "objects"
+file = "objects.csv"
+[motion]
+kind = "record"
+files = "{folder}"
+scale_to = {{ im = "pga", value = {{ dist = "grid", values = [1.0, 2.5, 4.0, 6.0] }} }}
+[design]
+kind = "stripes"
+slide_limits = [0.005, 0.05]
+[run]
+model = "{model}"
+[hazard]
+kind = "power_law"
+k0 = 2e-4
+k = 2.3
+im = "pga"
+units = "g"
+"""
+NAME = "<b>Bronze & Co</b>"
+
+
+def _run(tmp_path, model):
+    """Run the study (3 generated records) and write its report; (dataset, page, seconds)."""
+    from distributed import Client
+
+    from rockstudy.study import load_study, run_study
+    from rockstudy.study.report import make_report
+    from rockstudy.study.running.store import open_result
+
+    folder = tmp_path / "records"
+    folder.mkdir()
+    for i, tp in enumerate((0.3, 0.5, 0.8)):
+        rec = rs.motions.synthetic_near_fault(pulse_period=tp, pga=2.0, seed=7 + i, duration=2.5)
+        write_at2(folder / f"r{i}.AT2", rec)
+    (tmp_path / "objects.csv").write_text(OBJECTS)
+    path = tmp_path / "museum.toml"
+    path.write_text(STUDY.format(folder=folder, model=model))
+    start = time.perf_counter()
+    cube = tmp_path / "cube.zarr"
+    with Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as c:
+        run_study(load_study(path), cube, client=c, base_dir=tmp_path, progress=False)
+    page = make_report(cube, tmp_path / "report")
+    return open_result(cube).load(), page.read_text(), time.perf_counter() - start
+
+
+@pytest.fixture(scope="module")
+def auto_study(tmp_path_factory):
+    return _run(tmp_path_factory.mktemp("auto"), "auto")
+
+
+def test_auto_keeps_housners_decision_of_every_point(auto_study):
+    """overturned_rocking is rs.simulate's decision without friction, point by point."""
+    ds = auto_study[0]
+    blocks = {"Amphora": (0.3, 0.45), NAME: (0.5, 0.3)}
+    files = json.loads(ds.attrs["record_files"])
+    for r, f in enumerate(files):
+        rec = read_pair(f)
+        for s, (name, (R, alpha)) in enumerate(blocks.items()):
+            block = rs.Block(half_diagonal=R, slenderness=alpha)
+            for k in range(ds.sizes["level"]):
+                scale = float(ds["scale"].isel(record=r, structure=s, level=k))
+                housner = rs.simulate(block, rec.scaled(scale))
+                got = int(ds["overturned_rocking"].isel(record=r, structure=s, level=k))
+                assert got == int(housner.overturned), (r, name, k)
+    assert ds.attrs["slide_limits"] == [0.005, 0.05]
+
+
+def test_the_report_has_the_sliding_sections_and_escapes_names(auto_study):
+    ds, page, _ = auto_study
+    for heading in (
+        "Sliding: fragility and annual rates per slide limit",
+        "Contact model against the rocking-only model",
+        "Regimes: what each record drove each object into",
+    ):
+        assert f"<h2>{heading}</h2>" in page
+    for csv in ("slide_fragility.csv", "annual_sliding.csv", "contact_vs_rocking.csv"):
+        assert f"<a href='{csv}'>" in page
+    assert "regimes.csv" in page
+    assert NAME not in page  # never raw
+    assert html.escape(NAME) in page
+    assert "counts as exceeding every slide limit" in page
+    # the regimes table names, per object, the regime of every record at every level
+    table = sliding.regimes(ds)
+    assert table.shape == (2 * 3, 4)
+    assert (table.loc["Amphora"] != "rest").any(axis=None)
+    # the amphora (mu < tan alpha) slides: its annual rate of exceeding the smaller limit is
+    # at least that of the larger one
+    out = sliding.slide_risk(ds, rs.risk.HazardCurve.power_law(2e-4, 2.3, "pga", "g"), n_boot=0)
+    amph = out.sel(structure="Amphora")["annual_rate"].values
+    if np.isfinite(amph).all():
+        assert amph[0] >= amph[1]
+
+
+def test_under_the_contact_model_the_report_says_the_rocking_only_rate_needs_auto(tmp_path):
+    _, page, _ = _run(tmp_path, "contact")
+    assert "<h2>Contact model against the rocking-only model</h2>" in page
+    assert html.escape('the rocking-only answer needs model = "auto"') in page
