@@ -209,3 +209,25 @@ def test_regimes_name_each_records_regime_per_object_and_level():
     assert table.loc[("Bronze", 2), LEVELS_G[3]] == sliding.REGIME_NAMES[int(code[2, 1, 3])]
     assert table.loc[("Amphora", 1), LEVELS_G[2]] == "not run"
     assert table.shape == (2 * 3, LEVELS_G.size)
+
+
+def test_rates_of_nested_limits_that_cross_are_flagged():
+    """Every record's capacity at 2 D0 is above its capacity at D0 (the exceedances nest), but
+    a far wider spread at 2 D0 makes its lognormal's rate the higher (Cornell's closed form,
+    k0 theta^-k exp(k^2 beta^2 / 2)): the smaller limit is flagged ``crossed``."""
+    ds, _ = _ida()
+    c = ds["slide_capacity"].isel(slide_limit=0).values / STANDARD_GRAVITY
+    z = np.random.default_rng(2).standard_normal(c.shape)
+    wide = c * np.exp(3.0 * np.abs(z))
+    ds["slide_capacity"][1] = wide * STANDARD_GRAVITY
+    ds["capacity_scale"][:] = 100.0  # overturning far above both
+    k0, k = 1e-4, 2.5
+    out = sliding.slide_risk(ds, risk.HazardCurve.power_law(k0, k, "pga", "g"), n_boot=0)
+    for j, name in enumerate(NAMES):
+        rate = [
+            k0 * t**-k * np.exp(k**2 * b**2 / 2)
+            for t, b in map(_lognormal_mle, (c[:, j], wide[:, j]))
+        ]
+        assert rate[1] > rate[0]  # the case this test builds
+        flags = out["crossed"].sel(structure=name).values
+        assert flags.tolist() == [True, False]

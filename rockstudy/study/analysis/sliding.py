@@ -175,7 +175,9 @@ def slide_risk(ds: xr.Dataset, hazard, limits=None, years: float = 50.0, **kw) -
     with the whole lognormal (``uplift_cut=False``: a block slides below its uplift PGA).
     Its variables on (``slide_limit``, ``structure``), the structures in the design's
     order; ``n_overturning`` is named ``n_exceeding`` (records under which the object slid
-    more than d or overturned) and ``status`` reads "exceeded d" for "overturned". ``kw``:
+    more than d or overturned) and ``status`` reads "exceeded d" for "overturned";
+    ``crossed`` is True at a limit whose rate lies below that of a larger limit (the fits of
+    nested exceedances, made apart, cross there: read the two rates as about equal). ``kw``:
     ``n_boot``, ``conf_level``, ``seed``, ``min_overturning`` (the records that must exceed
     d for "ok").
     """
@@ -183,7 +185,20 @@ def slide_risk(ds: xr.Dataset, hazard, limits=None, years: float = 50.0, **kw) -
     frames = [object_risk(limit_design(ds, x), hazard, years, uplift_cut=False, **kw) for x in d]
     out = _concat_objects(frames, "slide_limit", d, ds["structure"].values)
     out["slide_limit"].attrs.update(units="m", long_name="slide limit d of P(max_slide > d)")
+    out["crossed"] = _crossed(out["annual_rate"])
     return out.rename(n_overturning="n_exceeding")
+
+
+def _crossed(rate: xr.DataArray) -> xr.DataArray:
+    """True where the rate of exceeding a limit is above that of a smaller limit: the data
+    nest (a slide past the larger d is past the smaller), but the two lognormals are fitted
+    apart and may cross; read such rates as about equal."""
+    values = rate.transpose("slide_limit", "structure").values
+    finite = np.where(np.isfinite(values), values, -np.inf)
+    larger = np.fmax.accumulate(finite[::-1], axis=0)[::-1]  # max over this limit and above
+    above_larger = np.zeros(values.shape, bool)
+    above_larger[:-1] = values[:-1] < larger[1:]  # a larger limit's rate is higher
+    return xr.DataArray(above_larger, dims=("slide_limit", "structure"), coords=rate.coords)
 
 
 def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Dataset:

@@ -140,11 +140,19 @@ def _rates(page, ctx, limits):
         "annual_rate_lo": "lambda, 5 %",
         "annual_rate_hi": "lambda, 95 %",
         "probability": f"P({ctx.years:g} yr)",
+        "crossed": "below a larger d's rate (the fits cross)",
     }
     frame = out[list(columns)].to_dataframe()[list(columns)].rename(columns=columns)
     frame.index = pd.MultiIndex.from_tuples(
         [(d, str(o)) for d, o in frame.index], names=["slide limit d [m]", "object"]
     )
+    if bool(out["crossed"].any()):
+        page.warning(
+            "The rate of exceeding a slide limit lies below that of a larger limit for some "
+            "objects (column 'below a larger d's rate'): every slide past the larger d is past "
+            "the smaller one, but the two lognormals are fitted apart and cross; read both "
+            "rates as about equal (more records narrow them)."
+        )
     page.table(
         frame,
         "annual_sliding",
@@ -158,9 +166,15 @@ def _rates(page, ctx, limits):
 def contact_section(page, ctx):
     """Per object: how much the contact model changed the answer against Housner's
     rocking-only model (the ratio of the annual rates of overturning)."""
-    if not (_contact(ctx) and ctx.objects) or ctx.kind.capacities:
+    if not (_contact(ctx) and ctx.objects):
         return
     page.heading("Contact model against the rocking-only model")
+    if ctx.kind.capacities:
+        page.text(
+            "An IDA's ladder runs one model: the rocking-only comparison needs a cloud or "
+            'stripes design under model = "auto".'
+        )
+        return
     if "overturned_rocking" not in ctx.ds:
         page.text(
             'This design ran the contact model on every scene (model = "contact"): the '
