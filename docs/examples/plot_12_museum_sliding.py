@@ -115,19 +115,26 @@ stripes = multiple_stripes(
 hazard = rs.risk.HazardCurve.power_law(2e-4, 2.3, im="pga", units="g")
 slides = sliding.slide_risk(stripes, hazard, limits=[0.01, 0.05], n_boot=0)
 effect = sliding.contact_effect(stripes, hazard, n_boot=0)
+
+
+def per_year(rate):
+    """A rate as printed: 'not estimable' where there is none (NaN)."""
+    return f"{rate:.2g}/yr" if np.isfinite(rate) else "not estimable"
+
+
 for label in objects:
     s, e = slides.sel(structure=label), effect.sel(structure=label)
     rates = ", ".join(
-        f"d = {100 * d:g} cm: {r:.2g}/yr ({st})"
+        f"d = {100 * d:g} cm: {per_year(r)} ({st})"
         for d, r, st in zip(s.slide_limit.values, s.annual_rate.values, s.status.values,
                             strict=True)
     )
     print(f"{label}: sliding past {rates}")
-    print(f"  overturning, rocking-only model: {float(e.annual_rate_rocking):.2g}/yr "
+    print(f"  overturning, rocking-only model: {per_year(float(e.annual_rate_rocking))} "
           f"({int(e.n_overturned_rocking)} points overturned, {e.status_rocking.values}); "
-          f"contact model: {float(e.annual_rate_contact):.2g}/yr "
-          f"({int(e.n_overturned_contact)} points, {e.status_contact.values}); "
-          f"ratio {float(e.ratio):.2g}")
+          f"contact model: {per_year(float(e.annual_rate_contact))} "
+          f"({int(e.n_overturned_contact)} points, {e.status_contact.values}); ratio "
+          + (f"{float(e.ratio):.2g}" if np.isfinite(float(e.ratio)) else "none"))
 
 fig, ax = plt.subplots(figsize=(7.5, 3.6))
 names = list(objects)

@@ -117,6 +117,9 @@ def _fragility_figure(page, ctx, table, limits):
         ax.tick_params(labelsize=FONT)
         if ax.lines:
             ax.legend(fontsize=FONT, loc="lower right")
+    if not any(ax.lines for ax in axes[0]):  # no fit at any limit: the table says why
+        plt.close(fig)
+        return
     fig.tight_layout()
     page.figure(
         fig,
