@@ -131,3 +131,44 @@ def test_under_the_contact_model_the_report_says_the_rocking_only_rate_needs_aut
     _, page, _ = _run(tmp_path, "contact")
     assert "<h2>Contact model against the rocking-only model</h2>" in page
     assert html.escape('the rocking-only answer needs model = "auto"') in page
+
+
+def test_an_ida_with_slide_capacities_reports_its_sliding(tmp_path):
+    """An IDA of named objects with ``slide_capacity`` (dims slide_limit, record, structure;
+    in the units of ``capacity``; here half the overturning capacity at the smaller limit,
+    and NaN, never reached, at the larger one): the report fits the slide capacities (the
+    lognormal MLE of those at d1, the overturning capacities at d2: an overturning exceeds
+    every limit), gives their annual rates, and says that an IDA has no rocking-only
+    comparison."""
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+    from rockstudy.study.report import record_report
+
+    records = [
+        rs.motions.synthetic_near_fault(pulse_period=tp, pga=2.0, seed=20 + i, duration=4.0)
+        for i, tp in enumerate((0.4, 0.6, 0.9, 1.2))
+    ]
+    blocks = {"Vase <i>": rs.Block(half_diagonal=0.4, slenderness=0.25)}
+    ds = incremental_dynamic_analysis(records, blocks, step=0.1, tolerance=0.05, scan=0)
+    cap = ds["capacity"].values
+    ds["slide_capacity"] = (
+        ("slide_limit", "record", "structure"),
+        np.stack([cap / 2, cap * np.nan]),
+    )
+    ds = ds.assign_coords(slide_limit=[0.01, 0.05])
+    ds.attrs["slide_limits"] = [0.01, 0.05]
+    hazard = rs.risk.HazardCurve.power_law(2e-4, 2.3, "pga", "g")
+    page = record_report(ds, tmp_path, n_boot=0, hazard=hazard).read_text()
+    assert "<h2>Sliding: fragility and annual rates per slide limit</h2>" in page
+    assert "An IDA&#x27;s ladder runs one model" in page
+    table = pd.read_csv(tmp_path / "slide_fragility.csv", index_col=[0, 1])
+    pga_g = ds["capacity_scale"].values[:, 0] * ds["pga"].values / rs.constants.STANDARD_GRAVITY
+    for d, c in ((0.01, pga_g / 2), (0.05, pga_g)):
+        row = table.loc[(d, "Vase <i>")]
+        theta = np.exp(np.mean(np.log(c)))
+        assert row["median PGA [g]"] == pytest.approx(theta, rel=1e-9)  # the report in g
+        assert row["beta (MLE)"] == pytest.approx(np.std(np.log(c)), rel=1e-9)
+    rates = pd.read_csv(tmp_path / "annual_sliding.csv", index_col=[0, 1])
+    assert (
+        rates.loc[(0.01, "Vase <i>"), "lambda(max_slide > d) [1/yr]"]
+        > rates.loc[(0.05, "Vase <i>"), "lambda(max_slide > d) [1/yr]"]
+    )
