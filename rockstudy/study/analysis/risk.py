@@ -283,6 +283,7 @@ def object_risk(
     conf_level: float = CONF_LEVEL,
     seed: int = SEED,
     min_overturning: int = 5,
+    uplift_cut: bool = True,
 ) -> xr.Dataset:
     """Per object: the fragility in the hazard's IM, lambda_OT, P(OT in ``years``) and bands.
 
@@ -316,6 +317,11 @@ def object_risk(
         Records under which an object must have overturned for ``status`` "ok" (fewer:
         "few", whatever the number of records: 3 of 3 records rest on 3 capacities), a whole
         number >= 1.
+    uplift_cut : bool
+        True (default): for a PGA hazard and horizontal records, the fragility is 0 below each
+        object's uplift PGA (see ``truncated_at_uplift`` below). False: the whole lognormal,
+        for a demand that needs no uplift (sliding: a block slides below its uplift PGA,
+        :func:`~rockstudy.study.analysis.sliding.slide_risk`).
 
     Returns
     -------
@@ -364,6 +370,8 @@ def object_risk(
     to_hazard = to_si(im, unit) / hazard.si_factor
     uplift = _uplift(ds, hazard)
     level = cut_levels(ds, hazard.im, hazard.units, uplift)
+    if not uplift_cut:
+        level = np.full(ds.sizes["structure"], np.nan)
     # an overturning seen below that level (which the physics forbids): the data and the cut
     # disagree, and the fragility is not cut
     refused = cut_refused(level, fitter[4] * to_hazard)

@@ -189,6 +189,9 @@ def outputs(study) -> dict:
         for name in rd.MODEL_KEYS:
             o = _outputs.OUTPUTS[name]
             out[name] = (o.long_name, o.units, o.store_dtype, o.fill, None)
+    if study.run.model == "auto" and not kind.capacities:  # rd.ROCKING_KEYS
+        long_name = "overturned (1) under Housner's rocking-only model; -1 if failed"
+        out["overturned_rocking"] = (long_name, *_RUN["overturned"][1:], None)
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
         "1",
@@ -419,6 +422,8 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
     de = study["design"]
+    if de.get("slide_limits"):  # the slide fragility's d (analysis.sliding)
+        attrs["slide_limits"] = [float(d) for d in de["slide_limits"]]
     attrs.update(
         design=kind.name,
         method=study["run"]["method"],

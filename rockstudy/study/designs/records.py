@@ -31,7 +31,7 @@ from ...constants import G
 from ...dynamics import outputs as _outputs
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
-from ...dynamics.batch import CONTACT_OUTPUTS, SLIDE_OUTPUTS
+from ...dynamics.batch import CONTACT_OUTPUTS, MODEL_CONTACT, SLIDE_OUTPUTS
 from ...dynamics.methods import MAX_STEPS
 from ...dynamics.simulate import check_friction
 from ...motions import Record
@@ -352,10 +352,29 @@ def _contact_model(model, friction, n):
 MODEL_KEYS = ("model", *SLIDE_OUTPUTS)
 
 
+#: Kept under ``model="auto"`` besides :data:`MODEL_KEYS`: Housner's overturning decision of
+#: every point (the rocking-only answer, which "auto" computes first).
+ROCKING_KEYS = ("overturned_rocking",)
+
+
 def _keys(contact, model):
-    """The outputs a design keeps: :data:`_OUT`, the friction check with ``contact``, and
-    :data:`MODEL_KEYS` under the contact model (``model`` not None)."""
-    return _OUT + (CONTACT_OUTPUTS if contact else ()) + (() if model is None else MODEL_KEYS)
+    """The outputs a design keeps: :data:`_OUT`, the friction check with ``contact``,
+    :data:`MODEL_KEYS` under the contact model (``model`` not None) and :data:`ROCKING_KEYS`
+    under ``"auto"``."""
+    keys = _OUT + (CONTACT_OUTPUTS if contact else ()) + (() if model is None else MODEL_KEYS)
+    return keys + (ROCKING_KEYS if model is not None and model[0] == "auto" else ())
+
+
+def _rocking_decision(record, st, idx, scales, method, rtol, max_steps, run):
+    """Housner's ``overturned`` of each point of an ``"auto"`` run ``run``: its own where
+    Housner's model answered, Housner's model run again on the points the contact model
+    answered (``model`` 3; the rocking kernel: a small cost beside the contact model's)."""
+    decision = np.asarray(run["overturned"], bool).copy()
+    again = np.flatnonzero(run["model"] == MODEL_CONTACT)
+    if again.size:
+        out = _run(record, st, idx[again], scales[again], method, rtol, max_steps, ("overturned",))
+        decision[again] = out["overturned"]
+    return decision
 
 
 _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
@@ -388,9 +407,16 @@ def _run_below_free_fall(
     for name in MODEL_KEYS if model is not None else ():
         entry = _outputs.OUTPUTS[name]
         out[name] = np.full(scales.size, entry.fill, entry.store_dtype)
+    if ROCKING_KEYS[0] in keys:
+        out[ROCKING_KEYS[0]] = np.zeros(scales.size, bool)
     if ok.any():
-        wanted = keys if contact or model is not None else None
+        wanted = None
+        if contact or model is not None:
+            wanted = tuple(k for k in keys if k not in ROCKING_KEYS)
         run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps, wanted, model)
+        if ROCKING_KEYS[0] in keys:
+            args = (method, rtol, max_steps, run)
+            run[ROCKING_KEYS[0]] = _rocking_decision(record, st, idx[ok], scales[ok], *args)
         for k in keys:
             out[k][ok] = run[k]
     return out
@@ -450,7 +476,9 @@ def cloud(
         "contact" or "auto" with ``friction`` (one mu or one per structure, none NaN) runs
         the contact model as :func:`rockstudy.simulate_batch` does, and keeps ``model``,
         ``max_slide``, ``residual_slide``, ``first_slip_time``, ``time_slide``,
-        ``time_slide_rock``, ``time_flight`` and ``regime`` of every point; "rocking"
+        ``time_slide_rock``, ``time_flight`` and ``regime`` of every point ("auto" also
+        ``overturned_rocking``: Housner's decision of every point, the rocking-only answer
+        of :func:`rockstudy.study.analysis.sliding.contact_effect`); "rocking"
         (default): Housner's model (with the friction check where ``friction`` is given).
 
     Returns

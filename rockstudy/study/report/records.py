@@ -39,6 +39,8 @@ from ._page import (
 )
 from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
+from .sliding import contact_section, regime_section
+from .sliding import section as sliding_section
 
 __all__ = [
     "DESIGNS",
@@ -581,6 +583,8 @@ SECTIONS = [
     ),
     ro.object_fragility,
     risk_section,
+    sliding_section,
+    contact_section,
     _section(
         "Intensity-measure efficiency",
         lambda page, ctx: _efficiency(page, ctx),
@@ -604,6 +608,7 @@ SECTIONS = [
         when=lambda ctx: ctx.compare is not None and _fits(ctx),
     ),
     ro.friction_check,
+    regime_section,
     _section("Per-record breakdown", lambda page, ctx: _per_record(page, ctx.ds)),
     _section(
         "Self-similarity on records",

@@ -1,0 +1,248 @@
+"""The record report's sections on sliding, for a design run under the contact model: each
+object's fragility of sliding P(max_slide > d) per slide limit d (a table and a figure of the
+curves), its annual rate of exceeding each d at the site, how much the contact model changed
+the annual rate of overturning against Housner's rocking-only model, and the regime each record
+drove each object into (:mod:`rockstudy.study.analysis.sliding`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..analysis import sliding
+from ..analysis.sampled import fragility_curve
+from ._page import _plt, shown_separation
+from .objects import FONT, quoted_to_report, si_to_report
+
+__all__ = ["contact_section", "regime_section", "section"]
+
+#: How the report counts an overturned point against a slide limit.
+_OVERTURNED_NOTE = (
+    "A point exceeds d where the block slid more than d or overturned: a block that "
+    "overturned has lost its position, so an overturning counts as exceeding every slide limit."
+)
+
+
+def _limits(ctx):
+    """The report's slide limits [m] (the design's, or the study's ``[design]``), or None."""
+    given = ctx.ds.attrs.get("slide_limits")
+    if not given and ctx.study is not None and ctx.study.design is not None:
+        given = ctx.study.design.slide_limits
+    return np.asarray(given, float) if given is not None and len(given) else None
+
+
+def _contact(ctx) -> bool:
+    """Whether the design ran the contact model (it stores the slide of its points)."""
+    return "max_slide" in ctx.ds or "slide_capacity" in ctx.ds
+
+
+def section(page, ctx):
+    """Per object: the fragility of sliding per slide limit and, with a hazard curve, the
+    annual rate of exceeding each limit."""
+    if not (_contact(ctx) and ctx.objects):
+        return
+    page.heading("Sliding: fragility and annual rates per slide limit")
+    limits = _limits(ctx)
+    if limits is None:
+        page.text(
+            "The design ran the contact model, but gives no slide limits: give [design] "
+            "slide_limits = [d1, d2, ...] (m) for the fragility of sliding P(max_slide > d)."
+        )
+        return
+    try:
+        with shown_separation():  # the table says which fits are separated
+            table = sliding.slide_fragility(ctx.ds, limits, im="pga", n_boot=ctx.n_boot)
+    except ValueError as err:
+        page.text(f"No fragility of sliding: {err}")
+        return
+    f = quoted_to_report(ctx.units, "pga")
+    for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
+        table[col] = table[col] * f
+    page.text(
+        "The fragility of sliding P(max_slide > d | PGA) of each object, for each slide limit "
+        "d, fitted as the design fits overturning ("
+        + ctx.kind.text["fit"]
+        + "). "
+        + _OVERTURNED_NOTE
+    )
+    _fragility_figure(page, ctx, table, limits)
+    page.table(_fragility_table(table, ctx.units), "slide_fragility", _FRAGILITY_CAPTION)
+    if ctx.hazard is not None:
+        _rates(page, ctx, limits)
+
+
+_FRAGILITY_CAPTION = "Fragility of sliding of each object per slide limit d (90 % bands)"
+
+
+def _fragility_table(table, units) -> pd.DataFrame:
+    """The fits of :func:`~rockstudy.study.analysis.sliding.slide_fragility` as shown."""
+    shown = table[["theta", "theta_lo", "theta_hi", "beta", "n", "separated", "no_rise"]]
+    shown = shown.rename(
+        columns={
+            "theta": f"median PGA [{units}]",
+            "theta_lo": "median, lower",
+            "theta_hi": "median, upper",
+            "beta": "beta (MLE)",
+            "n": "points",
+            "separated": "outcomes separated (no fit)",
+            "no_rise": "no rise with the intensity (no fit)",
+        }
+    )
+    shown.index = shown.index.set_names(["slide limit d [m]", "object"])
+    return shown
+
+
+def _fragility_figure(page, ctx, table, limits):
+    """One panel per slide limit: each object's fitted P(max_slide > d | PGA) and band."""
+    low, high = np.nanmin(table["im_min"]), np.nanmax(table["im_max"])
+    if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
+        return
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(limits), figsize=(4.6 * len(limits), 3.8), squeeze=False)
+    grid = np.geomspace(low / 1.2, high * 1.2, 200)
+    for ax, d in zip(axes[0], limits, strict=True):
+        fits = table.xs(float(d), level="slide_limit")
+        curve = fragility_curve(fits, grid)
+        for g in curve.group.values:
+            c = curve.sel(group=g)
+            if not np.isfinite(c.probability.values).any():
+                continue
+            color = ctx.colors[str(g)]
+            ax.plot(grid, c.probability, "-", color=color, label=ctx.text(str(g)))
+            ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=color)
+        ax.set(xscale="log", ylim=(-0.02, 1.02), title=f"d = {d:g} m")
+        ax.set_xlabel(f"PGA [{ctx.units}]", fontsize=FONT + 1)
+        ax.set_ylabel("P(max_slide > d) [-]", fontsize=FONT + 1)
+        ctx.log_ticks(ax)
+        ax.tick_params(labelsize=FONT)
+        if ax.lines:
+            ax.legend(fontsize=FONT, loc="lower right")
+    if not any(ax.lines for ax in axes[0]):  # no fit at any limit: the table says why
+        plt.close(fig)
+        return
+    fig.tight_layout()
+    page.figure(
+        fig,
+        "slide_fragility",
+        "Fragility of sliding of each object, one panel per slide limit d: the lognormal fit "
+        "of P(max_slide > d | PGA) (an overturning counts as exceeding d), 90 % pointwise band",
+    )
+
+
+def _rates(page, ctx, limits):
+    """The annual rate of exceeding each slide limit, per object, with its band."""
+    try:
+        out = sliding.slide_risk(ctx.ds, ctx.hazard, limits, ctx.years, n_boot=ctx.n_boot)
+    except ValueError as err:
+        page.text(f"No annual rates of sliding: {err}")
+        return
+    columns = {
+        "status": "status",
+        "n_exceeding": "records exceeding d",
+        "annual_rate": "lambda(max_slide > d) [1/yr]",
+        "annual_rate_lo": "lambda, 5 %",
+        "annual_rate_hi": "lambda, 95 %",
+        "probability": f"P({ctx.years:g} yr)",
+        "crossed": "below a larger d's rate (the fits cross)",
+    }
+    frame = out[list(columns)].to_dataframe()[list(columns)].rename(columns=columns)
+    frame.index = pd.MultiIndex.from_tuples(
+        [(d, str(o)) for d, o in frame.index], names=["slide limit d [m]", "object"]
+    )
+    if bool(out["crossed"].any()):
+        page.warning(
+            "The rate of exceeding a slide limit lies below that of a larger limit for some "
+            "objects (column 'below a larger d's rate'): every slide past the larger d is past "
+            "the smaller one, but the two lognormals are fitted apart and cross; read both "
+            "rates as about equal (more records narrow them)."
+        )
+    page.table(
+        frame,
+        "annual_sliding",
+        "Annual rate of exceeding each slide limit d per object: the fragility of sliding "
+        "integrated against the site's hazard curve (Cornell et al. 2002), the whole lognormal "
+        "(a block slides below its uplift PGA); statuses as for overturning, 'overturned' "
+        "read as 'exceeded d'",
+    )
+
+
+def contact_section(page, ctx):
+    """Per object: how much the contact model changed the answer against Housner's
+    rocking-only model (the ratio of the annual rates of overturning)."""
+    if not (_contact(ctx) and ctx.objects):
+        return
+    page.heading("Contact model against the rocking-only model")
+    if ctx.kind.capacities:
+        page.text(
+            "An IDA's ladder runs one model: the rocking-only comparison needs a cloud or "
+            'stripes design under model = "auto".'
+        )
+        return
+    if "overturned_rocking" not in ctx.ds:
+        page.text(
+            'This design ran the contact model on every scene (model = "contact"): the '
+            'rocking-only answer needs model = "auto", which runs Housner\'s model on every '
+            "scene first and keeps its decision (overturned_rocking)."
+        )
+        return
+    if ctx.hazard is None:
+        page.text("The ratio of the annual rates of overturning needs the site's hazard curve.")
+        return
+    try:
+        out = sliding.contact_effect(ctx.ds, ctx.hazard, ctx.years, n_boot=0)
+    except ValueError as err:
+        page.text(f"No comparison of the models' annual rates: {err}")
+        return
+    frame = out.to_dataframe()[
+        [
+            "n_overturned_rocking",
+            "n_overturned_contact",
+            "annual_rate_rocking",
+            "annual_rate_contact",
+            "ratio",
+            "status_rocking",
+            "status_contact",
+        ]
+    ]
+    frame.index = pd.Index([str(v) for v in frame.index], name="object")
+    page.table(
+        frame.rename(
+            columns={
+                "n_overturned_rocking": "points overturned, rocking-only",
+                "n_overturned_contact": "points overturned, contact model",
+                "annual_rate_rocking": "lambda_OT rocking-only [1/yr]",
+                "annual_rate_contact": "lambda_OT contact model [1/yr]",
+                "ratio": "ratio contact / rocking-only",
+                "status_rocking": "status, rocking-only",
+                "status_contact": "status, contact model",
+            }
+        ),
+        "contact_vs_rocking",
+        "How much the contact model changed each object's annual rate of overturning: "
+        "Housner's rocking-only model (its decision on every scene, which model 'auto' runs "
+        "first) against the contact model's, each fitted and integrated the same way (point "
+        "estimates); a ratio below 1: sliding spared the object, above 1: slip or flight "
+        "toppled it where rocking alone would not",
+    )
+
+
+def regime_section(page, ctx):
+    """Per object: the regime each record drove it into (the contact model's ``regime``)."""
+    if not (ctx.objects and "regime" in ctx.ds):
+        return
+    page.heading("Regimes: what each record drove each object into")
+    table = sliding.regimes(ctx.ds)
+    names = dict(zip(map(str, ctx.ds["record"].values), ctx.record_names(), strict=True))
+    table.index = pd.MultiIndex.from_tuples(
+        [(str(o), names[str(r)]) for o, r in table.index], names=["object", "record"]
+    )
+    if "level" in ctx.ds.dims:
+        f = si_to_report(ctx.units, ctx.ds.attrs.get("im", "pga"))
+        table.columns = [f"{ctx.stripe_label()} = {v * f:.3g}" for v in table.columns]
+    page.table(
+        table,
+        "regimes",
+        "The most involved regime of the contact model each record drove each object into "
+        "(rest < slide < rock < slide-rock < flight), per stripe level where the records are "
+        "scaled; 'not run': the point did not run",
+    )
