@@ -405,7 +405,7 @@ def test_a_cloud_of_objects_under_auto_stores_each_objects_slide(tmp_path):
         ("friction = 0.8", "", "run.model", "needs the friction coefficient"),
     ],
 )
-def test_a_design_refuses_bad_slide_limits_and_the_contact_model_in_an_ida(
+def test_a_design_refuses_bad_slide_limits_and_the_contact_model_without_friction(
     tmp_path, old, new, field, words
 ):
     """slide_limits: > 0 m, increasing, with the contact model; the contact model: with

@@ -381,10 +381,7 @@ def simulate_batch(
             rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
         )
 
-    if model == "contact" and not _needs_check(wanted, model):  # the contact model answers
-        out, codes = _rows_at_rest(n), np.zeros(n, np.int8)  # every row: Housner's not run
-    else:
-        out, codes = solve(rows)
+    out, codes = _unsolved(n) if _contact_only(wanted, model) else solve(rows)
     cols = _columns(out, codes)
     if "conditioning" in wanted:
         cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
@@ -402,6 +399,18 @@ def simulate_batch(
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
     source = "record" if record is not None else f"{pulse} pulse"
     return _as_dataset(result, inputs, method, rtol, source)
+
+
+def _contact_only(wanted, model) -> bool:
+    """Whether the contact model answers every row and nothing asked for needs Housner's
+    model (``model="contact"`` without ``friction_demand``): it is then not run."""
+    return model == "contact" and not _needs_check(wanted, model)
+
+
+def _unsolved(n):
+    """(kernel rows, model codes) of n rows Housner's model did not run: the rows of scenes
+    at rest (:func:`_rows_at_rest`), code 0, for the contact model to write over."""
+    return _rows_at_rest(n), np.zeros(n, np.int8)
 
 
 def _controls(method, rtol, max_steps, half_diagonal, frequency_parameter):
