@@ -402,15 +402,14 @@ def test_a_cloud_of_objects_under_auto_stores_each_objects_slide(tmp_path):
         ("[0.01, 0.05]", "[0.05, 0.01]", "design.slide_limits", "increasing"),
         ("[0.01, 0.05]", "[0.0, 0.05]", "design.slide_limits", "must be > 0"),
         ('"auto"', '"rocking"', "design.slide_limits", "contact model"),
-        ('"cloud"', '"ida"', "run.model", "IDA"),
         ("friction = 0.8", "", "run.model", "needs the friction coefficient"),
     ],
 )
-def test_a_design_refuses_bad_slide_limits_and_the_contact_model_in_an_ida(
+def test_a_design_refuses_bad_slide_limits_and_the_contact_model_without_friction(
     tmp_path, old, new, field, words
 ):
-    """slide_limits: > 0 m, increasing, with the contact model; the contact model: not in an
-    IDA, and with every object's friction (the statue has none without the study's)."""
+    """slide_limits: > 0 m, increasing, with the contact model; the contact model: with
+    every object's friction (the statue has none without the study's)."""
     folder = tmp_path / "records"
     folder.mkdir()
     rec = rs.motions.synthetic_near_fault(pulse_period=0.5, pga=2.5, seed=1, duration=2.0)

@@ -28,8 +28,9 @@ PulseName = Literal["sine", "cosine", "half-sine", "ricker"]
 #: The models :func:`simulate_batch` runs a scene under (its ``model``): Housner's no-slip
 #: block, the planar contact model, or Housner's with the contact model where it fails.
 CONTACT_CHOICES = ("rocking", "contact", "auto")
-#: The ``model`` output of a row the contact model answered (0-2: :mod:`._auto`).
-MODEL_CONTACT = 3
+#: The ``model`` output of a row the contact model answered (0-2: :mod:`._auto`): by its
+#: kernels, or by its ``solve_ivp`` reference where the kernel reached its step limit.
+MODEL_CONTACT, MODEL_CONTACT_REFERENCE = 3, 4
 #: batch method -> kernel model (None: chosen row by row); what each method can run is in
 #: :data:`rockstudy.dynamics.methods.METHODS`
 _MODELS = {"nonlinear": _rocking.MODEL_NONLINEAR, "linear": _rocking.MODEL_LINEAR, "auto": None}
@@ -334,8 +335,9 @@ def simulate_batch(
         overturning time if overturned, NaN if it never lifted),
         ``status`` (0 ok, 1 step limit reached), ``steps`` (integrator steps taken: DOP853,
         or Taylor steps inside a record; 0 for the exact solver), ``model`` (0 rest without
-        integration, 1 linear, 2 nonlinear: what each row ran); only those of ``outputs`` (and
-        ``status``) if given.
+        integration, 1 linear, 2 nonlinear, 3 the contact model's kernels, 4 its ``solve_ivp``
+        reference where its kernel reached the step limit: what each row ran); only those of
+        ``outputs`` (and ``status``) if given.
     """
     _check_model(model, friction, method)
     wanted = _requested_outputs(outputs, model, friction is not None)
@@ -379,14 +381,14 @@ def simulate_batch(
             rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
         )
 
-    out, codes = solve(rows)
+    out, codes = _unsolved(n) if _contact_only(wanted, model) else solve(rows)
     cols = _columns(out, codes)
     if "conditioning" in wanted:
         cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
     if _needs_check(wanted, model):
         _add_contact_outputs(cols, rows, codes, method, rtol, max_steps)
     if model != "rocking":
-        motions = _RowMotions(pulse, record, mp, amplitude, period, cycles, n)
+        motions = contact_model.RowMotions(pulse, record, mp, amplitude, period, cycles, n)
         _add_contact_model(cols, rows, mu, model, motions, rtol)
     result = {name: cols[name] for name in wanted}
     if not as_dataset:
@@ -397,6 +399,18 @@ def simulate_batch(
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
     source = "record" if record is not None else f"{pulse} pulse"
     return _as_dataset(result, inputs, method, rtol, source)
+
+
+def _contact_only(wanted, model) -> bool:
+    """Whether the contact model answers every row and nothing asked for needs Housner's
+    model (``model="contact"`` without ``friction_demand``): it is then not run."""
+    return model == "contact" and not _needs_check(wanted, model)
+
+
+def _unsolved(n):
+    """(kernel rows, model codes) of n rows Housner's model did not run: the rows of scenes
+    at rest (:func:`_rows_at_rest`), code 0, for the contact model to write over."""
+    return _rows_at_rest(n), np.zeros(n, np.int8)
 
 
 def _controls(method, rtol, max_steps, half_diagonal, frequency_parameter):
@@ -483,51 +497,38 @@ def _friction_columns(friction, n) -> tuple:
     return static, kinetic
 
 
-class _RowMotions:
-    """The Motion of each row of :func:`simulate_batch` (the record scaled by the row's
-    scale, or the row's pulse), built on demand for the contact model."""
-
-    def __init__(self, pulse, record, mp, amplitude, period, cycles, n):
-        self.record, self.scale = record, mp[:, 0]
-        if record is None:
-            self.pulse = PULSES[pulse]
-            columns = (amplitude, period, cycles)
-            self.amplitude, self.period, self.cycles = (
-                np.broadcast_to(np.asarray(x, dtype=float), (n,)) for x in columns
-            )
-            self.counted = pulse in ("sine", "cosine")  # the others take no cycles
-
-    def __getitem__(self, i):
-        if self.record is not None:
-            return self.record.scaled(float(self.scale[i]))
-        extra = {"cycles": int(self.cycles[i])} if self.counted else {}
-        return self.pulse(amplitude=float(self.amplitude[i]), period=float(self.period[i]), **extra)
-
-
 def _add_contact_model(cols, rows, mu, model, motions, rtol):
-    """Run the contact model (:func:`.contact_model.contact_outputs`) on the rows of
-    ``cols`` that ``model`` gives it (all of them, or under ``"auto"`` those of
-    :func:`_beyond_housner`), writing its outputs over Housner's there; the other rows get
-    the slide outputs of a block that did not slip (:func:`_no_slip`)."""
-    p, alpha, eta = rows[:3]
+    """Run the contact model on the rows of ``cols`` that ``model`` gives it (all of them, or
+    under ``"auto"`` those of :func:`_beyond_housner`), all at once
+    (:func:`.contact_model.contact_rows`), writing its outputs over Housner's there; the
+    other rows get the slide outputs of a block that did not slip (:func:`_no_slip`). A row
+    the kernel could not answer, which the ``solve_ivp`` reference did, has ``model``
+    :data:`MODEL_CONTACT_REFERENCE`."""
+    p, alpha, eta, kind, mp, times, samples, vsamples = rows
     n = p.size
-    if model == "auto":
-        chosen = _beyond_housner(cols, mu[0])
-    else:
-        chosen = np.ones(n, bool)
+    chosen = _beyond_housner(cols, mu[0]) if model == "auto" else np.ones(n, bool)
     cols.update(_no_slip(cols))
+    idx = np.flatnonzero(chosen)
     untimed = [
         name for name in outputs.KERNEL_ROW.names if "contact" not in outputs.OUTPUTS[name].models
     ]
-    for i in np.flatnonzero(chosen):
-        one = contact_model.contact_outputs(
-            p[i], alpha[i], eta[i], motions[i], (mu[0][i], mu[1][i]), rtol
-        )
-        for name, value in one.items():
-            cols.setdefault(name, np.zeros(n, np.asarray(value).dtype))[i] = value
     for name in untimed:  # the kernel outputs the contact model leaves out
-        cols[name][chosen] = outputs.OUTPUTS[name].fill
-    cols["model"][chosen] = MODEL_CONTACT
+        cols[name][idx] = outputs.OUTPUTS[name].fill
+    cols["model"][idx] = MODEL_CONTACT
+    if not idx.size:
+        return
+    found, referred = contact_model.contact_rows(
+        p[idx],
+        alpha[idx],
+        eta[idx],
+        (mu[0][idx], mu[1][idx]),
+        (kind, mp[idx], times, samples, vsamples),
+        rtol,
+        lambda j: motions[idx[j]],
+    )
+    for name, values in found.items():
+        cols.setdefault(name, np.zeros(n, values.dtype))[idx] = values
+    cols["model"][idx[referred]] = MODEL_CONTACT_REFERENCE
 
 
 def _beyond_housner(cols, mu_s):

@@ -7,13 +7,15 @@ import functools
 import math
 import warnings
 
+import numba
 import numpy as np
 
 from .. import _validate
 from .._warnings import IncompleteReferenceWarning
 from ..constants import G
 from ..motions import _kernels as mk
-from ._contact_scene import MAX_STEPS, STATUS_NO_SOLUTION, contact_scene
+from ..motions.pulses import PULSES
+from ._contact_scene import MAX_STEPS, STATUS_NO_SOLUTION, contact_batch, contact_scene
 from ._sliding import slide_record
 from .contact import ContactCheck, check_contact
 from .methods import STATUS_STEP_LIMIT, StepLimitError
@@ -30,6 +32,8 @@ __all__ = [
     "MIN_FRICTION",
     "contact_history",
     "contact_outputs",
+    "contact_rows",
+    "RowMotions",
     "regime_code",
     "ROW_OUTPUTS",
     "friction_pair",
@@ -167,7 +171,7 @@ def contact_history(p, alpha, eta, motion, friction, method, rtol, t_max) -> dic
     return {**r, "solver": SOLVER}
 
 
-def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
+def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None, method="auto") -> dict:
     """The batch outputs of one scene under the contact model (what
     :func:`rockstudy.simulate_batch` stores for a row its ``model`` runs the contact model on).
 
@@ -183,6 +187,9 @@ def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
         Relative tolerance of the reference (the sliding kernel is exact).
     t_max : float, optional
         End of the history [s]; by default until the block rests after the motion.
+    method : {"auto", "scipy"}
+        The solver (:func:`contact_history`): the exact sliding kernel or the event-driven
+        kernel (``"auto"``), or the ``solve_ivp`` reference (``"scipy"``).
 
     Returns
     -------
@@ -198,7 +205,7 @@ def contact_outputs(p, alpha, eta, motion, friction, rtol, t_max=None) -> dict:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", IncompleteReferenceWarning)
         try:
-            r = contact_history(p, alpha, eta, motion, friction, "auto", rtol, t_max)
+            r = contact_history(p, alpha, eta, motion, friction, method, rtol, t_max)
         except StepLimitError:  # the kernel did not converge: the row's failed fill
             return _failed_row()
     incomplete = any(issubclass(w.category, IncompleteReferenceWarning) for w in caught)
@@ -241,6 +248,107 @@ def regime_code(regime_times) -> int:
     one of that order with time spent in it (``regime_times``: seconds by regime name)."""
     moving = enumerate(REGIMES[1:], start=1)
     return max((i for i, name in moving if regime_times.get(name, 0.0) > 0.0), default=0)
+
+
+class RowMotions:
+    """The Motion of each row of :func:`rockstudy.simulate_batch` (the record scaled by the row's
+    scale, or the row's pulse), built on demand for the contact model."""
+
+    def __init__(self, pulse, record, mp, amplitude, period, cycles, n):
+        self.record, self.scale = record, mp[:, 0]
+        if record is None:
+            self.pulse = PULSES[pulse]
+            columns = (amplitude, period, cycles)
+            self.amplitude, self.period, self.cycles = (
+                np.broadcast_to(np.asarray(x, dtype=float), (n,)) for x in columns
+            )
+            self.counted = pulse in ("sine", "cosine")  # the others take no cycles
+
+    def __getitem__(self, i):
+        if self.record is not None:
+            return self.record.scaled(float(self.scale[i]))
+        extra = {"cycles": int(self.cycles[i])} if self.counted else {}
+        return self.pulse(amplitude=float(self.amplitude[i]), period=float(self.period[i]), **extra)
+
+
+def contact_rows(p, alpha, eta, friction, motion_rows, rtol, motion_of):
+    """The batch outputs of many scenes under the contact model, in one parallel call of the
+    kernels (:func:`._contact_scene.contact_batch`: the exact sliding kernel where
+    :func:`slides_only` allows it, the event-driven kernel elsewhere), each row the answer
+    :func:`contact_outputs` gives its scene.
+
+    A row the kernel cannot answer within :data:`._contact_scene.MAX_STEPS` steps (a
+    chatter that does not settle) is run again by the ``solve_ivp`` reference
+    (:func:`contact_outputs` with ``method="scipy"``; its ``status`` 1 where the reference
+    stopped at its cap of phases). A row without a solution (Painleve's paradox, mu_k > 4/3)
+    has none under the reference either: a ValueError naming the row.
+
+    Parameters
+    ----------
+    p, alpha, eta : array of float
+        Frequency parameter [rad/s], slenderness [rad] and restitution of each row.
+    friction : (array, array)
+        (mu_s, mu_k) of each row, checked.
+    motion_rows : tuple
+        (kind, mp, times, samples, vsamples) of the rows, as
+        :func:`rockstudy.simulate_batch` encodes them.
+    rtol : float
+        Relative tolerance.
+    motion_of : callable
+        motion_of(i): the Motion of row i (for the reference).
+
+    Returns
+    -------
+    (dict, ndarray of bool)
+        The outputs ``status`` and :data:`ROW_OUTPUTS` as arrays, and which rows the
+        reference answered.
+    """
+    _refuse_smooth(friction)
+    parallel = numba.get_num_threads() > 1
+    out = contact_batch(p, alpha, eta, *friction, motion_rows, rtol, MAX_STEPS, parallel)
+    _refuse_no_solution(out["status"], friction[1])
+    cols = {"status": out["status"].astype(np.int64)}
+    cols.update({name: out[name].copy() for name in ROW_OUTPUTS if name != "regime"})
+    cols["regime"] = _regime_codes(out)
+    referred = out["status"] != 0
+    for i in np.flatnonzero(referred):
+        friction_i = (float(friction[0][i]), float(friction[1][i]))
+        one = contact_outputs(p[i], alpha[i], eta[i], motion_of(i), friction_i, rtol, None, "scipy")
+        for name, value in one.items():
+            cols[name][i] = value
+    return cols, referred
+
+
+def _refuse_smooth(friction):
+    """A ValueError naming the first row whose friction is below :data:`MIN_FRICTION` (as
+    :func:`contact_history` refuses one scene), before any run."""
+    low = np.flatnonzero(np.minimum(*friction) < MIN_FRICTION)
+    if low.size:
+        i = int(low[0])
+        pair = (float(friction[0][i]), float(friction[1][i]))
+        raise ValueError(
+            f"friction: row {i}: friction must lie in [{MIN_FRICTION:g}, 10] for the contact "
+            f"model, got {pair!r}"
+        )
+
+
+def _refuse_no_solution(status, kinetic):
+    """A ValueError naming the first row the kernel found without a solution."""
+    bad = np.flatnonzero(status == STATUS_NO_SOLUTION)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(
+            f"friction: row {i}: mu_k = {float(kinetic[i])!r} gives the contact model no "
+            "solution in this scene (Painleve's paradox, possible only for mu_k > 4/3)"
+        )
+
+
+def _regime_codes(rows) -> np.ndarray:
+    """:func:`regime_code` of each row of a contact batch (its ``time_<regime>`` fields)."""
+    codes = np.zeros(rows.size, np.int8)
+    for i, name in enumerate(REGIMES[1:], start=1):
+        codes[rows[f"time_{name}"] > 0.0] = i
+    return codes
 
 
 def simulate_contact(p, alpha, eta, motion, friction, method, rtol, t_max, rocking):

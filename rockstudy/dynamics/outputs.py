@@ -164,7 +164,8 @@ OUTPUTS = {
         _int(
             "model",
             "i1",
-            "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear, 3 contact model",
+            "model that ran: 0 rest (no uplift), 1 linear, 2 nonlinear, 3 contact model, 4 "
+            "contact model by its solve_ivp reference (its kernel reached the step limit)",
             "i1",
             models=MODELS,
             stage="batch",

@@ -171,6 +171,7 @@ def outputs(study) -> dict:
         out["capacity"] = (_IDA["capacity"][0], unit, "f8", np.nan, None)
         for k in _STEPS:
             out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
+        out.update(_ida_contact_outputs(study, unit))
     else:
         out.update({k: (*v, None) for k, v in _RUN.items()})
         if kind.levels:
@@ -185,7 +186,7 @@ def outputs(study) -> dict:
     if study.friction_coefficients() is not None:  # the contact check (spec.Study.friction)
         for name in ("friction_demand", "lift_off"):
             out[name] = (*CONTACT_VARIABLES[name], None)
-    if study.run.model != "rocking":  # the contact model's (rockstudy.dynamics.outputs)
+    if study.run.model != "rocking" and not kind.capacities:  # rockstudy.dynamics.outputs
         for name in rd.MODEL_KEYS:
             o = _outputs.OUTPUTS[name]
             out[name] = (o.long_name, o.units, o.store_dtype, o.fill, None)
@@ -208,11 +209,27 @@ def ida_steps(study) -> int:
     most that, up to max_pga_ratio a_up, in steps of ``1 + step``), the bisection (from
     ``1 + step`` down to ``1 + tolerance``) and the scan."""
     o = study.design.ida()
-    span = 2.0 * o.max_pga_ratio * study.largest_uplift_over_rest()
+    span = 2.0 * o.max_pga_ratio * study.largest_uplift_over_rest() * _slip_span(study)
     ladder = math.ceil(math.log(span) / math.log1p(o.step)) + 2
     ratio = math.log1p(o.step) / math.log1p(o.tolerance)
     bisect = math.ceil(math.log2(ratio)) + 1 if ratio > 1 else 0
-    return ladder + bisect + o.scan
+    return ladder + bisect * (1 + len(_slide_limits(study))) + o.scan
+
+
+def _slip_span(study) -> float:
+    """How far below the rest level g theta_cr the contact model's ladder starts: at most
+    theta_cr / mu_s (its lowest rung is the slip level g min(theta_cr, mu_s);
+    :func:`.records.incremental_dynamic_analysis`), 1 under Housner's model."""
+    if study.run.model == "rocking":
+        return 1.0
+    mu = float(np.min(study.friction_coefficients()))
+    return max(1.0, study.largest_critical_rotation() / mu)
+
+
+def _slide_limits(study) -> list:
+    """The slides d [m] of an IDA's slide capacities: ``design.slide_limits`` (under the
+    contact model: validated by the study)."""
+    return list(study.design.slide_limits) if study.run.model != "rocking" else []
 
 
 def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
@@ -231,6 +248,8 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     if kind.levels:
         coords["level"] = ("level", study.motion.scale_to.levels())
     coords["period"] = ("period", stored_periods(study))
+    if kind.capacities and _slide_limits(study):
+        coords["slide_limit"] = ("slide_limit", np.array(_slide_limits(study)), {"units": "m"})
     ds = xr.Dataset(data, coords=coords)
     names = [str(h) if v is None else [str(h), str(v)] for _, h, v in pairs]
     ds.attrs.update(
@@ -279,7 +298,40 @@ def stored_periods(study) -> np.ndarray:
 def _widths(study) -> dict:
     """Sizes of the extra dimensions of the outputs."""
     steps = design_kind(study.design.kind).capacities
-    return {"period": stored_periods(study).size, "step": ida_steps(study) if steps else 0}
+    return {
+        "period": stored_periods(study).size,
+        "step": ida_steps(study) if steps else 0,
+        "slide_limit": len(_slide_limits(study)) if steps else 0,
+    }
+
+
+def _ida_contact_outputs(study, unit) -> dict:
+    """The IDA's outputs under the contact model: its outputs at each simulated point
+    (``step_<name>``, extra dimension ``step``) and, with ``design.slide_limits``, the slide
+    capacities (extra dimension ``slide_limit``; ``unit``: that of ``capacity``)."""
+    if study.run.model == "rocking":
+        return {}
+    out = {}
+    for name, step in zip(rd.MODEL_KEYS, rd.STEP_MODEL_VARIABLES, strict=True):
+        o = _outputs.OUTPUTS[name]
+        out[step] = (f"{o.long_name}, at each simulated point", o.units, "f8", np.nan, "step")
+    if _slide_limits(study):
+        out["slide_capacity"] = (
+            "first intensity at which max_slide exceeds slide_limit (NaN: not below the "
+            "largest rung), in the units of the design's im",
+            unit,
+            "f8",
+            np.nan,
+            "slide_limit",
+        )
+        out["slide_capacity_scale"] = (
+            "lowest scale seen to slide more than slide_limit",
+            "1",
+            "f8",
+            np.nan,
+            "slide_limit",
+        )
+    return out
 
 
 def empty_rows(study, n: int) -> dict:
@@ -307,6 +359,8 @@ def _run_design(study, record, structures, levels, friction):
     kw["friction"] = friction
     if run.model != "rocking":  # spec.Study._contact_model: every structure has its mu
         kw["model"] = run.model
+        if kind.capacities:
+            kw["slide_limits"] = _slide_limits(study)
     if kind.levels:
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
         kw.update(levels=levels, im=t.im, period=t.period)
@@ -360,6 +414,8 @@ def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
             result[name][rows] = np.broadcast_to(values, rows.shape).astype(result[name].dtype)
         elif extra == "period":
             result[name][rows] = np.broadcast_to(values, (rows.size, width["period"]))
+        elif extra == "slide_limit":  # (slide_limit, row) of the design
+            result[name][rows] = np.asarray(var.transpose("row", "slide_limit").values)
         else:  # IDA steps: (row, step), padded with NaN to the study's bound
             k = values.shape[-1]
             if k > width["step"]:
@@ -405,6 +461,12 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         "period": cube["period"].values,
         "record_name": ("record", np.array(names, dtype=object)),
     }
+    if "slide_limit" in cube.coords:  # an IDA's slide capacities, as the API orders them
+        coords["slide_limit"] = cube["slide_limit"]
+        dims = ("slide_limit", "record", "structure")
+        for k, (var_dims, values, var_attrs) in list(out.items()):
+            if var_dims[-1:] == ("slide_limit",):
+                out[k] = (dims, np.moveaxis(values, -1, 0), var_attrs)
     if kind.levels:
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)

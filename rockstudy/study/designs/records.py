@@ -46,6 +46,7 @@ from ...structures.block import (
 )
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
+from . import ida_slides
 
 __all__ = [
     "CENSORED_REASONS",
@@ -56,6 +57,7 @@ __all__ = [
     "record_labels",
     "STATUS_FREE_FALL",
     "STEP_KINDS",
+    "STEP_MODEL_VARIABLES",
     "STEP_VARIABLES",
 ]
 
@@ -350,6 +352,8 @@ def _contact_model(model, friction, n):
 
 #: What a design keeps of the contact model: the model of each point, its slip and regimes.
 MODEL_KEYS = ("model", *SLIDE_OUTPUTS)
+#: The contact model's outputs of each point of an IDA curve (:data:`MODEL_KEYS`).
+STEP_MODEL_VARIABLES = tuple(f"step_{k}" for k in MODEL_KEYS)
 
 
 #: Kept under ``model="auto"`` besides :data:`MODEL_KEYS`: Housner's overturning decision of
@@ -626,6 +630,8 @@ def incremental_dynamic_analysis(
     max_steps: int = MAX_STEPS,
     friction=None,
     contact: bool | None = None,
+    model: str = "rocking",
+    slide_limits=(),
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -677,6 +683,16 @@ def incremental_dynamic_analysis(
         the first overturning (of a censored block: the highest it stood at).
         ``method="linear"`` runs the exact piecewise solution of the linearized model for
         records without a vertical component.
+    model : {"rocking", "contact", "auto"}
+        "contact" or "auto" with ``friction`` (one mu or one per structure) takes every
+        overturning decision from the contact model (:func:`rockstudy.simulate_batch`'s
+        ``model``), with the same ladder, bisection and guarantee; the lowest rung is then
+        the scale below which the block neither lifts nor slips (abs(u_h'') below
+        (g + u_v'') min(alpha, mu_s) everywhere), and every point keeps the contact
+        model's outputs (``step_model``, ``step_max_slide``, ...).
+    slide_limits : sequence of float
+        Slides d [m] (> 0, increasing; under the contact model only): ``slide_capacity``,
+        the first scale at which ``max_slide`` > d (see :func:`.ida_slides.slide_scales`).
 
     Returns
     -------
@@ -691,17 +707,25 @@ def incremental_dynamic_analysis(
         ``simulations`` and ``status`` (0 ok; 1 if a simulation hit the step limit). On
         (record, structure, step), in increasing scale (NaN-padded): every simulated point,
         ``step_scale``, ``step_max_rotation``, ``step_overturned`` and ``step_kind``
-        (:data:`STEP_KINDS`): the IDA curves. Attributes: the options and ``n_simulations``.
+        (:data:`STEP_KINDS`): the IDA curves; under the contact model also ``step_<name>``
+        for each of :data:`MODEL_KEYS`. With ``slide_limits``: ``slide_capacity`` (in the
+        units of ``capacity``) and ``slide_capacity_scale`` on (slide_limit, record,
+        structure), NaN where max_slide never exceeded d below the largest rung. ``rungs``
+        counts the rungs of both climbs. Attributes: the options and ``n_simulations``.
     """
     options = IdaOptions(im, period, step, tolerance, max_pga_ratio, scan)
     records = _records(records)
     st = _structures(structures)
-    contact = _friction_check(friction, contact, st["critical_rotation"].size)
+    n = st["critical_rotation"].size
+    contact = _friction_check(friction, contact, n)
+    model = _contact_model(model, friction, n)
+    limits = ida_slides.slide_limits(slide_limits, model)
     period, periods = _target(im, period, periods)
     ds = _record_dataset(records, st, periods, damping)
     measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
-    results = [_ida_record(r, st, options, method, rtol, max_steps) for r in records]
-    ds = _ida_tables(ds, results)
+    args = (options, method, rtol, max_steps, model, limits)
+    results = [_ida_record(r, st, *args) for r in records]
+    ds = _ida_tables(ds, results, model is not None)
     if contact:
         ds["friction_demand"], ds["lift_off"] = _ida_contact(
             records, st, ds, method, rtol, max_steps
@@ -714,6 +738,8 @@ def incremental_dynamic_analysis(
             "long_name": f"overturning {im} (first overturning level)",
         },
     )
+    if limits.size:
+        ds = ida_slides.slide_tables(ds, results, limits, measure, _ms.power(im))
     ds["censored_reason"].attrs.update(cf_flags(CENSORED_REASONS))
     ds.attrs.update(
         design="ida",
@@ -751,8 +777,9 @@ def _ida_contact(records, st, ds, method, rtol, max_steps):
     return (dims, demand), (dims, lift)
 
 
-def _ida_tables(ds, results):
-    """The per-record results of :func:`_ida_record` as (record, structure[, step]) arrays."""
+def _ida_tables(ds, results, contact_model=False):
+    """The per-record results of :func:`_ida_record` as (record, structure[, step]) arrays;
+    ``contact_model``: with the contact model's outputs of each point."""
     dims = ("record", "structure")
     for k in _IDA_FLOATS:
         ds[k] = (dims, np.array([res[k] for res in results], float))
@@ -761,12 +788,13 @@ def _ida_tables(ds, results):
     ds["censored"] = ds["censored_reason"] > 0
     ds["survives_above_capacity"] = np.isfinite(ds["highest_survival_scale"])
     n_step = max(max(len(h) for h in res["history"]) for res in results)
-    steps = np.full((len(results), ds.sizes["structure"], max(n_step, 1), 4), np.nan)
+    names = STEP_VARIABLES + (STEP_MODEL_VARIABLES if contact_model else ())
+    steps = np.full((len(results), ds.sizes["structure"], max(n_step, 1), len(names)), np.nan)
     for i, res in enumerate(results):
         for j, h in enumerate(res["history"]):
             if h:
                 steps[i, j, : len(h)] = sorted(h)
-    for c, k in enumerate(STEP_VARIABLES):
+    for c, k in enumerate(names):
         ds[k] = (dims + ("step",), steps[..., c])
     return ds
 
@@ -802,6 +830,14 @@ def _rest_scale(record, alpha, ceiling):
     return np.where(lifts, lo, ceiling)
 
 
+def _rest_slope(st, model):
+    """The slope of the level (g + u_v'') x below which nothing moves, per structure: the
+    linearized rest level alpha; under the contact model (``model``) also mu_s, below which
+    the base cannot slip."""
+    alpha = st["critical_rotation"]
+    return alpha if model is None else np.minimum(alpha, model[1])
+
+
 def _ladder(low, top, ceiling, q):
     """The rungs of one structure: low q^k below min(top, ceiling), then top if it is below
     the free-fall ceiling (at least one rung, every rung below the ceiling)."""
@@ -813,41 +849,63 @@ def _ladder(low, top, ceiling, q):
 
 
 class _Points:
-    """Runs batches of (structure, scale) points of one record and keeps every outcome."""
+    """Runs batches of (structure, scale) points of one record and keeps every outcome: a
+    row (scale, max_rotation, overturned, kind[, the contact model's :data:`MODEL_KEYS`])
+    per point (``model``: as :func:`_run`'s)."""
 
-    def __init__(self, record, st, method, rtol, max_steps):
+    def __init__(self, record, st, method, rtol, max_steps, model=None):
         n = st["critical_rotation"].size
         self.args = (record, st, method, rtol, max_steps)
+        self.model = model
+        self.keys = _IDA_OUT + (() if model is None else MODEL_KEYS)
         self.history = [[] for _ in range(n)]
         self.sims = np.zeros(n, np.int64)
         self.status = np.zeros(n, np.int64)
 
-    def run(self, idx, scales, kind):
+    def outcomes(self, idx, scales, kind) -> dict:
+        """The outputs (:attr:`keys`) of the structures ``idx`` at ``scales``, kept."""
         record, st, method, rtol, max_steps = self.args
-        out = _run(record, st, idx, scales, method, rtol, max_steps, _IDA_OUT)
-        for j, s, m, o in zip(idx, scales, out["max_rotation"], out["overturned"], strict=True):
-            self.history[j].append((s, m, float(o), kind))
+        out = _run(record, st, idx, scales, method, rtol, max_steps, self.keys, self.model)
+        extra = [np.asarray(out[k], float) for k in self.keys[len(_IDA_OUT) :]]
+        for r, (j, s) in enumerate(zip(idx, scales, strict=True)):
+            point = (s, out["max_rotation"][r], float(out["overturned"][r]), kind)
+            self.history[j].append(point + tuple(float(e[r]) for e in extra))
         np.add.at(self.sims, idx, 1)
         self.status[idx] |= out["status"] != 0
-        return out["overturned"]
+        return out
+
+    def column(self, name) -> int:
+        """The column of the contact model's output ``name`` in a row of :attr:`history`."""
+        return 4 + self.keys.index(name) - len(_IDA_OUT)
+
+    def run(self, idx, scales, kind):
+        """Whether each point overturned (:meth:`outcomes`)."""
+        return self.outcomes(idx, scales, kind)["overturned"]
 
 
 _IDA_OUT = ("max_rotation", "overturned")
 
 
-def _climb(points, ladders):
-    """Climb every structure's ladder, ``_RUNGS_PER_CALL`` rungs per structure and call,
-    until its first overturning rung. Returns that rung's index (-1: none) and the number of
-    rungs simulated, per structure."""
+def _overturned(out):
+    """Whether each point of a batch's outputs overturned."""
+    return np.asarray(out["overturned"], bool)
+
+
+def _climb(points, ladders, start=None, crossed=_overturned):
+    """Climb every structure's ladder from its rung ``start`` (default 0; at the ladder's
+    end: not climbed), ``_RUNGS_PER_CALL`` rungs per structure and call, until its first
+    rung where ``crossed(outputs)`` holds (default: it overturns). Returns that rung's
+    index (-1: none) and the number of rungs simulated in all, per structure."""
     sizes = np.array([r.size for r in ladders])
-    done = np.zeros(sizes.size, np.int64)
+    done = np.zeros(sizes.size, np.int64) if start is None else np.array(start, np.int64)
     first = np.full(sizes.size, -1)
-    active = np.arange(sizes.size)
+    active = np.flatnonzero(done < sizes)
     while active.size:
         ks = [np.arange(done[j], min(done[j] + _RUNGS_PER_CALL, sizes[j])) for j in active]
         rows = np.repeat(active, [k.size for k in ks])
         ks = np.concatenate(ks)
-        over = points.run(rows, np.array([ladders[j][k] for j, k in zip(rows, ks, strict=True)]), 0)
+        scales = np.array([ladders[j][k] for j, k in zip(rows, ks, strict=True)])
+        over = crossed(points.outcomes(rows, scales, 0))
         for j in active:
             sel = rows == j
             if over[sel].any():
@@ -857,18 +915,18 @@ def _climb(points, ladders):
     return first, done
 
 
-def _ida_record(record, st, options, method, rtol, max_steps):
-    """Ladder, bisection and scan of all structures under one record (see the public
-    function)."""
+def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits=()):
+    """Ladder, bisection and scan of all structures under one record, and the slide
+    capacities of ``limits`` (see the public function; ``model`` as :func:`_run`'s)."""
     n = st["critical_rotation"].size
     pga = record.peak
     if not pga > 0:
         raise ValueError(f"records: the record {record.name!r} has PGA 0; it cannot be scaled")
     ceiling = free_fall_scale(record)
     top = options.max_pga_ratio * st["uplift_acceleration"] / pga
-    low = np.broadcast_to(_rest_scale(record, st["critical_rotation"], ceiling), (n,))
+    low = np.broadcast_to(_rest_scale(record, _rest_slope(st, model), ceiling), (n,))
     ladders = [_ladder(low[j], top[j], ceiling, 1.0 + options.step) for j in range(n)]
-    points = _Points(record, st, method, rtol, max_steps)
+    points = _Points(record, st, method, rtol, max_steps, model)
     first, done = _climb(points, ladders)
     found = first >= 0
     hi, lo = np.full(n, np.nan), np.full(n, np.nan)
@@ -887,6 +945,7 @@ def _ida_record(record, st, options, method, rtol, max_steps):
         hi[active[over]] = s[over]
         lo[active[~over]] = s[~over]
     _scan(points, ladders, done, found, options.scan)
+    slides = ida_slides.slide_scales(points, ladders, done, limits, options.tolerance, _climb)
     band = [_switch_band(h, c) for h, c in zip(points.history, hi, strict=True)]
     reason = np.where(found, 0, np.where(top < ceiling, 1, 2))
     return {
@@ -899,6 +958,7 @@ def _ida_record(record, st, options, method, rtol, max_steps):
         "simulations": points.sims,
         "status": points.status,
         "history": points.history,
+        "slide_capacity_scale": slides,
     }
 
 
@@ -920,7 +980,8 @@ def _switch_band(history, capacity):
     [capacity, that scale] that overturn); NaNs if none survives above it."""
     if not history or not np.isfinite(capacity):
         return np.nan, np.nan
-    s, _, over, _ = np.array(history).T
+    points = np.array(history)
+    s, over = points[:, 0], points[:, 2]
     above = (s > capacity) & (over == 0)
     if not above.any():
         return np.nan, np.nan

@@ -114,9 +114,8 @@ class Study(_Model):
     @model_validator(mode="after")
     def _contact_model(self):
         """``run.model = "contact"`` or ``"auto"`` needs the friction of every scene (the
-        study's ``friction``, or each object's), and runs in a Monte Carlo study or a cloud
-        or stripes design (an IDA runs Housner's model with the friction check);
-        ``design.slide_limits`` needs it."""
+        study's ``friction``, or each object's), in a Monte Carlo study or any record
+        design; ``design.slide_limits`` needs it."""
         model = self.run.model
         if model == "rocking":
             if self.design is not None and self.design.slide_limits:
@@ -132,13 +131,6 @@ class Study(_Model):
                 "run.model",
                 f"{model!r} runs the contact model, which needs the friction coefficient mu of "
                 "every scene: give friction (top level, or per object), or model = 'rocking'",
-            )
-        if self.design is not None and design_kind(self.design.kind).capacities:
-            raise FieldError(
-                "run.model",
-                f"{model!r} is not available in an {self.design.kind.upper()} design yet "
-                "(its ladder runs Housner's model with the friction check): give model = "
-                "'rocking', or a cloud or stripes design",
             )
         return self
 
