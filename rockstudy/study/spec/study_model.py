@@ -125,6 +125,7 @@ class Study(_Model):
                     "'auto' (with friction)",
                 )
             return self
+        self._contact_structures()
         mu = self.friction_coefficients()
         if mu is None or np.isnan(mu).any():
             raise FieldError(
@@ -133,6 +134,24 @@ class Study(_Model):
                 "every scene: give friction (top level, or per object), or model = 'rocking'",
             )
         return self
+
+    def _contact_structures(self):
+        """The contact model is of a rectangular block on its base: a FieldError naming the
+        structure (or the object) of another kind, whose equivalent block has no base that
+        slides."""
+        st = self.structure
+        if st.kind == "objects":
+            others = [(f"object {o.name!r}", o.kind) for o in st.objects if o.kind != "block"]
+        else:
+            others = [("structure.kind", st.kind)] if st.kind != "block" else []
+        if others:
+            who, kind = others[0]
+            raise FieldError(
+                "run.model",
+                f"{self.run.model!r} runs the contact model of a rectangular block on a base "
+                f"with friction; {who} is a {kind} (its equivalent block has no such base): "
+                "give model = 'rocking', or leave it out of the study",
+            )
 
     def friction_coefficients(self) -> np.ndarray | None:
         """The friction coefficient of each object (NaN where none is given), the study's
