@@ -20,17 +20,22 @@ def _housner(block, motion):
 
 
 def test_plinth_that_cannot_move_leaves_the_upper_block_housners():
-    """A wide, heavy plinth never lifts: the statue on it is Housner's block on the ground."""
+    """A wide, heavy plinth never lifts: the statue on it, centred or not, is Housner's
+    block on the ground."""
     lower, upper = Block(6.0, 0.9), Block(0.5, 0.2)
-    for amplitude, period in ((3.0, 0.6), (2.2, 1.0), (5.0, 0.3)):
+    for amplitude, period, offset in ((3.0, 0.6, 0.0), (2.2, 1.0, -2.0), (5.0, 0.3, 1.5)):
         motion = SinePulse(amplitude=amplitude, period=period)
-        r = rs.simulate(StackedBlocks(lower, upper, density_ratio=0.5), motion, rtol=1e-12)
+        pair = StackedBlocks(lower, upper, density_ratio=0.5, offset=offset)
+        r = rs.simulate(pair, motion, rtol=1e-12)
         assert not np.any(np.isin(r.regime, ["lower", "both"]))  # the plinth stayed put
         ref = _housner(upper, motion)
         assert r.overturned == ref.overturned
         assert r.max_rotation_upper == pytest.approx(ref.max_rotation, rel=1e-9)
         assert r.max_rotation_lower == 0.0
         assert r.overturned_body == ("upper" if ref.overturned else None)
+        ds = r.to_xarray()
+        assert ds.attrs["max_rotation_upper"] == r.max_rotation_upper
+        np.testing.assert_array_equal(ds["theta_upper"].values, r.theta_upper)
 
 
 def test_upper_block_of_vanishing_mass_leaves_the_lower_block_housners():

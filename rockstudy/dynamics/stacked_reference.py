@@ -16,12 +16,14 @@ closes it, as the single-block kernels' rest rule) or to ``t_max``.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from .. import _validate
+from .._warnings import AccuracyWarning
 from ..constants import FALL_ROTATION, G
 from ..structures.block import frequency_parameter
 from . import stacked as st
@@ -76,7 +78,9 @@ class StackedResult:
         "scipy": this module.
     info : dict
         ``solver``, ``rtol``, ``phases``, ``energy_lost`` [J per unit thickness, the impacts'
-        losses] and what ran.
+        losses], ``missed_impacts`` (extrema found beyond a pivot: impacts the steps
+        stepped over, warned about with an :class:`~rockstudy.AccuracyWarning`) and what
+        ran.
     """
 
     t: np.ndarray
@@ -180,6 +184,7 @@ class _Log:
         self.rows, self.regimes = [], []
         self.peak = [0.0, 0.0]
         self.impacts, self.interfaces, self.lost = [], [], 0.0
+        self.missed = 0
 
     def row(self, state):
         (a1, a2), (w1, w2) = state.angles()
@@ -298,12 +303,7 @@ def _phase(scene, state, log):
     for i, name in enumerate(names):
         if events[i].terminal and sol.t_events[i].size and sol.t_events[i][0] <= t_end:
             first, t_end, y_end = name, sol.t_events[i][0], sol.y_events[i][0]
-    for i, name in enumerate(names):
-        if name[0] == "peak":
-            for t, y in zip(sol.t_events[i], sol.y_events[i], strict=True):
-                if t <= t_end:
-                    k = name[1]
-                    log.peak[k] = max(log.peak[k], abs(_angle(k, y, n, sel)[0]))
+    _log_peaks(scene, log, sol, names, t_end, sel)
     for t, y in zip(sol.t[1:-1], sol.y[:, 1:-1].T, strict=True):
         if t < t_end:
             state.t, state.q, state.qd = t, sel @ y[:n], sel @ y[n:]
@@ -311,6 +311,22 @@ def _phase(scene, state, log):
     state.t, state.q, state.qd = t_end, sel @ y_end[:n], sel @ y_end[n:]
     log.row(state)
     return _act(scene, state, log, first)
+
+
+def _log_peaks(scene, log, sol, names, t_end, sel):
+    """Raise the logged peaks to the phase's extrema of |angle| before ``t_end``. An extremum
+    on the wrong side of its pivot (s angle < -1e-12 alpha) is an impact the steps missed
+    (the angle dipped through zero and back inside one step): counted in
+    ``log.missed``, which the result reports and warns about."""
+    n = sel.shape[1]
+    for i, (kind, k, side) in enumerate(names):
+        if kind != "peak":
+            continue
+        for t, y in zip(sol.t_events[i], sol.y_events[i], strict=True):
+            angle = _angle(k, y, n, sel)[0]
+            if t <= t_end:
+                log.peak[k] = max(log.peak[k], abs(angle))
+                log.missed += side * angle < -1e-12 * scene.alpha[k]
 
 
 def _act(scene, state, log, event):
@@ -477,6 +493,14 @@ def _pack(scene, state, log, fell, phases) -> StackedResult:
     """The result of a run."""
     rows = np.array(log.rows)
     peaks = list(log.peak)
+    if log.missed:
+        warnings.warn(
+            f"StackedBlocks: {log.missed} impact(s) missed by the steps (an angle dipped "
+            f"through zero inside one step) at rtol {scene.rtol:g}: the result is not "
+            "reliable; run at a tighter rtol",
+            AccuracyWarning,
+            stacklevel=3,
+        )
     if fell in ("lower", "both"):
         peaks[st.LOWER] = FALL_ROTATION
     if fell == "upper":
@@ -501,6 +525,7 @@ def _pack(scene, state, log, fell, phases) -> StackedResult:
             "rtol": scene.rtol,
             "phases": phases + 1,
             "energy_lost": float(log.lost),
+            "missed_impacts": int(log.missed),
         },
     )
 
