@@ -17,12 +17,14 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
+from ..structures.stacked import StackedBlocks
 from . import _auto, _linear, _linear_record, _rocking, contact, contact_model
 from ._vertical import refuse_free_fall, uplift_ratio
 from .conditioning import peak_change, perturbed
 from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
 from .result import RockingResult, describe
+from .stacked_reference import simulate_stacked_blocks
 
 __all__ = [
     "check_friction",
@@ -486,6 +488,10 @@ def simulate(
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
+    if isinstance(structure, StackedBlocks):  # its solve_ivp reference (no kernel yet)
+        options = dict(initial_rotation=initial_rotation, initial_velocity=initial_velocity)
+        options.update(t_eval=t_eval, dt_out=dt_out, friction=friction, conditioning=conditioning)
+        return simulate_stacked_blocks(structure, motion, method, rtol, t_max, **options)
     kind, mp, _, _, vsamples = motion.kernel_spec()
     refuse_free_fall(vsamples, mp[0])
     method_for(

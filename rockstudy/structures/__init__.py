@@ -18,6 +18,7 @@ from .equivalent import (
     restitution_symmetric_body,
 )
 from .mechanism import EquivalentBlock, Mechanism, RockingParameters
+from .stacked import StackedBlocks
 
 __all__ = [
     "Arch",
@@ -29,6 +30,7 @@ __all__ = [
     "PointMassStrut",
     "RockingParameters",
     "RockingWall",
+    "StackedBlocks",
     "SymmetricFrame",
     "block_parameters",
     "frequency_parameter",
