@@ -26,9 +26,11 @@ from numba import njit, prange
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
+from . import _contact_taylor as ct
 from . import slide_rock as sr
 from ._free_map import _rotation_at, _travel_time, free_peak_time, free_rocking_map
 from ._sliding import sliding_scene
+from ._taylor import poly_end, poly_value, work_arrays
 from ._uplift import _next_break, _skip_quiet
 from ._vertical import refuse_free_fall
 from .constants import (
@@ -41,6 +43,7 @@ from .constants import (
     STEP_GROW_LIMIT,
     STEP_SAFETY,
     STEP_SHRINK_LIMIT,
+    TAYLOR_TOL_FRACTION,
     TOL_SAFETY,
 )
 
@@ -463,9 +466,18 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
         _log_state(hist, ta, st, blk, z)
         return 0
     t_ev = cs.refine(ev, rk, mode, st[S_T], z, K, s_ev, hs, zp, work)
+    z[:] = zp
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log)
+
+
+@njit(cache=True)
+def _at_event(ev, t_ev, blk, mot, st, ta, z, k, log):
+    """The phase in st reached the event ``ev`` at t_ev, with the state z there: its time
+    tallied and logged, then the regime after it (:func:`_transition`). Returns 0 (on),
+    2 (fell) or 3 (no solution)."""
+    hist, regime = log[0], int(st[S_REG])
     ta[T_TIMES + regime] += t_ev - st[S_T]
     st[S_T] = t_ev
-    z[:] = zp
     if ev == cs.EV_FALL:
         side = math.copysign(1.0, z[2]) if regime == sr.FLIGHT else st[S_SIDE]
         u = _flight_slip(blk, z, side) if regime == sr.FLIGHT else z[0]
@@ -480,10 +492,51 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
 
 
 @njit(cache=True)
+def _rock_attempt(blk, mot, st, ta, z, w, log, tol, t_end, k):
+    """One attempted Taylor step of the rock regime (:func:`._contact_taylor.rock_step`).
+    Returns 0 (on), 1 (rejected), 2 (fell), 3 (no solution), 4 (a step below the shortest)."""
+    p = math.sqrt(0.75 * G / blk.radius)
+    t = st[S_T]
+    t_next = _next_stop(mot, t, k, t_end)
+    h = min(st[S_H], STEP_CAP / p)
+    last = h >= t_next - t
+    hs = t_next - t if last else h
+    fresh = st[S_FRESH] > 0.0
+    outcome, n, ev, s_ev, s_pk = ct.rock_step(
+        w, blk, mot, k, t, z[1], z[4], st[S_SIDE], hs, tol, fresh
+    )
+    if outcome == ct.REJECTED:
+        if hs * p < MIN_STEP:
+            return 4
+        st[S_H] = 0.5 * hs
+        return 1
+    st[S_H] = max(h, 2.0 * hs) if last else 2.0 * hs
+    st[S_FRESH] = 0.0
+    c = w[0]
+    if s_pk >= 0.0:
+        _raise_peaks(ta, t + s_pk * hs, poly_value(c, n, s_pk)[0], z[0])
+    if ev == cs.EV_NONE:
+        th1, dth1, _ = poly_end(c, n)
+        ta[T_TIMES + sr.ROCK] += hs
+        st[S_T] = t_next if last else t + hs
+        z[1], z[4] = th1, dth1 / hs
+        _log_state(log[0], ta, st, blk, z)
+        return 0
+    th, dth, _ = poly_value(c, n, s_ev)
+    z[1], z[4] = th, dth / hs
+    t_ev = t + s_ev * hs
+    if ev == cs.EV_IMPACT and t_ev <= t:  # a lift from rest that falls back at once
+        t_ev = np.nextafter(t, np.inf)
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log)
+
+
+@njit(cache=True)
 def _attempt(rk, blk, mot, st, ta, z, K, work, log, tol, t_end, k):
     """One attempted step of the phase in st (rejected: a shorter one next). Returns 0
     (on), 1 (rejected), 2 (fell), 3 (no solution), 4 (a step below the shortest)."""
     regime = int(st[S_REG])
+    if regime == sr.ROCK and ct.taylor_rock_applies(mot[0], k):
+        return _rock_attempt(blk, mot, st, ta, z, work[7], log, tol[1], t_end, k)
     mode = (regime, st[S_SIDE], st[S_SLIP], blk, mot, k)
     z1, tmp = work[1], work[2]
     p = math.sqrt(0.75 * G / blk.radius)
@@ -495,7 +548,7 @@ def _attempt(rk, blk, mot, st, ta, z, K, work, log, tol, t_end, k):
     cs.rk_step(rk, mode, st[S_T], z, hs, K, z1, tmp)
     t1 = t_next if last else st[S_T] + hs
     cs.deriv(mode, t1, z1, K[12])
-    err = cs.rk_error(rk, K, hs, z, z1, work[6][1 if regime == sr.FLIGHT else 0], tol)
+    err = cs.rk_error(rk, K, hs, z, z1, work[6][1 if regime == sr.FLIGHT else 0], tol[0])
     if not err <= 1.0:  # rejected (NaN: slide-rock without a solution, or a bad step)
         if hs * p < MIN_STEP:
             return 3 if err != err else 4
@@ -530,8 +583,10 @@ def contact_run(blk, mot, rtol, t_max, max_steps, log):
         np.empty(6),
         np.empty((n_trace, 2)),
         _scales(blk),
+        work_arrays(),
     )
-    tol, rec, k, code = CONTACT_TOL_FRACTION * TOL_SAFETY * rtol, mot[0] == KIND_RECORD, 0, 0
+    tol = (CONTACT_TOL_FRACTION * TOL_SAFETY * rtol, TAYLOR_TOL_FRACTION * TOL_SAFETY * rtol)
+    rec, k, code = mot[0] == KIND_RECORD, 0, 0
     _row(hist, ta, 0.0, 0.0, 0.0, 0.0)
     while True:
         if int(st[S_REG]) == sr.REST:
