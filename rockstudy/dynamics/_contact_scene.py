@@ -62,7 +62,10 @@ CONTACT_TOL_FRACTION = 0.1
 (T_MAX_THETA, T_PEAK_TIME, T_MAX_U, T_N_IMPACTS, T_FIRST_SLIP, T_LIFT, T_STEPS) = range(7)
 (T_FIRST_IMPACT, T_OVER_TIME, T_STATUS, T_N_HIST, T_U_END) = range(7, 12)
 T_TIMES = 12  # seconds in each regime, 5 slots
-N_TALLIES = 17
+# the convergence signals: the least relative margin of a friction decision, and the events
+# on the first step of a regime (:func:`_tally_margin`, :func:`_at_event`)
+T_MARGIN, T_CLOSE = 17, 18
+N_TALLIES = 19
 # the run's state (one float array): regime, corner, slip direction, time, step, fresh, and
 # whether the half-cycle under way started at a sticking impact after the motion (clean)
 S_REG, S_SIDE, S_SLIP, S_T, S_H, S_FRESH, S_CLEAN = range(7)
@@ -82,6 +85,9 @@ CONTACT_ROW = np.dtype(
         ("residual_slide", "f8"),
         ("first_slip_time", "f8"),
         ("lift_off", "bool"),
+        ("converged", "bool"),
+        ("decision_margin", "f8"),
+        ("close_events", "i8"),
     ]
     + [(f"time_{name}", "f8") for name in sr.REGIMES]
 )
@@ -95,6 +101,7 @@ def _new_tallies():
     """The tallies of a scene at rest at t = 0."""
     ta = np.zeros(N_TALLIES)
     ta[T_PEAK_TIME] = ta[T_FIRST_SLIP] = ta[T_FIRST_IMPACT] = ta[T_OVER_TIME] = np.nan
+    ta[T_MARGIN] = np.inf
     return ta
 
 
@@ -156,10 +163,24 @@ def _start_sliding(blk, st, ta, z, u_dot):
 
 
 @njit(cache=True)
+def _tally_margin(ta, static, f_h, f_v):
+    """Lower the least margin of the friction decisions to that of ``|F|`` <= mu_s N with
+    the force (or impulse) (f_h, f_v), relative to mu_s N: a decision within the state's
+    error of its threshold may go either way (:func:`contact_batch` flags it)."""
+    cone = static * f_v
+    if cone > 0.0:
+        ta[T_MARGIN] = min(ta[T_MARGIN], abs(cone - abs(f_h)) / cone)
+
+
+@njit(cache=True)
 def _from_flat(blk, mot, st, ta, z, k):
     """The regime a flat block at rest (or whose slip just stopped) enters at st[S_T]."""
     a_h, a_v = cs.ground(mot, st[S_T], k)
     regime, side = sr.initiation_regime(a_h, a_v, blk.static, blk.kinetic, blk.radius, blk.alpha)
+    if regime != sr.REST and blk.static >= math.tan(blk.alpha):  # rock or not: the forces
+        acc = sr.rocking_acceleration(0.0, a_h, a_v, side, blk.radius, blk.alpha)
+        f = sr.contact_forces(0.0, 0.0, acc, 0.0, a_h, a_v, side, blk.radius, blk.alpha)
+        _tally_margin(ta, blk.static, f[0], f[1])
     z[1], z[3], z[4] = 0.0, 0.0, 0.0
     if regime == sr.SLIDE and blk.kinetic > math.tan(blk.alpha):
         regime = sr.SLIDE_ROCK
@@ -193,6 +214,7 @@ def _impact(blk, st, ta, z, imps):
     w_plus = sr.rocking_impact(u_dot, w, side, blk.eta, R, alpha)
     ax, ay = sr.centre_velocity(0.0, 0.0, w_plus, corner, R, alpha)
     p_h, p_v = ax - bx, ay - by
+    _tally_margin(ta, blk.static, p_h, p_v)
     if p_v > 0.0 and abs(p_h) <= blk.static * p_v and corner * w_plus > 0.0:
         z[3], z[4] = 0.0, w_plus
         _enter(st, ta, sr.ROCK, corner, st[S_SLIP])
@@ -259,6 +281,7 @@ def _stop_corner(blk, mot, st, ta, z, k):
     R, alpha, side = blk.radius, blk.alpha, st[S_SIDE]
     th_dd = sr.rocking_acceleration(z[1], a_h, a_v, side, R, alpha)
     f_h, f_v = sr.contact_forces(z[1], z[4], th_dd, 0.0, a_h, a_v, side, R, alpha)
+    _tally_margin(ta, blk.static, f_h, f_v)
     if abs(f_h) <= blk.static * f_v:
         _enter(st, ta, sr.ROCK, side, st[S_SLIP])
     else:
@@ -467,15 +490,19 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
         return 0
     t_ev = cs.refine(ev, rk, mode, st[S_T], z, K, s_ev, hs, zp, work)
     z[:] = zp
-    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log)
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, fresh)
 
 
 @njit(cache=True)
-def _at_event(ev, t_ev, blk, mot, st, ta, z, k, log):
+def _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, fresh):
     """The phase in st reached the event ``ev`` at t_ev, with the state z there: its time
-    tallied and logged, then the regime after it (:func:`_transition`). Returns 0 (on),
-    2 (fell) or 3 (no solution)."""
+    tallied and logged (an event on the first DOP853 step of a regime, ``fresh``, counted: two
+    events inside one step, where the sampled events may miss a third one; the Taylor steps
+    locate theirs on the step polynomial, as the rocking kernels do), then the regime after
+    it (:func:`_transition`). Returns 0 (on), 2 (fell) or 3 (no solution)."""
     hist, regime = log[0], int(st[S_REG])
+    if fresh and t_ev > st[S_T]:
+        ta[T_CLOSE] += 1.0
     ta[T_TIMES + regime] += t_ev - st[S_T]
     st[S_T] = t_ev
     if ev == cs.EV_FALL:
@@ -527,7 +554,7 @@ def _rock_attempt(blk, mot, st, ta, z, w, log, tol, t_end, k):
     t_ev = t + s_ev * hs
     if ev == cs.EV_IMPACT and t_ev <= t:  # a lift from rest that falls back at once
         t_ev = np.nextafter(t, np.inf)
-    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log)
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, False)
 
 
 @njit(cache=True)
@@ -626,6 +653,9 @@ def _write(out, i, ta, over):
     row.residual_slide = np.nan if over else ta[T_U_END]
     row.first_slip_time = ta[T_FIRST_SLIP]
     row.lift_off = ta[T_LIFT] > 0.0
+    row.converged = row.status == 0
+    row.decision_margin = ta[T_MARGIN]
+    row.close_events = int(ta[T_CLOSE])
     row.time_rest = ta[T_TIMES + sr.REST]
     row.time_slide = ta[T_TIMES + sr.SLIDE]
     row.time_rock = ta[T_TIMES + sr.ROCK]
@@ -710,6 +740,7 @@ def contact_scene(
     row = np.empty(1, CONTACT_ROW)
     _write(row, 0, ta, over)
     out = {name: row[name][0].item() for name in CONTACT_ROW.names}
+    out["converged"] = out["converged"] and not out["decision_margin"] < DECISION_BAND * rtol
     out.update(t=hist[:n, 0], theta=hist[:n, 1], theta_dot=hist[:n, 2], slide=hist[:n, 3])
     out["impact_times"] = imps[:n_imp].copy()
     out["regime_times"] = {name: out.pop(f"time_{name}") for name in sr.REGIMES}
@@ -736,7 +767,8 @@ def contact_batch(
     Returns
     -------
     numpy structured array of :data:`CONTACT_ROW`, one per row; a row whose ``status`` is
-    not 0 did not converge (1) or has no solution (3).
+    not 0 did not converge (1) or has no solution (3); a row whose ``converged`` is False
+    (:func:`flag_unconverged`) must not be used as an answer at rtol either.
     """
     kind, mp, times, samples, vsamples = motion_rows
     refuse_free_fall(vsamples, mp[:, 0], batch=True)
@@ -744,6 +776,63 @@ def contact_batch(
         np.ascontiguousarray(np.broadcast_to(x, np.shape(p)), dtype=float)
         for x in (p, alpha, eta, static, kinetic)
     )
-    arrays = (np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples))
+    cols = tuple(cols)
+    mp, times, samples, vsamples = (
+        np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples)
+    )
     run = contact_batch_kernel if parallel else contact_batch_serial
-    return run(*cols, np.int64(kind), *arrays, float(rtol), int(max_steps))
+
+    def rows(index, tolerance):
+        """The kernel's rows ``index`` at ``tolerance``."""
+        picked = (c[index] for c in cols)
+        motion = (np.int64(kind), mp[index], times, samples, vsamples)
+        return run(*picked, *motion, tolerance, int(max_steps))
+
+    out = rows(slice(None), float(rtol))
+    flag_unconverged(out, cols[0], cols[1], rows, float(rtol))
+    return out
+
+
+#: Relative margin of a friction decision, in units of rtol, below which a scene's answer is
+#: flagged outright: the decision lies within the state's error of its threshold.
+DECISION_BAND = 10.0
+#: Relative margin, in units of rtol, below which a scene is run again at rtol *
+#: RERUN_FACTOR to see whether its answer holds (as is any scene with an event on the first
+#: step of a regime: two events inside one step).
+SUSPECT_BAND = 1e4
+RERUN_FACTOR = 1e-2
+#: Change of max_rotation or max_slide between the two runs, in units of rtol, beyond which
+#: a scene's answer did not converge: relative to |x| plus FLOOR alpha (resp. FLOOR R alpha),
+#: the measure of the accuracy benchmark.
+CONVERGED_RTOL = 10.0
+FLOOR = 1e-2
+
+
+def _moved(a, b, p, alpha, rtol):
+    """Whether rows b answer differently from rows a (blocks p, alpha) by more than
+    CONVERGED_RTOL rtol: a status, an overturning decision, max_rotation or max_slide."""
+    radius = 0.75 * G / (p * p)
+    d_theta = np.abs(a["max_rotation"] - b["max_rotation"])
+    d_u = np.abs(a["max_slide"] - b["max_slide"])
+    bound = CONVERGED_RTOL * rtol
+    return (
+        (a["status"] != b["status"])
+        | (a["overturned"] != b["overturned"])
+        | ~(d_theta <= bound * (np.abs(b["max_rotation"]) + FLOOR * alpha))
+        | ~(d_u <= bound * (np.abs(b["max_slide"]) + FLOOR * radius * alpha))
+    )
+
+
+def flag_unconverged(out, p, alpha, rows, rtol):
+    """Set ``converged`` of the batch rows ``out`` (blocks p, alpha): False where the status
+    is not 0, where a friction decision lay within DECISION_BAND rtol of its threshold, and
+    where the cheap signals (a decision within SUSPECT_BAND rtol, an event on a regime's
+    first step) call for a second run, ``rows(index, rtol * RERUN_FACTOR)``, whose answer
+    moved by more than CONVERGED_RTOL rtol (:func:`_moved`)."""
+    ok = out["status"] == 0
+    margin = out["decision_margin"]
+    suspect = np.flatnonzero(ok & ((margin < SUSPECT_BAND * rtol) | (out["close_events"] > 0)))
+    if suspect.size:
+        fine = rows(suspect, rtol * RERUN_FACTOR)
+        ok[suspect] &= ~_moved(out[suspect], fine, p[suspect], alpha[suspect], rtol)
+    out["converged"] = ok & ~(margin < DECISION_BAND * rtol)

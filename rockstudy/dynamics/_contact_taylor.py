@@ -74,10 +74,10 @@ def rock_force_events(c, n, x, hs, side, static, radius, alpha, gr):
 def _quiet_forces(c, n, hs, side, blk, gr):
     """Whether no force event can lie inside the step: at its ends and middle every g is
     positive and exceeds :data:`FORCE_MARGIN` times its spread there."""
-    args = (hs, side, blk.static, blk.radius, blk.alpha, gr)
-    g0 = rock_force_events(c, n, 0.0, *args)
-    g1 = rock_force_events(c, n, 0.5, *args)
-    g2 = rock_force_events(c, n, 1.0, *args)
+    mu, radius, alpha = blk.static, blk.radius, blk.alpha
+    g0 = rock_force_events(c, n, 0.0, hs, side, mu, radius, alpha, gr)
+    g1 = rock_force_events(c, n, 0.5, hs, side, mu, radius, alpha, gr)
+    g2 = rock_force_events(c, n, 1.0, hs, side, mu, radius, alpha, gr)
     for e in range(3):
         lo = min(g0[e], g1[e], g2[e])
         if not lo > FORCE_MARGIN * (max(g0[e], g1[e], g2[e]) - lo):
