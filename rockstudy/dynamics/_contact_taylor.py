@@ -31,6 +31,7 @@ from . import _contact_steps as cs
 from . import slide_rock as sr
 from ._taylor import (
     MODEL_NONLINEAR,
+    NO_REFCOUNT,
     OF_VALUE,
     poly_end,
     poly_root,
@@ -58,7 +59,7 @@ def taylor_rock_applies(kind, k):
     return k < 0 or kind == KIND_RECORD
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def rock_force_events(c, n, x, hs, side, static, radius, alpha, gr):
     """g of the slip events (mu_s N - F, mu_s N + F) and of lift-off (N) at unit step time x
     on the step polynomial c of order n; ``gr`` = (a_h, a_v) at the step's ends (a_h0, a_h1,
@@ -70,12 +71,11 @@ def rock_force_events(c, n, x, hs, side, static, radius, alpha, gr):
     return static * f_v - f_h, static * f_v + f_h, f_v
 
 
-@njit(cache=True)
-def _quiet_forces(c, n, hs, side, blk, gr):
-    """Whether no force event can lie inside the step: at its ends and middle every g is
-    positive and exceeds :data:`FORCE_MARGIN` times its spread there."""
+@njit(cache=True, **NO_REFCOUNT)
+def _quiet_forces(c, n, hs, side, blk, gr, g0):
+    """Whether no force event can lie inside the step: at its ends and middle (g0 at its
+    start) every g is positive and exceeds :data:`FORCE_MARGIN` times its spread there."""
     mu, radius, alpha = blk.static, blk.radius, blk.alpha
-    g0 = rock_force_events(c, n, 0.0, hs, side, mu, radius, alpha, gr)
     g1 = rock_force_events(c, n, 0.5, hs, side, mu, radius, alpha, gr)
     g2 = rock_force_events(c, n, 1.0, hs, side, mu, radius, alpha, gr)
     for e in range(3):
@@ -85,7 +85,7 @@ def _quiet_forces(c, n, hs, side, blk, gr):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _bisect_force(e, c, n, hs, side, blk, gr, lo, hi):
     """The crossing of force event e (> 0 at lo, <= 0 at hi) on the polynomial, by bisection
     to adjacent doubles of unit step time."""
@@ -100,21 +100,27 @@ def _bisect_force(e, c, n, hs, side, blk, gr, lo, hi):
             hi = mid
 
 
-@njit(cache=True)
-def first_force_event(c, n, hs, side, blk, gr, fresh, s_end):
-    """(event, unit step time) of the first slip or lift-off before s_end, or (EV_NONE, 2.0):
-    screened by :func:`_quiet_forces` (not on a first step, ``fresh``, whose g are taken
-    positive at its start, as :func:`._contact_steps.first_event` does), then sampled and
-    bisected."""
-    if not fresh and _quiet_forces(c, n, hs, side, blk, gr):
+@njit(cache=True, **NO_REFCOUNT)
+def first_force_event(c, n, hs, side, blk, gr, fresh, s_end, prev):
+    """(event, unit step time) of the first slip or lift-off before s_end, or (EV_NONE, 2.0).
+
+    On the first step of the regime (``fresh``) a g below 0 at the start is the event, at
+    once (a slip right after an impact), and a g of 0 there is taken positive (the regime's
+    entry decided it so). Then the step is screened (:func:`_quiet_forces`), and where that
+    does not rule a crossing out, g is sampled at :data:`._contact_steps.EVENT_POINTS` and
+    the first crossing bisected (``prev``: work space of 3)."""
+    g0 = rock_force_events(c, n, 0.0, hs, side, blk.static, blk.radius, blk.alpha, gr)
+    for e in range(3):
+        prev[e] = g0[e]
+        if fresh and g0[e] < 0.0:
+            return FORCE_EVENTS[e], 0.0
+        if fresh and g0[e] == 0.0:
+            prev[e] = 1.0
+    if _quiet_forces(c, n, hs, side, blk, gr, g0):
         return cs.EV_NONE, 2.0
-    prev = np.ones(3)
-    if not fresh:
-        prev[:] = rock_force_events(c, n, 0.0, hs, side, blk.static, blk.radius, blk.alpha, gr)
     lo = 0.0
-    count = cs.EVENT_POINTS + (len(cs.FRESH_POINTS) if fresh else 0)
-    for j in range(count):
-        x = min(cs.sample_point(j, fresh), s_end)
+    for j in range(cs.EVENT_POINTS):
+        x = min(cs.sample_point(j, False), s_end)
         g = rock_force_events(c, n, x, hs, side, blk.static, blk.radius, blk.alpha, gr)
         best, best_x = cs.EV_NONE, 2.0
         for e in range(3):
@@ -139,18 +145,19 @@ def _scales(th, om, hs, p, alpha, tol):
     return sc_x, sc_v
 
 
-@njit(cache=True)
-def rock_step(w, blk, mot, k, t, th, om, side, hs, tol, fresh):
-    """One Taylor step of the rock regime from (t, th, om) on corner ``side``, of length hs
-    (inside record segment k, or after the motion: k = -1), at the local tolerance ``tol``.
+@njit(cache=True, **NO_REFCOUNT)
+def rock_step(w, prev, blk, gr, th, om, side, hs, tol, fresh):
+    """One Taylor step of the rock regime from (th, om) on corner ``side``, of length hs,
+    under the ground ``gr`` = (a_h, a_v) at its ends (a_h0, a_h1, a_v0, a_v1) [m/s^2],
+    linear between, at the local tolerance ``tol`` (``prev``: work space of 3).
 
     Returns (outcome, order n, event, unit step time of the event (1.0 if none), unit step
-    time of the peak of s theta before it (-1.0 if none)); the polynomial stays in w[0].
+    time of the peak of s theta before it (-1.0 if none), theta and d theta / d sigma at
+    the step's end); the polynomial stays in w[0].
     The event is the first of the impact, the fall, a slip and lift-off (EV_NONE if none).
     """
     p = math.sqrt(0.75 * G / blk.radius)
-    a_h0, a_v0 = cs.ground(mot, t, k)
-    a_h1, a_v1 = cs.ground(mot, t + hs, k)
+    a_h0, a_h1, a_v0, a_v1 = gr
     sc_x, sc_v = _scales(th, om, hs, p, blk.alpha, tol)
     dd0 = np.nan
     if th == 0.0 and om == 0.0:  # from rest: rise as the initiation test said (_taylor)
@@ -159,7 +166,7 @@ def rock_step(w, blk, mot, k, t, th, om, side, hs, tol, fresh):
         w, th, om, side, p, blk.alpha, MODEL_NONLINEAR, hs, a_h0, a_h1, a_v0, a_v1, sc_x, sc_v, dd0
     )
     if not err <= 1.0:
-        return REJECTED, n, cs.EV_NONE, 1.0, -1.0
+        return REJECTED, n, cs.EV_NONE, 1.0, -1.0, th, om
     c = w[0]
     th1, dth1, _ = poly_end(c, n)
     ev, s_ev = cs.EV_NONE, 1.0
@@ -168,10 +175,9 @@ def rock_step(w, blk, mot, k, t, th, om, side, hs, tol, fresh):
         ev, s_ev = cs.EV_IMPACT, s_imp
     elif side * th1 >= FALL_ROTATION:
         ev, s_ev = cs.EV_FALL, poly_root(c, n, side * FALL_ROTATION, -side, OF_VALUE, 0.0, 1.0)
-    gr = (a_h0, a_h1, a_v0, a_v1)
-    ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev)
+    ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev, prev)
     if s_f <= s_ev:
         ev, s_ev = ev_f, s_f
     du_end = side * (poly_value(c, n, s_ev)[1] if s_ev < 1.0 else dth1)
     s_pk = step_peak(c, n, side, s_ev, du_end)
-    return ACCEPTED, n, ev, s_ev, s_pk
+    return ACCEPTED, n, ev, s_ev, s_pk, th1, dth1
