@@ -12,9 +12,10 @@ alpha) runs at ``--rtol`` (1e-10), the reference (``solve_ivp`` DOP853 with even
 max(|x|) + 1e-2 alpha, resp. 1e-2 R alpha: see FLOOR), in units of rtol; the scenes whose
 decisions (overturned, lift-off, slipped, impact count) differ, and whether each lies in the
 threshold band (the reference's decision flips when the amplitude moves by 1e-6 of itself);
-the scenes the kernel flagged (status != 0); and, of the scenes beyond 10 rtol, those that
-are ill-conditioned (the kernel's own answer moves by more than the error when the amplitude
-moves by 1e-9 of itself: the reference at rtol 1e-12 cannot be closer than that).
+the scenes the kernel flagged (status != 0, or not ``converged``); and, of the scenes beyond
+10 rtol, those that are ill-conditioned (the kernel's own answer moves by more than the error
+when the amplitude moves by 1e-9 of itself: the reference at rtol 1e-12 cannot be closer than
+that).
 
     python benchmarks/contact_accuracy.py [--scenes 2000] [--rtol 1e-10] [--window 8]
 """
@@ -179,6 +180,7 @@ def main():
     recs = records(args.window)
     per = -(-args.scenes // len(recs))
     errs, mismatched, flagged, regimes, conds = [], [], 0, np.zeros(5), []
+    unconverged = []  # (beyond 10 rtol, flagged not converged) of each scene compared
     cpu_k = cpu_r = 0.0
     for name, t, a_h, a_v in recs:
         rows = scenes(rng, per, a_h, a_v)
@@ -193,6 +195,7 @@ def main():
             r = reference(t, a_h, a_v, row)
             cpu_r += time.process_time() - t0
             errs.append(compare(k, r, row))
+            unconverged.append((max(errs[-1]) > 10 * args.rtol, not k["converged"]))
             if max(errs[-1]) > 10 * args.rtol:
                 conds.append(max(errs[-1]) <= conditioning(t, a_h, a_v, row, k, args.rtol))
             regimes += [
@@ -223,6 +226,11 @@ def main():
     for m in mismatched:
         print("   ", m)
     print(f"flagged by the kernel (status != 0): {flagged}")
+    beyond_flag = np.array(unconverged, dtype=bool).reshape(-1, 2)
+    print(
+        f"flagged not converged (status 0): {beyond_flag[:, 1].sum()}, of which beyond 10 rtol: "
+        f"{(beyond_flag[:, 0] & beyond_flag[:, 1]).sum()} (of {beyond_flag[:, 0].sum()})"
+    )
     print(f"CPU: kernel {cpu_k:.1f} s, reference {cpu_r:.1f} s")
 
 

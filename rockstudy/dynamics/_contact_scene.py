@@ -4,21 +4,25 @@ scenes in parallel.
 
 The scene follows :mod:`.slide_rock_reference` event for event (its transitions are the
 same functions of :mod:`.slide_rock`): rest ends where :func:`.slide_rock.leaves_rest` turns
-positive, located to the ulp on the motion's monotone pieces; a contact or flight phase is
-stepped by DOP853 (:mod:`._contact_steps`), stopping at every record sample, and its events
-(impact, fall, slip, stick, lift-off, landing) are sampled on each step's dense output,
-located by bisection, then refined on a true step. After the motion the block moves on until
-it rests (a stick, or Housner's Zeno rule after an impact) or falls.
+positive, located to the ulp on the motion's monotone pieces; rock (Housner's equation)
+under a record or after the motion is stepped by the rocking kernels' Taylor series, its
+events located on the step polynomial (:mod:`._contact_taylor`, one call per phase:
+:func:`_rock_phase`); the other contact and flight phases are stepped by DOP853
+(:mod:`._contact_steps`), and their events (impact, fall, slip, stick, lift-off, landing)
+sampled on each step's dense output, located by bisection, then refined on a true step.
+Every step stops at each record sample. After the motion the block moves on until it rests
+(a stick, or Housner's Zeno rule after an impact) or falls.
 
 A scene's ``status``: 0 (ok), 1 (the step limit: the answer did not converge, e.g. a chatter
 that never settles), 3 (no solution: Painleve's paradox, mu_k > 4/3). A batch row whose
-status is not 0 must not be used as an answer.
+status is not 0 must not be used as an answer, nor one whose ``converged`` is False
+(:func:`flag_unconverged`: its answer moves by more than 10 rtol at rtol / 100, or a
+friction decision whose outcome jumps lay within 10 rtol of its threshold).
 """
 
 from __future__ import annotations
 
 import math
-from collections import namedtuple
 
 import numpy as np
 from numba import njit, prange
@@ -26,10 +30,46 @@ from numba import njit, prange
 from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
+from . import _contact_taylor as ct
 from . import slide_rock as sr
+from ._contact_flag import DECISION_BAND, flag_unconverged
+from ._contact_rest import _from_flat, _rest
+from ._contact_state import (
+    S_CLEAN,
+    S_FRESH,
+    S_H,
+    S_REG,
+    S_SIDE,
+    S_SLIP,
+    S_T,
+    T_CLOSE,
+    T_FIRST_IMPACT,
+    T_FIRST_SLIP,
+    T_LIFT,
+    T_MARGIN,
+    T_MAX_THETA,
+    T_MAX_U,
+    T_N_HIST,
+    T_N_IMPACTS,
+    T_OVER_TIME,
+    T_PEAK_TIME,
+    T_STATUS,
+    T_STEPS,
+    T_TIMES,
+    T_U_END,
+    Body,
+    _enter,
+    _flight_slip,
+    _log_state,
+    _new_tallies,
+    _raise_peaks,
+    _row,
+    _tally_impact,
+    _tally_margin,
+)
 from ._free_map import _rotation_at, _travel_time, free_peak_time, free_rocking_map
 from ._sliding import sliding_scene
-from ._uplift import _next_break, _skip_quiet
+from ._taylor import poly_value, work_arrays
 from ._vertical import refuse_free_fall
 from .constants import (
     ATOL_FRACTION,
@@ -41,6 +81,7 @@ from .constants import (
     STEP_GROW_LIMIT,
     STEP_SAFETY,
     STEP_SHRINK_LIMIT,
+    TAYLOR_TOL_FRACTION,
     TOL_SAFETY,
 )
 
@@ -54,15 +95,6 @@ STEP_CAP = 0.5
 #: times the state's error: at TOL_SAFETY alone, 1 of 300 random pulse scenes erred by
 #: 2.8e-9 in max_slide at rtol 1e-10 (a slip 3e-10 s late); at 1e-1 more, none by 1e-9.
 CONTACT_TOL_FRACTION = 0.1
-
-# the tallies of a scene (one float array)
-(T_MAX_THETA, T_PEAK_TIME, T_MAX_U, T_N_IMPACTS, T_FIRST_SLIP, T_LIFT, T_STEPS) = range(7)
-(T_FIRST_IMPACT, T_OVER_TIME, T_STATUS, T_N_HIST, T_U_END) = range(7, 12)
-T_TIMES = 12  # seconds in each regime, 5 slots
-N_TALLIES = 17
-# the run's state (one float array): regime, corner, slip direction, time, step, fresh, and
-# whether the half-cycle under way started at a sticking impact after the motion (clean)
-S_REG, S_SIDE, S_SLIP, S_T, S_H, S_FRESH, S_CLEAN = range(7)
 
 #: The fields of a contact batch row: the rocking kernels' row, then the contact outputs.
 CONTACT_ROW = np.dtype(
@@ -79,65 +111,12 @@ CONTACT_ROW = np.dtype(
         ("residual_slide", "f8"),
         ("first_slip_time", "f8"),
         ("lift_off", "bool"),
+        ("converged", "bool"),
+        ("decision_margin", "f8"),
+        ("close_events", "i8"),
     ]
     + [(f"time_{name}", "f8") for name in sr.REGIMES]
 )
-
-Body = namedtuple("Body", ("radius", "alpha", "eta", "static", "kinetic"))
-Body.__doc__ = """A block with its friction: R [m], alpha [rad], Housner's eta, mu_s, mu_k."""
-
-
-@njit(cache=True)
-def _new_tallies():
-    """The tallies of a scene at rest at t = 0."""
-    ta = np.zeros(N_TALLIES)
-    ta[T_PEAK_TIME] = ta[T_FIRST_SLIP] = ta[T_FIRST_IMPACT] = ta[T_OVER_TIME] = np.nan
-    return ta
-
-
-@njit(cache=True)
-def _row(hist, ta, t, theta, theta_dot, u):
-    """A history row (t, theta, theta_dot, u) (kept while ``hist`` has room); the peaks of
-    |theta| (and its time) and |u| follow it."""
-    n = int(ta[T_N_HIST])
-    if n < hist.shape[0]:
-        hist[n, 0], hist[n, 1], hist[n, 2], hist[n, 3] = t, theta, theta_dot, u
-    ta[T_N_HIST] = n + 1
-    ta[T_U_END] = u
-    _raise_peaks(ta, t, theta, u)
-
-
-@njit(cache=True)
-def _raise_peaks(ta, t, theta, u):
-    """Raise max |theta| (with its time) and max |u| to a state's."""
-    if abs(theta) > ta[T_MAX_THETA]:
-        ta[T_MAX_THETA], ta[T_PEAK_TIME] = abs(theta), t
-    ta[T_MAX_U] = max(ta[T_MAX_U], abs(u))
-
-
-@njit(cache=True)
-def _flight_slip(blk, z, side):
-    """u [m] of a block in flight: x_c - s b of the corner s = sign(theta) (``side`` at 0)."""
-    corner = math.copysign(1.0, z[2]) if z[2] != 0.0 else side
-    phi = blk.alpha - corner * z[2]
-    return z[0] + corner * blk.radius * (math.sin(phi) - math.sin(blk.alpha))
-
-
-@njit(cache=True)
-def _log_state(hist, ta, st, blk, z):
-    """A history row of the state (t, theta, theta_dot, u) in any regime."""
-    if int(st[S_REG]) == sr.FLIGHT:
-        _row(hist, ta, st[S_T], z[2], z[5], _flight_slip(blk, z, st[S_SIDE]))
-    else:
-        _row(hist, ta, st[S_T], z[1], z[4], z[0])
-
-
-@njit(cache=True)
-def _enter(st, ta, regime, side, slip):
-    """Enter ``regime`` on corner ``side`` slipping towards ``slip`` at st[S_T]."""
-    st[S_REG], st[S_SIDE], st[S_SLIP], st[S_FRESH], st[S_CLEAN] = regime, side, slip, 1.0, 0.0
-    if (regime == sr.SLIDE or regime == sr.SLIDE_ROCK) and math.isnan(ta[T_FIRST_SLIP]):
-        ta[T_FIRST_SLIP] = st[S_T]
 
 
 @njit(cache=True)
@@ -150,28 +129,6 @@ def _start_sliding(blk, st, ta, z, u_dot):
         return
     s = math.copysign(1.0, u_dot)
     _enter(st, ta, sr.SLIDE if blk.kinetic <= math.tan(blk.alpha) else sr.SLIDE_ROCK, s, s)
-
-
-@njit(cache=True)
-def _from_flat(blk, mot, st, ta, z, k):
-    """The regime a flat block at rest (or whose slip just stopped) enters at st[S_T]."""
-    a_h, a_v = cs.ground(mot, st[S_T], k)
-    regime, side = sr.initiation_regime(a_h, a_v, blk.static, blk.kinetic, blk.radius, blk.alpha)
-    z[1], z[3], z[4] = 0.0, 0.0, 0.0
-    if regime == sr.SLIDE and blk.kinetic > math.tan(blk.alpha):
-        regime = sr.SLIDE_ROCK
-    _enter(st, ta, regime, side, side)
-
-
-@njit(cache=True)
-def _tally_impact(ta, imps, t):
-    """Count an impact (its time into ``imps`` while it has room; the first one's time)."""
-    n = int(ta[T_N_IMPACTS])
-    if n < imps.shape[0]:
-        imps[n] = t
-    ta[T_N_IMPACTS] = n + 1.0
-    if math.isnan(ta[T_FIRST_IMPACT]):
-        ta[T_FIRST_IMPACT] = t
 
 
 @njit(cache=True)
@@ -190,6 +147,7 @@ def _impact(blk, st, ta, z, imps):
     w_plus = sr.rocking_impact(u_dot, w, side, blk.eta, R, alpha)
     ax, ay = sr.centre_velocity(0.0, 0.0, w_plus, corner, R, alpha)
     p_h, p_v = ax - bx, ay - by
+    _tally_margin(ta, blk.static, p_h, p_v)
     if p_v > 0.0 and abs(p_h) <= blk.static * p_v and corner * w_plus > 0.0:
         z[3], z[4] = 0.0, w_plus
         _enter(st, ta, sr.ROCK, corner, st[S_SLIP])
@@ -256,6 +214,7 @@ def _stop_corner(blk, mot, st, ta, z, k):
     R, alpha, side = blk.radius, blk.alpha, st[S_SIDE]
     th_dd = sr.rocking_acceleration(z[1], a_h, a_v, side, R, alpha)
     f_h, f_v = sr.contact_forces(z[1], z[4], th_dd, 0.0, a_h, a_v, side, R, alpha)
+    _tally_margin(ta, blk.static, f_h, f_v)
     if abs(f_h) <= blk.static * f_v:
         _enter(st, ta, sr.ROCK, side, st[S_SLIP])
     else:
@@ -335,75 +294,6 @@ def _transition(ev, blk, mot, st, ta, z, k, imps):
 
 
 @njit(cache=True)
-def _leaves(blk, mot, t, k):
-    """:func:`.slide_rock.leaves_rest` under the ground at t (> 0 where the block leaves rest)."""
-    a_h, a_v = cs.ground(mot, t, k)
-    return sr.leaves_rest(a_h, a_v, blk.static, blk.radius, blk.alpha)
-
-
-@njit(cache=True)
-def _leave_rest_time(blk, mot, t0, k):
-    """The first time >= t0 at which a block at rest leaves it, or inf: the motion cut at
-    its extrema and zeros (:func:`._uplift._next_break`), where the test is monotone, and
-    located by bisection to the ulp; a record's quiet samples skipped below the level
-    g min(mu_s, tan alpha) (:func:`._uplift._skip_quiet`)."""
-    kind, mp, times, samples, vsamples = mot
-    dur, rec = mp[3], kind == KIND_RECORD
-    if t0 > dur:
-        return np.inf
-    k = segment_index(times, t0, k) if rec else 0
-    if _leaves(blk, mot, t0, k) > 0.0:
-        return t0
-    angle = math.atan(min(blk.static, math.tan(blk.alpha)))  # of the level g tan(angle)
-    lo = t0
-    while lo < dur:
-        if rec and vsamples.size == 0:
-            lo = _skip_quiet(
-                mp, times, samples, angle, MODEL_NONLINEAR, lo, segment_index(times, lo, k)
-            )
-            if lo >= dur:
-                break
-        if rec:
-            k = segment_index(times, lo, k)
-        hi = _next_break(kind, mp, times, lo, k)
-        k_hi = segment_index(times, hi, k) if rec else 0
-        if _leaves(blk, mot, hi, k_hi) > 0.0:
-            while True:
-                mid = 0.5 * (lo + hi)
-                if mid <= lo or mid >= hi:
-                    return hi
-                if _leaves(blk, mot, mid, k) > 0.0:
-                    hi = mid
-                else:
-                    lo = mid
-        lo = hi
-    return np.inf
-
-
-@njit(cache=True)
-def _rest(blk, mot, st, ta, z, hist, t_end, k):
-    """From rest at st[S_T] (record segment k, a hint): on to the time the block leaves it
-    (True), or to the end of the motion (False)."""
-    end = min(mot[1][3], t_end)
-    t0 = st[S_T]
-    t_up = _leave_rest_time(blk, mot, t0, k) if t0 < end else np.inf
-    if t_up >= end:
-        stop = max(t0, end)
-        ta[T_TIMES + sr.REST] += stop - t0
-        if stop > t0:
-            st[S_T] = stop
-            _row(hist, ta, stop, 0.0, 0.0, z[0])
-        return False
-    ta[T_TIMES + sr.REST] += t_up - t0
-    st[S_T] = t_up
-    if t_up > t0:
-        _row(hist, ta, t_up, 0.0, 0.0, z[0])
-    k = segment_index(mot[2], t_up, k) if mot[0] == KIND_RECORD else 0
-    _from_flat(blk, mot, st, ta, z, k)
-    return True
-
-
-@njit(cache=True)
 def _scales(blk):
     """Absolute error scales of the six states (as fractions of the tolerance): row 0 in
     contact, row 1 in flight."""
@@ -463,9 +353,22 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
         _log_state(hist, ta, st, blk, z)
         return 0
     t_ev = cs.refine(ev, rk, mode, st[S_T], z, K, s_ev, hs, zp, work)
+    z[:] = zp
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, fresh)
+
+
+@njit(cache=True)
+def _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, fresh):
+    """The phase in st reached the event ``ev`` at t_ev, with the state z there: its time
+    tallied and logged (an event on the first DOP853 step of a regime, ``fresh``, counted: two
+    events inside one step, where the sampled events may miss a third one; the Taylor steps
+    locate theirs on the step polynomial, as the rocking kernels do), then the regime after
+    it (:func:`_transition`). Returns 0 (on), 2 (fell) or 3 (no solution)."""
+    hist, regime = log[0], int(st[S_REG])
+    if fresh and t_ev > st[S_T]:
+        ta[T_CLOSE] += 1.0
     ta[T_TIMES + regime] += t_ev - st[S_T]
     st[S_T] = t_ev
-    z[:] = zp
     if ev == cs.EV_FALL:
         side = math.copysign(1.0, z[2]) if regime == sr.FLIGHT else st[S_SIDE]
         u = _flight_slip(blk, z, side) if regime == sr.FLIGHT else z[0]
@@ -477,6 +380,67 @@ def _accepted(rk, blk, mot, st, ta, z, K, z1, hs, k, log, work, found, zp):
     if code == 0:
         _log_state(hist, ta, st, blk, z)
     return code
+
+
+@njit(cache=True)
+def _rock_phase(blk, mot, st, ta, z, w, log, tol, t_end, k, max_steps):
+    """Taylor steps of the rock regime (:func:`_rock_attempt`) while the ground is linear on
+    each (a record, or none after the motion), the block rocks (through its impacts), the
+    time is below t_end and the steps below ``max_steps``: one call per phase, not per step.
+    Returns (0, or 2 fell, 3 no solution, 4 a step below the shortest; the record segment)."""
+    rec, code = mot[0] == KIND_RECORD, 0
+    while int(st[S_REG]) == sr.ROCK and st[S_T] < t_end and ta[T_STEPS] < max_steps:
+        after = st[S_T] >= mot[1][3]
+        if rec and not after:
+            k = segment_index(mot[2], st[S_T], k)
+        if not ct.taylor_rock_applies(mot[0], -1 if after else k):
+            break
+        code = _rock_attempt(blk, mot, st, ta, z, w, log, tol, t_end, -1 if after else k)
+        ta[T_STEPS] += 1.0
+        if code >= 2:
+            break
+    return code, k
+
+
+@njit(cache=True, inline="always")
+def _rock_attempt(blk, mot, st, ta, z, w, log, tol, t_end, k):
+    """One attempted Taylor step of the rock regime (:func:`._contact_taylor.rock_step`).
+    Returns 0 (on), 1 (rejected), 2 (fell), 3 (no solution), 4 (a step below the shortest)."""
+    p = math.sqrt(0.75 * G / blk.radius)
+    t = st[S_T]
+    t_next = _next_stop(mot, t, k, t_end)
+    h = min(st[S_H], STEP_CAP / p)
+    last = h >= t_next - t
+    hs = t_next - t if last else h
+    fresh = st[S_FRESH] > 0.0
+    a_h0, a_v0 = cs.ground(mot, t, k)
+    a_h1, a_v1 = cs.ground(mot, t + hs, k)
+    gr = (a_h0, a_h1, a_v0, a_v1)
+    outcome, n, ev, s_ev, s_pk, th1, dth1 = ct.rock_step(
+        w[0], w[1], blk, gr, z[1], z[4], st[S_SIDE], hs, tol, fresh
+    )
+    if outcome == ct.REJECTED:
+        if hs * p < MIN_STEP:
+            return 4
+        st[S_H] = 0.5 * hs
+        return 1
+    st[S_H] = max(h, 2.0 * hs) if last else 2.0 * hs
+    st[S_FRESH] = 0.0
+    c = w[0][0]
+    if s_pk >= 0.0:
+        _raise_peaks(ta, t + s_pk * hs, poly_value(c, n, s_pk)[0], z[0])
+    if ev == cs.EV_NONE:
+        ta[T_TIMES + sr.ROCK] += hs
+        st[S_T] = t_next if last else t + hs
+        z[1], z[4] = th1, dth1 / hs
+        _log_state(log[0], ta, st, blk, z)
+        return 0
+    th, dth, _ = poly_value(c, n, s_ev)
+    z[1], z[4] = th, dth / hs
+    t_ev = t + s_ev * hs
+    if ev == cs.EV_IMPACT and t_ev <= t:  # a lift from rest that falls back at once
+        t_ev = np.nextafter(t, np.inf)
+    return _at_event(ev, t_ev, blk, mot, st, ta, z, k, log, False)
 
 
 @njit(cache=True)
@@ -530,8 +494,10 @@ def contact_run(blk, mot, rtol, t_max, max_steps, log):
         np.empty(6),
         np.empty((n_trace, 2)),
         _scales(blk),
+        (work_arrays(), np.empty(3)),
     )
-    tol, rec, k, code = CONTACT_TOL_FRACTION * TOL_SAFETY * rtol, mot[0] == KIND_RECORD, 0, 0
+    tol = (CONTACT_TOL_FRACTION * TOL_SAFETY * rtol, TAYLOR_TOL_FRACTION * TOL_SAFETY * rtol)
+    rec, k, code = mot[0] == KIND_RECORD, 0, 0
     _row(hist, ta, 0.0, 0.0, 0.0, 0.0)
     while True:
         if int(st[S_REG]) == sr.REST:
@@ -543,10 +509,16 @@ def contact_run(blk, mot, rtol, t_max, max_steps, log):
         if ta[T_STEPS] >= max_steps:
             ta[T_STATUS] = STATUS_MAX_STEPS
             break
+        if int(st[S_REG]) == sr.ROCK:
+            code, k = _rock_phase(blk, mot, st, ta, z, work[7], log, tol[1], t_max, k, max_steps)
+            if code >= 2:
+                break
+            if int(st[S_REG]) != sr.ROCK or st[S_T] >= t_max or ta[T_STEPS] >= max_steps:
+                continue
         after = st[S_T] >= mot[1][3]
         if rec and not after:
             k = segment_index(mot[2], st[S_T], k)
-        code = _attempt(rk, blk, mot, st, ta, z, K, work, log, tol, t_max, -1 if after else k)
+        code = _attempt(rk, blk, mot, st, ta, z, K, work, log, tol[0], t_max, -1 if after else k)
         ta[T_STEPS] += 1.0
         if code >= 2:
             break
@@ -571,6 +543,9 @@ def _write(out, i, ta, over):
     row.residual_slide = np.nan if over else ta[T_U_END]
     row.first_slip_time = ta[T_FIRST_SLIP]
     row.lift_off = ta[T_LIFT] > 0.0
+    row.converged = row.status == 0
+    row.decision_margin = ta[T_MARGIN]
+    row.close_events = int(ta[T_CLOSE])
     row.time_rest = ta[T_TIMES + sr.REST]
     row.time_slide = ta[T_TIMES + sr.SLIDE]
     row.time_rock = ta[T_TIMES + sr.ROCK]
@@ -655,6 +630,8 @@ def contact_scene(
     row = np.empty(1, CONTACT_ROW)
     _write(row, 0, ta, over)
     out = {name: row[name][0].item() for name in CONTACT_ROW.names}
+    jumps = out["decision_margin"] < DECISION_BAND * rtol and static > kinetic
+    out["converged"] = out["converged"] and not jumps
     out.update(t=hist[:n, 0], theta=hist[:n, 1], theta_dot=hist[:n, 2], slide=hist[:n, 3])
     out["impact_times"] = imps[:n_imp].copy()
     out["regime_times"] = {name: out.pop(f"time_{name}") for name in sr.REGIMES}
@@ -681,7 +658,8 @@ def contact_batch(
     Returns
     -------
     numpy structured array of :data:`CONTACT_ROW`, one per row; a row whose ``status`` is
-    not 0 did not converge (1) or has no solution (3).
+    not 0 did not converge (1) or has no solution (3); a row whose ``converged`` is False
+    (:func:`flag_unconverged`) must not be used as an answer at rtol either.
     """
     kind, mp, times, samples, vsamples = motion_rows
     refuse_free_fall(vsamples, mp[:, 0], batch=True)
@@ -689,6 +667,18 @@ def contact_batch(
         np.ascontiguousarray(np.broadcast_to(x, np.shape(p)), dtype=float)
         for x in (p, alpha, eta, static, kinetic)
     )
-    arrays = (np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples))
+    cols = tuple(cols)
+    mp, times, samples, vsamples = (
+        np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples)
+    )
     run = contact_batch_kernel if parallel else contact_batch_serial
-    return run(*cols, np.int64(kind), *arrays, float(rtol), int(max_steps))
+
+    def rows(index, tolerance):
+        """The kernel's rows ``index`` at ``tolerance``."""
+        picked = (c[index] for c in cols)
+        motion = (np.int64(kind), mp[index], times, samples, vsamples)
+        return run(*picked, *motion, tolerance, int(max_steps))
+
+    out = rows(slice(None), float(rtol))
+    flag_unconverged(out, cols, rows, float(rtol))
+    return out

@@ -220,7 +220,7 @@ EARLIEST = 1.0 / EVENT_POINTS
 
 
 @njit(cache=True)
-def _sample_point(j, fresh):
+def sample_point(j, fresh):
     """The j-th sample point of a step (FRESH_POINTS first on a regime's first step)."""
     if fresh:
         if j < len(FRESH_POINTS):
@@ -245,7 +245,7 @@ def first_event(events, mode, t, h, z, K, z1, fresh, tmp, trace):
         prev[e] = 1.0 if fresh or ev == EV_NONE else event_value(ev, mode, t, z)
     n = EVENT_POINTS + (len(FRESH_POINTS) if fresh else 0)
     for j in range(n):
-        s = _sample_point(j, fresh)
+        s = sample_point(j, fresh)
         dense(s, h, z, K, z1, tmp)
         f_h = f_v = math.nan
         if with_forces:
