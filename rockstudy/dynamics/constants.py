@@ -74,6 +74,10 @@ NO_STOP = np.int64(-1)  # a phase's stop_at_impacts: never
 STATUS_OK = 0
 STATUS_MAX_STEPS = 1
 STATUS_HISTORY_FULL = 2
+#: A batch row of the contact model whose answer did not converge with rtol (the kernel's
+#: ``converged`` flag: a friction decision within 10 rtol of its threshold with mu_s > mu_k,
+#: or an answer that moves by more than 10 rtol at rtol / 100).
+STATUS_UNCONVERGED = 4
 
 #: Post-impact speed below which the block is taken to be at rest, as a fraction of p*alpha.
 REST_FRACTION = 1e-4

@@ -17,6 +17,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ._contact_scene import MAX_STEPS, STATUS_NO_SOLUTION, contact_batch, contact_scene
 from ._sliding import slide_record
+from .constants import STATUS_UNCONVERGED
 from .contact import ContactCheck, check_contact
 from .methods import STATUS_STEP_LIMIT, StepLimitError
 from .outputs import TIMED_REGIMES
@@ -280,8 +281,11 @@ def contact_rows(p, alpha, eta, friction, motion_rows, rtol, motion_of):
     A row the kernel cannot answer within :data:`._contact_scene.MAX_STEPS` steps (a
     chatter that does not settle) is run again by the ``solve_ivp`` reference
     (:func:`contact_outputs` with ``method="scipy"``; its ``status`` 1 where the reference
-    stopped at its cap of phases). A row without a solution (Painleve's paradox, mu_k > 4/3)
-    has none under the reference either: a ValueError naming the row.
+    stopped at its cap of phases). A row whose answer did not converge with rtol (the
+    kernel's ``converged`` flag, :mod:`._contact_flag`) keeps it with ``status``
+    :data:`~.constants.STATUS_UNCONVERGED` (4), to be used as no answer. A row without a
+    solution (Painleve's paradox, mu_k > 4/3) has none under the reference either: a
+    ValueError naming the row.
 
     Parameters
     ----------
@@ -307,7 +311,8 @@ def contact_rows(p, alpha, eta, friction, motion_rows, rtol, motion_of):
     parallel = numba.get_num_threads() > 1
     out = contact_batch(p, alpha, eta, *friction, motion_rows, rtol, MAX_STEPS, parallel)
     _refuse_no_solution(out["status"], friction[1])
-    cols = {"status": out["status"].astype(np.int64)}
+    unconverged = (out["status"] == 0) & ~out["converged"]
+    cols = {"status": np.where(unconverged, STATUS_UNCONVERGED, out["status"]).astype(np.int64)}
     cols.update({name: out[name].copy() for name in ROW_OUTPUTS if name != "regime"})
     cols["regime"] = _regime_codes(out)
     referred = out["status"] != 0

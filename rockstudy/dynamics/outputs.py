@@ -127,7 +127,8 @@ OUTPUTS = {
         _int(
             "status",
             "i8",
-            "0 ok, 1 step limit reached (the contact model: its cap of phases)",
+            "0 ok, 1 step limit reached (the contact model: its cap of phases), 4 the contact "
+            "model's answer did not converge with rtol",
             in_study=False,
             models=_WITH_CONTACT,
         ),
