@@ -370,20 +370,21 @@ def simulate_batch(
     rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
     linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
 
-    def solve(rows):
+    check = _needs_check(wanted, model)
+
+    def solve(rows, demand=False):
         if kernel_model is not None:
-            return _run(rows, np.arange(n), kernel_model, rtol, max_steps), np.full(
+            return _run(rows, np.arange(n), kernel_model, rtol, max_steps, demand), np.full(
                 n, _CODES[kernel_model], np.int8
             )
-        return _auto_rows(
-            rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
-        )
+        motion = (pulse if record is None else None, cycles)
+        return _auto_rows(rows, motion, rtol, max_steps, linear_ok, demand)
 
-    out, codes = solve(rows)
+    out, codes = solve(rows, check)
     cols = _columns(out, codes)
     if "conditioning" in wanted:
         cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
-    if _needs_check(wanted, model):
+    if check:
         _add_contact_outputs(cols, rows, codes, method, rtol, max_steps)
     if model != "rocking":
         motions = _RowMotions(pulse, record, mp, amplitude, period, cycles, n)
@@ -424,7 +425,7 @@ def _add_contact_outputs(cols, rows, codes, method, rtol, max_steps):
     pass reached the step limit gets that status)."""
     from ._batch_contact import contact_rows
 
-    demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
+    demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps, cols)
     cols["status"] = np.where(limited, STATUS_STEP_LIMIT, cols["status"])
     cols.update(zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True))
 
@@ -516,9 +517,8 @@ def _add_contact_model(cols, rows, mu, model, motions, rtol):
     else:
         chosen = np.ones(n, bool)
     cols.update(_no_slip(cols))
-    untimed = [
-        name for name in outputs.KERNEL_ROW.names if "contact" not in outputs.OUTPUTS[name].models
-    ]
+    kernel = outputs.names("kernel")
+    untimed = [name for name in kernel if "contact" not in outputs.OUTPUTS[name].models]
     for i in np.flatnonzero(chosen):
         one = contact_model.contact_outputs(
             p[i], alpha[i], eta[i], motions[i], (mu[0][i], mu[1][i]), rtol
@@ -636,8 +636,9 @@ def _requested_outputs(outputs, model="rocking", friction=False):
     return tuple(name for name in allowed if name in names or name == "status")
 
 
-def _run(rows, idx, model, rtol, max_steps):
-    """The kernel rows (:data:`.outputs.KERNEL_ROW`) of the rows ``idx`` under one model. The
+def _run(rows, idx, model, rtol, max_steps, demand=False):
+    """The kernel rows (:data:`.outputs.KERNEL_ROW`) of the rows ``idx`` under one model, with
+    the friction demand where the kernel computes it if ``demand`` (:mod:`._demand`). The
     exact linear record solver has constant coefficients: a record with a vertical component
     runs the kernel."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
@@ -648,15 +649,17 @@ def _run(rows, idx, model, rtol, max_steps):
         return _linear_record.record_batch(*args, mp[idx, 0], times, samples)
     trig = kind == mk.KIND_TRIG and model != _rocking.MODEL_TABLE and not vsamples.size
     kernel = _BATCH_KERNELS[trig, numba.get_num_threads() == 1]  # trig: compiles in half
-    return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps)
+    return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps, demand)
 
 
-def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
+def _auto_rows(rows, motion, tolerance, max_steps, linear_ok=True, demand=False):
     """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`); the
     linear model only if ``linear_ok`` (no output outside its bound was asked for), and only
     under one-cycle trigonometric pulses, the one case its error table covers (none is known
-    under records: see :func:`simulate_batch`)."""
+    under records: see :func:`simulate_batch`). ``motion``: (pulse name or None, cycles);
+    ``demand``: the kernels compute the friction demand (:func:`_run`)."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
+    pulse, cycles = motion
     n = p.size
     if pulse is not None:
         psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
@@ -678,13 +681,13 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
     ):
         idx = np.flatnonzero(codes == code)
         if idx.size:
-            out[idx] = _run(rows, idx, model, rtol, max_steps)
+            out[idx] = _run(rows, idx, model, rtol, max_steps, demand)
     ratio = out["max_rotation"] / alpha
     small = np.flatnonzero((codes == _auto.MODEL_NONLINEAR) & (ratio < _auto.SMALL_ROTATION))
     rtols = _auto.kernel_rtol_small(tolerance, ratio[small])
     for rtol in np.unique(rtols):
         idx = small[rtols == rtol]
-        out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps)
+        out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps, demand)
     return out, codes
 
 
