@@ -29,7 +29,7 @@ to the last time ``|theta|`` = alpha counts: samples beyond alpha are held apart
 only when the block comes back below it.
 
 The state lives in the scene's tallies (:data:`._logs.TALLIES`, fields ``d_*``) and the
-samples of a step in rows of the Taylor work array (:data:`._taylor.ROW_SIG` ...).
+polynomial of the step before in a row of the Taylor work array (:data:`._taylor.ROW_PREV`).
 """
 
 from __future__ import annotations
@@ -40,28 +40,31 @@ import numpy as np
 from numba import njit
 
 from ..constants import G
-from ..motions._kernels import ground_acceleration, vertical_acceleration
+from ..motions._kernels import KIND_RECORD, ground_acceleration, vertical_acceleration
 from ._taylor import (
     FMA,
     NO_REFCOUNT,
     OF_VALUE,
     ROW_C,
-    ROW_CLS,
-    ROW_SIG,
-    ROW_VAL,
+    ROW_C_SERIES,
+    ROW_PREV,
+    ROW_S,
     poly_root,
     poly_value,
 )
 
-#: Points inside each Taylor step at which the forces are evaluated (besides its end).
+#: Points inside each Taylor step at which the forces are evaluated (besides its end), but
+#: inside a record (its steps end on its samples).
 INTERIOR = 2
-#: Iterations at most of the refinement of a step's largest ratio between its neighbouring
-#: samples (:func:`_parabolic`), until the bracket is REFINE_TOL of the step.
+#: Iterations at most of the refinement of a local maximum between its neighbouring
+#: samples (:func:`_parabolic`), until the parabola's vertex moves less than REFINE_TOL
+#: (relative to the bracket; the ratio then exact to ~REFINE_TOL^2) or the bracket is that
+#: short.
 REFINE_ITERATIONS = 30
 REFINE_TOL = 1e-6
-#: Where the refinement of a largest sample at an end of a step tests the slope: this
-#: fraction of the way from the end to the midpoint towards the next sample.
-END_OFFSET = 1e-3
+#: Where the refinement of a largest sample at the start (the end) of a rocking phase tests
+#: the slope: this fraction of the way to the next (the previous) sample.
+START_OFFSET = 1e-3
 #: Largest slenderness [rad] for which free rocking (no ground motion, below the overturning
 #: energy) needs less friction than tan alpha and keeps F_v > 0 (checked on a dense grid of
 #: energies and rotations: the ratio peaks at 0.75 tan alpha for small alpha and reaches
@@ -75,7 +78,12 @@ def force_ratio(th, om, s, a_h, a_v, p, alpha):
     """(``|F_h|`` / F_v, F_v / m) of a block rocking on side s at theta = th [rad], theta_dot
     = om [rad/s] under the ground (a_h, a_v) [m/s^2]; the ratio inf where F_v <= 0."""
     x = alpha * s - th
-    sx, cx = math.sin(x), math.cos(x)
+    return _ratio(math.sin(x), math.cos(x), om, a_h, a_v, p)
+
+
+@njit(cache=True, fastmath=FMA, inline="always")
+def _ratio(sx, cx, om, a_h, a_v, p):
+    """:func:`force_ratio` from S = sin x, C = cos x (x = alpha s - theta)."""
     gam = G + a_v
     r_acc = -0.75 * (gam * sx + a_h * cx)  # R theta_ddot
     r_om2 = 0.75 * G * (om / p) ** 2  # R theta_dot^2
@@ -95,27 +103,47 @@ def free_rocking_ratio(c, energy):
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
-def _sample(c, n, sig, hs, s, p, alpha, mot, ground):
-    """(ratio, F_v / m, u = s theta) at unit step time sig of the step polynomial c of order n
-    (length hs [s]); ground = (t0 [s], record segment, whether the motion still acts)."""
-    t0, k, forced = ground
-    th, d, _ = poly_value(c, n, sig)
+def _sample(w, ta, tau, step):
+    """(ratio, F_v / m, u = s theta) at time tau [s] on the polynomial of the step that holds
+    it: the current one (``step`` = (t0, hs, n, k, s, p, alpha, mot), its polynomial in
+    w[ROW_C]) or, before t0, the step before (w[ROW_PREV], its t0, hs, n, k in ``ta``)."""
+    t0, hs, n, k, s, p, alpha, mot = step
+    row = ROW_C
+    if tau < t0:
+        t0, hs, n, k, row = ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k, ROW_PREV
+    th, d, _ = poly_value(w[row], n, (tau - t0) / hs)
     a_h = a_v = 0.0
-    if forced:
-        kind, mp, times, samples, vsamples = mot
-        t = t0 + sig * hs
-        a_h = ground_acceleration(kind, mp, times, samples, t, k)
-        a_v = vertical_acceleration(kind, mp, times, vsamples, t, k)
+    kind, mp, times, samples, vsamples = mot
+    if t0 < mp[3]:  # the step lies within the motion
+        a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
     ratio, f_v = force_ratio(th, d / hs, s, a_h, a_v, p, alpha)
     return ratio, f_v, s * th
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
-def _sample_taken(ta, c, n, sig, hs, s, p, alpha, mot, ground):
-    """:func:`_sample`, counted (:func:`_take`); returns its ratio."""
-    r, f_v, u = _sample(c, n, sig, hs, s, p, alpha, mot, ground)
-    _take(ta, r, f_v, u > alpha)
-    return r
+def _sample_end(w, tau, end, step):
+    """:func:`_sample` at the end of the current step (unit step time 1), where its state
+    ``end`` = (theta, theta_dot) is known: S = sin x and C = cos x as the sums of their
+    series (to order n - 2, within the step's tolerance: their next terms are of the size of
+    the last two of theta's, which the step's error test bounds), the ground at tau [s]."""
+    t0, hs, n, k, s, p, alpha, mot = step
+    s0 = s1 = c0 = c1 = 0.0
+    for j in range(0, n - 2, 2):  # two sums each: shorter dependency chains
+        s0 += w[ROW_S, j]
+        c0 += w[ROW_C_SERIES, j]
+        s1 += w[ROW_S, j + 1]
+        c1 += w[ROW_C_SERIES, j + 1]
+    if (n - 1) % 2 == 1:
+        s0 += w[ROW_S, n - 2]
+        c0 += w[ROW_C_SERIES, n - 2]
+    kind, mp, times, samples, vsamples = mot
+    a_h = a_v = 0.0
+    if t0 < mp[3]:
+        a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
+    ratio, f_v = _ratio(s0 + s1, c0 + c1, end[1], a_h, a_v, p)
+    return ratio, f_v, s * end[0]
 
 
 @njit(cache=True, inline="always")
@@ -139,39 +167,6 @@ def _keep_over(ta):
     ta.d_min_fv = min(ta.d_min_fv, ta.d_min_fv_over)
     ta.d_over = 0.0
     ta.d_min_fv_over = np.inf
-
-
-@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _parabolic(c, n, x, f, hs, s, p, alpha, mot, ground):
-    """The largest ratio near the best of three samples x[1] (x[0] < x[1] < x[2], f[1] the
-    largest of f), by successive parabolic interpolation kept inside the bracket, a
-    golden-section step where the parabola's vertex would not shrink it: (ratio, F_v, u) at
-    the best point evaluated (f[1] with F_v NaN if none beat it)."""
-    x0, x1, x2 = x
-    f0, f1, f2 = f
-    best = (f1, np.nan, np.nan)
-    for _ in range(REFINE_ITERATIONS):
-        h0, h2 = x1 - x0, x2 - x1
-        xv = x1 - (1.0 - _GOLD) * h0 if h0 > h2 else x1 + (1.0 - _GOLD) * h2
-        xp = _vertex_at(x0, f0, x1, f1, x2, f2)
-        if abs(xp - x1) <= REFINE_TOL:
-            break  # converged: the parabola's vertex is the best point
-        if x0 < xp < x2:
-            xv = xp
-        if h0 + h2 <= REFINE_TOL:
-            break
-        r, f_v, u = _sample(c, n, xv, hs, s, p, alpha, mot, ground)
-        if r > f1:
-            best = (r, f_v, u)
-            if xv < x1:
-                x2, f2, x1, f1 = x1, f1, xv, r
-            else:
-                x0, f0, x1, f1 = x1, f1, xv, r
-        elif xv < x1:
-            x0, f0 = xv, r
-        else:
-            x2, f2 = xv, r
-    return best
 
 
 @njit(cache=True, inline="always")
@@ -199,108 +194,128 @@ def _vertex(x0, f0, x1, f1, x2, f2):
     return f1 - b * b / (4.0 * a) if a < 0.0 else f1
 
 
-@njit(cache=True, **NO_REFCOUNT)
-def _insert_crossings(w, c, n, m, s, alpha, hs, p, mot, ground, ta):
-    """Insert, between samples on either side of alpha, the sample at ``|theta|`` = alpha
-    itself (the end of the response that counts if the block falls from there). Returns the
-    new number of samples."""
-    sig, val, cls = w[ROW_SIG], w[ROW_VAL], w[ROW_CLS]
-    j = 0
-    while j < m - 1:
-        if cls[j] != cls[j + 1]:
-            up = cls[j] == 0.0
-            x = poly_root(c, n, s * alpha, -s if up else s, OF_VALUE, sig[j], sig[j + 1])
-            r, f_v, _ = _sample(c, n, x, hs, s, p, alpha, mot, ground)
-            for i in range(m, j + 1, -1):
-                sig[i], val[i], cls[i] = sig[i - 1], val[i - 1], cls[i - 1]
-            sig[j + 1], val[j + 1], cls[j + 1] = x, r, 0.0
-            _take(ta, r, f_v, False)
-            m += 1
-            j += 1
-        j += 1
-    return m
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+def _parabolic(w, ta, x, f, step):
+    """Count the largest ratio near the best of three times x[1] (x[0] < x[1] < x[2], f[1]
+    the largest of f), found by successive parabolic interpolation kept inside the bracket, a
+    golden-section step where the parabola's vertex would not shrink it."""
+    x0, x1, x2 = x
+    f0, f1, f2 = f
+    tol = REFINE_TOL * (x2 - x0)
+    for _ in range(REFINE_ITERATIONS):
+        h0, h2 = x1 - x0, x2 - x1
+        xv = x1 - (1.0 - _GOLD) * h0 if h0 > h2 else x1 + (1.0 - _GOLD) * h2
+        xp = _vertex_at(x0, f0, x1, f1, x2, f2)
+        if abs(xp - x1) <= tol or h0 + h2 <= tol:
+            break  # converged: the parabola's vertex is the best point
+        if x0 < xp < x2:
+            xv = xp
+        r, f_v, u = _sample(w, ta, xv, step)
+        _take(ta, r, f_v, u > step[6])
+        if r > f1:
+            if xv < x1:
+                x2, f2, x1, f1 = x1, f1, xv, r
+            else:
+                x0, f0, x1, f1 = x1, f1, xv, r
+        elif xv < x1:
+            x0, f0 = xv, r
+        else:
+            x2, f2 = xv, r
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _end_bracket(ta, w, c, n, m, j, hs, s, p, alpha, mot, ground):
-    """Three points (in time order) around the largest ratio of a step whose largest sample
-    j is an end of it (0 or m - 1), from the midpoint towards the next sample i and a point
-    END_OFFSET of the way back from the end: (near, mid, i) where the ratio still rises at
-    mid, else (end, near, mid). Where the ratio rises into the end (near below it), the
-    middle ratio is below the end's: the end is the largest."""
-    sig, val = w[ROW_SIG], w[ROW_VAL]
-    i = 1 if j == 0 else m - 2
-    end = sig[j]
-    mid = 0.5 * (sig[i] + end)
-    near = end + END_OFFSET * (mid - end)
-    f_mid = _sample_taken(ta, c, n, mid, hs, s, p, alpha, mot, ground)
-    f_near = _sample_taken(ta, c, n, near, hs, s, p, alpha, mot, ground)
-    if f_mid >= f_near:
-        x, f = (near, mid, sig[i]), (f_near, f_mid, val[i])
-    else:
-        x, f = (end, near, mid), (val[j], f_near, f_mid)
-    if j == 0:
-        return x, f
-    return (x[2], x[1], x[0]), (f[2], f[1], f[0])
-
-
-@njit(cache=True, **NO_REFCOUNT)
-def _refine(w, c, n, m, over, hs, s, p, alpha, mot, ground, ta):
-    """Refine the largest sample of one side of alpha (``over``) of a step, between its
-    neighbours, where it may exceed the largest ratio of that side so far."""
-    sig, val, cls = w[ROW_SIG], w[ROW_VAL], w[ROW_CLS]
-    j = -1
-    for i in range(m):
-        if cls[i] == over and (j < 0 or val[i] > val[j]):
-            j = i
-    best = ta.d_over if over else ta.d_best
-    if j < 0 or not math.isfinite(val[j]):
+def _refine_window(w, ta, tc, fc, step):
+    """Refine the middle sample of the grid's last three (a, b in ``ta``, c = (tc, fc)) where
+    it is a local maximum, all three on one side of alpha, that may exceed the largest ratio
+    of that side so far; a at the start of a rocking phase (none: f -inf) refines from b, the
+    phase's first sample, by the slope START_OFFSET of the way to c."""
+    t_a, fa, tb, fb = ta.d_ta, ta.d_fa, ta.d_tb, ta.d_fb
+    over = ta.d_cb
+    if not (fb >= fc and fb >= fa and math.isfinite(fb)):
         return
-    estimate = val[j]
-    if 0 < j < m - 1:
-        estimate = _vertex(sig[j - 1], val[j - 1], sig[j], val[j], sig[j + 1], val[j + 1])
-    if estimate < best:
+    if math.isfinite(fa):
+        if ta.d_ca != over or _vertex(t_a, fa, tb, fb, tc, fc) < (ta.d_over if over else ta.d_best):
+            return
+        _parabolic(w, ta, (t_a, tb, tc), (fa, fb, fc), step)
         return
-    if 0 < j < m - 1:
-        x, f = (sig[j - 1], sig[j], sig[j + 1]), (val[j - 1], val[j], val[j + 1])
-    else:
-        x, f = _end_bracket(ta, w, c, n, m, j, hs, s, p, alpha, mot, ground)
-        if not f[1] >= max(f[0], f[2]):
-            return  # the ratio rises into the step's end: the end is the largest
-    r, f_v, u = _parabolic(c, n, x, f, hs, s, p, alpha, mot, ground)
-    if f_v == f_v and (u > alpha) == over:
-        _take(ta, r, f_v, over)
+    near = tb + START_OFFSET * (tc - tb)
+    r, f_v, u = _sample(w, ta, near, step)
+    _take(ta, r, f_v, u > step[6])
+    if r > fb and r >= fc:
+        _parabolic(w, ta, (tb, near, tc), (fb, r, fc), step)
 
 
 @njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
-    """Count an accepted Taylor step of length hs [s] from t [s] up to t_end (its end or its
-    event) on side s, whose polynomial of order n is in w[ROW_C] (record segment k): its
-    samples and their refinement (module docstring)."""
-    c = w[ROW_C]
-    sig, val, cls = w[ROW_SIG], w[ROW_VAL], w[ROW_CLS]
-    ground = (t, k, t < mot[1][3])
-    se = (t_end - t) / hs
-    m = INTERIOR + 2
-    for j in range(m):
-        sig[j] = se * j / (m - 1)
-        if j == 0 and ta.d_fresh == 0:  # the end of the step before
-            val[0], cls[0] = ta.d_last, ta.d_last_over
-            continue
-        r, f_v, u = _sample(c, n, sig[j], hs, s, p, alpha, mot, ground)
-        over = u > alpha
-        val[j], cls[j] = r, 1.0 if over else 0.0
-        _take(ta, r, f_v, over)
+def _close(w, ta, step):
+    """Close the grid of a rocking phase whose last sample is b (an impact, the overturning,
+    the end of the motion): where the ratio falls into b (a point START_OFFSET of the way
+    back to a lies above it), refine between a and b."""
+    t_a, fa, tb, fb = ta.d_ta, ta.d_fa, ta.d_tb, ta.d_fb
+    ta.d_fa = ta.d_fb = -np.inf
+    if not (math.isfinite(fa) and math.isfinite(fb)) or ta.d_ca != ta.d_cb:
+        return
+    near = tb - START_OFFSET * (tb - t_a)
+    r, f_v, u = _sample(w, ta, near, step)
+    _take(ta, r, f_v, u > step[6])
+    if r > fb and r >= fa:
+        _parabolic(w, ta, (t_a, near, tb), (fa, r, fb), step)
+
+
+@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+def _push(w, ta, tau, step, end=(np.nan, np.nan)):
+    """Evaluate, count and add to the grid the sample at tau [s] (in time order), with the
+    sample at ``|theta|`` = alpha before it where the two lie on either side of alpha (the
+    end of the response that counts if the block falls from there); refine the grid's local
+    maximum (:func:`_refine_window`). ``end``: (theta, theta_dot) where tau is the current
+    step's full end (:func:`_sample_end`), NaN elsewhere."""
+    if end[0] == end[0]:
+        r, f_v, u = _sample_end(w, tau, end, step)
+    else:
+        r, f_v, u = _sample(w, ta, tau, step)
+    alpha = step[6]
+    over = 1.0 if u > alpha else 0.0
+    if math.isfinite(ta.d_fb) and over != ta.d_cb:
+        t0, hs, n, s = step[0], step[1], step[2], step[4]
+        lo = max((ta.d_tb - t0) / hs, 0.0)
+        up = over == 1.0
+        x = poly_root(w[ROW_C], n, s * alpha, -s if up else s, OF_VALUE, lo, (tau - t0) / hs)
+        rc, fvc, _ = _sample(w, ta, t0 + x * hs, step)
+        _take(ta, rc, fvc, False)
+        _shift(ta, t0 + x * hs, rc, 0.0)
+    _take(ta, r, f_v, over == 1.0)
+    _refine_window(w, ta, tau, r, step)
+    _shift(ta, tau, r, over)
+
+
+@njit(cache=True, inline="always")
+def _shift(ta, t, f, over):
+    """The grid's last two samples become (b, (t, f, over))."""
+    ta.d_ta, ta.d_fa, ta.d_ca = ta.d_tb, ta.d_fb, ta.d_cb
+    ta.d_tb, ta.d_fb, ta.d_cb = t, f, over
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
+    """Count an accepted Taylor step of length hs [s] from t [s] up to t_end on side s, whose
+    polynomial of order n is in w[ROW_C] (record segment k): its samples on the grid and
+    their refinement (module docstring); keep it as the step before (w[ROW_PREV]). ``end``:
+    (theta, theta_dot) at t_end where it is the step's end, NaN where it is an event. Inlined
+    into the phase loop (a call with its flattened arguments costs a record step ~10 %)."""
+    step = (t, hs, n, k, s, p, alpha, mot)
+    if ta.d_fresh != 0:  # a rocking phase starts: a new grid
+        _close(w, ta, step)
+        _push(w, ta, t, step)
+    kind, mp = mot[0], mot[1]
+    inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
+    for j in range(1, inside + 1):
+        _push(w, ta, t + (t_end - t) * j / (inside + 1), step)
+    _push(w, ta, t_end, step, end)
+    if end[0] != end[0]:  # an impact or the overturning ends the phase
+        _close(w, ta, step)
+    for j in range(n + 1):
+        w[ROW_PREV, j] = w[ROW_C, j]
+    ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k = t, hs, n, k
     ta.d_fresh = 0
-    ta.d_last, ta.d_last_over = val[m - 1], cls[m - 1]
-    mixed = False
-    for j in range(1, m):
-        mixed = mixed or cls[j] != cls[0]
-    if mixed:
-        m = _insert_crossings(w, c, n, m, s, alpha, hs, p, mot, ground, ta)
-    _refine(w, c, n, m, 0.0, hs, s, p, alpha, mot, ground, ta)
-    if mixed or cls[0] == 1.0:
-        _refine(w, c, n, m, 1.0, hs, s, p, alpha, mot, ground, ta)
 
 
 @njit(cache=True)

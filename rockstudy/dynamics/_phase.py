@@ -200,7 +200,8 @@ def _make_phase(general):
             if trig_only or taylor:
                 _log_poly_step(log, ta, w, order, t, hs, t_end)
                 if stepping.demand:
-                    demand_step(ta, w, order, t, hs, t_end, s, p, alpha, mot, k)
+                    end = (th1, om1) if ev == EV_NONE else (np.nan, np.nan)
+                    demand_step(ta, w, order, t, hs, t_end, s, p, alpha, mot, k, end)
             else:
                 args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
                 _log_dop853_step(log, ta, args, t, t_end, th, om, f0, kx, kv)
