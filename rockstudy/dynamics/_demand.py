@@ -41,6 +41,7 @@ from numba import njit
 
 from ..constants import G
 from ..motions._kernels import KIND_RECORD, ground_acceleration, vertical_acceleration
+from ._rhs import _record_acceleration
 from ._taylor import (
     FMA,
     NO_REFCOUNT,
@@ -140,7 +141,10 @@ def _sample_end(w, tau, end, step):
     kind, mp, times, samples, vsamples = mot
     a_h = a_v = 0.0
     if t0 < mp[3]:
-        a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        if kind == KIND_RECORD:  # the step ends on a sample: no interpolation
+            a_h = _record_acceleration(mp, times, samples, tau, k)
+        else:
+            a_h = ground_acceleration(kind, mp, times, samples, tau, k)
         a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
     ratio, f_v = _ratio(s0 + s1, c0 + c1, end[1], a_h, a_v, p)
     return ratio, f_v, s * end[0]
