@@ -40,8 +40,8 @@ _CODES = {
 
 #: The outputs returned by default (:data:`.outputs.OUTPUTS`: the kernels' and the model).
 OUTPUTS = outputs.names("kernel", "batch")
-#: Outputs returned only when ``outputs`` names them (each lifting row is run again with a
-#: history: see :mod:`._batch_contact`).
+#: Outputs returned only when ``outputs`` names them (the rocking kernel computes them on the
+#: way; the rows it leaves out are run again with a history: see :mod:`._batch_contact`).
 CONTACT_OUTPUTS = outputs.names("contact")
 #: Returned only when ``outputs`` names it: every row is run again with its amplitude times
 #: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
@@ -271,10 +271,10 @@ def simulate_batch(
         cheaper linear model; asking for any other output runs the kernel on every row that
         lifts, so that no returned value lies outside what ``auto`` promises. Also, never by
         default: ``friction_demand`` and ``lift_off`` (as
-        :attr:`rockstudy.RockingResult.friction_demand`), for which every row that lifts is
-        run again on its own with a history (the single-scene path, same model and rtol;
-        1-40 ms a row), while a row that never lifts has ``max |u_h''| / (g + u_v'')``,
-        exactly, without a run. Also never by default: ``conditioning``, the relative change
+        :attr:`rockstudy.RockingResult.friction_demand`), computed by the kernel on its
+        Taylor steps (a linearized or Ricker row that lifts is run again with a history, 1-40
+        ms: :mod:`._batch_contact`); a row that never lifts: ``max |u_h''| / (g + u_v'')``.
+        Also never by default: ``conditioning``, the relative change
         of ``max_rotation`` when the amplitude (a pulse's, a record's ``scale``) grows by
         1e-9 (:func:`rockstudy.dynamics.conditioning.peak_change`: inf where the overturning
         decision changes, NaN where a run reached the step limit), for which every row is run
