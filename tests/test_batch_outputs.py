@@ -106,7 +106,7 @@ def test_peak_time_of_an_overturned_or_resting_block(method):
     )
     assert out["overturned"][0] and out["peak_time"][0] == out["overturn_time"][0]
     assert out["max_rotation"][1] == 0 and np.isnan(out["peak_time"][1])
-    for name in outputs.KERNEL_ROW.names:
+    for name in outputs.names("kernel"):
         np.testing.assert_equal(out[name][1], outputs.OUTPUTS[name].at_rest)
     assert 0 < out["peak_time"][2] and not out["overturned"][2]
 
@@ -218,7 +218,7 @@ def test_every_batch_kernel_writes_its_row():
         assert not out["overturned"][0] and out["n_impacts"][0] > 0, name
         assert np.isnan(out["overturn_time"][0]), name
         assert 0 < out["first_impact_time"][0] and 0 < out["peak_time"][0], name
-        for field in outputs.KERNEL_ROW.names:
+        for field in outputs.names("kernel"):
             assert out[field].dtype == np.dtype(outputs.OUTPUTS[field].dtype), (name, field)
     assert _rows.new_rows(3).dtype == outputs.KERNEL_ROW
 

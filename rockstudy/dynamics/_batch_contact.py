@@ -1,11 +1,13 @@
 """The friction demand and lift-off of :func:`rockstudy.simulate_batch` rows (private).
 
-The batch kernels keep no history, and the demand needs one; so the rows that lift are run
+The rocking kernel computes them on the way for Housner's block stepped by Taylor series
+(:mod:`._demand`: pulses and records); a row that never lifts needs no run: its demand is
+``max |u_h''| / (g + u_v'')`` exactly. The rows the kernel leaves uncomputed (NaN: the exact
+linear solvers, the linearized block, DOP853 steps of a Ricker wavelet, a mapped free rocking
+of a block stockier than :data:`._demand.FREE_ROCKING_SLENDERNESS`) and that lift are run
 again, one by one, through the single-scene path of :func:`rockstudy.simulate` with the same
 encoding, model and tolerance, and their histories go through
-:func:`rockstudy.dynamics.contact.check_contact`. The batch's other outputs are untouched (its
-kernels run as before); a row that never lifts needs no run: its demand is
-``max |u_h''| / (g + u_v'')`` exactly.
+:func:`rockstudy.dynamics.contact.check_contact`. The batch's other outputs are untouched.
 """
 
 from __future__ import annotations
@@ -36,13 +38,15 @@ class _RowMotion(Motion):
         return float(self._spec[1][3])
 
 
-def contact_rows(rows, codes, method, rtol, max_steps):
+def contact_rows(rows, codes, method, rtol, max_steps, kernel):
     """(friction_demand, lift_off) of every row: ``rows`` = (p, alpha, eta, kind, mp, times,
     samples, vsamples) as :func:`rockstudy.simulate_batch` encodes them, ``codes`` the model
     each row ran (:data:`rockstudy.dynamics._auto.MODEL_NAMES`), ``method`` and ``rtol`` the
-    batch's (``"auto"`` reruns its nonlinear rows at the kernel's rtol, as it ran them).
-    A row whose history run reaches ``max_steps`` has a NaN demand, ``lift_off`` False and
-    True in the third array (the batch gives it status 1)."""
+    batch's (``"auto"`` reruns its nonlinear rows at the kernel's rtol, as it ran them),
+    ``kernel`` the batch's output columns (``friction_demand`` and ``lift_off`` as the kernels
+    computed them, NaN where not, and ``status``). A row whose history run reaches
+    ``max_steps`` has a NaN demand, ``lift_off`` False and True in the third array (the batch
+    gives it status 1); so has a row whose kernel reached it."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
     if kind == mk.KIND_RECORD:
         psi = uplift_ratio(mp[:, 0], alpha, samples, vsamples)
@@ -53,7 +57,12 @@ def contact_rows(rows, codes, method, rtol, max_steps):
     limited = np.zeros(p.size, bool)
     linear_rows = codes == _auto.MODEL_LINEAR  # lift at g alpha, below g tan(alpha)
     lifts = psi >= np.where(linear_rows, alpha / np.tan(alpha), 1.0)
-    for i in np.flatnonzero(lifts):
+    computed = ~np.isnan(kernel["friction_demand"])
+    demand[computed] = kernel["friction_demand"][computed]
+    lift_off[computed] = kernel["lift_off"][computed] != 0
+    failed = kernel["status"] != 0
+    demand[failed], lift_off[failed], limited[failed] = np.nan, False, True
+    for i in np.flatnonzero(lifts & ~computed & ~failed):
         motion = _RowMotion((kind, mp[i], times, samples, vsamples))
         linear = codes[i] == _auto.MODEL_LINEAR
         run = _linear_exact if linear else _kernel

@@ -193,6 +193,8 @@ def _exact_outcome(tallies, over, t_over):
         steps=0,
         first_impact_time=ta.first_impact_time,
         peak_time=t_over if over else ta.peak_time,
+        friction_demand=np.nan,  # not computed by the exact solvers: see _batch_contact
+        lift_off=False,
         log_rows=(ta.n_history, ta.n_impact_times, ta.n_peaks),
     )
 

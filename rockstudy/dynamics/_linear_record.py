@@ -594,6 +594,8 @@ def _then_tail(inside, tail, dur):
         steps=0,
         first_impact_time=inside.first_impact_time if n_imp > 0 else tail.first_impact_time + dur,
         peak_time=tail.peak_time + dur if later else inside.peak_time,
+        friction_demand=inside.friction_demand,
+        lift_off=inside.lift_off,
         log_rows=inside.log_rows,
     )
 

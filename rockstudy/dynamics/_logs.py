@@ -27,6 +27,29 @@ TALLIES = np.dtype(
         ("n_impact_times", np.int64),
         ("n_peaks", np.int64),
         ("n_dense", np.int64),
+        # the friction demand (:mod:`._demand`): the largest ratio |F_h| / F_v and least F_v
+        # [m/s^2] up to alpha and beyond it; the grid's last two samples (time, ratio, side
+        # of alpha: 1.0 beyond) and the step before (its start, length, order and record
+        # segment); whether the next step starts a rocking phase, samples counted, and
+        # whether a part of the response was left uncovered (a DOP853 step, a mapped free
+        # rocking)
+        ("d_best", np.float64),
+        ("d_min_fv", np.float64),
+        ("d_over", np.float64),
+        ("d_min_fv_over", np.float64),
+        ("d_ta", np.float64),
+        ("d_fa", np.float64),
+        ("d_ca", np.float64),
+        ("d_tb", np.float64),
+        ("d_fb", np.float64),
+        ("d_cb", np.float64),
+        ("d_prev_t", np.float64),
+        ("d_prev_hs", np.float64),
+        ("d_prev_n", np.int64),
+        ("d_prev_k", np.int64),
+        ("d_fresh", np.int64),
+        ("d_samples", np.int64),
+        ("d_uncovered", np.int64),
     ],
     align=True,
 )
@@ -49,6 +72,9 @@ def new_tallies(max_rotation):
     ta.max_rotation = max_rotation
     ta.peak_time = 0.0 if max_rotation > 0.0 else np.nan
     ta.first_impact_time = np.nan
+    ta.d_min_fv = ta.d_min_fv_over = np.inf
+    ta.d_fa = ta.d_fb = -np.inf  # an empty grid
+    ta.d_fresh = 1
     return tallies
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from ..motions._kernels import KIND_RECORD, KIND_TRIG, segment_index
+from ._demand import demand_step
 from ._events import EV_NONE, EV_OVER, EV_REJECT, _impact, _zeno
 from ._logs import _log_dop853_step, _log_peak, _log_poly_step, _push, raise_max
 from ._rhs import _accel, _ground_after, _vertical_after
@@ -29,14 +30,16 @@ PhaseState.__doc__ = """The state of a rocking phase (:func:`_phase`): the time 
 
 
 Stepping = namedtuple(
-    "Stepping", ("p", "alpha", "eta", "model", "omega_rest", "tol", "max_steps", "fall", "table")
+    "Stepping",
+    ("p", "alpha", "eta", "model", "omega_rest", "tol", "max_steps", "fall", "table", "demand"),
 )
 
 
 Stepping.__doc__ = """What a rocking phase (:func:`_phase`) steps: the body (p [rad/s], alpha
 [rad], eta, model, ``fall`` [rad] and ``table`` of a :class:`Body`), the speed ``omega_rest``
 [rad/s] below which an impact leaves it at rest, the local error target ``tol`` (TOL_SAFETY
-rtol) and the most steps ``max_steps`` of one phase."""
+rtol), the most steps ``max_steps`` of one phase, and whether the friction demand is computed
+on its steps (``demand``: :mod:`._demand`)."""
 
 
 @njit(cache=True)
@@ -92,6 +95,7 @@ def _after_impact(stepping, mot, log, ta, t, th, om, s, k, t_ev, om_ev):
     kind, mp, times, samples, vsamples = mot
     hist, imps = log[0], log[1]
     t, om = _impact(t, th, om, t_ev, om_ev, stepping.eta, ta, imps, hist)
+    ta.d_fresh = 1  # the forces jump at an impact: the next step's start is a sample
     if kind == KIND_RECORD:
         k = segment_index(times, min(t, mp[3]), k)
     a_g = _ground_after(kind, mp, times, samples, t, k)
@@ -163,6 +167,7 @@ def _make_phase(general):
         kx, kv, w = wk
         k = segment_index(times, t, FIRST) if kind == KIND_RECORD else 0
         f0 = _accel_after(stepping, mot, t, k, th, om, s)
+        ta.d_fresh = 1
         steps = 0
         code = PH_END
         while t < t_stop:
@@ -194,9 +199,13 @@ def _make_phase(general):
             t_end = t1 if ev == EV_NONE else t_ev  # the step's end, or its event
             if trig_only or taylor:
                 _log_poly_step(log, ta, w, order, t, hs, t_end)
+                if stepping.demand:
+                    end = (th1, om1) if ev == EV_NONE else (np.nan, np.nan)
+                    demand_step(ta, w, order, t, hs, t_end, s, p, alpha, mot, k, end)
             else:
                 args = (p, alpha, s, model, kind, mp, times, samples, vsamples, k, tab)
                 _log_dop853_step(log, ta, args, t, t_end, th, om, f0, kx, kv)
+                ta.d_uncovered = 1
             if ev == EV_OVER:
                 t, th, om = _fell(hist, ta, t_ev, s * fall, om_ev, fall)
                 code = PH_OVER

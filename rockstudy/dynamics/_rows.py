@@ -27,3 +27,5 @@ def write_row(out, i, r):
     row.steps = r.steps
     row.first_impact_time = r.first_impact_time
     row.peak_time = r.peak_time
+    row.friction_demand = r.friction_demand
+    row.lift_off = r.lift_off

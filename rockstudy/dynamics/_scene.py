@@ -12,6 +12,7 @@ from numba import njit, prange
 
 from ..constants import FALL_ROTATION
 from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ._demand import FREE_ROCKING_SLENDERNESS, demand_outcome
 from ._free_map import free_peak_time, free_rocking_map, free_tail_end
 from ._logs import _push, new_tallies, raise_max
 from ._phase import PhaseState, Stepping, _phase, _phase_trig, _variant_named, _work_arrays
@@ -21,6 +22,7 @@ from ._uplift import next_uplift
 from .constants import (
     FIRST,
     FIRST_STEP,
+    MODEL_NONLINEAR,
     MODEL_TABLE,
     NO_STOP,
     NO_TABLE,
@@ -46,14 +48,18 @@ eta [-], the model (MODEL_NONLINEAR, MODEL_LINEAR or MODEL_TABLE), the rotation 
 ``table`` (:data:`NO_TABLE` for a block)."""
 
 
-Controls = namedtuple("Controls", ("rtol", "max_steps", "free_map", "tail_end"))
+Controls = namedtuple(
+    "Controls", ("rtol", "max_steps", "free_map", "tail_end", "demand"), defaults=(False,)
+)
 
 
 Controls.__doc__ = """How a :func:`scene` is computed: the relative tolerance ``rtol``, the
 most steps of one phase ``max_steps`` (exceeded: STATUS_MAX_STEPS), whether the free rocking
 after the motion is mapped (``free_map``: :func:`free_rocking_map`, no history) rather than
-integrated, and ``tail_end`` [s], where an integrated free rocking stops
-(:func:`free_tail_end`)."""
+integrated, ``tail_end`` [s], where an integrated free rocking stops
+(:func:`free_tail_end`), and whether the friction demand and lift-off of Housner's block are
+computed (``demand``, default False: :mod:`._demand`; NaN otherwise, and for the other
+models)."""
 
 
 Start = namedtuple("Start", ("theta", "theta_dot"))
@@ -77,6 +83,8 @@ SceneOutcome = namedtuple(
         "first_impact_time",
         "n_peaks",
         "peak_time",
+        "friction_demand",
+        "lift_off",
     ),
 )
 
@@ -87,15 +95,18 @@ STATUS_MAX_STEPS), ``max_rotation`` max |theta| [rad], ``overturned``, ``n_impac
 rows, ``n_impact_times`` impact times, ``n_peaks`` peaks: more than the arrays hold means
 they overflowed), ``steps`` (integrator steps: DOP853, or Taylor inside a record) and
 ``first_impact_time`` [s] (NaN if none), ``peak_time`` [s] when max |theta| was reached (the
-overturning time if it overturned; NaN if it never rocked)."""
+overturning time if it overturned; NaN if it never rocked), ``friction_demand`` and
+``lift_off`` (:func:`._demand.demand_outcome`: NaN and False where not computed)."""
 
 
 @njit(cache=True)
-def _outcome(code, state, tallies):
+def _outcome(code, state, tallies, body):
     """The :class:`SceneOutcome` of a scene whose last phase ended with ``code`` in ``state`` (a
-    :class:`PhaseState`), from its tallies (the array of :func:`new_tallies`)."""
+    :class:`PhaseState`), from its tallies (the array of :func:`new_tallies`) and its
+    :class:`Body`."""
     ta = tallies[0]
     over = code == PH_OVER
+    demand, lift_off = demand_outcome(ta, over, body.eta, body.alpha)
     return SceneOutcome(
         status=STATUS_MAX_STEPS if code == PH_FAIL else STATUS_OK,
         max_rotation=ta.max_rotation,
@@ -108,6 +119,8 @@ def _outcome(code, state, tallies):
         first_impact_time=ta.first_impact_time,
         n_peaks=ta.n_peaks,
         peak_time=state.t if over else ta.peak_time,
+        friction_demand=demand,
+        lift_off=lift_off,
     )
 
 
@@ -168,8 +181,18 @@ def _scene_start(body, controls, start):
     th0, om0 = start.theta, start.theta_dot
     omega_rest = REST_FRACTION * p * alpha
     tol = TOL_SAFETY * controls.rtol
+    demand = controls.demand and body.model == MODEL_NONLINEAR
     stepping = Stepping(
-        p, alpha, body.eta, body.model, omega_rest, tol, controls.max_steps, body.fall, body.table
+        p,
+        alpha,
+        body.eta,
+        body.model,
+        omega_rest,
+        tol,
+        controls.max_steps,
+        body.fall,
+        body.table,
+        demand,
     )
     s0 = math.copysign(1.0, th0 if th0 != 0.0 else om0)  # the side the start rocks on
     state = PhaseState(0.0, th0, om0, s0, FIRST_STEP / p)
@@ -246,6 +269,8 @@ def _make_scene(general):
                     state, body.p, body.alpha, eta, body.model, omega_rest
                 )
             if controls.free_map and not over and eta < 1.0:
+                if body.alpha > FREE_ROCKING_SLENDERNESS:  # its demand is not bounded
+                    ta.d_uncovered = 1
                 _raise_to_mapped_peak(ta, state, body, peak)
                 ta.n_impacts += n_post
             else:  # integrate the free rocking: for the history, to time the overturning, or to
@@ -258,7 +283,7 @@ def _make_scene(general):
                     code, state = _phase_trig(
                         stepping, mot, log, state, ta, wk, controls.tail_end, NO_STOP
                     )
-        return _outcome(code, state, tallies)
+        return _outcome(code, state, tallies, body)
 
     return scene
 
@@ -280,9 +305,12 @@ def _make_scene_batch(general, parallel=True):
 
     @njit(cache=True, parallel=parallel)
     @_variant_named(general, serial=not parallel)
-    def scene_batch(p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps):
+    def scene_batch(
+        p, alpha, eta, model, kind, mp, times, samples, vsamples, rtol, max_steps, demand=False
+    ):
         """:func:`scene` over rows of (p, alpha, eta, mp[i]) with the free-rocking map, in parallel
-        (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|).
+        (``vsamples``: the vertical component, empty for none; scaled by |mp[i, 0]|), with the
+        friction demand and lift-off of Housner's block if ``demand`` (:mod:`._demand`).
 
         Returns an array of :data:`.outputs.KERNEL_ROW` rows.
         """
@@ -291,7 +319,8 @@ def _make_scene_batch(general, parallel=True):
         for i in prange(p.shape[0]):
             body = Body(p[i], alpha[i], eta[i], model, FALL_ROTATION, NO_TABLE)
             mot = (kind, mp[i], times, samples, vsamples)
-            ctl = Controls(rtol, max_steps, True, free_tail_end(p[i], eta[i], mp[i, 3]))
+            tail = free_tail_end(p[i], eta[i], mp[i, 3])
+            ctl = Controls(rtol, max_steps, True, tail, demand)
             if general:
                 r = scene(body, mot, ctl, Start(0.0, 0.0), no_log)
             else:

@@ -68,8 +68,8 @@ FMA = {"contract"}
 @njit(cache=True)
 def work_arrays():
     """Coefficient work space of :func:`taylor_coefficients`: rows c, j x_j, S, C and the
-    ground series F."""
-    return np.empty((5, MAX_ORDER + 1))
+    ground series F; and the polynomial of the step before (:mod:`._demand`)."""
+    return np.empty((6, MAX_ORDER + 1))
 
 
 #: 1/k and 1/(k (k-1)), read by the recurrences (constants: no division in the loops).
@@ -80,6 +80,8 @@ _INV2 = np.array([0.0, 0.0] + [1.0 / (k * (k - 1)) for k in range(2, MAX_ORDER +
 #: Rows of the work array: the scaled coefficients c_k, j x_j, the series S and C, and the
 #: series F of the ground term of a trigonometric pulse (:func:`taylor_coefficients_trig`).
 ROW_C, ROW_JX, ROW_S, ROW_C_SERIES, ROW_F = 0, 1, 2, 3, 4
+#: Row of the polynomial of the step before, kept by the friction demand (:mod:`._demand`).
+ROW_PREV = 5
 
 
 @njit(cache=True, inline="always")

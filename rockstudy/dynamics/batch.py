@@ -41,8 +41,8 @@ _CODES = {
 
 #: The outputs returned by default (:data:`.outputs.OUTPUTS`: the kernels' and the model).
 OUTPUTS = outputs.names("kernel", "batch")
-#: Outputs returned only when ``outputs`` names them (each lifting row is run again with a
-#: history: see :mod:`._batch_contact`).
+#: Outputs returned only when ``outputs`` names them (the rocking kernel computes them on the
+#: way; the rows it leaves out are run again with a history: see :mod:`._batch_contact`).
 CONTACT_OUTPUTS = outputs.names("contact")
 #: Returned only when ``outputs`` names it: every row is run again with its amplitude times
 #: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
@@ -272,10 +272,10 @@ def simulate_batch(
         cheaper linear model; asking for any other output runs the kernel on every row that
         lifts, so that no returned value lies outside what ``auto`` promises. Also, never by
         default: ``friction_demand`` and ``lift_off`` (as
-        :attr:`rockstudy.RockingResult.friction_demand`), for which every row that lifts is
-        run again on its own with a history (the single-scene path, same model and rtol;
-        1-40 ms a row), while a row that never lifts has ``max |u_h''| / (g + u_v'')``,
-        exactly, without a run. Also never by default: ``conditioning``, the relative change
+        :attr:`rockstudy.RockingResult.friction_demand`), computed by the kernel on its
+        Taylor steps (a linearized or Ricker row that lifts is run again with a history, 1-40
+        ms: :mod:`._batch_contact`); a row that never lifts: ``max |u_h''| / (g + u_v'')``.
+        Also never by default: ``conditioning``, the relative change
         of ``max_rotation`` when the amplitude (a pulse's, a record's ``scale``) grows by
         1e-9 (:func:`rockstudy.dynamics.conditioning.peak_change`: inf where the overturning
         decision changes, NaN where a run reached the step limit), for which every row is run
@@ -372,20 +372,21 @@ def simulate_batch(
     rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
     linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
 
-    def solve(rows):
+    check = _needs_check(wanted, model)
+
+    def solve(rows, demand=False):
         if kernel_model is not None:
-            return _run(rows, np.arange(n), kernel_model, rtol, max_steps), np.full(
+            return _run(rows, np.arange(n), kernel_model, rtol, max_steps, demand), np.full(
                 n, _CODES[kernel_model], np.int8
             )
-        return _auto_rows(
-            rows, pulse if record is None else None, cycles, rtol, max_steps, linear_ok
-        )
+        motion = (pulse if record is None else None, cycles)
+        return _auto_rows(rows, motion, rtol, max_steps, linear_ok, demand)
 
-    out, codes = _unsolved(n) if _contact_only(wanted, model) else solve(rows)
+    out, codes = _unsolved(n) if _contact_only(wanted, model) else solve(rows, check)
     cols = _columns(out, codes)
     if "conditioning" in wanted:
         cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
-    if _needs_check(wanted, model):
+    if check:
         _add_contact_outputs(cols, rows, codes, method, rtol, max_steps)
     if model != "rocking":
         motions = contact_model.RowMotions(pulse, record, mp, amplitude, period, cycles, n)
@@ -438,7 +439,7 @@ def _add_contact_outputs(cols, rows, codes, method, rtol, max_steps):
     pass reached the step limit gets that status)."""
     from ._batch_contact import contact_rows
 
-    demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps)
+    demand, lift_off, limited = contact_rows(rows, codes, method, rtol, max_steps, cols)
     cols["status"] = np.where(limited, STATUS_STEP_LIMIT, cols["status"])
     cols.update(zip(CONTACT_OUTPUTS, (demand, lift_off), strict=True))
 
@@ -509,9 +510,8 @@ def _add_contact_model(cols, rows, mu, model, motions, rtol):
     chosen = _beyond_housner(cols, mu[0]) if model == "auto" else np.ones(n, bool)
     cols.update(_no_slip(cols))
     idx = np.flatnonzero(chosen)
-    untimed = [
-        name for name in outputs.KERNEL_ROW.names if "contact" not in outputs.OUTPUTS[name].models
-    ]
+    kernel = outputs.names("kernel")
+    untimed = [name for name in kernel if "contact" not in outputs.OUTPUTS[name].models]
     for name in untimed:  # the kernel outputs the contact model leaves out
         cols[name][idx] = outputs.OUTPUTS[name].fill
     cols["model"][idx] = MODEL_CONTACT
@@ -637,8 +637,9 @@ def _requested_outputs(outputs, model="rocking", friction=False):
     return tuple(name for name in allowed if name in names or name == "status")
 
 
-def _run(rows, idx, model, rtol, max_steps):
-    """The kernel rows (:data:`.outputs.KERNEL_ROW`) of the rows ``idx`` under one model. The
+def _run(rows, idx, model, rtol, max_steps, demand=False):
+    """The kernel rows (:data:`.outputs.KERNEL_ROW`) of the rows ``idx`` under one model, with
+    the friction demand where the kernel computes it if ``demand`` (:mod:`._demand`). The
     exact linear record solver has constant coefficients: a record with a vertical component
     runs the kernel."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
@@ -649,15 +650,17 @@ def _run(rows, idx, model, rtol, max_steps):
         return _linear_record.record_batch(*args, mp[idx, 0], times, samples)
     trig = kind == mk.KIND_TRIG and model != _rocking.MODEL_TABLE and not vsamples.size
     kernel = _BATCH_KERNELS[trig, numba.get_num_threads() == 1]  # trig: compiles in half
-    return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps)
+    return kernel(*args, model, kind, mp[idx], times, samples, vsamples, rtol, max_steps, demand)
 
 
-def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
+def _auto_rows(rows, motion, tolerance, max_steps, linear_ok=True, demand=False):
     """``method="auto"``: rest, linear or nonlinear row by row (see :mod:`._auto`); the
     linear model only if ``linear_ok`` (no output outside its bound was asked for), and only
     under one-cycle trigonometric pulses, the one case its error table covers (none is known
-    under records: see :func:`simulate_batch`)."""
+    under records: see :func:`simulate_batch`). ``motion``: (pulse name or None, cycles);
+    ``demand``: the kernels compute the friction demand (:func:`_run`)."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
+    pulse, cycles = motion
     n = p.size
     if pulse is not None:
         psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
@@ -679,13 +682,13 @@ def _auto_rows(rows, pulse, cycles, tolerance, max_steps, linear_ok=True):
     ):
         idx = np.flatnonzero(codes == code)
         if idx.size:
-            out[idx] = _run(rows, idx, model, rtol, max_steps)
+            out[idx] = _run(rows, idx, model, rtol, max_steps, demand)
     ratio = out["max_rotation"] / alpha
     small = np.flatnonzero((codes == _auto.MODEL_NONLINEAR) & (ratio < _auto.SMALL_ROTATION))
     rtols = _auto.kernel_rtol_small(tolerance, ratio[small])
     for rtol in np.unique(rtols):
         idx = small[rtols == rtol]
-        out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps)
+        out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps, demand)
     return out, codes
 
 

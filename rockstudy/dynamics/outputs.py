@@ -75,6 +75,10 @@ class Output:
     at_rest : float or int
         Its value for a scene that never lifts (``"kernel"`` outputs: what ``method="auto"``
         gives the rows it decides are at rest without a kernel).
+    in_row : bool
+        Whether the batch kernels write it in their row (:data:`KERNEL_ROW`) although another
+        stage completes it: the friction check, which the rocking kernel computes on the way
+        (:mod:`._demand`; NaN where it did not) and :func:`simulate_batch` completes.
     """
 
     name: str
@@ -87,6 +91,7 @@ class Output:
     stage: str = "kernel"
     in_study: bool = True
     at_rest: float | int = 0
+    in_row: bool = False
 
     def __post_init__(self):
         if self.stage not in STAGES:
@@ -185,6 +190,8 @@ OUTPUTS = {
             "with a lift-off)",
             models=_BLOCK_MODELS,
             stage="contact",
+            at_rest=_NAN,
+            in_row=True,
         ),
         _int(
             "lift_off",
@@ -194,6 +201,7 @@ OUTPUTS = {
             "i1",
             models=(*_BLOCK_MODELS, "contact"),
             stage="contact",
+            in_row=True,
         ),
         _f8(
             "max_slide",
@@ -259,5 +267,8 @@ def names(*stages: str) -> tuple:
 
 #: The outputs a study may ask for (``run.outputs``), in table order.
 STUDY_OUTPUTS = tuple(o.name for o in OUTPUTS.values() if o.in_study)
-#: The row every batch kernel writes per scene: one field per ``"kernel"`` output.
-KERNEL_ROW = np.dtype([(name, OUTPUTS[name].dtype) for name in names("kernel")])
+#: The row every batch kernel writes per scene: one field per ``"kernel"`` output, and the
+#: friction check's outputs that the kernels compute on the way (``in_row``).
+KERNEL_ROW = np.dtype(
+    [(o.name, o.dtype) for o in OUTPUTS.values() if o.stage == "kernel" or o.in_row]
+)
