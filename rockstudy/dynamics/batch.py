@@ -410,8 +410,8 @@ def _contact_only(wanted, model) -> bool:
 
 def _unsolved(n):
     """(kernel rows, model codes) of n rows Housner's model did not run: the rows of scenes
-    at rest (:func:`_rows_at_rest`), code 0, for the contact model to write over."""
-    return _rows_at_rest(n), np.zeros(n, np.int8)
+    at rest (:func:`.outputs.rows_at_rest`), code 0, for the contact model to write over."""
+    return outputs.rows_at_rest(n), np.zeros(n, np.int8)
 
 
 def _controls(method, rtol, max_steps, half_diagonal, frequency_parameter):
@@ -675,7 +675,7 @@ def _auto_rows(rows, motion, tolerance, max_steps, linear_ok=True, demand=False)
         codes[(codes == _auto.MODEL_NONLINEAR) & one_cycle & (bound <= tolerance)] = (
             _auto.MODEL_LINEAR
         )
-    out = _rows_at_rest(n)
+    out = outputs.rows_at_rest(n)
     for code, model, rtol in (
         (_auto.MODEL_LINEAR, _rocking.MODEL_LINEAR, tolerance),
         (_auto.MODEL_NONLINEAR, _rocking.MODEL_NONLINEAR, _auto.kernel_rtol(tolerance)),
@@ -690,12 +690,3 @@ def _auto_rows(rows, motion, tolerance, max_steps, linear_ok=True, demand=False)
         idx = small[rtols == rtol]
         out[idx] = _run(rows, idx, _rocking.MODEL_NONLINEAR, rtol, max_steps, demand)
     return out, codes
-
-
-def _rows_at_rest(n):
-    """n kernel rows (:data:`.outputs.KERNEL_ROW`) of scenes that never lift: each output's
-    ``at_rest`` value."""
-    out = np.empty(n, outputs.KERNEL_ROW)
-    for name in outputs.KERNEL_ROW.names:
-        out[name] = outputs.OUTPUTS[name].at_rest
-    return out

@@ -29,6 +29,7 @@ __all__ = [
     "TIMED_REGIMES",
     "Output",
     "names",
+    "rows_at_rest",
 ]
 
 #: The models a batch runs (:func:`rockstudy.simulate_batch`): Housner's block by the
@@ -272,3 +273,12 @@ STUDY_OUTPUTS = tuple(o.name for o in OUTPUTS.values() if o.in_study)
 KERNEL_ROW = np.dtype(
     [(o.name, o.dtype) for o in OUTPUTS.values() if o.stage == "kernel" or o.in_row]
 )
+
+
+def rows_at_rest(n):
+    """n kernel rows (:data:`KERNEL_ROW`) of scenes that never lift: each output's
+    ``at_rest`` value."""
+    out = np.empty(n, KERNEL_ROW)
+    for name in KERNEL_ROW.names:
+        out[name] = OUTPUTS[name].at_rest
+    return out
