@@ -373,6 +373,7 @@ def simulate(
     dt_out: float | None = None,
     friction: float | None = None,
     conditioning: bool = False,
+    orientation: float | None = None,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -472,6 +473,14 @@ def simulate(
         by the same method, and give the relative change of ``max_rotation`` as
         ``result.conditioning`` (:mod:`rockstudy.dynamics.conditioning`): above 1e-3 the
         scene is ill-conditioned. Off by default: it doubles the cost.
+    orientation : float, optional
+        The angle psi [rad] of the structure's rocking plane, from the record's x component
+        (``acceleration``) towards its y component (``acceleration_y``): the structure rocks
+        under a_psi = a_x cos(psi) + a_y sin(psi) (:meth:`rockstudy.motions.Record.oriented`;
+        psi + pi mirrors the motion, so the response). A motion of one horizontal component
+        (a pulse, a record without ``acceleration_y``) takes psi = 0 and pi only (pi
+        mirrors it); other angles are refused. None (default): the motion as given (a
+        two-component record's x component); ``result.info["orientation"]`` says which.
 
     Returns
     -------
@@ -486,6 +495,8 @@ def simulate(
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
+    if orientation is not None:
+        motion = motion.oriented(orientation)
     kind, mp, _, _, vsamples = motion.kernel_spec()
     refuse_free_fall(vsamples, mp[0])
     method_for(
@@ -541,6 +552,7 @@ def simulate(
         rtol_requested=rtol,
         initial_rotation=th0,
         initial_velocity=om0,
+        orientation=0.0 if orientation is None else float(orientation),
     )
     return contact.with_contact(r, motion, method) if block else r
 
