@@ -10,6 +10,7 @@ the files the tests write, and pyrotd (the peer library of rotated spectra), to 
 import math
 
 import numpy as np
+import pyrotd
 import pytest
 from _helpers import write_at2
 
@@ -230,3 +231,83 @@ def test_an_orientation_off_the_axis_of_a_one_component_motion_is_refused():
     assert np.allclose(mirrored.peak_rotations, oracle.peak_rotations, rtol=1e-12)
     with pytest.raises(ValueError, match="orientation"):
         rock(a_pair(), orientation=float("inf"))
+
+
+# ------------------------------------------------------------------- RotD50 and RotD100
+
+PYROTD_ANGLES = np.arange(180)  # pyrotd's default: 0 to 179 degrees
+
+
+def padded_pair(seed):
+    """A pair followed by 90 s of rest: pyrotd's oscillator is a periodic (FFT) one, which
+    equals the oscillator started at rest once the response has died out before the record
+    repeats (at T = 2 s and 5 %, e^(-0.05 (2 pi / 2) 90) = 7e-7)."""
+    ax, ay = pair_samples(seed)
+    rest = np.zeros(20000 - ax.size)
+    return Record(np.r_[ax, rest], dt=DT, acceleration_y=np.r_[ay, rest], name=f"pair{seed}")
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_pga_rotd_equals_pyrotd(seed):
+    rec = padded_pair(seed)
+    want = pyrotd.calc_rotated_percentiles(
+        [rec.acceleration, rec.acceleration_y], PYROTD_ANGLES, [50, 100], method="rigorous"
+    ).spec_accel
+    assert rec.intensity_measure("pga_rotd50") == pytest.approx(want[0], rel=1e-12)
+    assert rec.intensity_measure("pga_rotd100") == pytest.approx(want[1], rel=1e-12)
+    # RotD100 at 1 degree: within cos(0.5 degree) of the peak of |a| over every direction
+    vector = np.max(np.hypot(rec.acceleration, rec.acceleration_y))
+    assert vector * math.cos(math.radians(0.5)) <= rec.intensity_measure("pga_rotd100") <= vector
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_sa_rotd_equals_pyrotd(seed):
+    """pyrotd's pseudo-spectral acceleration (osc_type "psa", as the registry's sa), its
+    oscillator upsampled 4 times for the peaks between samples; 1e-3 (measured: 2.0e-4)."""
+    rec = padded_pair(seed)
+    for period in (0.2, 0.5, 1.0, 2.0):
+        want = pyrotd.calc_rotated_spec_accels(
+            DT,
+            rec.acceleration,
+            rec.acceleration_y,
+            [1.0 / period],
+            0.05,
+            percentiles=[50, 100],
+            angles=PYROTD_ANGLES,
+            max_freq_ratio=4 * (0.5 / DT) * period,  # 4 x the Nyquist frequency
+        ).spec_accel
+        for which, expected in zip(("sa_rotd50", "sa_rotd100"), want, strict=True):
+            got = rec.intensity_measure(which, period=period, damping=0.05)
+            assert got == pytest.approx(expected, rel=1e-3)
+
+
+def test_sa_rotd_is_the_spectrum_along_each_angle():
+    """The combined states of the two components give, angle by angle, the spectrum
+    kernel's Sa of the oriented record (the median and the largest of those 180 values)."""
+    rec = a_pair(14)
+    for period in (0.05, 0.7):  # 0.05 s: the kernel's sub-steps (omega dt = 0.63)
+        along = [rec.oriented(np.radians(d)).intensity_measure("sa", period) for d in range(180)]
+        assert rec.intensity_measure("sa_rotd50", period) == pytest.approx(
+            np.median(along), rel=1e-12
+        )
+        assert rec.intensity_measure("sa_rotd100", period) == pytest.approx(max(along), rel=1e-12)
+
+
+def test_rotd_measures_scale_and_refuse_one_component():
+    rec = a_pair(15)
+    scaled = rec.scaled_to(0.4 * STANDARD_GRAVITY, im="pga_rotd50")
+    assert scaled.intensity_measure("pga_rotd50") == pytest.approx(
+        0.4 * STANDARD_GRAVITY, rel=1e-12
+    )
+    one = Record(rec.acceleration, dt=DT, name="x only")
+    for name, period in (
+        ("pga_rotd50", None),
+        ("pga_rotd100", None),
+        ("sa_rotd50", 1.0),
+        ("sa_rotd100", 1.0),
+    ):
+        with pytest.raises(
+            ValueError, match=rf"the measure '{name}' is of a pair .*'x only' has one"
+        ):
+            one.intensity_measure(name, period)
+    assert "pga_rotd50" not in one.intensity_measures()  # not listed: one component has none
