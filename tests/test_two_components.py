@@ -311,3 +311,43 @@ def test_rotd_measures_scale_and_refuse_one_component():
         ):
             one.intensity_measure(name, period)
     assert "pga_rotd50" not in one.intensity_measures()  # not listed: one component has none
+
+
+def test_simulate_batch_takes_an_orientation_per_row():
+    """Rows of several orientations, interleaved: each row equals the batch of the
+    one-component record along its angle, in the rows' order."""
+    import rockstudy as rs
+
+    pair = a_pair(16)
+    psi = np.array([0.9, 0.0, 0.9 + math.pi, math.pi / 2, 0.9, 2.0])
+    scale = np.array([1.0, 1.5, 1.0, 0.8, 2.0, 1.2])
+    got = rs.simulate_batch(record=pair, orientation=psi, scale=scale, **BLOCK)
+    for i, angle in enumerate(psi):
+        along = math.cos(angle) * pair.acceleration + math.sin(angle) * pair.acceleration_y
+        alone = rs.simulate_batch(record=Record(along, dt=DT), scale=scale[i], **BLOCK)
+        for name, values in got.items():
+            assert values[i] == pytest.approx(alone[name][0], rel=1e-9, nan_ok=True), name
+    assert got["max_rotation"][0] == pytest.approx(got["max_rotation"][2], rel=1e-7)  # mirror
+    ds = rs.simulate_batch(record=pair, orientation=psi, scale=scale, as_dataset=True, **BLOCK)
+    assert np.array_equal(ds["orientation"].values, psi)
+    assert np.array_equal(ds["scale"].values, scale)
+    assert np.array_equal(ds["max_rotation"].values, got["max_rotation"])
+
+
+def test_simulate_batch_orientation_of_one_component_motions():
+    import rockstudy as rs
+
+    pulses = dict(amplitude=4.0, period=0.6, **BLOCK)
+    got = rs.simulate_batch(orientation=[0.0, math.pi], **pulses)
+    mirrored = rs.simulate_batch(**{**pulses, "amplitude": [4.0, -4.0]})
+    for name, values in got.items():
+        assert np.array_equal(values, mirrored[name], equal_nan=True), name
+    with pytest.raises(ValueError, match="orientation = 0.5 rad: the sine pulse has one"):
+        rs.simulate_batch(orientation=0.5, **pulses)
+    ax, _ = pair_samples(17)
+    with pytest.raises(ValueError, match="orientation = 0.5 rad: the record 'x' has one"):
+        rs.simulate_batch(record=Record(ax, dt=DT, name="x"), orientation=[0.0, 0.5], **BLOCK)
+    with pytest.raises(ValueError, match=r"orientation\[1\] = nan"):
+        rs.simulate_batch(record=a_pair(), orientation=[0.0, np.nan], **BLOCK)
+    with pytest.raises(ValueError, match="orientation: 3, scale: 2"):
+        rs.simulate_batch(record=a_pair(), orientation=[0, 1, 2], scale=[1, 2], **BLOCK)
