@@ -351,3 +351,19 @@ def test_simulate_batch_orientation_of_one_component_motions():
         rs.simulate_batch(record=a_pair(), orientation=[0.0, np.nan], **BLOCK)
     with pytest.raises(ValueError, match="orientation: 3, scale: 2"):
         rs.simulate_batch(record=a_pair(), orientation=[0, 1, 2], scale=[1, 2], **BLOCK)
+
+
+def test_a_floor_motion_keeps_both_horizontal_components():
+    """The building filters each direction alike (linear): the floor motion of the pair along
+    psi is the floor motion of the ground motion along psi, and y is the floor motion of y."""
+    from rockstudy.motions import Building, floor_motion
+
+    pair = a_pair(18)
+    building = Building.uniform_shear(5, 0.5, 0.05)
+    floor = floor_motion(pair, building, 3)
+    alone_y = floor_motion(Record(pair.acceleration_y, dt=DT), building, 3).acceleration
+    assert np.allclose(floor.acceleration_y, alone_y, rtol=0, atol=1e-12 * np.max(abs(alone_y)))
+    for psi in (0.4, 2.2):
+        want = floor_motion(pair.oriented(psi), building, 3).acceleration
+        got = floor.oriented(psi).acceleration
+        assert np.allclose(got, want, rtol=0, atol=1e-12 * np.max(np.abs(want)))
