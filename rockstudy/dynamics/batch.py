@@ -18,6 +18,7 @@ from ..motions import _kernels as mk
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from . import _auto, _linear, _linear_record, _rocking, conditioning, contact_model, outputs
+from ._oriented import with_orientation
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 from .simulate import MAX_FRICTION
@@ -198,6 +199,7 @@ def _motion_inputs(record, mp, amplitude, period, cycles, n):
     return {name: np.broadcast_to(np.asarray(value), (n,)) for name, value in values}
 
 
+@with_orientation(_common_length, _column)  # the orientation column: rows grouped by angle
 def simulate_batch(
     *,
     half_diagonal=None,
@@ -323,6 +325,9 @@ def simulate_batch(
         answered have no slip (0; NaN, with ``first_slip_time``, where the block overturned:
         the fall's slip lies outside that model) and ``regime`` 0 or 2. ``conditioning`` is
         refused with these models.
+    orientation : float or array_like, optional
+        The angle psi [rad] of each row's rocking plane, as :func:`rockstudy.simulate`'s (rows
+        grouped by angle, a batch each; a dataset gains the ``orientation`` coordinate).
 
     Returns
     -------
@@ -602,11 +607,7 @@ def _as_dataset(result, inputs, method, rtol, motion):
     return xr.Dataset(
         {k: var(k, v) for k, v in result.items()},
         coords={k: var(k, v) for k, v in inputs.items()},
-        attrs={
-            "method": method,
-            "rtol": rtol,
-            "motion": motion,
-        },
+        attrs={"method": method, "rtol": rtol, "motion": motion},
     )
 
 

@@ -375,6 +375,7 @@ def simulate(
     dt_out: float | None = None,
     friction: float | None = None,
     conditioning: bool = False,
+    orientation: float | None = None,
 ) -> RockingResult:
     """Rock a structure through a ground motion.
 
@@ -474,6 +475,14 @@ def simulate(
         by the same method, and give the relative change of ``max_rotation`` as
         ``result.conditioning`` (:mod:`rockstudy.dynamics.conditioning`): above 1e-3 the
         scene is ill-conditioned. Off by default: it doubles the cost.
+    orientation : float, optional
+        The angle psi [rad] of the structure's rocking plane, from the record's x component
+        (``acceleration``) towards its y component (``acceleration_y``): the structure rocks
+        under a_psi = a_x cos(psi) + a_y sin(psi) (:meth:`rockstudy.motions.Record.oriented`;
+        psi + pi mirrors the motion, so the response). A motion of one horizontal component
+        (a pulse, a record without ``acceleration_y``) takes psi = 0 and pi only (pi
+        mirrors it); other angles are refused. None (default): the motion as given (a
+        two-component record's x component); ``result.info["orientation"]`` says which.
 
     Returns
     -------
@@ -488,6 +497,8 @@ def simulate(
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
+    if orientation is not None:
+        motion = motion.oriented(orientation)
     if isinstance(structure, StackedBlocks):  # its solve_ivp reference (no kernel yet)
         options = dict(initial_rotation=initial_rotation, initial_velocity=initial_velocity)
         options.update(t_eval=t_eval, dt_out=dt_out, friction=friction, conditioning=conditioning)
@@ -547,6 +558,7 @@ def simulate(
         rtol_requested=rtol,
         initial_rotation=th0,
         initial_velocity=om0,
+        orientation=0.0 if orientation is None else float(orientation),
     )
     return contact.with_contact(r, motion, method) if block else r
 

@@ -210,7 +210,10 @@ def floor_motion(record: Record, building: Building, floor: int) -> Record:
         u_g'' + sum_j Gamma_j phi_j(floor) q_j'' on the record's own samples, exact for the
         linearly interpolated record, named ``"<name> (floor k)"``, with ``metadata``
         ``building`` and ``floor`` (over the record's own). A vertical component is kept
-        as it is: the building is taken as rigid vertically.
+        as it is: the building is taken as rigid vertically. A second horizontal component
+        (``acceleration_y``) is filtered by the same modes (a building whose modes are the
+        same in both directions); for other modes along y, give each direction its own
+        building: ``floor_motion(record.oriented(psi), building_psi, floor)``.
 
     Raises
     ------
@@ -228,17 +231,17 @@ def floor_motion(record: Record, building: Building, floor: int) -> Record:
         return record
     steps = np.array(intensity._steps(record.time), dtype=float)
     _check_phase_steps(building.periods, steps)
-    acc = record.acceleration + _modal_acceleration(
-        2.0 * math.pi / building.periods,
-        np.array(building.damping),
-        building.floor_factors(floor),
-        steps,
-        np.array(record.acceleration, dtype=float),
-    )
+    factors = building.floor_factors(floor)
+    omegas, zetas = 2.0 * math.pi / building.periods, np.array(building.damping)
+
+    def at_floor(ground):
+        return ground + _modal_acceleration(omegas, zetas, factors, steps, np.array(ground))
+
     return Record(
-        acc,
+        at_floor(record.acceleration),
         time=record.time,
         name=f"{record.name} (floor {floor})",
         vertical=record.vertical,
         metadata={**record.metadata, "building": building, "floor": floor},
+        acceleration_y=None if record.acceleration_y is None else at_floor(record.acceleration_y),
     )

@@ -297,13 +297,10 @@ def spectral_displacement(t, acc, periods, damping: float = 0.05):
     out = np.zeros(periods.size)
     if periods.size == 0:
         return out
-    steps = np.array(_steps(t), dtype=float)  # writable C copies: one kernel signature for
-    _check_long_periods(periods, steps)  # every input (a read-only or strided record too)
+    steps = kernel_steps(t)
     acc = np.array(acc, dtype=float)
     omegas = 2.0 * math.pi / periods
-    phase = omegas * float(np.max(steps))
-    substeps = np.ceil(np.maximum(phase, 1e-300) / SPECTRUM_PHASE_STEP)
-    direct = substeps * steps.size <= SPECTRUM_MAX_WORK
+    substeps, direct = substeps_of(omegas, steps)
     for k in np.unique(substeps[direct]):
         sel = direct & (substeps == k)
         out[sel] = _spectrum.peak_displacements(
@@ -312,6 +309,24 @@ def spectral_displacement(t, acc, periods, damping: float = 0.05):
     for j in np.flatnonzero(~direct):
         out[j] = rigid_limit_displacement(t, acc, periods[j], zeta)
     return out
+
+
+def kernel_steps(t) -> np.ndarray:
+    """The steps [s] of the sample times ``t`` as the spectrum kernels read them (a writable
+    C copy: one kernel signature for every input), checked against :data:`MIN_PHASE_STEP`
+    by the caller's periods (:func:`_check_long_periods`)."""
+    return np.array(_steps(t), dtype=float)
+
+
+def substeps_of(omegas, steps) -> tuple[np.ndarray, np.ndarray]:
+    """(sub-steps per record step, whether the kernel runs them) of oscillators ``omegas``
+    [rad/s] over ``steps`` [s]: omega h <= :data:`SPECTRUM_PHASE_STEP` in every sub-step,
+    and at most :data:`SPECTRUM_MAX_WORK` sub-steps in all (else the rigid limit). Refuses
+    periods too long for the steps (ValueError naming ``periods``)."""
+    _check_long_periods(2.0 * math.pi / np.asarray(omegas), steps)
+    phase = np.asarray(omegas) * float(np.max(steps))
+    substeps = np.ceil(np.maximum(phase, 1e-300) / SPECTRUM_PHASE_STEP)
+    return substeps, substeps * steps.size <= SPECTRUM_MAX_WORK
 
 
 #: Largest omega h [rad] of a (sub-)step of the spectrum kernel.

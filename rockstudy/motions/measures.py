@@ -40,7 +40,7 @@ import numpy as np
 
 from .. import _validate
 from ..constants import STANDARD_GRAVITY
-from . import intensity, units
+from . import intensity, rotd, units
 
 __all__ = [
     "label",
@@ -513,6 +513,20 @@ def _builtins():
     register_measure("sa", _spectral(2), unit="m/s^2", label="Sa", **spectral, **to_g)
     register_measure("psv", _spectral(1), unit="m/s", label="PSV", listed=False, **spectral)
     register_measure("sd", _spectral(0), unit="m", label="Sd", listed=False, **spectral)
+    _rotd_builtins(to_g, spectral)
+
+
+def _rotd_builtins(to_g: dict, spectral: dict) -> None:
+    """RotD50 and RotD100 of PGA and Sa (:mod:`rockstudy.motions.rotd`): measures of a pair
+    of horizontal components, so not listed (a record of one component has none of them)."""
+    for which, words in (("rotd50", "RotD50"), ("rotd100", "RotD100")):
+        pair = {"unit": "m/s^2", "listed": False, **to_g}
+        register_measure(
+            f"pga_{which}", rotd.pga_rotd(which), power=1, label=f"PGA {words}", **pair
+        )
+        register_measure(
+            f"sa_{which}", rotd.sa_rotd(which), label=f"Sa {words}", **spectral, **pair
+        )
 
 
 _builtins()

@@ -17,7 +17,7 @@ from .. import _validate
 from .._warnings import UnitsWarning
 from ..constants import STANDARD_GRAVITY
 from . import _kernels, intensity, measures
-from .base import Motion
+from .base import Motion, axis_sign, check_orientation
 from .pulse_extraction import extract_pulse
 from .units import acceleration_units
 from .wavelet_pulse import extract_wavelet_pulse
@@ -113,6 +113,11 @@ class Record(Motion):
         What the record is, for the reader (e.g. the building and floor of a floor motion,
         :func:`rockstudy.motions.floor_motion`); kept by :meth:`scaled`, never read by the
         motion or its measures.
+    acceleration_y : array_like, optional
+        The second horizontal component [m/s^2], at right angles to ``acceleration`` (the x
+        component), on the same samples. The record still moves an object along x, and its
+        measures are those of x; :meth:`oriented` gives the motion along any direction of the
+        plane, and the measures of the pair (``pga_rotd50``, ``sa_rotd100``, ...) read both.
 
     Intensity measures (:meth:`intensity_measures`, :meth:`response_spectrum`, :meth:`pulse`) are
     computed once and cached; the sample arrays are read-only for that reason.
@@ -124,6 +129,7 @@ class Record(Motion):
     name: str = ""
     vertical: np.ndarray | None = None
     metadata: dict | None = field(default=None, repr=False)
+    acceleration_y: np.ndarray | None = field(default=None, repr=False)
     _times: np.ndarray = field(init=False, repr=False)
     _cache: dict = field(init=False, repr=False)
 
@@ -159,16 +165,10 @@ class Record(Motion):
             times = times - times[0]
             dt = float(np.median(steps))
             _check_timing(acc.size, float(times[-1]), dt, float(np.min(steps)), "time")
-        if self.vertical is not None:
-            vert = _samples("vertical", self.vertical)
-            if vert.size != acc.size:
-                raise ValueError(
-                    f"vertical has {vert.size} samples but acceleration has {acc.size}; "
-                    "the vertical component must be given on the same samples"
-                )
-            vert = vert.copy()
-            vert.flags.writeable = False
-            object.__setattr__(self, "vertical", vert)
+        for name, what in _COMPONENTS.items():
+            values = getattr(self, name)
+            if values is not None:
+                object.__setattr__(self, name, _component(name, values, acc.size, what))
         acc = acc.copy()
         times = np.array(times, dtype=float)
         acc.flags.writeable = False
@@ -190,8 +190,9 @@ class Record(Motion):
     def scaled(self, factor: float) -> Record:
         """The same record with every sample multiplied by ``factor`` (negative mirrors).
 
-        A vertical component is multiplied by ``|factor|``: mirroring the horizontal direction
-        does not turn the vertical upside down.
+        Both horizontal components are multiplied by ``factor``; a vertical component by
+        ``|factor|``: mirroring the horizontal directions does not turn the vertical upside
+        down.
         """
         factor = _validate.number("factor", factor)
         if not math.isfinite(factor):
@@ -199,10 +200,9 @@ class Record(Motion):
         with np.errstate(over="ignore", under="ignore"):  # refused below, naming the factor
             acc = self.acceleration * factor
             vertical = None if self.vertical is None else self.vertical * abs(factor)
+            y = None if self.acceleration_y is None else self.acceleration_y * factor
         try:
-            return Record(
-                acc, time=self._times, name=self.name, vertical=vertical, metadata=self.metadata
-            )
+            return self._replace(acceleration=acc, vertical=vertical, acceleration_y=y)
         except ValueError as exc:
             raise ValueError(f"factor = {factor:g} on the record {self.name!r}: {exc}") from None
 
@@ -343,21 +343,62 @@ class Record(Motion):
             ) from None
         return self._cached(("pulse", method), lambda: extract(self._times, self.acceleration))
 
+    def _replace(self, **changes) -> Record:
+        """This record with the fields ``changes`` (acceleration, name, vertical, metadata,
+        acceleration_y) replaced, on the same times."""
+        fields = {
+            "acceleration": self.acceleration,
+            "name": self.name,
+            "vertical": self.vertical,
+            "metadata": self.metadata,
+            "acceleration_y": self.acceleration_y,
+        }
+        fields.update(changes)
+        return Record(time=self._times, **fields)
+
+    def _with_component(self, name: str, other: Record, path) -> Record:
+        """This record with the component ``name`` (``vertical`` or ``acceleration_y``) the
+        samples of ``other``, read from ``path``; a ValueError naming the field and the file
+        unless they share this record's samples."""
+        n, m = self.acceleration.size, other.acceleration.size
+        if n != m or not np.allclose(other._times, self._times, rtol=1e-9, atol=1e-12):
+            raise ValueError(
+                f"{_FIELDS[name]}: {path} has {m} samples at dt={other.dt!r} s but the "
+                f"horizontal record {self.name!r} has {n} at dt={self.dt!r} s; "
+                f"{_COMPONENTS[name]} must be given on the same samples"
+            )
+        return self._replace(**{name: other.acceleration})
+
     def _with_vertical(self, vertical: Record, path) -> Record:
         """This record with the vertical component ``vertical`` read from ``path``."""
-        n, m = self.acceleration.size, vertical.acceleration.size
-        if n != m or not np.allclose(vertical._times, self._times, rtol=1e-9, atol=1e-12):
-            raise ValueError(
-                f"vertical: {path} has {m} samples at dt={vertical.dt!r} s but the horizontal "
-                f"record {self.name!r} has {n} at dt={self.dt!r} s; an H/V pair must share "
-                "its samples"
-            )
-        return Record(
-            self.acceleration,
-            time=self._times,
-            name=self.name,
-            vertical=vertical.acceleration,
-            metadata=self.metadata,
+        return self._with_component("vertical", vertical, path)
+
+    @property
+    def two_components(self) -> bool:
+        """Whether the record carries a second horizontal component (``acceleration_y``)."""
+        return self.acceleration_y is not None
+
+    def oriented(self, psi: float) -> Record:
+        """The one-component record along the direction at angle ``psi`` [rad] from the x
+        component towards y: a_psi(t) = a_x(t) cos(psi) + a_y(t) sin(psi).
+
+        The vertical component and the metadata are kept; ``metadata["orientation"]`` is
+        ``psi``. A one-component record has no y: only psi = 0 (itself) and psi = pi (itself
+        mirrored, ``scaled(-1)``), up to a whole number of turns, are directions it has;
+        other angles are refused.
+        """
+        psi = check_orientation(psi)
+        c, s = math.cos(psi), math.sin(psi)
+        if self.acceleration_y is None:
+            c, s = axis_sign(psi, f"the record {self.name!r}"), 0.0
+        y = 0.0 if self.acceleration_y is None else self.acceleration_y
+        return self._cached(
+            ("oriented", psi),
+            lambda: self._replace(
+                acceleration=c * self.acceleration + s * y,
+                acceleration_y=None,
+                metadata={**self.metadata, "orientation": psi},
+            ),
         )
 
     def kernel_spec(self):
@@ -374,7 +415,7 @@ class Record(Motion):
         )
 
     @classmethod
-    def from_at2(cls, path, vertical=None) -> Record:
+    def from_at2(cls, path, vertical=None, h2=None) -> Record:
         """Read a PEER NGA ``.AT2`` file (acceleration in g), returned in m/s^2.
 
         g is standard gravity, 9.80665 m/s^2 (:data:`rockstudy.constants.STANDARD_GRAVITY`),
@@ -383,7 +424,9 @@ class Record(Motion):
 
         Both header styles are read: ``NPTS= 2048, DT= .0066 SEC`` (with or without filter
         information after it) and the older ``2048 0.0066 NPTS, DT``. ``vertical`` is the path
-        of the vertical component's ``.AT2`` file, on the same samples.
+        of the vertical component's ``.AT2`` file, and ``h2`` that of the second horizontal
+        component (``acceleration_y``, e.g. the ``...090.AT2`` of a ``...000.AT2``), each on
+        the same samples (NPTS and DT): else a ValueError naming the file.
         """
         path = Path(path)
         lines = read_text_file(path).splitlines()
@@ -401,9 +444,10 @@ class Record(Motion):
             raise ValueError(f"{path}: line 3 must state 'UNITS OF G'")
         values = _at2_values(path, lines, npts)
         record = _build(path, lambda: cls(values * STANDARD_GRAVITY, dt=dt, name=path.stem))
-        return (
-            record if vertical is None else record._with_vertical(cls.from_at2(vertical), vertical)
-        )
+        for name, other in (("acceleration_y", h2), ("vertical", vertical)):
+            if other is not None:
+                record = record._with_component(name, cls.from_at2(other), other)
+        return record
 
     @classmethod
     def from_csv(
@@ -490,6 +534,30 @@ class Record(Motion):
 #: resampling, the mean period's zero-padded spectrum (complex: two each, and a power of 2
 #: above its length) and the pulse scan's convolutions.
 _WORK_ARRAYS = 12
+
+
+#: The components a record may carry beside ``acceleration``: field -> what it is.
+_COMPONENTS = {
+    "vertical": "the vertical component",
+    "acceleration_y": "the second horizontal component",
+}
+
+#: The argument that gives each component from a file.
+_FIELDS = {"vertical": "vertical", "acceleration_y": "h2"}
+
+
+def _component(name: str, values, n: int, what: str) -> np.ndarray:
+    """The read-only samples of the component ``name`` (:data:`_COMPONENTS`), checked as
+    :func:`_samples` and to be ``n`` long (the length of ``acceleration``)."""
+    arr = _samples(name, values)
+    if arr.size != n:
+        raise ValueError(
+            f"{name} has {arr.size} samples but acceleration has {n}; {what} must be given on "
+            "the same samples"
+        )
+    arr = arr.copy()
+    arr.flags.writeable = False
+    return arr
 
 
 def _samples(name: str, values) -> np.ndarray:

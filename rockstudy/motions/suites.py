@@ -13,7 +13,14 @@ from pathlib import Path
 
 from .records import Record, UnitsError, not_a_file
 
-__all__ = ["load_suite", "read_pair", "RECORD_SUFFIXES", "suite_pairs", "units_refusal"]
+__all__ = [
+    "load_suite",
+    "read_pair",
+    "RECORD_SUFFIXES",
+    "suite_files",
+    "suite_pairs",
+    "units_refusal",
+]
 
 #: Suffixes (case-insensitive) of the files read from a folder.
 RECORD_SUFFIXES = (".at2", ".dat", ".txt", ".csv")
@@ -78,23 +85,24 @@ def _read(path: Path, units: str, field: str) -> Record:
         raise ValueError(f"{field}: cannot read the record file {str(path)!r}: {exc}") from exc
 
 
-def _vertical_rule(vertical):
-    if vertical is None:
+def _name_rule(rule, field: str = "vertical", example="(r'\\d{3}\\.AT2$', '-UP.AT2')"):
+    """The (compiled regex, replacement) of a pairing ``rule`` given as ``field``, or None."""
+    if rule is None:
         return None
+    what = "vertical" if field == "vertical" else "second horizontal component"
     try:
-        if isinstance(vertical, (str, bytes)):
+        if isinstance(rule, (str, bytes)):
             raise TypeError("a single string")
-        pattern, replacement = vertical
+        pattern, replacement = rule
         return re.compile(pattern), str(replacement)
     except (TypeError, ValueError, re.error) as exc:
         raise ValueError(
-            "vertical must be None or a (regex, replacement) pair that maps a horizontal file "
-            f"name to its vertical file's name, e.g. (r'\\d{{3}}\\.AT2$', '-UP.AT2'); got "
-            f"{vertical!r} ({exc})"
+            f"{field} must be None or a (regex, replacement) pair that maps a horizontal file "
+            f"name to its {what} file's name, e.g. {example}; got {rule!r} ({exc})"
         ) from None
 
 
-def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
+def load_suite(source, vertical=None, units: str = "g", h2=None) -> list[Record]:
     """Read a suite of ground-motion records.
 
     Parameters
@@ -115,6 +123,14 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
     units : {"g", "m/s2", "m/s^2", "cm/s2", "cm/s^2"}
         Units of the acceleration column of text files (``.AT2`` files are in g: units other
         than g on ``.AT2`` files alone are refused).
+    h2 : (str, str), optional
+        Pairing of the two horizontal components, as ``vertical`` pairs verticals: a regular
+        expression and its replacement mapping each (x) horizontal file's name to its second
+        horizontal component's (``acceleration_y``), e.g. ``(r"000\\.AT2$", "090.AT2")``
+        pairs ``RSN126_GAZLI_GAZ000.AT2`` with ``RSN126_GAZLI_GAZ090.AT2``. Files that are
+        some record's second component are not read as records of their own; a file that is
+        no record's component must match every pattern given (``vertical`` and ``h2``), and
+        every file the patterns name must exist.
 
     Returns
     -------
@@ -125,16 +141,16 @@ def load_suite(source, vertical=None, units: str = "g") -> list[Record]:
     Raises
     ------
     ValueError
-        Naming the field (``source`` or ``vertical``) and the file: a folder or glob without
-        record files, a file that cannot be read, a file listed twice, a missing vertical
-        file, an H/V pair of different lengths or steps, or ``units`` other than g on
-        ``.AT2`` files alone (``units``).
+        Naming the field (``source``, ``vertical`` or ``h2``) and the file: a folder or glob
+        without record files, a file that cannot be read, a file listed twice, a missing
+        vertical or second file, components of different lengths or steps, or ``units``
+        other than g on ``.AT2`` files alone (``units``).
     """
-    pairs = suite_pairs(source, vertical)
-    refusal = units_refusal(pairs, units)
+    files = suite_files(source, vertical, h2=h2)
+    refusal = units_refusal(files, units)
     if refusal:
         raise ValueError(f"units: {refusal}")
-    return [read_pair(h, v, units) for h, v in pairs]
+    return [read_pair(h, v, units, h2=y) for h, v, y in files]
 
 
 def units_refusal(pairs, units: str) -> str | None:
@@ -162,73 +178,113 @@ def suite_pairs(
     ValueError for a folder or glob without record files, a missing file, a file named twice,
     or a broken pairing.
     """
+    return [(h, v) for h, v, _ in suite_files(source, vertical, field, vertical_field)]
+
+
+def suite_files(
+    source, vertical=None, field: str = "source", vertical_field: str = "vertical", h2=None
+) -> list[tuple[Path, Path | None, Path | None]]:
+    """The (horizontal, vertical or None, second horizontal or None) files of a suite,
+    without reading them: :func:`suite_pairs` with the ``h2`` pairing of :func:`load_suite`
+    (named ``h2`` in the messages)."""
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     if not items:
         raise ValueError(f"{field}: an empty list names no record")
-    rule = _vertical_rule(vertical)
-    pairs: list[tuple[Path, Path | None]] = []
+    rules = {1: _name_rule(vertical, vertical_field), 2: _name_rule(h2, "h2", _H2_EXAMPLE)}
+    files: list[list] = []
     for item in items:
         if isinstance(item, tuple):
             if len(item) != 2:
                 raise ValueError(f"{field}: a pair must be (horizontal, vertical), got {item!r}")
-            pairs.append((Path(item[0]), Path(item[1])))
+            files.append([Path(item[0]), Path(item[1]), None])
         else:
-            pairs.extend((p, None) for p in _expand(item, field))
-    if rule is not None:
-        pairs = _pair_by_name(pairs, rule, vertical_field)
+            files.extend([p, None, None] for p in _expand(item, field))
+    names = {1: vertical_field, 2: "h2"}
+    rules = {slot: (rule, names[slot]) for slot, rule in rules.items() if rule is not None}
+    if rules:
+        files = _pair_by_name(files, rules)
     seen = {}
-    for h, _ in pairs:
+    for h, _, _ in files:
         key = h.resolve()
         if key in seen:
             raise ValueError(f"{field}: the file {str(h)!r} is named twice")
         seen[key] = h
-    return pairs
+    return [tuple(f) for f in files]
+
+
+#: An example of an ``h2`` pairing, for its message.
+_H2_EXAMPLE = "(r'000\\.AT2$', '090.AT2')"
 
 
 def read_pair(
-    horizontal, vertical=None, units: str = "g", field: str = "source", vertical_field="vertical"
+    horizontal,
+    vertical=None,
+    units: str = "g",
+    field: str = "source",
+    vertical_field="vertical",
+    h2=None,
 ) -> Record:
-    """One record from its horizontal file and, optionally, its vertical file (same samples);
-    any failure is a ValueError naming the field (``field``, ``vertical_field``) and the file."""
+    """One record from its horizontal file and, optionally, its vertical file and its second
+    horizontal file ``h2`` (same samples); any failure is a ValueError naming the field
+    (``field``, ``vertical_field``, ``h2``) and the file."""
     rec = _read(Path(horizontal), units, field)
-    if vertical is not None:
+    for name, path, where in (("acceleration_y", h2, "h2"), ("vertical", vertical, vertical_field)):
+        if path is None:
+            continue
         try:
-            rec = rec._with_vertical(_read(Path(vertical), units, vertical_field), vertical)
+            rec = rec._with_component(name, _read(Path(path), units, where), path)
         except ValueError as exc:
             text = str(exc)
-            raise ValueError(
-                text if text.startswith(vertical_field) else f"{vertical_field}: {text}"
-            ) from None
+            if text.startswith(f"{_COMPONENT_FIELD[name]}:"):
+                text = text.partition(": ")[2]
+            raise ValueError(text if text.startswith(where) else f"{where}: {text}") from None
     return rec
 
 
-def _pair_by_name(pairs, rule, field="vertical"):
-    """Attach to each horizontal file its vertical file by the (regex, replacement) rule."""
-    pattern, replacement = rule
+#: The field :meth:`Record._with_component` names in its messages.
+_COMPONENT_FIELD = {"vertical": "vertical", "acceleration_y": "h2"}
+
+
+def _pair_by_name(files, rules):
+    """Fill each record's component files by the rules {slot: ((regex, replacement), field)}
+    (slot 1 the vertical, 2 the second horizontal): a file some rule names from another is
+    that record's component, every other file is a record and must match every rule."""
+    named = set()
+    for h, _, _ in files:
+        for (pattern, replacement), _ in rules.values():
+            if pattern.search(h.name):
+                named.add(h.with_name(pattern.sub(replacement, h.name)).resolve())
     out = []
-    verticals = set()
-    for h, v in pairs:
-        if v is not None:
-            out.append((h, v))
+    for entry in files:
+        h = entry[0]
+        if h.resolve() in named:
             continue
-        if not pattern.search(h.name):
-            continue  # decided below: a vertical file of another record, or an error
-        v = h.with_name(pattern.sub(replacement, h.name))
-        verticals.add(v.resolve())
-        out.append((h, v))
-    for h, v in pairs:
-        if v is None and not pattern.search(h.name) and h.resolve() not in verticals:
-            raise ValueError(
-                f"{field}: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
-                "record's vertical component; every file must be one or the other"
-            )
-    out = [(h, v) for h, v in out if h.resolve() not in verticals]
-    for h, v in out:
-        what = not_a_file(v)
-        if what == "missing":
-            raise ValueError(f"{field}: the vertical file {str(v)!r} of {str(h)!r} is missing")
-        if what:
-            raise ValueError(
-                f"{field}: the vertical file {str(v)!r} of {str(h)!r} is {what}, not a file"
-            )
+        for slot, ((pattern, replacement), field) in rules.items():
+            if entry[slot] is not None:
+                continue  # an explicit (horizontal, vertical) pair
+            if not pattern.search(h.name):
+                raise ValueError(
+                    f"{field}: the file {str(h)!r} does not match {pattern.pattern!r} and is no "
+                    f"record's {_SLOTS[slot]}; every file must be one or the other"
+                )
+            entry[slot] = h.with_name(pattern.sub(replacement, h.name))
+            _refuse_missing(entry[slot], h, field, _SLOTS[slot])
+        out.append(entry)
     return out
+
+
+#: What each slot of a suite's (horizontal, vertical, second horizontal) files is.
+_SLOTS = {1: "vertical component", 2: "second horizontal component"}
+
+
+def _refuse_missing(path, horizontal, field, what):
+    """A ValueError naming ``field`` where the component file ``path`` of ``horizontal`` is
+    missing or not a file."""
+    found = not_a_file(path)
+    name = "vertical file" if what.startswith("vertical") else "second horizontal file"
+    if found == "missing":
+        raise ValueError(f"{field}: the {name} {str(path)!r} of {str(horizontal)!r} is missing")
+    if found:
+        raise ValueError(
+            f"{field}: the {name} {str(path)!r} of {str(horizontal)!r} is {found}, not a file"
+        )
