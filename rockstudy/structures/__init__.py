@@ -17,6 +17,7 @@ from .equivalent import (
     SymmetricFrame,
     restitution_symmetric_body,
 )
+from .isolated import IsolatedBlock, isolated_restitution
 from .mechanism import EquivalentBlock, Mechanism, RockingParameters
 
 __all__ = [
@@ -25,6 +26,7 @@ __all__ = [
     "Block",
     "ConicalShell",
     "EquivalentBlock",
+    "IsolatedBlock",
     "Mechanism",
     "PointMassStrut",
     "RockingParameters",
@@ -32,6 +34,7 @@ __all__ = [
     "SymmetricFrame",
     "block_parameters",
     "frequency_parameter",
+    "isolated_restitution",
     "restitution_housner",
     "restitution_symmetric_body",
     "uplift_acceleration",
