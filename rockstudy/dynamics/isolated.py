@@ -21,7 +21,7 @@ Two regimes:
 
 The block lifts when the base's absolute acceleration at rest passes g tan(alpha)
 (:func:`uplift_side`), impacts exchange momentum between block and base
-(:func:`impact_velocities`), and it overturns at |theta| = pi/2. The ``solve_ivp`` path that
+(:func:`impact_velocities`), and it overturns at ``|theta|`` = pi/2. The ``solve_ivp`` path that
 integrates them is :mod:`rockstudy.dynamics.isolated_reference`.
 """
 

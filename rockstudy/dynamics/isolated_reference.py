@@ -3,10 +3,11 @@
 The regimes and equations are those of :mod:`rockstudy.dynamics.isolated` (Vassiliou & Makris
 2012): rest (the isolated mass on its spring and dashpot), rocking on either side of the moving
 base, impacts with momentum exchange, overturning. Each regime is integrated by
-``solve_ivp`` (DOP853) with events: the uplift (the base's absolute acceleration at rest passing
-g tan(alpha)), the impact (theta = 0), the overturning (|theta| = pi/2) and the peaks of
-|x_b| and |theta|. Phases stop at every sample of a record (where u_g'' has a kink) and at the
-end of the motion. This is the only solver of the model so far: no numba kernel yet.
+``solve_ivp`` (DOP853) with events: the uplift (the base's absolute acceleration at rest
+passing g tan(alpha)), the impact (theta = 0), the overturning (``|theta|`` = pi/2) and the
+peaks of ``|x_b|`` and ``|theta|``. Phases stop at every sample of a record (where u_g'' has a
+kink) and at the end of the motion. This is the only solver of the model so far: no numba
+kernel yet.
 """
 
 from __future__ import annotations
@@ -149,7 +150,7 @@ def _rest_phase(scene, log, t, x, xd):
     events = [
         _event(lambda t_, y: a_b(y) + limit, True, -1.0),  # lifts onto the positive pivot
         _event(lambda t_, y: a_b(y) - limit, True, 1.0),  # onto the negative one
-        _event(lambda t_, y: y[1], False, 0.0),  # a peak of |x_b|
+        _event(lambda t_, y: y[1], False, 0.0),  # a peak of ``|x_b|``
     ]
     sol = _solve(scene, rhs, t, _rest_window(scene, t), [x, xd], events, scene.atol[:2])
     lifts = [float(sol.t_events[i][0]) for i in (0, 1) if sol.t_events[i].size]
@@ -193,7 +194,7 @@ def _rest_window(scene, t):
 def _settled(scene, log, x, xd):
     """Whether a block at rest after the motion, the base at (x_b, x_b'), can never lift again
     nor the base pass its peak so far: the free isolator's energy E = (x_b'^2 + omega^2
-    x_b^2) / 2 does not grow, |x_b| <= sqrt(2 E) / omega and the base's acceleration
+    x_b^2) / 2 does not grow, ``|x_b|`` <= sqrt(2 E) / omega and the base's acceleration
     |2 zeta omega x_b' + omega^2 x_b| <= omega sqrt(1 + 4 zeta^2) sqrt(2 E) (Cauchy-Schwarz)."""
     w, zeta = scene.body.omega, scene.body.zeta
     amp = math.hypot(x, xd / w)
@@ -202,8 +203,9 @@ def _settled(scene, log, x, xd):
 
 
 def _rocking_events(side, t0):
-    """The impact (theta back to 0, terminal), the overturning (|theta| = pi/2, terminal), and
-    the peaks of |x_b| and of |theta| (non-terminal) of a rocking phase on ``side`` from t0 [s].
+    """The impact (theta back to 0, terminal), the overturning (``|theta|`` = pi/2, terminal),
+    and the peaks of ``|x_b|`` and of ``|theta|`` (non-terminal) of a rocking phase on
+    ``side`` from t0 [s].
     A phase starts at theta = 0 (after an uplift or an impact) and side theta grows first, so
     the impact's function is taken as 1 at t0: Brent's method, which scipy runs on the step's
     dense output, then finds the return to 0 after a short hop inside the first step rather

@@ -25,16 +25,16 @@ class IsolatedResult:
         x_b [m] and x_b' [m/s], the base's displacement and velocity relative to the ground
         (the isolator's deformation).
     max_rotation : float
-        Max |theta| [rad]; pi/2 if the block overturned.
+        Max ``|theta|`` [rad]; pi/2 if the block overturned.
     overturned : bool
-        Whether the block fell over (|theta| reached pi/2); the history ends there.
+        Whether the block fell over (``|theta|`` reached pi/2); the history ends there.
     max_isolator_displacement : float
-        Max |x_b| [m] over the history (up to the overturning, if any), located on the
+        Max ``|x_b|`` [m] over the history (up to the overturning, if any), located on the
         integrator's dense output at the zeros of x_b'.
     impact_times, uplift_times : ndarray
         Times [s] of the impacts on the base and of the uplifts from rest.
     overturn_time : float
-        When |theta| reached pi/2 [s]; NaN if the block survived.
+        When ``|theta|`` reached pi/2 [s]; NaN if the block survived.
     method : str
         ``"scipy"``: the ``solve_ivp`` reference (no numba kernel yet).
     info : dict
@@ -104,7 +104,11 @@ class IsolatedResult:
             max_isolator_displacement=self.max_isolator_displacement,
             overturn_time=self.overturn_time,
             method=self.method,
-            **{k: v for k, v in self.info.items() if isinstance(v, int | float | str)},
+            **{
+                k: int(v) if isinstance(v, bool) else v
+                for k, v in self.info.items()
+                if isinstance(v, int | float | str)
+            },
         )
         if self.isolator_capacity is not None:
             ds.attrs["isolator_capacity"] = self.isolator_capacity
