@@ -302,3 +302,17 @@ def test_bad_types_and_options():
     vertical = Record(np.ones(5), dt=0.01, vertical=np.ones(5))
     with pytest.raises(ValueError, match="vertical"):
         rs.simulate(iso, vertical)
+
+
+def test_dense_output_ends_with_the_history():
+    """Without t_max, times beyond the end of the history are refused (naming t_eval); dt_out
+    gives the uniform grid up to that end; after an overturning the state is NaN."""
+    iso = rs.IsolatedBlock(rs.Block(1.0, 0.2), 1.0, 1.0, 0.2)
+    pulse = SinePulse(amplitude=3.0, period=0.5)
+    r = rs.simulate(iso, pulse, dt_out=0.01)
+    assert r.t_eval[0] == 0.0 and r.t_eval[-1] <= r.t[-1] < r.t_eval[-1] + 0.01
+    with pytest.raises(ValueError, match="t_eval"):
+        rs.simulate(iso, pulse, t_eval=[0.0, r.t[-1] + 1.0])
+    falls = rs.IsolatedBlock(rs.Block(0.3, 0.2), 1.0, 0.05, 0.05)
+    r = rs.simulate(falls, SinePulse(amplitude=12.0, period=0.6), t_eval=[0.0, 5.0])
+    assert r.overturned and r.theta_eval[0] == 0.0 and np.isnan(r.theta_eval[1])

@@ -424,9 +424,9 @@ def _simulate(structure, motion, rtol, t_max, x0, t_eval):
     dense = {} if t_eval is None else _dense(log, t_eval, t_ot if over else math.inf)
     return IsolatedResult(
         *(rows[:, i].copy() for i in (0, 3, 4, 1, 2)),
-        max_rotation=FALL_ROTATION if over else log.max_theta,
+        max_rotation=FALL_ROTATION if over else float(log.max_theta),
         overturned=over,
-        max_isolator_displacement=log.max_x,
+        max_isolator_displacement=float(log.max_x),
         impact_times=np.array(log.impacts, dtype=float),
         uplift_times=np.array(log.uplifts, dtype=float),
         overturn_time=t_ot,

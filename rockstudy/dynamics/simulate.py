@@ -382,6 +382,9 @@ def simulate(
     ----------
     structure : Block or structure with ``mechanism()`` and ``equivalent_block()``
         The rocking block (p, alpha, eta), or a structure of [003] (wall, arch, frame, ...).
+        An :class:`~rockstudy.IsolatedBlock` runs its ``solve_ivp`` reference instead
+        (:func:`~rockstudy.dynamics.isolated_reference.simulate_isolated`, which says what it
+        takes) and returns an :class:`~rockstudy.dynamics.isolated_result.IsolatedResult`.
     motion : Motion
         Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``. A
         record's vertical component u_v'' (upwards) acts as gravity g + u_v'' (Housner's
