@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from . import closedform, motions, risk, similarity, structures
     from .dynamics import RockingResult, StepLimitError, simulate, simulate_batch
     from .motions.records import UnitsError
-    from .structures import Block, StackedBlocks
+    from .structures import Block, IsolatedBlock, StackedBlocks
     from .study.running.runner import FailedSamplesError, ResourceError, SchedulerError
     from .study.running.store import DamagedCube, StoreError
     from .study.spec.ida_options import IdaOptionError
@@ -49,6 +49,7 @@ __version__ = "0.1.0"
 _LAZY = {
     "Block": (".structures", "Block"),
     "StackedBlocks": (".structures", "StackedBlocks"),
+    "IsolatedBlock": (".structures", "IsolatedBlock"),
     "RockingResult": (".dynamics", "RockingResult"),
     "simulate": (".dynamics", "simulate"),
     "simulate_batch": (".dynamics", "simulate_batch"),
@@ -85,6 +86,7 @@ __all__ = [
     "LinearizationWarning",
     "LooseToleranceWarning",
     "IncompleteReferenceWarning",
+    "IsolatedBlock",
     "RockingResult",
     "SeparationWarning",
     "StackedBlocks",

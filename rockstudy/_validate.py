@@ -254,3 +254,17 @@ def uniform_times(dt_out: float, end: float) -> np.ndarray:
         "give a larger dt_out, or t_eval",
     )
     return np.minimum(dt_out * np.arange(int(math.floor(end / dt_out)) + 1), end)
+
+
+def initial_state(initial_rotation, initial_velocity) -> tuple[float, float]:
+    """The initial (theta [rad], theta_dot [rad/s]) of a simulation as floats, or a ValueError
+    naming ``initial_rotation`` (it must lie in (-pi/2, pi/2)) or ``initial_velocity`` (finite).
+    """
+    half_pi = math.pi / 2
+    th0 = in_open_interval(
+        "initial_rotation", initial_rotation, -half_pi, half_pi, "(-pi/2, pi/2) rad"
+    )
+    om0 = number("initial_velocity", initial_velocity)
+    if not math.isfinite(om0):
+        raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
+    return th0, om0

@@ -17,10 +17,12 @@ from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
 from ..structures.block import block_parameters
 from ..structures.equivalent import ConicalShell, PointMassStrut, SymmetricFrame
+from ..structures.isolated import IsolatedBlock
 from ..structures.stacked import StackedBlocks
 from . import _auto, _linear, _linear_record, _rocking, contact, contact_model
 from ._vertical import refuse_free_fall, uplift_ratio
 from .conditioning import peak_change, perturbed
+from .isolated_reference import simulate_isolated
 from .methods import MAX_STEPS, StepLimitError, method_for
 from .reference import simulate_reference
 from .result import RockingResult, describe
@@ -383,6 +385,9 @@ def simulate(
     ----------
     structure : Block or structure with ``mechanism()`` and ``equivalent_block()``
         The rocking block (p, alpha, eta), or a structure of [003] (wall, arch, frame, ...).
+        An :class:`~rockstudy.IsolatedBlock` runs its ``solve_ivp`` reference instead
+        (:func:`~rockstudy.dynamics.isolated_reference.simulate_isolated`, which says what it
+        takes) and returns an :class:`~rockstudy.dynamics.isolated_result.IsolatedResult`.
     motion : Motion
         Ground acceleration, e.g. :class:`rockstudy.motions.SinePulse` or a ``Record``. A
         record's vertical component u_v'' (upwards) acts as gravity g + u_v'' (Housner's
@@ -499,6 +504,9 @@ def simulate(
         raise TypeError(f"motion must be a rockstudy Motion, got {type(motion).__name__}")
     if orientation is not None:
         motion = motion.oriented(orientation)
+    if isinstance(structure, IsolatedBlock):  # the solve_ivp reference, its own result
+        args = (rtol, t_max, initial_rotation, initial_velocity, t_eval, dt_out, friction)
+        return simulate_isolated(structure, motion, method, *args, conditioning)
     if isinstance(structure, StackedBlocks):  # its solve_ivp reference (no kernel yet)
         options = dict(initial_rotation=initial_rotation, initial_velocity=initial_velocity)
         options.update(t_eval=t_eval, dt_out=dt_out, friction=friction, conditioning=conditioning)
@@ -516,12 +524,7 @@ def simulate(
     max_steps = _validate.max_steps(max_steps)
     if t_max is not None:
         t_max = _validate.positive("t_max", t_max)
-    th0 = _validate.in_open_interval(
-        "initial_rotation", initial_rotation, -FALL_ROTATION, FALL_ROTATION, "(-pi/2, pi/2) rad"
-    )
-    om0 = _validate.number("initial_velocity", initial_velocity)
-    if not math.isfinite(om0):
-        raise ValueError(f"initial_velocity must be finite, got {initial_velocity!r}")
+    th0, om0 = _validate.initial_state(initial_rotation, initial_velocity)
     if method in ("nonlinear", "mechanism"):
         _auto.warn_loose_tolerance(rtol)
     x0 = (th0, om0)

@@ -17,6 +17,7 @@ from .equivalent import (
     SymmetricFrame,
     restitution_symmetric_body,
 )
+from .isolated import IsolatedBlock, isolated_restitution
 from .mechanism import EquivalentBlock, Mechanism, RockingParameters
 from .stacked import StackedBlocks
 
@@ -26,6 +27,7 @@ __all__ = [
     "Block",
     "ConicalShell",
     "EquivalentBlock",
+    "IsolatedBlock",
     "Mechanism",
     "PointMassStrut",
     "RockingParameters",
@@ -34,6 +36,7 @@ __all__ = [
     "SymmetricFrame",
     "block_parameters",
     "frequency_parameter",
+    "isolated_restitution",
     "restitution_housner",
     "restitution_symmetric_body",
     "uplift_acceleration",
