@@ -7,6 +7,7 @@ itself either way: on Shenton's slide-rock threshold its max slide jumps by far 
 batch."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -45,3 +46,17 @@ def test_a_row_on_a_stick_slip_threshold_gets_the_unconverged_status():
     assert list(out["status"]) == [STATUS_UNCONVERGED, 0]
     far = slide(1.05 * mu)
     assert out["max_slide"][1] == pytest.approx(far["max_slide"], rel=10 * RTOL, abs=1e-12)
+
+
+def test_simulate_warns_on_a_stick_slip_decision_on_its_threshold():
+    """The single-scene path says the same of the same scene: an AccuracyWarning naming
+    rtol; 5 % above the threshold it is silent."""
+    t = np.arange(0.0, 0.405, 0.01)
+    record = Record(np.full(t.size, LEVEL * G), time=t)
+    mu = sr.uplift_force_ratio(LEVEL, ALPHA)
+    block = rs.Block(half_diagonal=RADIUS, slenderness=ALPHA)
+    with pytest.warns(rs.AccuracyWarning, match="did not converge with rtol"):
+        rs.simulate(block, record, friction=(mu, 0.5 * mu), rtol=RTOL)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", rs.AccuracyWarning)
+        rs.simulate(block, record, friction=(1.05 * mu, 0.525 * mu), rtol=RTOL)

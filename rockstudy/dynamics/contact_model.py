@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 from .. import _validate
-from .._warnings import IncompleteReferenceWarning
+from .._warnings import AccuracyWarning, IncompleteReferenceWarning
 from ..constants import G
 from ..motions import _kernels as mk
 from ..motions.pulses import PULSES
@@ -415,6 +415,14 @@ def _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max, m
         )
     if r["status"] != 0:
         raise StepLimitError(method, max_steps)
+    if not r.get("converged", True):
+        warnings.warn(
+            f"the contact model's answer did not converge with rtol={rtol:g}: a friction "
+            "decision (stick or slip, mu_s > mu_k) lay within 10 rtol of its threshold, where "
+            "the answer jumps; method='scipy' at a tighter rtol, or mu_s = mu_k, decides it",
+            AccuracyWarning,
+            stacklevel=4,
+        )
     r["regime_sequence"] = None
     return r
 
