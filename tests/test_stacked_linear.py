@@ -10,7 +10,7 @@ import rockstudy as rs
 from rockstudy.constants import G
 from rockstudy.dynamics.stacked_linear import simulate_stacked_linear
 from rockstudy.dynamics.stacked_reference import simulate_stacked
-from rockstudy.motions import Record, SinePulse
+from rockstudy.motions import Record, RickerWavelet, SinePulse
 from rockstudy.structures import Block, StackedBlocks
 
 
@@ -69,24 +69,37 @@ def test_vanishing_upper_mass_leaves_the_lower_block_housners_linear_block(motio
     np.testing.assert_allclose(r.impact_times[:n], ref.impact_times[:n], rtol=1e-9)
 
 
-#: (R_1, alpha_1, R_2, alpha_2, density ratio, a_g / (g alpha_1), pulse period [s]) at the
-#: scale 1 of alpha, and the regime that shows both bodies moving ("both": both rocking at
-#: once; "lower": the statue locked to its rocking plinth); neither body overturns.
+#: (R_1, alpha_1, R_2, alpha_2, density ratio, a_g / (g alpha_1), pulse period [s] or None
+#: for the record of :func:`_shape`) at the scale 1 of alpha, and the regime that shows both
+#: bodies moving ("both": both rocking at once; "lower": the statue locked to its rocking
+#: plinth); neither body overturns.
 SCENES = [
     ((1.0, 0.2, 0.3, 0.25, 0.5, 1.2, 0.3), "both"),
     ((1.0, 0.2, 0.3, 0.25, 0.5, 1.05, 0.5), "both"),
     ((1.2, 0.15, 0.3, 0.3, 2.0, 1.2, 0.5), "lower"),
+    ((1.2, 0.15, 0.3, 0.3, 2.0, 1.3, None), "lower"),
 ]
 
 
-def _peaks(scene, scale, t_max):
-    """Peak rotations over alpha, linearised and nonlinear (reference at rtol 1e-12), of a
-    scene at ``scale`` times its slenderness (and ground amplitude)."""
+def _shape():
+    """A decaying record's shape (peak 1, dt 0.01 s, 1.2 s long) with a ripple."""
+    t = np.arange(0.0, 1.2, 0.01)
+    shape = np.sin(2 * np.pi * t / 0.6) * np.exp(-t) + 0.15 * np.sin(2 * np.pi * t / 0.17)
+    return np.concatenate([shape / np.abs(shape).max(), np.zeros(1)])
+
+
+def _peaks(scene, scale):
+    """The linearised and the nonlinear (reference at rtol 1e-12) results of a scene at
+    ``scale`` times its slenderness and ground amplitude, to 1 s after the motion."""
     r1, a1, r2, a2, rho, psi, period = scene
     pair = StackedBlocks(Block(r1, a1 * scale), Block(r2, a2 * scale), density_ratio=rho)
-    motion = SinePulse(amplitude=psi * G * a1 * scale, period=period)
-    lin = simulate_stacked_linear(pair, motion, t_max=period + t_max)
-    ref = simulate_stacked(pair, motion, rtol=1e-12, t_max=period + t_max)
+    amplitude = psi * G * a1 * scale
+    if period is None:
+        motion = Record(amplitude * _shape(), dt=0.01)
+    else:
+        motion = SinePulse(amplitude=amplitude, period=period)
+    lin = simulate_stacked_linear(pair, motion, t_max=motion.duration + 1.0)
+    ref = simulate_stacked(pair, motion, rtol=1e-12, t_max=motion.duration + 1.0)
     assert not lin.overturned and not ref.overturned
     return lin, ref
 
@@ -98,7 +111,7 @@ def test_linearised_model_differs_from_the_nonlinear_by_alpha_squared(scene, reg
     halvings, for each body that rocks."""
     errors, rocks = [], None
     for scale in (0.125, 0.0625, 0.03125):
-        lin, ref = _peaks(scene, scale, 1.0)
+        lin, ref = _peaks(scene, scale)
         rocks = [ref.max_rotation_lower > 0.0, ref.max_rotation_upper > 0.0]
         assert [lin.max_rotation_lower > 0.0, lin.max_rotation_upper > 0.0] == rocks
         errors.append(
@@ -112,3 +125,17 @@ def test_linearised_model_differs_from_the_nonlinear_by_alpha_squared(scene, reg
     for k in range(2):
         if rocks[k]:
             assert np.all((orders[:, k] >= 1.7) & (orders[:, k] <= 2.3)), orders
+
+
+def test_input_errors_name_the_argument():
+    """A motion the exact solution does not cover (a Ricker wavelet, a vertical component)
+    and a bad t_max are refused by name."""
+    pair = StackedBlocks(Block(1.0, 0.2), Block(0.3, 0.25))
+    with pytest.raises(ValueError, match="motion"):
+        simulate_stacked_linear(pair, RickerWavelet(amplitude=3.0, period=0.5))
+    acc = np.r_[np.zeros(3), 3.0, np.zeros(3)]
+    with pytest.raises(ValueError, match="motion"):
+        simulate_stacked_linear(pair, Record(acc, dt=0.01, vertical=0.5 * acc))
+    for bad in (0.0, -1.0, np.nan):
+        with pytest.raises(ValueError, match="t_max"):
+            simulate_stacked_linear(pair, SinePulse(3.0, 0.5), t_max=bad)
