@@ -319,6 +319,20 @@ def _root(phase, row, offset, a, b, from_zero=False):
     return brentq(fun, a, b, xtol=1e-15, rtol=4.0 * np.finfo(float).eps, maxiter=200)
 
 
+def _dip(phase, rows, i, times, values):
+    """(a, b): the first grid interval where the impact function s angle (row i of an
+    "impact" event, its rate the "peak" row i + 2) is not negative at either end but dips
+    below zero inside (the rate changes sign there, at a time b where s angle < 0): an impact
+    a sign scan of the grid misses; None if there is none."""
+    angle, rate = values[i], values[i + 2]
+    turning = (rate[:-1] * rate[1:] < 0.0) & (angle[:-1] >= 0.0) & (angle[1:] > 0.0)
+    for j in np.flatnonzero(turning) + 1:
+        t = _root(phase, rows[i + 2], 0.0, times[j - 1], times[j])
+        if rows[i] @ phase.at(t) < 0.0:
+            return times[j - 1], t
+    return None
+
+
 def _first_event(phase, rows, offsets, kinds, times, values):
     """(time, kind) of the first terminal event on the grid, polished by :func:`_root`, or
     (t1, None)."""
@@ -327,10 +341,14 @@ def _first_event(phase, rows, offsets, kinds, times, values):
         if kind[0] == "peak":
             continue
         j = _crossing(values[i], kind[0])
-        if j is None or times[j - 1] > best[0]:
+        dip = _dip(phase, rows, i, times, values) if kind[0] == "impact" else None
+        if dip is not None and (j is None or dip[0] < times[j - 1]):
+            t = _root(phase, rows[i], 0.0, *dip)
+        elif j is None or times[j - 1] > best[0]:
             continue
-        from_zero = kind[0] == "impact" and j == 1 and rows[i] @ phase.z0 == 0.0
-        t = _root(phase, rows[i], offsets[i], times[j - 1], times[j], from_zero)
+        else:
+            from_zero = kind[0] == "impact" and j == 1 and rows[i] @ phase.z0 == 0.0
+            t = _root(phase, rows[i], offsets[i], times[j - 1], times[j], from_zero)
         if t < best[0] or best[1] is None:
             best = (t, kind) if t <= best[0] else best
     return best
