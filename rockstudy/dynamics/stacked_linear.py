@@ -304,15 +304,25 @@ def _crossing(values, name):
 def _root(phase, row, offset, a, b, from_zero=False):
     """The time in [a, b] where row @ z(t) = offset (Brent's method on the exact solution);
     a where the bracket holds no sign change (an event at the phase's start). With
-    ``from_zero`` (an angle leaving zero at a = t0), the root of (row @ z(t)) / (t - t0), its
-    next zero (a rebound shorter than a grid step)."""
-
-    def fun(t):
-        value = float(row @ phase.at(t)) - offset
-        return value / (t - phase.t0) if from_zero else value
-
+    ``from_zero`` (an angle leaving zero at a = t0, in the first grid step), the root of
+    (row @ z(t)) / (t - t0)^m, its next zero (a rebound shorter than a grid step), from the
+    series of the step with its m leading zero terms dropped (the angle, and its rate too
+    after an uplift from rest): no cancellation near t0."""
     if from_zero:
-        a = a + 1e-9 * (b - a)
+        coefficients = phase.series(0) @ row
+        leading = np.flatnonzero(coefficients)
+        if not leading.size:  # the angle stays at zero: no rebound to find
+            return a
+        coefficients = coefficients[leading[0] :]
+
+        def fun(t):
+            return float(np.polynomial.polynomial.polyval(t - phase.t0, coefficients))
+
+    else:
+
+        def fun(t):
+            return float(row @ phase.at(t)) - offset
+
     fa, fb = fun(a), fun(b)
     if fa == 0.0 or fa * fb > 0.0:
         return a
