@@ -27,7 +27,8 @@ system z' = Z z, z = (q_r, q_r', w), solved by the matrix exponential z(t) = e^{
 z_0: nothing is integrated. The grid step's e^{Z h} (h = 1/20 of the fastest time scale of Z)
 and z(t_i + tau) inside a step are their Taylor series summed to rounding
 (``scipy.linalg.expm`` where that would not converge). Events are roots of linear functions
-of z on this exact solution (bracketed on the grid, polished by Brent's method): impacts
+of z on this exact solution (bracketed on the grid, or at a turning point for an angle that
+dips through zero and back inside one step; polished by Brent's method): impacts
 (an angle through zero), uplifts (a lock margin through zero, the linearised
 :func:`.stacked.lock_margins`), peaks (a rate through zero) and the fall (an angle at pi/2).
 The impacts conserve the momenta about the new pivots at the pivot configuration
