@@ -329,15 +329,16 @@ def _log_peaks(scene, log, sol, names, t_end, sel):
                 log.missed += side * angle < -1e-12 * scene.alpha[k]
 
 
-def _act(scene, state, log, event):
-    """The event's consequence: an impact, an uplift, or a fall (the body's name)."""
+def _act(scene, state, log, event, at_pivots=False):
+    """The event's consequence: an impact (:func:`_impact`, ``at_pivots`` passed on), an
+    uplift, or a fall (the body's name)."""
     if event is None:
         return None
     kind, k, corner = event
     if kind == "uplift":
         state.flat[k], state.sides[k] = False, corner
     elif kind == "impact":
-        _impact(scene, state, log, k)
+        _impact(scene, state, log, k, at_pivots)
     else:
         if k == st.UPPER:
             return "upper"
@@ -375,20 +376,23 @@ def _consistent(flat, sides, closing, rates, margins, resting) -> bool:
     return True
 
 
-def _impact(scene, state, log, k):
+def _impact(scene, state, log, k, at_pivots=False):
     """An impact of interface k (and of the other if simultaneous): the first consistent
     post-impact regime of :func:`.stacked.impact_candidates`, its velocities conserving the
-    generalised momenta about the new pivots (:func:`.stacked.post_impact_velocity`)."""
+    generalised momenta about the new pivots (:func:`.stacked.post_impact_velocity`), taken
+    at the state's angles, or ``at_pivots`` at the pivot configuration q = 0 (the linearised
+    rule of :mod:`.stacked_linear`)."""
     geo, hits = scene.geo, _impacting(scene, state, k)
     (a1, a2), rates = state.angles()
     th1, phi = (0.0 if hits[st.LOWER] else a1), (0.0 if hits[st.UPPER] else a2)
     state.q = np.array([th1, th1 + phi])
-    v_before = st.body_velocities(geo, state.q, state.qd, *state.sides)
-    e_before = st.mechanical_energy(geo, state.q, state.qd, *state.sides)
+    q = np.zeros(2) if at_pivots else state.q
+    v_before = st.body_velocities(geo, q, state.qd, *state.sides)
+    e_before = st.mechanical_energy(geo, q, state.qd, *state.sides)
     slow = [abs(rates[i]) < scene.rest_speed[i] for i in (0, 1)]
     closing = [hits[i] or state.flat[i] for i in (0, 1)]
     for flat, s1, s2 in st.impact_candidates(state.flat, state.sides, hits, slow):
-        qd_r, margins = st.post_impact_velocity(geo, state.q, v_before, s1, s2, flat)
+        qd_r, margins = st.post_impact_velocity(geo, q, v_before, s1, s2, flat)
         qd = st.selection(flat) @ qd_r
         resting = [slow[i] and hits[i] for i in (0, 1)]
         if _consistent(flat, (s1, s2), closing, (qd[0], qd[1] - qd[0]), margins, resting):
@@ -399,7 +403,7 @@ def _impact(scene, state, log, k):
             f"{'ground' if k == st.LOWER else 'upper interface'})"
         )
     state.flat, state.sides, state.qd = list(flat), [s1, s2], qd
-    log.lost += e_before - st.mechanical_energy(geo, state.q, qd, s1, s2)
+    log.lost += e_before - st.mechanical_energy(geo, q, qd, s1, s2)
     log.impacts.append(state.t)
     log.interfaces.append("both" if all(hits) else ("lower", "upper")[k])
     log.row(state)
