@@ -665,6 +665,7 @@ measures.reserve_names(
         *STRUCTURE_VARIABLES,
         *_RUN,
         *_IDA,
+        *_ida_rocking_outputs("1"),
         *CONTACT_VARIABLES,
         *_STEPS,
         *OTHER_VARIABLES,
