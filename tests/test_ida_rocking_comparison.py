@@ -170,3 +170,11 @@ def test_a_contact_ida_study_says_the_comparison_needs_auto(tmp_path):
     assert "<h2>Contact model against the rocking-only model</h2>" in page
     assert html.escape('the rocking-only answer needs model = "auto"') in page
     assert not (tmp_path / "report" / "contact_vs_rocking.csv").exists()
+
+
+def test_the_rocking_twins_names_are_reserved_for_the_store():
+    from rockstudy.motions import measures
+    from rockstudy.study.designs import record_rows  # noqa: F401  (reserves the names)
+
+    with pytest.raises(ValueError, match="'capacity_rocking' is reserved"):
+        measures.register_measure("capacity_rocking", lambda r: 1.0, unit="1", power=1.0)
