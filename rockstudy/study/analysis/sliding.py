@@ -22,8 +22,9 @@ curve (:func:`~rockstudy.study.analysis.risk.object_risk`, with its bootstrap ba
 whole lognormal: a block slides below its uplift PGA, so the fragility is not cut there.
 
 Under ``model="auto"`` Housner's model runs first on every scene, and the design keeps its
-decision as ``overturned_rocking``: :func:`contact_effect` fits both and gives, per object,
-the ratio of the annual rates of overturning, contact model over rocking-only.
+decision as ``overturned_rocking``; an IDA climbs every ladder under Housner's model too and
+keeps ``capacity_rocking``: :func:`contact_effect` fits both and gives, per object, the ratio
+of the annual rates of overturning, contact model over rocking-only.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from ..designs.records import IDA_ROCKING_VARIABLES
 from ..spec.design_kinds import kind_of
 from . import record_fragility as rf
 from .risk import object_risk
@@ -119,17 +121,33 @@ def limit_design(ds: xr.Dataset, d: float) -> xr.Dataset:
 
 
 def rocking_design(ds: xr.Dataset) -> xr.Dataset:
-    """The design ``ds`` with the outcome of Housner's rocking-only model
-    (``overturned_rocking``, kept by ``model="auto"``) as its ``overturned``."""
-    if "overturned_rocking" not in ds:
+    """The design ``ds`` with the outcome of Housner's rocking-only model as its own, both
+    kept by ``model="auto"``: ``overturned_rocking`` as ``overturned`` (stripes and clouds);
+    for an IDA ``capacity_rocking``, ``capacity_scale_rocking``,
+    ``capacity_scale_lower_rocking``, ``censored_rocking`` and ``status_rocking`` as
+    ``capacity``, ``capacity_scale`` ... (Housner's ladder)."""
+    ida = kind_of(ds).capacities
+    needed = "capacity_rocking" if ida else "overturned_rocking"
+    if needed not in ds:
         raise ValueError(
-            "ds: holds no overturned_rocking (Housner's decision of each scene): the "
-            "rocking-only answer needs a cloud or stripes run with model='auto' (a study's "
-            '[run] model = "auto"), which runs Housner\'s model on every scene first'
+            f"ds: holds no {needed} (Housner's answer): the rocking-only answer needs "
+            "model='auto' (a study's [run] model = \"auto\"), which runs Housner's model "
+            + ("on every ladder too" if ida else "on every scene first")
         )
     view = ds.copy()
-    view["overturned"] = ds["overturned_rocking"]
+    names = ("capacity", *IDA_ROCKING_VARIABLES) if ida else ("overturned",)
+    for name in names:
+        view[name] = ds[f"{name}_rocking"]
     return view
+
+
+def _n_overturned(design) -> xr.DataArray:
+    """Per structure, the points (records of an IDA) that ran and overturned."""
+    if kind_of(design).capacities:
+        over = design["censored"] == 0
+    else:
+        over = design["overturned"] == 1
+    return over.where(design["status"] == 0, False).sum([k for k in over.dims if k != "structure"])
 
 
 def slide_fragility(
@@ -204,7 +222,9 @@ def _crossed(rate: xr.DataArray) -> xr.DataArray:
 def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Dataset:
     """Per object: the annual rate of overturning under the contact model (the design's
     answer) and under Housner's rocking-only model (``overturned_rocking`` of
-    ``model="auto"``), and their ratio.
+    ``model="auto"``; an IDA's ``capacity_rocking``, its ladder under Housner's model), and
+    their ratio: each through :func:`~rockstudy.study.analysis.risk.object_risk`, the
+    design's own fitter and integral.
 
     Returns
     -------
@@ -212,8 +232,9 @@ def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Data
         On ``structure`` (the design's order): ``annual_rate`` and ``status`` of each model
         (``annual_rate_contact``, ``annual_rate_rocking``, ``status_contact``,
         ``status_rocking``), the overturning points of each (``n_overturned_contact``,
-        ``n_overturned_rocking``), and ``ratio`` = contact / rocking (NaN where either rate
-        is not estimable; inf where only the rocking one is 0).
+        ``n_overturned_rocking``; of an IDA the records under which it overturned), and
+        ``ratio`` = contact / rocking (NaN where either rate is not estimable; inf where only
+        the rocking one is 0).
     """
     order = ds["structure"].values
     rock = rocking_design(ds)
@@ -222,10 +243,7 @@ def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Data
         risk = object_risk(design, hazard, years, **kw).sel(structure=order)
         out[f"annual_rate_{name}"] = risk["annual_rate"]
         out[f"status_{name}"] = risk["status"]
-        over = design["overturned"] == 1
-        out[f"n_overturned_{name}"] = over.where(design["status"] == 0, False).sum(
-            [k for k in over.dims if k != "structure"]
-        )
+        out[f"n_overturned_{name}"] = _n_overturned(design)
     with np.errstate(divide="ignore", invalid="ignore"):
         out["ratio"] = out["annual_rate_contact"] / out["annual_rate_rocking"]
     out.attrs.update(im=hazard.im, units=hazard.units, years=float(years))

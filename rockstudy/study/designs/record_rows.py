@@ -315,6 +315,8 @@ def _ida_contact_outputs(study, unit) -> dict:
     for name, step in zip(rd.MODEL_KEYS, rd.STEP_MODEL_VARIABLES, strict=True):
         o = _outputs.OUTPUTS[name]
         out[step] = (f"{o.long_name}, at each simulated point", o.units, "f8", np.nan, "step")
+    if study.run.model == "auto":  # Housner's ladder too (rd._ida_rocking)
+        out.update(_ida_rocking_outputs(unit))
     if _slide_limits(study):
         out["slide_capacity"] = (
             "first intensity at which max_slide exceeds slide_limit (NaN: not below the "
@@ -331,6 +333,23 @@ def _ida_contact_outputs(study, unit) -> dict:
             np.nan,
             "slide_limit",
         )
+    return out
+
+
+def _ida_rocking_outputs(unit) -> dict:
+    """The rocking-only twins an IDA keeps under ``model="auto"`` (``unit``: that of
+    ``capacity``)."""
+    out = {}
+    for name in ("capacity", *rd.IDA_ROCKING_VARIABLES, "simulations"):
+        long_name, units, dtype, fill = _IDA.get(name) or (
+            "0 ok; 1 a simulation hit the step limit",
+            "1",
+            "i8",
+            -1,
+        )
+        units = unit if name == "capacity" else units
+        twin = (f"{long_name}, under Housner's rocking-only model", units, dtype, fill, None)
+        out[f"{name}_rocking"] = twin
     return out
 
 
@@ -497,11 +516,10 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         attrs.update(im=t["im"], im_period=np.nan if t["period"] is None else t["period"])
     if kind.capacities:
         attrs.update(rd.IdaOptions.given(de).attrs())
-        attrs["n_simulations"] = int(
-            np.nansum(np.where(ds["simulations"] >= 0, ds["simulations"], 0))
-        )
-        for k in _BOOLS:  # as the API: bool (a failed row: False,
-            ds[k] = ds[k] == 1  # with run_status 2 and NaN capacity)
+        sims = [ds[k] for k in ("simulations", "simulations_rocking") if k in ds]
+        attrs["n_simulations"] = int(sum(np.nansum(np.where(v >= 0, v, 0)) for v in sims))
+        for k in _BOOLS + ("censored_rocking",) * ("censored_rocking" in ds):
+            ds[k] = ds[k] == 1  # as the API: bool (a failed row: False, NaN capacity)
         used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
         ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
     else:  # as the API: bool, and the points not run are not simulations
@@ -647,6 +665,7 @@ measures.reserve_names(
         *STRUCTURE_VARIABLES,
         *_RUN,
         *_IDA,
+        *_ida_rocking_outputs("1"),
         *CONTACT_VARIABLES,
         *_STEPS,
         *OTHER_VARIABLES,

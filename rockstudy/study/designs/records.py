@@ -689,7 +689,12 @@ def incremental_dynamic_analysis(
         ``model``), with the same ladder, bisection and guarantee; the lowest rung is then
         the scale below which the block neither lifts nor slips (abs(u_h'') below
         (g + u_v'') min(alpha, mu_s) everywhere), and every point keeps the contact
-        model's outputs (``step_model``, ``step_max_slide``, ...).
+        model's outputs (``step_model``, ``step_max_slide``, ...). "auto" also climbs
+        every ladder under Housner's model (the same ladder, bisection and scan; the rocking
+        kernel, cheap beside the contact model) and keeps its answer: ``capacity_rocking``
+        (as ``capacity``), ``capacity_scale_rocking``, ``capacity_scale_lower_rocking``,
+        ``censored_rocking``, ``status_rocking`` and ``simulations_rocking``, the
+        rocking-only answer of :func:`rockstudy.study.analysis.sliding.contact_effect`.
     slide_limits : sequence of float
         Slides d [m] (> 0, increasing; under the contact model only): ``slide_capacity``,
         the first scale at which ``max_slide`` > d (see :func:`.ida_slides.slide_scales`).
@@ -730,14 +735,11 @@ def incremental_dynamic_analysis(
         ds["friction_demand"], ds["lift_off"] = _ida_contact(
             records, st, ds, method, rtol, max_steps
         )
-    ds["capacity"] = (
-        ("record", "structure"),
-        np.where(ds["censored"], np.nan, measure * ds["capacity_scale"] ** _ms.power(im)),
-        {
-            "units": "1" if im in _ms.RATIOS else _ms.MEASURES[im].unit,
-            "long_name": f"overturning {im} (first overturning level)",
-        },
-    )
+    ds["capacity"] = _capacity(ds["capacity_scale"], ds["censored"], measure, im)
+    if model is not None and model[0] == "auto":
+        housner = (options, method, rtol, max_steps, None, NO_LIMITS)
+        rocking = [_ida_record(r, st, *housner) for r in records]
+        ds = _ida_rocking(ds, rocking, measure, im)
     if limits.size:
         ds = ida_slides.slide_tables(ds, results, limits, measure, _ms.power(im))
     ds["censored_reason"].attrs.update(cf_flags(CENSORED_REASONS))
@@ -746,8 +748,48 @@ def incremental_dynamic_analysis(
         **options.attrs(),
         method=method,
         rtol=rtol,
-        n_simulations=int(ds["simulations"].sum()),
+        n_simulations=sum(
+            int(ds[k].sum()) for k in ("simulations", "simulations_rocking") if k in ds
+        ),
     )
+    return ds
+
+
+def _capacity(scale, censored, measure, im) -> tuple:
+    """The ``capacity`` variable: the capacity scales ``scale`` (record, structure) in the
+    measure ``im`` of each record (``measure``), NaN where ``censored``."""
+    return (
+        ("record", "structure"),
+        np.where(censored, np.nan, measure * scale ** _ms.power(im)),
+        {
+            "units": "1" if im in _ms.RATIOS else _ms.MEASURES[im].unit,
+            "long_name": f"overturning {im} (first overturning level)",
+        },
+    )
+
+
+#: No slide limits: Housner's ladder of an IDA under ``model="auto"`` has no slide capacities.
+NO_LIMITS = np.empty(0)
+#: The variables of an IDA kept under ``model="auto"`` for Housner's rocking-only ladder as
+#: ``<name>_rocking`` (besides ``capacity_rocking``).
+IDA_ROCKING_VARIABLES = ("capacity_scale", "capacity_scale_lower", "censored", "status")
+
+
+def _ida_rocking(ds, results, measure, im):
+    """``ds`` with the rocking-only twins of its capacities: the per-record results of
+    :func:`_ida_record` under Housner's model (the same ladder, bisection and scan) as
+    ``capacity_rocking``, ``<name>_rocking`` for :data:`IDA_ROCKING_VARIABLES` and
+    ``simulations_rocking``."""
+    dims = ("record", "structure")
+    table = {k: np.array([res[k] for res in results]) for k in _IDA_FLOATS + _IDA_INTS}
+    censored = table["censored_reason"] > 0
+    for k in IDA_ROCKING_VARIABLES[:2]:
+        ds[f"{k}_rocking"] = (dims, table[k].astype(float))
+    ds["censored_rocking"] = (dims, censored)
+    ds["status_rocking"] = (dims, table["status"].astype(np.int64))
+    ds["simulations_rocking"] = (dims, table["simulations"].astype(np.int64))
+    ds["capacity_rocking"] = _capacity(ds["capacity_scale_rocking"], censored, measure, im)
+    ds["capacity_rocking"].attrs["long_name"] += " under Housner's rocking-only model"
     return ds
 
 

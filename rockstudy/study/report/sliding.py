@@ -32,8 +32,9 @@ def _limits(ctx):
 
 
 def _contact(ctx) -> bool:
-    """Whether the design ran the contact model (it stores the slide of its points)."""
-    return "max_slide" in ctx.ds or "slide_capacity" in ctx.ds
+    """Whether the design ran the contact model (it stores the slide of its points, or of
+    each point of an IDA curve)."""
+    return bool({"max_slide", "slide_capacity", "step_max_slide"} & set(ctx.ds.variables))
 
 
 def section(page, ctx):
@@ -172,13 +173,14 @@ def contact_section(page, ctx):
     if not (_contact(ctx) and ctx.objects):
         return
     page.heading("Contact model against the rocking-only model")
-    if ctx.kind.capacities:
+    if ctx.kind.capacities and "capacity_rocking" not in ctx.ds:
         page.text(
-            "An IDA's ladder runs one model: the rocking-only comparison needs a cloud or "
-            'stripes design under model = "auto".'
+            'An IDA\'s ladder runs one model unless the design runs under model = "auto": '
+            'the rocking-only answer needs model = "auto", which also climbs every ladder '
+            "under Housner's model and keeps its capacities (capacity_rocking)."
         )
         return
-    if "overturned_rocking" not in ctx.ds:
+    if not ctx.kind.capacities and "overturned_rocking" not in ctx.ds:
         page.text(
             'This design ran the contact model on every scene (model = "contact"): the '
             'rocking-only answer needs model = "auto", which runs Housner\'s model on every '
@@ -205,11 +207,12 @@ def contact_section(page, ctx):
         ]
     ]
     frame.index = pd.Index([str(v) for v in frame.index], name="object")
+    counted = "records" if ctx.kind.capacities else "points"
     page.table(
         frame.rename(
             columns={
-                "n_overturned_rocking": "points overturned, rocking-only",
-                "n_overturned_contact": "points overturned, contact model",
+                "n_overturned_rocking": f"{counted} overturned, rocking-only",
+                "n_overturned_contact": f"{counted} overturned, contact model",
                 "annual_rate_rocking": "lambda_OT rocking-only [1/yr]",
                 "annual_rate_contact": "lambda_OT contact model [1/yr]",
                 "ratio": "ratio contact / rocking-only",
@@ -220,7 +223,8 @@ def contact_section(page, ctx):
         "contact_vs_rocking",
         "How much the contact model changed each object's annual rate of overturning: "
         "Housner's rocking-only model (its decision on every scene, which model 'auto' runs "
-        "first) against the contact model's, each fitted and integrated the same way (point "
+        "first; of an IDA, its ladder climbed again under Housner's model) against the "
+        "contact model's, each fitted and integrated the same way (point "
         "estimates); a ratio below 1: sliding spared the object, above 1: slip or flight "
         "toppled it where rocking alone would not",
     )
