@@ -329,7 +329,8 @@ def test_the_scaling_power_is_the_measures_own():
     from rockstudy.motions.measures import MEASURES
 
     t = np.arange(0, 4.0, 0.01)
-    rec = Record(np.sin(2 * np.pi * t) * np.exp(-0.3 * t), dt=0.01, name="x")
+    y = 0.7 * np.cos(3 * np.pi * t) * np.exp(-0.5 * t)  # a second component for the RotD ones
+    rec = Record(np.sin(2 * np.pi * t) * np.exp(-0.3 * t), acceleration_y=y, dt=0.01, name="x")
     for k, m in MEASURES.items():
         p = m.power
         period = 0.5 if m.needs_period else None

@@ -254,7 +254,7 @@ def _pair_by_name(files, rules):
         for (pattern, replacement), _ in rules.values():
             if pattern.search(h.name):
                 named.add(h.with_name(pattern.sub(replacement, h.name)).resolve())
-    out = []
+    out, named_here = [], []
     for entry in files:
         h = entry[0]
         if h.resolve() in named:
@@ -268,8 +268,10 @@ def _pair_by_name(files, rules):
                     f"record's {_SLOTS[slot]}; every file must be one or the other"
                 )
             entry[slot] = h.with_name(pattern.sub(replacement, h.name))
-            _refuse_missing(entry[slot], h, field, _SLOTS[slot])
+            named_here.append((entry[slot], h, field, _SLOTS[slot]))
         out.append(entry)
+    for found in named_here:  # a file that matches no rule is named first, then one missing
+        _refuse_missing(*found)
     return out
 
 
