@@ -2,7 +2,8 @@
 
 ``python bit_identity.py dump OUT.npz`` computes them with the rockstudy on the path;
 ``python bit_identity.py compare A.npz B.npz`` compares every array of A with B's
-(np.array_equal, NaN equal) and prints the count; arrays new in B (an added output) are listed. Run ``dump`` once per tree (PYTHONPATH=tree), then ``compare``.
+(np.array_equal, NaN equal) and prints the count; arrays new in B (an added output) are
+listed. Run ``dump`` once per tree (PYTHONPATH=tree), then ``compare``.
 """
 
 from __future__ import annotations

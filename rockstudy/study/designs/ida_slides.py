@@ -51,6 +51,7 @@ def slide_scales(points, ladders, done, limits, tolerance, climb) -> np.ndarray:
     ``ladders`` the rungs of each structure, of which the first ``done`` were simulated
     (raised in place by the rungs this climb adds); ``climb`` the ladder climb of
     :func:`.records._climb`."""
+    limits = np.asarray(limits, dtype=float)
     out = np.full((limits.size, len(ladders)), np.nan)
     if not limits.size:
         return out

@@ -169,11 +169,15 @@ def _batch_calls_of(methods):
 
 def _record_measure_calls():
     """Intensity measures, spectrum and pulse of a record (studies store them per record),
-    and a floor motion (a study on a floor replaces each record by one)."""
-    from ...motions import Building, floor_motion, synthetic_near_fault
+    a floor motion (a study on a floor replaces each record by one), and the RotD measures
+    of a pair of components."""
+    from ...motions import Building, Record, floor_motion, synthetic_near_fault
 
     record = synthetic_near_fault(pulse_period=1.0, pga=3.0, seed=0, duration=4.0)
     floor_motion(record, Building.uniform_shear(2, 0.5, 0.05), 1)
+    pair = Record(record.acceleration, acceleration_y=record.acceleration[::-1], dt=record.dt)
+    pair.intensity_measure("sa_rotd50", period=0.5)
+    pair.intensity_measure("pga_rotd100")
     record.intensity_measures(periods=[0.5, 1.0])
     record.response_spectrum([0.5, 1.0])
     record.pulse()
