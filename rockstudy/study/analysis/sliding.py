@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from ...dynamics.batch import MODEL_CONTACT
 from ..designs.records import IDA_ROCKING_VARIABLES
 from ..spec.design_kinds import kind_of
 from . import record_fragility as rf
@@ -122,7 +123,9 @@ def limit_design(ds: xr.Dataset, d: float) -> xr.Dataset:
 
 def rocking_design(ds: xr.Dataset) -> xr.Dataset:
     """The design ``ds`` with the outcome of Housner's rocking-only model as its own, both
-    kept by ``model="auto"``: ``overturned_rocking`` as ``overturned`` (stripes and clouds);
+    kept by ``model="auto"``: ``overturned_rocking`` as ``overturned`` (stripes and clouds;
+    its -1, Housner's model failed, as ``status`` 1, and a point only the contact model
+    failed on as ``status`` 0);
     for an IDA ``capacity_rocking``, ``capacity_scale_rocking``,
     ``capacity_scale_lower_rocking``, ``censored_rocking`` and ``status_rocking`` as
     ``capacity``, ``capacity_scale`` ... (Housner's ladder)."""
@@ -135,8 +138,13 @@ def rocking_design(ds: xr.Dataset) -> xr.Dataset:
             + ("on every ladder too" if ida else "on every scene first")
         )
     view = ds.copy()
-    names = ("capacity", *IDA_ROCKING_VARIABLES) if ida else ("overturned",)
-    for name in names:
+    if not ida:  # -1: Housner's model failed there; the contact model's failures are not its
+        rocking = ds["overturned_rocking"]
+        answered = ds["model"] >= MODEL_CONTACT if "model" in ds else False
+        view["status"] = xr.where(rocking < 0, 1, xr.where(answered, 0, ds["status"]))
+        view["overturned"] = rocking.clip(min=0).astype(ds["overturned"].dtype)
+        return view
+    for name in ("capacity", *IDA_ROCKING_VARIABLES):
         view[name] = ds[f"{name}_rocking"]
     return view
 

@@ -370,14 +370,18 @@ def _keys(contact, model):
 
 
 def _rocking_decision(record, st, idx, scales, method, rtol, max_steps, run):
-    """Housner's ``overturned`` of each point of an ``"auto"`` run ``run``: its own where
-    Housner's model answered, Housner's model run again on the points the contact model
-    answered (``model`` 3; the rocking kernel: a small cost beside the contact model's)."""
-    decision = np.asarray(run["overturned"], bool).copy()
-    again = np.flatnonzero(run["model"] == MODEL_CONTACT)
+    """Housner's ``overturned`` of each point of an ``"auto"`` run ``run`` (int8, -1 where
+    Housner's model failed: its status not 0): its own where Housner's model answered,
+    Housner's model run again on the points the contact model answered (``model`` 3, or 4
+    by its reference; the rocking kernel: a small cost beside the contact model's)."""
+    decision = np.asarray(run["overturned"], np.int8).copy()
+    answered = np.asarray(run["model"]) >= MODEL_CONTACT
+    decision[~answered & (np.asarray(run["status"]) != 0)] = -1
+    again = np.flatnonzero(answered)
     if again.size:
-        out = _run(record, st, idx[again], scales[again], method, rtol, max_steps, ("overturned",))
-        decision[again] = out["overturned"]
+        wanted = ("overturned", "status")
+        out = _run(record, st, idx[again], scales[again], method, rtol, max_steps, wanted)
+        decision[again] = np.where(out["status"] != 0, -1, out["overturned"])
     return decision
 
 
@@ -412,7 +416,7 @@ def _run_below_free_fall(
         entry = _outputs.OUTPUTS[name]
         out[name] = np.full(scales.size, entry.fill, entry.store_dtype)
     if ROCKING_KEYS[0] in keys:
-        out[ROCKING_KEYS[0]] = np.zeros(scales.size, bool)
+        out[ROCKING_KEYS[0]] = np.zeros(scales.size, np.int8)
     if ok.any():
         wanted = None
         if contact or model is not None:
@@ -987,8 +991,8 @@ def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits
         hi[active[over]] = s[over]
         lo[active[~over]] = s[~over]
     _scan(points, ladders, done, found, options.scan)
-    slides = ida_slides.slide_scales(points, ladders, done, limits, options.tolerance, _climb)
     band = [_switch_band(h, c) for h, c in zip(points.history, hi, strict=True)]
+    slides = ida_slides.slide_scales(points, ladders, done, limits, options.tolerance, _climb)
     reason = np.where(found, 0, np.where(top < ceiling, 1, 2))
     return {
         "capacity_scale": np.where(found, hi, np.nan),
