@@ -18,10 +18,19 @@ from ..motions import _kernels as mk
 from ..motions.pulses import MAX_CYCLES, PERIOD_RANGE, PULSES, pulse_kernel_rows
 from ..structures.block import FREQUENCY_PARAMETER_RANGE, HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
 from . import _auto, _linear, _linear_record, _rocking, conditioning, contact_model, outputs
+from ._batch_io import (
+    CONDITIONING_OUTPUTS,
+    CONTACT_OUTPUTS,
+    OUTPUTS,
+    SLIDE_OUTPUTS,
+    batch_dataset,
+    requested_outputs,
+)
 from ._oriented import with_orientation
 from ._vertical import refuse_free_fall, uplift_ratio
 from .methods import MAX_STEPS, STATUS_STEP_LIMIT, method_for
 from .simulate import MAX_FRICTION
+from .two_body_batch import two_body_batch
 
 __all__ = ["CONDITIONING_OUTPUTS", "CONTACT_OUTPUTS", "OUTPUTS", "PulseName", "simulate_batch"]
 
@@ -40,17 +49,6 @@ _CODES = {
     _rocking.MODEL_LINEAR: _auto.MODEL_LINEAR,
 }
 
-#: The outputs returned by default (:data:`.outputs.OUTPUTS`: the kernels' and the model).
-OUTPUTS = outputs.names("kernel", "batch")
-#: Outputs returned only when ``outputs`` names them (the rocking kernel computes them on the
-#: way; the rows it leaves out are run again with a history: see :mod:`._batch_contact`).
-CONTACT_OUTPUTS = outputs.names("contact")
-#: Returned only when ``outputs`` names it: every row is run again with its amplitude times
-#: 1 + 1e-9 (:mod:`.conditioning`), which doubles the cost.
-CONDITIONING_OUTPUTS = outputs.names("conditioning")
-#: Returned by default with ``model="contact"`` or ``"auto"`` (and only then): the slip and
-#: the regimes, by the contact model (:func:`.contact_model.contact_outputs`).
-SLIDE_OUTPUTS = outputs.names("contact_model")
 # (trig-only, one thread) -> batch kernel: on one thread (a study's workers) the serial
 # variants, which compile without the parallel loop's cost
 _BATCH_KERNELS = {
@@ -220,6 +218,7 @@ def simulate_batch(
     as_dataset: bool = False,
     friction=None,
     model: Literal["rocking", "contact", "auto"] = "rocking",
+    structure=None,
 ):
     """Rock many blocks through many pulses (or scaled copies of one record) in one call.
 
@@ -328,6 +327,10 @@ def simulate_batch(
     orientation : float or array_like, optional
         The angle psi [rad] of each row's rocking plane, as :func:`rockstudy.simulate`'s (rows
         grouped by angle, a batch each; a dataset gains the ``orientation`` coordinate).
+    structure : StackedBlocks or IsolatedBlock, or a sequence of one of them, optional
+        A two-body system (one, or one per row) instead of the block columns (refused beside
+        it): its outputs are those :func:`rockstudy.simulate` names for it
+        (:mod:`.two_body_batch`).
 
     Returns
     -------
@@ -344,8 +347,10 @@ def simulate_batch(
         reference where its kernel reached the step limit: what each row ran); only those of
         ``outputs`` (and ``status``) if given.
     """
+    if structure is not None:  # a two-body system: its own rows, from these arguments
+        return two_body_batch(dict(locals()))
     _check_model(model, friction, method)
-    wanted = _requested_outputs(outputs, model, friction is not None)
+    wanted = requested_outputs(outputs, model, friction is not None)
     method_for(
         method,
         batch=True,
@@ -369,11 +374,9 @@ def simulate_batch(
     )
     mu = None if friction is None else _friction_columns(friction, n)
     R, p, alpha, eta = _blocks(half_diagonal, frequency_parameter, theta_cr, restitution, n)
-    kind, mp, times, samples, vsamples = _motions(
-        pulse, record, scale, amplitude, period, cycles, n
-    )
-    p = np.ascontiguousarray(p, dtype=float)
-    eta = np.ascontiguousarray(eta, dtype=float)
+    motion_rows = _motions(pulse, record, scale, amplitude, period, cycles, n)
+    kind, mp, times, samples, vsamples = motion_rows
+    p, eta = (np.ascontiguousarray(x, dtype=float) for x in (p, eta))
     rows = (p, alpha, eta, kind, mp, times, samples, vsamples)
     linear_ok = set(wanted) <= set(_auto.COVERED_OUTPUTS + _auto.BOOKKEEPING_OUTPUTS)
 
@@ -404,7 +407,7 @@ def simulate_batch(
     inputs.update({} if mu is None else {"friction_static": mu[0], "friction_kinetic": mu[1]})
     inputs.update(_motion_inputs(record, mp, amplitude, period, cycles, n))
     source = "record" if record is not None else f"{pulse} pulse"
-    return _as_dataset(result, inputs, method, rtol, source)
+    return batch_dataset(result, inputs, method, rtol, source)
 
 
 def _contact_only(wanted, model) -> bool:
@@ -577,65 +580,6 @@ def _conditioning(out, out_perturbed):
     )
     ok = (out["status"] == 0) & (out_perturbed["status"] == 0)
     return np.where(ok, change, np.nan)
-
-
-#: long name and CF units of the inputs and outputs of :func:`simulate_batch`
-_BATCH_UNITS = {
-    **{o.name: (o.long_name, o.units) for o in outputs.OUTPUTS.values()},
-    "half_diagonal": ("half-diagonal R", "m"),
-    "frequency_parameter": ("frequency parameter p", "rad s-1"),
-    "slenderness": ("slenderness alpha", "rad"),
-    "critical_rotation": ("critical rotation theta_cr", "rad"),
-    "restitution": ("coefficient of restitution eta", "1"),
-    "amplitude": ("pulse amplitude a_g", "m s-2"),
-    "period": ("pulse period T_p", "s"),
-    "cycles": ("pulse cycles", "1"),
-    "scale": ("factor on the record", "1"),
-    "friction_static": ("static friction coefficient mu_s", "1"),
-    "friction_kinetic": ("kinetic friction coefficient mu_k", "1"),
-}
-
-
-def _as_dataset(result, inputs, method, rtol, motion):
-    """The outputs of :func:`simulate_batch` with its inputs as ``scene`` coordinates."""
-    import xarray as xr
-
-    def var(name, values):
-        long_name, units = _BATCH_UNITS.get(name, (name, "1"))
-        return ("scene", np.asarray(values), {"long_name": long_name, "units": units})
-
-    return xr.Dataset(
-        {k: var(k, v) for k, v in result.items()},
-        coords={k: var(k, v) for k, v in inputs.items()},
-        attrs={"method": method, "rtol": rtol, "motion": motion},
-    )
-
-
-def _requested_outputs(outputs, model="rocking", friction=False):
-    """The output names to return, in the order of :data:`OUTPUTS`, ``status`` included: by
-    default :data:`OUTPUTS`, with ``friction`` the friction check (:data:`CONTACT_OUTPUTS`;
-    under ``model="contact"`` its ``lift_off`` only: the demand needs Housner's model run
-    with a history), and under the contact model :data:`SLIDE_OUTPUTS`."""
-    allowed = OUTPUTS + CONTACT_OUTPUTS + SLIDE_OUTPUTS + CONDITIONING_OUTPUTS
-    if outputs is None:
-        check = ("lift_off",) if model == "contact" else CONTACT_OUTPUTS
-        slides = SLIDE_OUTPUTS if model != "rocking" else ()
-        names = OUTPUTS + (check if friction else ()) + slides
-    else:
-        names = [outputs] if isinstance(outputs, str) else list(outputs)
-    unknown = sorted(set(names) - set(allowed))
-    if unknown:
-        raise ValueError(f"outputs: unknown name(s) {unknown}; allowed: {list(allowed)}")
-    if model == "rocking" and set(names) & set(SLIDE_OUTPUTS):
-        raise ValueError(
-            f"outputs: {sorted(set(names) & set(SLIDE_OUTPUTS))} come from the contact model: "
-            "give friction= and model='contact' or 'auto'"
-        )
-    if model != "rocking" and "conditioning" in names:
-        raise ValueError(
-            f"outputs: conditioning is computed for Housner's model only, not model={model!r}"
-        )
-    return tuple(name for name in allowed if name in names or name == "status")
 
 
 def _run(rows, idx, model, rtol, max_steps, demand=False):
