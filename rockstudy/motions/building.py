@@ -27,7 +27,7 @@ from . import intensity
 from ._spectrum import _advance, step_coefficients
 from .records import Record
 
-__all__ = ["Building", "MAX_STOREYS", "floor_motion"]
+__all__ = ["Building", "MAX_STOREYS", "floor_motion", "ground_record", "with_ground"]
 
 #: Most storeys of :meth:`Building.uniform_shear` (and floors of a modal building).
 MAX_STOREYS = 1000
@@ -209,11 +209,13 @@ def floor_motion(record: Record, building: Building, floor: int) -> Record:
     Record
         u_g'' + sum_j Gamma_j phi_j(floor) q_j'' on the record's own samples, exact for the
         linearly interpolated record, named ``"<name> (floor k)"``, with ``metadata``
-        ``building`` and ``floor`` (over the record's own). A vertical component is kept
-        as it is: the building is taken as rigid vertically. A second horizontal component
-        (``acceleration_y``) is filtered by the same modes (a building whose modes are the
-        same in both directions); for other modes along y, give each direction its own
-        building: ``floor_motion(record.oriented(psi), building_psi, floor)``.
+        ``building``, ``floor`` and ``ground`` (the ground record itself: the record whose
+        intensity measures a design reports, :func:`ground_record`), over the record's own.
+        A vertical component is kept as it is: the building is taken as rigid vertically.
+        A second horizontal component (``acceleration_y``) is filtered by the same modes (a
+        building whose modes are the same in both directions); for other modes along y,
+        give each direction its own building:
+        ``floor_motion(record.oriented(psi), building_psi, floor)``.
 
     Raises
     ------
@@ -242,6 +244,26 @@ def floor_motion(record: Record, building: Building, floor: int) -> Record:
         time=record.time,
         name=f"{record.name} (floor {floor})",
         vertical=record.vertical,
-        metadata={**record.metadata, "building": building, "floor": floor},
+        metadata={**record.metadata, "building": building, "floor": floor, "ground": record},
         acceleration_y=None if record.acceleration_y is None else at_floor(record.acceleration_y),
     )
+
+
+def ground_record(record: Record) -> Record:
+    """The ground record of a motion: ``metadata["ground"]`` of a floor motion
+    (:func:`floor_motion`, :func:`with_ground`), else the record itself.
+
+    A building is linear, so scaling the ground record by s scales its floor motions by s: a
+    design on floor motions can scale, measure and report intensities in the ground record's
+    measures (those of the site's hazard curve) while the object feels the floor motion.
+    """
+    ground = record.metadata.get("ground")
+    return ground if isinstance(ground, Record) else record
+
+
+def with_ground(motion: Record, ground: Record) -> Record:
+    """``motion`` (a floor motion, or a component of a pair: :meth:`Record.oriented`) with
+    ``ground`` as its ground record (``metadata["ground"]``; see :func:`ground_record`)."""
+    if not isinstance(ground, Record):
+        raise TypeError(f"ground must be a Record, got {type(ground).__name__}")
+    return motion._replace(metadata={**motion.metadata, "ground": ground})

@@ -192,7 +192,7 @@ class Record(Motion):
 
         Both horizontal components are multiplied by ``factor``; a vertical component by
         ``|factor|``: mirroring the horizontal directions does not turn the vertical upside
-        down.
+        down. The ground record of a floor motion (``metadata["ground"]``) is scaled too.
         """
         factor = _validate.number("factor", factor)
         if not math.isfinite(factor):
@@ -201,8 +201,13 @@ class Record(Motion):
             acc = self.acceleration * factor
             vertical = None if self.vertical is None else self.vertical * abs(factor)
             y = None if self.acceleration_y is None else self.acceleration_y * factor
+        metadata = self.metadata
+        if isinstance(metadata.get("ground"), Record):  # a floor motion's ground scales with it
+            metadata = {**metadata, "ground": metadata["ground"].scaled(factor)}
         try:
-            return self._replace(acceleration=acc, vertical=vertical, acceleration_y=y)
+            return self._replace(
+                acceleration=acc, vertical=vertical, acceleration_y=y, metadata=metadata
+            )
         except ValueError as exc:
             raise ValueError(f"factor = {factor:g} on the record {self.name!r}: {exc}") from None
 

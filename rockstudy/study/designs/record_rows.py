@@ -28,21 +28,25 @@ import xarray as xr
 from ..._warnings import UpliftWarning
 from ...dynamics import outputs as _outputs
 from ...motions import measures
+from ...motions.building import with_ground
 from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
 from ..spec.design_kinds import design_kind
-from ..spec.feasibility import record_pairs
+from ..spec.feasibility import record_pairs, second_file
 from . import records as rd
 
 __all__ = [
     "CONTACT_VARIABLES",
     "design_dataset",
+    "design_motion",
     "design_rows",
     "empty_rows",
     "evaluate_rows",
     "GROUP_VARIABLES",
     "ida_steps",
     "load_record",
+    "motion_axes",
+    "motion_coords",
     "outputs",
     "PULSE_VARIABLES",
     "record_variables",
@@ -50,6 +54,7 @@ __all__ = [
     "sample_outputs",
     "scale_factors",
     "stored_periods",
+    "suite_records",
     "STRUCTURE_VARIABLES",
     "uplift_column",
 ]
@@ -238,8 +243,10 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     ``structures`` holds the sampler's structure columns (``sampler.n`` of each). The record
     files (named in the attribute ``record_files``) are listed, not read.
     """
-    pairs = record_pairs(study.motion, base_dir)
-    n_rec, n_st, n_lev = len(pairs), len(structures["critical_rotation"]), study.levels()
+    pairs = suite_records(study.motion, base_dir)
+    floors, angles = motion_axes(study)
+    n_motions = len(pairs) * len(floors) * (1 if angles is None else angles.size)
+    n_rec, n_st, n_lev = n_motions, len(structures["critical_rotation"]), study.levels()
     rec, st, lev = (a.ravel() for a in np.indices((n_rec, n_st, n_lev)))
     data = {k: ("sample", np.asarray(v)[st]) for k, v in structures.items()}
     data.update(record=("sample", rec), structure=("sample", st), level_index=("sample", lev))
@@ -251,10 +258,11 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     if kind.capacities and _slide_limits(study):
         coords["slide_limit"] = ("slide_limit", np.array(_slide_limits(study)), {"units": "m"})
     ds = xr.Dataset(data, coords=coords)
-    names = [str(h) if v is None else [str(h), str(v)] for _, h, v in pairs]
+    names = [str(h) if v is None else [str(h), str(v)] for _, h, v, _ in pairs]
     ds.attrs.update(
         record_files=json.dumps(names),
-        record_names=json.dumps([Path(h).stem for _, h, _ in pairs]),
+        record_names=json.dumps([Path(h).stem for _, h, _, _ in pairs]),
+        **_axes_attrs(study, pairs),
         record_design=study.design.kind,
         structures=n_st,
     )
@@ -265,11 +273,50 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     return ds
 
 
+def suite_records(motion, base_dir=None) -> list[tuple]:
+    """The records of a record motion: ``(field, horizontal, vertical or None, second
+    horizontal or None)`` files, as :func:`.feasibility.record_pairs` lists them, each with
+    its second horizontal component named by ``motion.h2`` (:func:`.feasibility.second_file`)."""
+    return [(f, h, v, second_file(motion, h)) for f, h, v in record_pairs(motion, base_dir)]
+
+
+def motion_axes(study) -> tuple[list[int], np.ndarray | None]:
+    """The floors of a design study (``[0]`` on the ground) and its orientations [rad] (None
+    without ``design.orientations``): every record runs on each (floor, orientation), motion
+    ``(record * floors + floor) * orientations + orientation`` of the rows' ``record``."""
+    floors = study.motion.floors() if study.motion.kind == "record" else [0]
+    return floors, study.design.angles()
+
+
+def _axes_attrs(study, pairs) -> dict:
+    """The attributes of the motion axes (:func:`motion_axes`): ``floors`` (a list of floors)
+    and ``orientations`` [rad] when given, and the second horizontal files."""
+    floors, angles = motion_axes(study)
+    out = {}
+    if isinstance(getattr(study.motion, "floor", None), list):
+        out["floors"] = json.dumps(floors)
+    if angles is not None:
+        out["orientations"] = json.dumps([float(a) for a in angles])
+    if any(y is not None for *_, y in pairs):
+        out["record_h2_files"] = json.dumps([None if y is None else str(y) for *_, y in pairs])
+    return out
+
+
 @lru_cache(maxsize=8)
 def _suite(motion_json: str, base_dir) -> tuple:
     from ..spec.motion_spec import RecordSpec
 
-    return tuple(record_pairs(RecordSpec.model_validate(json.loads(motion_json)), base_dir))
+    return tuple(suite_records(RecordSpec.model_validate(json.loads(motion_json)), base_dir))
+
+
+@lru_cache(maxsize=32)
+def _ground(motion_json: str, base_dir, index: int):
+    """Record ``index`` of a study's suite on the ground (read once per process)."""
+    from ..spec.motion_spec import RecordSpec
+
+    motion = RecordSpec.model_validate(json.loads(motion_json))
+    field, h, v, y = _suite(motion_json, base_dir)[index]
+    return read_pair(h, v, motion.units, field, h2=y)
 
 
 @lru_cache(maxsize=32)
@@ -279,8 +326,29 @@ def load_record(motion_json: str, base_dir, index: int):
     from ..spec.motion_spec import RecordSpec
 
     motion = RecordSpec.model_validate(json.loads(motion_json))
-    field, h, v = _suite(motion_json, base_dir)[index]
-    return motion.floor_motion(read_pair(h, v, motion.units, field))
+    return motion.floor_motion(_ground(motion_json, base_dir, index))
+
+
+def design_motion(study, base_dir, index: int):
+    """Motion ``index`` of a design study (:func:`motion_axes`): its record on its floor,
+    along its orientation (:meth:`rockstudy.motions.Record.oriented`), with the ground
+    record (both components) as the record a design measures
+    (:func:`rockstudy.motions.building.ground_record`). A ValueError names the record and
+    ``design.orientations`` if the record has one horizontal component."""
+    floors, angles = motion_axes(study)
+    n_or = 1 if angles is None else angles.size
+    record, rest = divmod(int(index), len(floors) * n_or)
+    floor, orientation = divmod(rest, n_or)
+    ground = _ground(study.motion.model_dump_json(), base_dir, record)
+    motion = study.motion.floor_motion(ground, floors[floor])
+    if angles is None:
+        return motion
+    if ground.acceleration_y is None:
+        raise ValueError(
+            f"design.orientations: the record {ground.name!r} has one horizontal component; "
+            "orientations need two (motion.h2 names each record's second one)"
+        )
+    return with_ground(motion.oriented(float(angles[orientation])), ground)
 
 
 def stored_periods(study) -> np.ndarray:
@@ -394,13 +462,12 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     outs = outputs(study)
     width = _widths(study)
     result = empty_rows(study, cols["sample"].size)
-    motion_json = study.motion.model_dump_json()
     on_levels = design_kind(study.design.kind).levels
     levels_all = study.motion.scale_to.levels() if on_levels else np.ones(1)
     friction = study.friction_coefficients()
     for r in np.unique(cols["record"]):
         rows = np.flatnonzero(cols["record"] == r)
-        rec = load_record(motion_json, base_dir, int(r))
+        rec = design_motion(study, base_dir, int(r))
         st_ids, st_pos = np.unique(cols["structure"][rows], return_inverse=True)
         first = rows[np.unique(st_pos, return_index=True)[1]]
         structures = {
@@ -445,31 +512,47 @@ def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
             result[name][rows, :k] = values
 
 
-def design_dataset(cube: xr.Dataset) -> xr.Dataset:
-    """Fold a design study's rows (the store's cube) into the layout of :mod:`.records`:
-    ``record`` x ``structure`` [x ``level``], per-record and per-structure tables, attributes.
-    """
-    kind = design_kind(cube.attrs["record_design"])
-    names = json.loads(cube.attrs["record_names"])
-    n_rec, n_st = len(names), int(cube.attrs["structures"])
+def _folded(cube, kind, shape, m_dims) -> dict:
+    """The variables of a design's rows on their dimensions: ``shape`` is (records, the
+    sizes of the motion axes ``m_dims``, structures); the levels of stripes follow. The
+    record and group variables are the ground record's (the same on every motion)."""
     n_lev = cube.sizes.get("level", 1) if kind.levels else 1
-    shape = (n_rec, n_st, n_lev)
-    study = json.loads(cube.attrs["study"])
+    first = (0,) * len(m_dims)
     out = {}
     for name, var in cube.data_vars.items():
         if var.dims[:1] != ("sample",) or name in ("record", "structure", "level_index"):
             continue
-        values = np.asarray(var.values).reshape(shape + var.shape[1:])
+        values = np.asarray(var.values).reshape(shape + (n_lev,) + var.shape[1:])
         new = "status" if name == "kernel_status" else "run_status" if name == "status" else name
         extra = var.dims[1:]
         if name in STRUCTURE_VARIABLES:
-            out[new] = (("structure",), values[0, :, 0], var.attrs)
+            out[new] = (("structure",), values[(0, *first, slice(None), 0)], var.attrs)
         elif name in record_variables() or name in measures.listed(True):
-            out[new] = (("record",) + extra, values[:, 0, 0], var.attrs)
-        elif name in GROUP_VARIABLES or not kind.levels:
-            out[new] = (("record", "structure") + extra, values[:, :, 0], var.attrs)
+            out[new] = (("record",) + extra, values[(slice(None), *first, 0, 0)], var.attrs)
+        elif name in GROUP_VARIABLES:
+            ground = values[(slice(None), *first)][:, :, 0]
+            out[new] = (("record", "structure") + extra, ground, var.attrs)
+        elif not kind.levels:
+            dims = ("record", *m_dims, "structure") + extra
+            out[new] = (dims, np.take(values, 0, axis=2 + len(m_dims)), var.attrs)
         else:
-            out[new] = (("record", "structure", "level"), values, var.attrs)
+            out[new] = (("record", *m_dims, "structure", "level"), values, var.attrs)
+    return out
+
+
+def design_dataset(cube: xr.Dataset) -> xr.Dataset:
+    """Fold a design study's rows (the store's cube) into the layout of :mod:`.records`:
+    ``record`` [x ``floor``] [x ``orientation``] x ``structure`` [x ``level``] (the floor and
+    orientation of a list of floors and of ``design.orientations``, :func:`motion_coords`),
+    per-record and per-structure tables, attributes.
+    """
+    kind = design_kind(cube.attrs["record_design"])
+    names = json.loads(cube.attrs["record_names"])
+    n_rec, n_st = len(names), int(cube.attrs["structures"])
+    axes = motion_coords(cube.attrs)
+    m_dims = tuple(axes)
+    study = json.loads(cube.attrs["study"])
+    out = _folded(cube, kind, (n_rec, *(len(v) for v in axes.values()), n_st), m_dims)
     coords = {
         "record": rd.record_labels(names),
         "structure": (
@@ -479,10 +562,11 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         ),
         "period": cube["period"].values,
         "record_name": ("record", np.array(names, dtype=object)),
+        **axes,
     }
     if "slide_limit" in cube.coords:  # an IDA's slide capacities, as the API orders them
         coords["slide_limit"] = cube["slide_limit"]
-        dims = ("slide_limit", "record", "structure")
+        dims = ("slide_limit", "record", *m_dims, "structure")
         for k, (var_dims, values, var_attrs) in list(out.items()):
             if var_dims[-1:] == ("slide_limit",):
                 out[k] = (dims, np.moveaxis(values, -1, 0), var_attrs)
@@ -520,13 +604,26 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         attrs["n_simulations"] = int(sum(np.nansum(np.where(v >= 0, v, 0)) for v in sims))
         for k in _BOOLS + ("censored_rocking",) * ("censored_rocking" in ds):
             ds[k] = ds[k] == 1  # as the API: bool (a failed row: False, NaN capacity)
-        used = np.isfinite(ds["step_scale"].values).any(axis=(0, 1))
+        steps = ds["step_scale"].values
+        used = np.isfinite(steps.reshape(-1, steps.shape[-1])).any(axis=0)
         ds = ds.isel(step=slice(0, max(int(used.nonzero()[0].max(initial=-1)) + 1, 1)))
     else:  # as the API: bool, and the points not run are not simulations
         ds["censored"] = ds["censored"] == 1
         attrs["n_simulations"] = int((~ds["censored"]).sum())
     ds.attrs = attrs
     return ds
+
+
+def motion_coords(attrs) -> dict:
+    """The motion axes of a design's cube (its attributes ``floors`` and ``orientations``,
+    :func:`motion_axes`): ``{"floor": floors, "orientation": angles [rad]}``, each only when
+    the study gives it."""
+    axes = {}
+    if "floors" in attrs:
+        axes["floor"] = np.array(json.loads(attrs["floors"]), np.int64)
+    if "orientations" in attrs:
+        axes["orientation"] = np.array(json.loads(attrs["orientations"]), float)
+    return axes
 
 
 def _old_uplift(ds, study: dict):

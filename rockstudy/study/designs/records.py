@@ -13,6 +13,12 @@ structure's uplift PGA, which :func:`rockstudy.study.analysis.risk.object_risk` 
 intensity of a scaled record is its unscaled value times ``scale`` (``scale`` squared for Arias
 intensity); :func:`rockstudy.study.analysis.record_fragility.intensity` forms it in quoted units.
 
+A floor motion (:func:`rockstudy.motions.floor_motion`) is simulated as the object feels it,
+but measured, scaled and reported in its ground record's measures
+(:func:`rockstudy.motions.building.ground_record`): the building is linear, so the ground
+record scaled by s gives the floor motion scaled by s, and the capacities are in the measure
+of the site's hazard curve.
+
 Rocking is not monotonic in intensity: a block that overturns at one scale can survive a
 higher one. The IDA reports the first overturning rung of a ladder of 1 % steps (refined by
 bisection) and the switch band above it, where the block is seen to survive again.
@@ -37,6 +43,7 @@ from ...dynamics.simulate import check_friction
 from ...motions import Record
 from ...motions import intensity as _im
 from ...motions import measures as _ms
+from ...motions.building import ground_record
 from ...structures.block import (
     block_parameters,
     frequency_parameter,
@@ -252,8 +259,9 @@ def _scale_for(level, measure, im):
 def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     """Measures of the unscaled records (on ``record``; on ``period`` too for those that need
     one) and their groups for each structure."""
-    ims = [r.intensity_measures(periods=periods, damping=damping) for r in records]
-    pulses = [r.pulse() for r in records]
+    grounds = [ground_record(r) for r in records]  # a floor motion reports its ground's
+    ims = [r.intensity_measures(periods=periods, damping=damping) for r in grounds]
+    pulses = [r.pulse() for r in grounds]
     data = {k: ("record", np.array([m[k] for m in ims], float)) for k in _ms.listed(False)}
     for k in _ms.listed(True) if len(periods) else ():  # (netCDF-3 reads no empty inner axis)
         data[k] = (
@@ -576,7 +584,8 @@ def multiple_stripes(
     model = _contact_model(model, friction, n)
     scales, outs = [], []
     for r in records:
-        s = _scale_for(levels[None, :], _record_measure(r, im, period, damping, st)[:, None], im)
+        measure = _record_measure(ground_record(r), im, period, damping, st)
+        s = _scale_for(levels[None, :], measure[:, None], im)
         scales.append(s)
         args = (method, rtol, max_steps, contact, model)
         outs.append(_run_below_free_fall(r, st, idx, s.ravel(), *args))
@@ -731,7 +740,9 @@ def incremental_dynamic_analysis(
     limits = ida_slides.slide_limits(slide_limits, model)
     period, periods = _target(im, period, periods)
     ds = _record_dataset(records, st, periods, damping)
-    measure = np.array([_record_measure(r, im, period, damping, st) for r in records])
+    measure = np.array(
+        [_record_measure(ground_record(r), im, period, damping, st) for r in records]
+    )
     args = (options, method, rtol, max_steps, model, limits)
     results = [_ida_record(r, st, *args) for r in records]
     ds = _ida_tables(ds, results, model is not None)

@@ -23,6 +23,7 @@ from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
 from ..spec.design_kinds import DESIGN_KINDS, design_kind, kind_of
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
+from . import floors
 from . import objects as ro
 from ._page import (
     _FRAGILITY_NAMES,
@@ -715,6 +716,12 @@ def record_report(
         )
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    if floors.has_dimensions(ds):  # a page per floor and orientation summary, linked
+        options = dict(description=description, appendix=appendix, units=units, study=study)
+        options.update(max_scale_factor=max_scale_factor, friction=friction, hazard=hazard)
+        return floors.dimension_report(
+            ds, out, record_report, title, n_boot, years=years, **options
+        )
     page = _Page(out)
     ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
     ctx.friction, ctx.im_label, ctx.study = friction, im_label, study

@@ -7,9 +7,11 @@ fit with the motion and the sampler is checked by the whole study
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 from typing import Annotated, Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from .design_kinds import DESIGN_KINDS, design_kind
@@ -21,6 +23,8 @@ from .structures import FieldError
 
 __all__ = ["DesignSpec"]
 
+#: Most orientations of a design (``design.orientations``).
+MAX_ORIENTATIONS = 360
 #: Largest slide limit taken [m] (``design.slide_limits``).
 MAX_SLIDE_LIMIT = 100.0
 #: A slide limit d [m] of ``design.slide_limits``.
@@ -37,7 +41,11 @@ class DesignSpec(_Model):
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio. ``slide_limits`` [m] are the slides d of the
     fragility of sliding, P(max_slide > d) (the contact model's ``max_slide``: with
-    ``run.model`` "contact" or "auto"), distinct and increasing."""
+    ``run.model`` "contact" or "auto"), distinct and increasing. ``orientations`` (n, for the
+    n angles k pi / n in [0, pi), or a list of angles [rad]) runs every record along each
+    orientation psi of the objects' rocking plane, a_x cos(psi) + a_y sin(psi)
+    (:meth:`rockstudy.motions.Record.oriented`): a dimension ``orientation`` of the design,
+    whose records need two horizontal components (``motion.h2``)."""
 
     kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
@@ -53,6 +61,36 @@ class DesignSpec(_Model):
     #: recorded; cloud and stripes designs).
     max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
     slide_limits: list[_SlideLimit] = Field(default=[], max_length=100)
+    #: The orientations psi [rad] of the objects' rocking plane (:meth:`angles`): a dimension
+    #: ``orientation`` of the design; each record then needs two horizontal components.
+    orientations: int | list[float] | None = None
+
+    @model_validator(mode="after")
+    def _orientations(self):
+        o = self.orientations
+        if o is None:
+            return self
+        if isinstance(o, int) and not 1 <= o <= MAX_ORIENTATIONS:
+            raise FieldError(
+                "orientations", f"must be a number of angles in 1..{MAX_ORIENTATIONS}, got {o}"
+            )
+        if isinstance(o, list):
+            if not 1 <= len(o) <= MAX_ORIENTATIONS or len(set(o)) < len(o):
+                raise FieldError(
+                    "orientations",
+                    f"a list must hold 1..{MAX_ORIENTATIONS} distinct angles [rad], got {o}",
+                )
+            if not all(math.isfinite(a) for a in o):
+                raise FieldError("orientations", f"the angles [rad] must be finite, got {o}")
+        return self
+
+    def angles(self):
+        """The orientations psi [rad] of the design: n equally spaced in [0, pi)
+        (``orientations = n``: k pi / n) or the list given; None without ``orientations``."""
+        o = self.orientations
+        if o is None:
+            return None
+        return np.pi * np.arange(o) / o if isinstance(o, int) else np.array(o, float)
 
     @model_validator(mode="after")
     def _increasing_slide_limits(self):

@@ -8,6 +8,7 @@ problem is one sentence naming the field, the quantity and what is allowed.
 from __future__ import annotations
 
 import math
+import re
 from functools import lru_cache
 from pathlib import Path
 
@@ -34,6 +35,7 @@ __all__ = [
     "problems",
     "read_problems",
     "record_pairs",
+    "second_file",
     "record_path",
     "size_notes",
     "UPLIFT_NOTE_GAP",
@@ -134,7 +136,7 @@ def notes(study, base_dir=None) -> list[str]:
         if v is None:
             continue
         vfield = field.replace("files", "vertical") if isinstance(mo.vertical, list) else field
-        rec = read_pair(h, v, mo.units, field, vfield)
+        rec = read_pair(h, v, mo.units, field, vfield, h2=second_file(mo, h))
         scaled = _largest_scaled_peak(study, rec)
         if scaled is None:
             continue
@@ -236,7 +238,7 @@ def _scaling_notes(study, base_dir) -> list[str]:
     limit = DEFAULT_MAX_SCALE_FACTOR if de is None else de.max_scale_factor
     found, top_pga, horizontal = [], 0.0, True
     for field, h, v in record_pairs(study.motion, base_dir):
-        rec = read_pair(h, v, study.motion.units, field, field)
+        rec = read_pair(h, v, study.motion.units, field, field, h2=second_file(study.motion, h))
         scaled = ("motion.files", 1.0) if cloud else _largest_scale(study, rec)
         if scaled is None:
             return found
@@ -267,9 +269,9 @@ def hazard_notes(study, base_dir) -> list[str]:
         return []
     curve = hazard.curve()
     values = [
-        read_pair(h, v, study.motion.units, field, field).intensity_measure(
-            curve.im, period=curve.period, damping=study.design.damping
-        )
+        read_pair(
+            h, v, study.motion.units, field, field, h2=second_file(study.motion, h)
+        ).intensity_measure(curve.im, period=curve.period, damping=study.design.damping)
         for field, h, v in record_pairs(study.motion, base_dir)
     ]
     said = suite_off_curve(curve, values)
@@ -304,7 +306,8 @@ def _read_each(motion, pairs):
     for field, h, v in pairs:
         vfield = field.replace("files", "vertical") if isinstance(motion.vertical, list) else field
         try:
-            yield field, h, read_pair(h, v, motion.units, field, vfield), None
+            y = second_file(motion, h)
+            yield field, h, read_pair(h, v, motion.units, field, vfield, h2=y), None
         except (OSError, ValueError) as exc:
             yield field, h, None, (_reason(exc, h) if isinstance(exc, OSError) else str(exc))
 
@@ -428,6 +431,37 @@ def _scaled_measures(study) -> list[tuple]:
 
 
 def record_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
+    """The records of a record motion: ``(field, horizontal file, vertical file or None)``,
+    in order, without the files that ``motion.h2`` names as some record's second horizontal
+    component (:func:`second_file`); see :func:`_listed_pairs`."""
+    pairs = _listed_pairs(motion, base_dir)
+    if getattr(motion, "h2", None) is None:
+        return pairs
+    pattern = re.compile(motion.h2.match)
+    named = {h.with_name(pattern.sub(motion.h2.replace, h.name)).resolve() for _, h, _ in pairs}
+    records = [p for p in pairs if Path(p[1]).resolve() not in named]
+    for _, h, _ in records:
+        second_file(motion, h)  # every record names its second component
+    return records
+
+
+def second_file(motion, horizontal) -> Path | None:
+    """The second horizontal file of the record ``horizontal``: ``motion.h2``'s ``re.sub(match,
+    replace, name)`` in the same folder (None without ``h2``); a ValueError naming
+    ``motion.h2`` if the name does not match."""
+    rule = getattr(motion, "h2", None)
+    if rule is None:
+        return None
+    horizontal = Path(horizontal)
+    if not re.search(rule.match, horizontal.name):
+        raise ValueError(
+            f"motion.h2: the file {str(horizontal)!r} does not match {rule.match!r} and is no "
+            "record's second horizontal component; every file must be one or the other"
+        )
+    return horizontal.with_name(re.sub(rule.match, rule.replace, horizontal.name))
+
+
+def _listed_pairs(motion, base_dir=None) -> list[tuple[str, Path, Path | None]]:
     """The records of a record motion: ``(field, horizontal file, vertical file or None)``,
     in order (a folder and a glob sorted by name), paths resolved by :func:`record_path`.
 

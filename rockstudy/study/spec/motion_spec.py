@@ -299,8 +299,16 @@ class RecordSpec(_Model):
 
     ``building`` (a :class:`BuildingSpec`) and ``floor`` (0 = the ground, to the building's
     top floor n) put the objects on a floor: every record is replaced by the absolute
-    acceleration of that floor (:func:`rockstudy.motions.floor_motion`) before it is scaled
-    and run. One floor per study (a list of floors is refused).
+    acceleration of that floor (:func:`rockstudy.motions.floor_motion`) before it is run. A
+    design measures, scales and reports each record by its ground record's measures (those of
+    the site's hazard curve: the building is linear, so the ground record scaled by s gives the
+    floor motion scaled by s); Monte Carlo rows scale the floor motion. A list of distinct
+    floors (``floor = [1, 3, 5]``, a design only) is a dimension ``floor`` of the design:
+    every design runs on every floor.
+
+    ``h2 = { match, replace }`` names each record's second horizontal component (in the same
+    folder, ``re.sub(match, replace, name)``; as ``load_suite(h2=)``): a design over
+    ``orientations`` needs it.
 
     A path is absolute as written, or relative to the study file's folder (never to the
     working folder; see :func:`.feasibility.record_path`). Only regular text files up to 64 MiB
@@ -316,6 +324,7 @@ class RecordSpec(_Model):
     scale_to: ScaleTo | None = None
     building: BuildingSpec | None = None
     floor: int | list[int] | None = None
+    h2: VerticalRule | None = None
 
     @field_validator("files")
     @classmethod
@@ -363,26 +372,40 @@ class RecordSpec(_Model):
         return self
 
     def _check_floor(self) -> None:
-        """``building`` and ``floor`` come together; ``floor`` is one floor in 0..n."""
+        """``building`` and ``floor`` come together; ``floor`` is one floor in 0..n, or a
+        list of distinct ones."""
         if (self.building is None) != (self.floor is None):
             given, other = ("building", "floor") if self.floor is None else ("floor", "building")
             raise FieldError(other, f"is required with {given} (the floor of the building)")
-        if isinstance(self.floor, list):
-            raise FieldError(
-                "floor",
-                "must be one floor (a whole number); a list of floors is not a study "
-                "dimension: run one study per floor",
-            )
-        if self.building is not None:
-            top = self.building.building().n_floors
-            if not 0 <= self.floor <= top:
-                raise FieldError("floor", f"must be in 0..{top} (0 = the ground), got {self.floor}")
+        if self.building is None:
+            return
+        floors = self.floors()
+        if not floors or len(set(floors)) < len(floors):
+            raise FieldError("floor", f"a list of floors must name distinct floors, got {floors}")
+        top = self.building.building().n_floors
+        for k in floors:
+            if not 0 <= k <= top:
+                raise FieldError("floor", f"must be in 0..{top} (0 = the ground), got {k}")
 
-    def floor_motion(self, record):
-        """``record`` as felt on ``floor`` of ``building`` (the record itself without them)."""
+    def floors(self) -> list[int]:
+        """The floors of the study (``[0]``, the ground, without a building)."""
+        if self.floor is None:
+            return [0]
+        return list(self.floor) if isinstance(self.floor, list) else [self.floor]
+
+    def floor_motion(self, record, floor=None):
+        """``record`` as felt on ``floor`` (default: the study's one floor) of ``building``
+        (the record itself without one; its ground record in ``metadata["ground"]``)."""
         if self.building is None:
             return record
-        return floor_motion(record, self.building.building(), self.floor)
+        if floor is None:
+            if isinstance(self.floor, list):
+                raise ValueError(
+                    "motion.floor: a list of floors is a dimension of a [design]; Monte Carlo "
+                    "rows take one floor"
+                )
+            floor = self.floor
+        return floor_motion(record, self.building.building(), floor)
 
     def target(self) -> ScaleTo | None:
         """The scaling target, with ``pga_ratio`` read as ``scale_to = { im = "pga_ratio" }``."""

@@ -242,6 +242,22 @@ class Study(_Model):
         return self
 
     @model_validator(mode="after")
+    def _floor_list(self):
+        """A list of floors is a dimension of a record design only."""
+        if isinstance(getattr(self.motion, "floor", None), list) and self.design is None:
+            raise FieldError(
+                "motion.floor", "a list of floors needs a [design]; Monte Carlo rows take one"
+            )
+        if self.design is not None and self.design.orientations is not None:
+            if getattr(self.motion, "h2", None) is None:
+                raise FieldError(
+                    "design.orientations",
+                    "needs records of two horizontal components: give motion.h2 = { match = "
+                    "'<regex>', replace = '<replacement>' } naming each record's second one",
+                )
+        return self
+
+    @model_validator(mode="after")
     def _hazard(self):
         hz, de = self.hazard, self.design
         if hz is None:
@@ -252,12 +268,6 @@ class Study(_Model):
                 "applies to a record [design] (cloud, stripes or ida) only: the fragility "
                 "it integrates is fitted per structure over records, which a Monte Carlo "
                 "or Sobol study does not have",
-            )
-        if getattr(self.motion, "floor", None):
-            raise FieldError(
-                "hazard",
-                "is a hazard curve of the ground motion, but on motion.floor > 0 the design's "
-                "intensity measures are the floor motion's: leave out [hazard] on a floor",
             )
         if measures.measure(hz.im).needs_period:
             stored = set(de.periods) | {de.period}
