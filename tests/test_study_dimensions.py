@@ -168,9 +168,7 @@ def test_an_ida_over_orientations_on_a_floor_with_a_hazard_reports_worst_and_med
     pairs, client, tmp_path
 ):
     motion = f"{H2}\n{SHEAR}\nfloor = 2"
-    design = (
-        '[design]\nkind = "ida"\nim = "pga"\nstep = 0.05\ntolerance = 0.02\norientations = 2'
-    )
+    design = '[design]\nkind = "ida"\nim = "pga"\nstep = 0.05\ntolerance = 0.02\norientations = 2'
     hazard = '[hazard]\nkind = "power_law"\nim = "pga"\nk0 = 1e-4\nk = 2.5\nunits = "g"\n'
     study = study_file(pairs, tmp_path, motion, design, hazard)
     out = tmp_path / "ida.zarr"
