@@ -8,10 +8,11 @@ fit with the motion and the sampler is checked by the whole study
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, model_validator
 
+from .damage_states import damage_states
 from .design_kinds import DESIGN_KINDS, design_kind
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR
 from .ida_options import IdaOptionError, IdaOptions
@@ -37,7 +38,11 @@ class DesignSpec(_Model):
     ranges). ``periods`` [s] are those of the spectral accelerations ``sa`` stored for every
     record, ``damping`` their damping ratio. ``slide_limits`` [m] are the slides d of the
     fragility of sliding, P(max_slide > d) (the contact model's ``max_slide``: with
-    ``run.model`` "contact" or "auto"), distinct and increasing."""
+    ``run.model`` "contact" or "auto"), distinct and increasing. ``damage_states``
+    ``{name = limit}`` are the damage states short of overturning
+    (:mod:`rockstudy.study.spec.damage_states`): a limit on the peak rotation ratio
+    abs(theta)/alpha in (0, 1] (1 = overturning), or ``{slide = d}`` on the peak slide [m]
+    (with the contact model)."""
 
     kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
@@ -53,6 +58,15 @@ class DesignSpec(_Model):
     #: recorded; cloud and stripes designs).
     max_scale_factor: float = Field(default=DEFAULT_MAX_SCALE_FACTOR, gt=1, le=1e6)
     slide_limits: list[_SlideLimit] = Field(default=[], max_length=100)
+    damage_states: dict[str, Any] = Field(default={}, max_length=100)
+
+    @model_validator(mode="after")
+    def _damage_states(self):
+        try:  # the contact model a slide state needs is checked by the study
+            self.states()
+        except ValueError as exc:
+            raise FieldError("damage_states", str(exc).partition(": ")[2]) from None
+        return self
 
     @model_validator(mode="after")
     def _increasing_slide_limits(self):
@@ -83,6 +97,19 @@ class DesignSpec(_Model):
         for name in ida:  # the stored study shows every option the run used
             object.__setattr__(self, name, getattr(options, name))
         return self
+
+    def states(self, contact: bool = True) -> tuple:
+        """The damage states (:func:`.damage_states.damage_states`); ``contact``: whether
+        the contact model runs (a slide state needs it)."""
+        return damage_states(self.damage_states, model=contact)
+
+    def slide_states_need_contact(self) -> None:
+        """A FieldError naming ``design.damage_states`` if a state is on the slide (the
+        contact model's max_slide, which Housner's model does not give)."""
+        try:
+            self.states(contact=False)
+        except ValueError as exc:
+            raise FieldError("design.damage_states", str(exc).partition(": ")[2]) from None
 
     def ida(self) -> IdaOptions:
         """The IDA's options (defaults filled in)."""
