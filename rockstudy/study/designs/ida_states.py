@@ -36,6 +36,8 @@ __all__ = [
     "DamageState",
     "damage_states",
     "states_attr",
+    "LONG_NAMES",
+    "state_coords",
     "state_scales",
     "state_tables",
 ]
@@ -119,14 +121,14 @@ def state_scales(points, ladders, states, alpha, capacity_scale, tolerance) -> n
 
 
 #: The long names of the IDA's variables of the damage states.
-_LONG_NAMES = {
+LONG_NAMES = {
     "state_capacity_scale": "lowest scale seen to reach the damage state",
     "state_capacity": "first intensity at which the damage state is reached (NaN: not below "
     "the last rung)",
 }
 
 
-def _state_coords(states) -> dict:
+def state_coords(states) -> dict:
     """The coordinates ``damage_state`` (the names), ``damage_demand`` and ``damage_limit``."""
     return {
         "damage_state": ("damage_state", np.array([s.name for s in states], dtype=object)),
@@ -143,15 +145,15 @@ def state_tables(ds, results, states, measure, power) -> xr.Dataset:
     """``state_capacity_scale`` and ``state_capacity`` (the record's ``measure`` times the
     scale to the measure's ``power``, in the units of ``capacity``) on (damage_state,
     record, structure) from the per-record results of the IDA (``state_capacity_scale`` of
-    each), with the coordinates of :func:`_state_coords` and ``attrs["damage_states"]``
+    each), with the coordinates of :func:`state_coords` and ``attrs["damage_states"]``
     (:func:`states_attr`)."""
     scale = np.stack([res["state_capacity_scale"] for res in results], axis=1)
     per_record = np.reshape(measure, (len(results), -1))
     values = {"state_capacity_scale": scale, "state_capacity": per_record * scale**power}
     units = {"state_capacity_scale": "1", "state_capacity": ds["capacity"].attrs["units"]}
-    ds = ds.assign_coords(_state_coords(states))
+    ds = ds.assign_coords(state_coords(states))
     for name, value in values.items():
-        attrs = {"units": units[name], "long_name": _LONG_NAMES[name]}
+        attrs = {"units": units[name], "long_name": LONG_NAMES[name]}
         ds[name] = (("damage_state", "record", "structure"), value, attrs)
     ds.attrs["damage_states"] = states_attr(states)
     return ds
