@@ -515,8 +515,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         for k, (var_dims, values, var_attrs) in list(out.items()):
             if var_dims[-1:] == ("slide_limit",):
                 out[k] = (dims, np.moveaxis(values, -1, 0), var_attrs)
-    if "damage_state" in cube.coords:  # an IDA's damage states, as the API orders them
-        _fold_states(out, coords, study)
+    _fold_states(out, coords, cube, study)  # an IDA's damage states, as the API orders them
     if kind.levels:
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)
@@ -532,14 +531,10 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     ds["vertical_component"] = ("record", np.array([isinstance(f, list) for f in files]))
     if "uplift_acceleration" not in ds:  # a cube written before the design carried it
         ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
-    attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
+    attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"} | _states_attr(study)
     de = study["design"]
     if de.get("slide_limits"):  # the slide fragility's d (analysis.sliding)
         attrs["slide_limits"] = [float(d) for d in de["slide_limits"]]
-    if de.get("damage_states"):  # the damage states' fits (analysis.states)
-        attrs["damage_states"] = ida_states.states_attr(
-            ida_states.damage_states(de["damage_states"], True)
-        )
     attrs.update(
         design=kind.name,
         method=study["run"]["method"],
@@ -564,9 +559,12 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     return ds
 
 
-def _fold_states(out, coords, study: dict) -> None:
-    """Put the damage-state variables of ``out`` on (damage_state, record, structure) and
-    name the states in ``coords`` (from the stored study's ``design.damage_states``)."""
+def _fold_states(out, coords, cube, study: dict) -> None:
+    """With an IDA's damage states (``damage_state`` in the ``cube``), put their variables
+    of ``out`` on (damage_state, record, structure) and name the states in ``coords`` (from
+    the stored study's ``design.damage_states``)."""
+    if "damage_state" not in cube.coords:
+        return
     states = ida_states.damage_states(study["design"]["damage_states"], True)
     coords.update(ida_states.state_coords(states))
     for k, (var_dims, values, var_attrs) in list(out.items()):
@@ -576,6 +574,15 @@ def _fold_states(out, coords, study: dict) -> None:
                 np.moveaxis(values, -1, 0),
                 var_attrs,
             )
+
+
+def _states_attr(study: dict) -> dict:
+    """``{"damage_states": the states as JSON}`` of a stored study's design (for the fits of
+    :mod:`rockstudy.study.analysis.states`), or {}."""
+    if not study["design"].get("damage_states"):
+        return {}
+    states = ida_states.damage_states(study["design"]["damage_states"], True)
+    return {"damage_states": ida_states.states_attr(states)}
 
 
 def _old_uplift(ds, study: dict):
