@@ -603,3 +603,13 @@ def chromium_figures(page):
     m = re.search(r'<body[^>]*data-figures="(\d+)/(\d+)"', out.stdout)
     assert m, out.stdout[-2000:]
     return int(m.group(1)), int(m.group(2))
+
+
+def wide_runs(scales, flags, step):
+    """The upper ends of the runs of consecutive True ``flags`` over increasing ``scales``
+    that span at least one ladder step (a factor ``1 + step``): a rung lies inside each."""
+    flags = np.asarray(flags, bool)
+    edges = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    wide = scales[stops] >= scales[starts] * (1.0 + step)
+    return list(scales[stops][wide])

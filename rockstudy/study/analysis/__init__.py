@@ -6,7 +6,8 @@ intensity measures; ``record_similarity`` checks whether block sizes collapse on
 ``fragility_fit`` holds the lognormal fits and bands they share; ``risk`` turns each named
 object's fragility and a site's hazard curve into its annual rate of overturning; ``sliding``
 fits the fragility of sliding P(max_slide > d) of designs under the contact model, its annual
-rate, and the ratio of the annual rates of overturning of the contact and rocking-only models.
+rate, and the ratio of the annual rates of overturning of the contact and rocking-only models;
+``states`` fits the fragility of each damage state short of overturning and its annual rate.
 """
 
 from .sampled import (

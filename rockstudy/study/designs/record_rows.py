@@ -33,6 +33,7 @@ from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
 from ..spec.design_kinds import design_kind
 from ..spec.feasibility import record_pairs, second_file
+from . import ida_states
 from . import records as rd
 
 __all__ = [
@@ -177,6 +178,7 @@ def outputs(study) -> dict:
         for k in _STEPS:
             out[k] = (k.replace("_", " ") + " of each simulated point", "1", "f8", np.nan, "step")
         out.update(_ida_contact_outputs(study, unit))
+        out.update(_state_outputs(study, unit))
     else:
         out.update({k: (*v, None) for k, v in _RUN.items()})
         if kind.levels:
@@ -218,7 +220,7 @@ def ida_steps(study) -> int:
     ladder = math.ceil(math.log(span) / math.log1p(o.step)) + 2
     ratio = math.log1p(o.step) / math.log1p(o.tolerance)
     bisect = math.ceil(math.log2(ratio)) + 1 if ratio > 1 else 0
-    return ladder + bisect * (1 + len(_slide_limits(study))) + o.scan
+    return ladder + bisect * (1 + len(_slide_limits(study)) + _state_bisections(study)) + o.scan
 
 
 def _slip_span(study) -> float:
@@ -235,6 +237,28 @@ def _slide_limits(study) -> list:
     """The slides d [m] of an IDA's slide capacities: ``design.slide_limits`` (under the
     contact model: validated by the study)."""
     return list(study.design.slide_limits) if study.run.model != "rocking" else []
+
+
+def _damage_states(study) -> tuple:
+    """The damage states of the design (:meth:`.DesignSpec.states`; a slide state needs the
+    contact model, which the study checked)."""
+    return study.design.states(contact=study.run.model != "rocking")
+
+
+def _state_bisections(study) -> int:
+    """How many damage states an IDA bisects (all but overturning, which is the capacity)."""
+    return sum(not s.overturning for s in _damage_states(study))
+
+
+def _state_outputs(study, unit) -> dict:
+    """An IDA's damage-state capacities (extra dimension ``damage_state``; ``unit``: that of
+    ``capacity``), with ``design.damage_states``."""
+    if not _damage_states(study):
+        return {}
+    return {
+        name: (ida_states.LONG_NAMES[name], units, "f8", np.nan, "damage_state")
+        for name, units in (("state_capacity", unit), ("state_capacity_scale", "1"))
+    }
 
 
 def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
@@ -257,6 +281,8 @@ def design_rows(study, structures: dict, base_dir=None) -> xr.Dataset:
     coords["period"] = ("period", stored_periods(study))
     if kind.capacities and _slide_limits(study):
         coords["slide_limit"] = ("slide_limit", np.array(_slide_limits(study)), {"units": "m"})
+    if kind.capacities and _damage_states(study):  # numbered here; named by design_dataset
+        coords["damage_state"] = ("damage_state", np.arange(len(_damage_states(study))))
     ds = xr.Dataset(data, coords=coords)
     names = [str(h) if v is None else [str(h), str(v)] for _, h, v, _ in pairs]
     ds.attrs.update(
@@ -370,6 +396,7 @@ def _widths(study) -> dict:
         "period": stored_periods(study).size,
         "step": ida_steps(study) if steps else 0,
         "slide_limit": len(_slide_limits(study)) if steps else 0,
+        "damage_state": len(_damage_states(study)) if steps else 0,
     }
 
 
@@ -448,6 +475,8 @@ def _run_design(study, record, structures, levels, friction):
         kw["model"] = run.model
         if kind.capacities:
             kw["slide_limits"] = _slide_limits(study)
+    if kind.capacities and de.damage_states:
+        kw["damage_states"] = de.damage_states
     if kind.levels:
         t = study.motion.scale_to  # its damping is design.damping (spec.Study._design)
         kw.update(levels=levels, im=t.im, period=t.period)
@@ -500,8 +529,8 @@ def _fill(result, outs, ds, rows, st_pos, lev_pos, width):
             result[name][rows] = np.broadcast_to(values, rows.shape).astype(result[name].dtype)
         elif extra == "period":
             result[name][rows] = np.broadcast_to(values, (rows.size, width["period"]))
-        elif extra == "slide_limit":  # (slide_limit, row) of the design
-            result[name][rows] = np.asarray(var.transpose("row", "slide_limit").values)
+        elif extra in ("slide_limit", "damage_state"):  # (slide_limit, row) of the design
+            result[name][rows] = np.asarray(var.transpose("row", extra).values)
         else:  # IDA steps: (row, step), padded with NaN to the study's bound
             k = values.shape[-1]
             if k > width["step"]:
@@ -570,6 +599,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         for k, (var_dims, values, var_attrs) in list(out.items()):
             if var_dims[-1:] == ("slide_limit",):
                 out[k] = (dims, np.moveaxis(values, -1, 0), var_attrs)
+    _fold_states(out, coords, cube, study)  # an IDA's damage states, as the API orders them
     if kind.levels:
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)
@@ -585,7 +615,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
     ds["vertical_component"] = ("record", np.array([isinstance(f, list) for f in files]))
     if "uplift_acceleration" not in ds:  # a cube written before the design carried it
         ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
-    attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"}
+    attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"} | _states_attr(study)
     de = study["design"]
     if de.get("slide_limits"):  # the slide fragility's d (analysis.sliding)
         attrs["slide_limits"] = [float(d) for d in de["slide_limits"]]
@@ -624,6 +654,32 @@ def motion_coords(attrs) -> dict:
     if "orientations" in attrs:
         axes["orientation"] = np.array(json.loads(attrs["orientations"]), float)
     return axes
+
+
+def _fold_states(out, coords, cube, study: dict) -> None:
+    """With an IDA's damage states (``damage_state`` in the ``cube``), put their variables
+    of ``out`` on (damage_state, record, structure) and name the states in ``coords`` (from
+    the stored study's ``design.damage_states``)."""
+    if "damage_state" not in cube.coords:
+        return
+    states = ida_states.damage_states(study["design"]["damage_states"], True)
+    coords.update(ida_states.state_coords(states))
+    for k, (var_dims, values, var_attrs) in list(out.items()):
+        if var_dims[-1:] == ("damage_state",):
+            out[k] = (
+                ("damage_state", "record", "structure"),
+                np.moveaxis(values, -1, 0),
+                var_attrs,
+            )
+
+
+def _states_attr(study: dict) -> dict:
+    """``{"damage_states": the states as JSON}`` of a stored study's design (for the fits of
+    :mod:`rockstudy.study.analysis.states`), or {}."""
+    if not study["design"].get("damage_states"):
+        return {}
+    states = ida_states.damage_states(study["design"]["damage_states"], True)
+    return {"damage_states": ida_states.states_attr(states)}
 
 
 def _old_uplift(ds, study: dict):

@@ -53,7 +53,7 @@ from ...structures.block import (
 )
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
-from . import ida_slides
+from . import ida_slides, ida_states
 
 __all__ = [
     "CENSORED_REASONS",
@@ -452,6 +452,7 @@ def cloud(
     friction=None,
     contact: bool | None = None,
     model: str = "rocking",
+    damage_states=None,
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -496,6 +497,10 @@ def cloud(
         ``overturned_rocking``: Housner's decision of every point, the rocking-only answer
         of :func:`rockstudy.study.analysis.sliding.contact_effect`); "rocking"
         (default): Housner's model (with the friction check where ``friction`` is given).
+    damage_states : mapping, optional
+        ``{name: limit}`` (see :mod:`.ida_states`): checked, and kept as
+        ``attrs["damage_states"]`` for the fits of each state
+        (:mod:`rockstudy.study.analysis.states`).
 
     Returns
     -------
@@ -513,6 +518,7 @@ def cloud(
     idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
     model = _contact_model(model, friction, idx.size)
+    states = ida_states.damage_states(damage_states, model is not None)
     outs = [
         _run_below_free_fall(r, st, idx, ones, method, rtol, max_steps, contact, model)
         for r in records
@@ -522,6 +528,13 @@ def cloud(
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     n_run = int((~ds["censored"]).sum())
     ds.attrs.update(design="cloud", method=method, rtol=rtol, n_simulations=n_run)
+    return _with_states(ds, states)
+
+
+def _with_states(ds, states):
+    """``ds`` with the damage ``states`` (if any) as ``attrs["damage_states"]``."""
+    if states:
+        ds.attrs["damage_states"] = ida_states.states_attr(states)
     return ds
 
 
@@ -542,6 +555,7 @@ def multiple_stripes(
     friction=None,
     contact: bool | None = None,
     model: str = "rocking",
+    damage_states=None,
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -559,6 +573,7 @@ def multiple_stripes(
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
     records, structures, periods, damping, method, rtol, max_steps, friction, contact, model
+    damage_states
         As in :func:`cloud`.
 
     Returns
@@ -582,6 +597,7 @@ def multiple_stripes(
     n = st["critical_rotation"].size
     idx = np.repeat(np.arange(n), levels.size)
     model = _contact_model(model, friction, n)
+    states = ida_states.damage_states(damage_states, model is not None)
     scales, outs = [], []
     for r in records:
         measure = _record_measure(ground_record(r), im, period, damping, st)
@@ -603,7 +619,7 @@ def multiple_stripes(
         rtol=rtol,
         n_simulations=int((~ds["censored"]).sum()),
     )
-    return ds
+    return _with_states(ds, states)
 
 
 # ------------------------------------------------------------------------------ IDA
@@ -645,6 +661,7 @@ def incremental_dynamic_analysis(
     contact: bool | None = None,
     model: str = "rocking",
     slide_limits=(),
+    damage_states=None,
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -711,6 +728,11 @@ def incremental_dynamic_analysis(
     slide_limits : sequence of float
         Slides d [m] (> 0, increasing; under the contact model only): ``slide_capacity``,
         the first scale at which ``max_slide`` > d (see :func:`.ida_slides.slide_scales`).
+    damage_states : mapping, optional
+        ``{name: limit}``: damage states on the peak rotation ratio ``|theta|/alpha`` (a limit
+        in (0, 1], 1 = overturning) or, under the contact model, on the peak slide
+        (``{"slide": d}``, d [m]): ``state_capacity``, the first scale at which each state is
+        reached, bisected as the overturning capacity (see :mod:`.ida_states`).
 
     Returns
     -------
@@ -728,7 +750,11 @@ def incremental_dynamic_analysis(
         (:data:`STEP_KINDS`): the IDA curves; under the contact model also ``step_<name>``
         for each of :data:`MODEL_KEYS`. With ``slide_limits``: ``slide_capacity`` (in the
         units of ``capacity``) and ``slide_capacity_scale`` on (slide_limit, record,
-        structure), NaN where max_slide never exceeded d below the largest rung. ``rungs``
+        structure), NaN where max_slide never exceeded d below the largest rung. With
+        ``damage_states``: ``state_capacity`` (in the units of ``capacity``; the overturning
+        state's is ``capacity``) and ``state_capacity_scale`` on (damage_state, record,
+        structure), NaN where the state was not reached, with ``damage_demand`` and
+        ``damage_limit`` on ``damage_state`` and ``attrs["damage_states"]``. ``rungs``
         counts the rungs of both climbs. Attributes: the options and ``n_simulations``.
     """
     options = IdaOptions(im, period, step, tolerance, max_pga_ratio, scan)
@@ -738,12 +764,13 @@ def incremental_dynamic_analysis(
     contact = _friction_check(friction, contact, n)
     model = _contact_model(model, friction, n)
     limits = ida_slides.slide_limits(slide_limits, model)
+    states = ida_states.damage_states(damage_states, model is not None)
     period, periods = _target(im, period, periods)
     ds = _record_dataset(records, st, periods, damping)
     measure = np.array(
         [_record_measure(ground_record(r), im, period, damping, st) for r in records]
     )
-    args = (options, method, rtol, max_steps, model, limits)
+    args = (options, method, rtol, max_steps, model, limits, states)
     results = [_ida_record(r, st, *args) for r in records]
     ds = _ida_tables(ds, results, model is not None)
     if contact:
@@ -757,6 +784,8 @@ def incremental_dynamic_analysis(
         ds = _ida_rocking(ds, rocking, measure, im)
     if limits.size:
         ds = ida_slides.slide_tables(ds, results, limits, measure, _ms.power(im))
+    if states:
+        ds = ida_states.state_tables(ds, results, states, measure, _ms.power(im))
     ds["censored_reason"].attrs.update(cf_flags(CENSORED_REASONS))
     ds.attrs.update(
         design="ida",
@@ -972,9 +1001,10 @@ def _climb(points, ladders, start=None, crossed=_overturned):
     return first, done
 
 
-def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits=()):
-    """Ladder, bisection and scan of all structures under one record, and the slide
-    capacities of ``limits`` (see the public function; ``model`` as :func:`_run`'s)."""
+def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits=(), states=()):
+    """Ladder, bisection and scan of all structures under one record, the slide
+    capacities of ``limits`` and those of the damage ``states`` (see the public function;
+    ``model`` as :func:`_run`'s)."""
     n = st["critical_rotation"].size
     pga = record.peak
     if not pga > 0:
@@ -1003,10 +1033,15 @@ def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits
         lo[active[~over]] = s[~over]
     _scan(points, ladders, done, found, options.scan)
     band = [_switch_band(h, c) for h, c in zip(points.history, hi, strict=True)]
+    capacity_scale = np.where(found, hi, np.nan)
+    alpha = np.broadcast_to(st["critical_rotation"], (n,))
+    damage = ida_states.state_scales(
+        points, ladders, states, alpha, capacity_scale, options.tolerance
+    )
     slides = ida_slides.slide_scales(points, ladders, done, limits, options.tolerance, _climb)
     reason = np.where(found, 0, np.where(top < ceiling, 1, 2))
     return {
-        "capacity_scale": np.where(found, hi, np.nan),
+        "capacity_scale": capacity_scale,
         "capacity_scale_lower": lo,
         "censored_reason": reason,
         "highest_survival_scale": np.array([b[0] for b in band]),
@@ -1016,6 +1051,7 @@ def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits
         "status": points.status,
         "history": points.history,
         "slide_capacity_scale": slides,
+        "state_capacity_scale": damage,
     }
 
 

@@ -42,6 +42,7 @@ from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
 from .sliding import contact_section, regime_section
 from .sliding import section as sliding_section
+from .states import section as states_section
 
 __all__ = [
     "DESIGNS",
@@ -585,6 +586,7 @@ SECTIONS = [
     ro.object_fragility,
     risk_section,
     sliding_section,
+    states_section,
     contact_section,
     _section(
         "Intensity-measure efficiency",

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
+from .damage_states import damage_states
 from .design_kinds import DESIGN_KINDS, design_kind
 from .feasibility import DEFAULT_MAX_SCALE_FACTOR
 from .ida_options import IdaOptionError, IdaOptions
@@ -45,7 +46,11 @@ class DesignSpec(_Model):
     n angles k pi / n in [0, pi), or a list of angles [rad]) runs every record along each
     orientation psi of the objects' rocking plane, a_x cos(psi) + a_y sin(psi)
     (:meth:`rockstudy.motions.Record.oriented`): a dimension ``orientation`` of the design,
-    whose records need two horizontal components (``motion.h2``)."""
+    whose records need two horizontal components (``motion.h2``). ``damage_states``
+    ``{name = limit}`` are the damage states short of overturning
+    (:mod:`rockstudy.study.spec.damage_states`): a limit on the peak rotation ratio
+    abs(theta)/alpha in (0, 1] (1 = overturning), or ``{slide = d}`` on the peak slide [m]
+    (with the contact model)."""
 
     kind: Literal[tuple(DESIGN_KINDS)]
     periods: list[_Period] = Field(default=[], max_length=1000)
@@ -64,6 +69,7 @@ class DesignSpec(_Model):
     #: The orientations psi [rad] of the objects' rocking plane (:meth:`angles`): a dimension
     #: ``orientation`` of the design; each record then needs two horizontal components.
     orientations: int | list[float] | None = None
+    damage_states: dict[str, Any] = Field(default={}, max_length=100)
 
     @model_validator(mode="after")
     def _orientations(self):
@@ -91,6 +97,14 @@ class DesignSpec(_Model):
         if o is None:
             return None
         return np.pi * np.arange(o) / o if isinstance(o, int) else np.array(o, float)
+
+    @model_validator(mode="after")
+    def _damage_states(self):
+        try:  # the contact model a slide state needs is checked by the study
+            self.states()
+        except ValueError as exc:
+            raise FieldError("damage_states", str(exc).partition(": ")[2]) from None
+        return self
 
     @model_validator(mode="after")
     def _increasing_slide_limits(self):
@@ -121,6 +135,19 @@ class DesignSpec(_Model):
         for name in ida:  # the stored study shows every option the run used
             object.__setattr__(self, name, getattr(options, name))
         return self
+
+    def states(self, contact: bool = True) -> tuple:
+        """The damage states (:func:`.damage_states.damage_states`); ``contact``: whether
+        the contact model runs (a slide state needs it)."""
+        return damage_states(self.damage_states, model=contact)
+
+    def slide_states_need_contact(self) -> None:
+        """A FieldError naming ``design.damage_states`` if a state is on the slide (the
+        contact model's max_slide, which Housner's model does not give)."""
+        try:
+            self.states(contact=False)
+        except ValueError as exc:
+            raise FieldError("design.damage_states", str(exc).partition(": ")[2]) from None
 
     def ida(self) -> IdaOptions:
         """The IDA's options (defaults filled in)."""

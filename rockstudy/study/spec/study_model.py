@@ -124,6 +124,8 @@ class Study(_Model):
                     "needs the contact model's max_slide: give [run] model = 'contact' or "
                     "'auto' (with friction)",
                 )
+            if self.design is not None:
+                self.design.slide_states_need_contact()
             return self
         self._contact_structures()
         mu = self.friction_coefficients()
