@@ -21,6 +21,7 @@ from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
+from ..designs.records import failed_points
 from ..spec.design_kinds import DESIGN_KINDS, design_kind, kind_of
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from . import objects as ro
@@ -123,8 +124,9 @@ def _summary(page, ds, relabel=str):
         "records": int(ds.sizes["record"]),
         "structures": int(ds.sizes["structure"]),
         "simulations": int(ds.attrs.get("n_simulations", 0)),
-        "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
+    for name, n in failed_points(ds["status"].values).items():
+        rows[f"points that failed ({name})"] = n
     if kind.scaled:
         rows["scaling measure"] = relabel(
             im_label(
