@@ -77,6 +77,7 @@ def _stripes():
     status = np.zeros(shape, np.int64)
     status[0, 1, 2] = STATUS_UNCONVERGED
     status[1, 0, 0] = STATUS_MAX_STEPS
+    status[1, 1, 1] = rd.STATUS_FREE_FALL
     return xr.Dataset(
         {
             "regime": (dims, np.full(shape, 2, np.int8)),
@@ -107,3 +108,4 @@ def test_the_report_counts_unconverged_points_apart_from_the_step_limit(tmp_path
     rows = pd.read_csv(tmp_path / "summary.csv", index_col=0)["value"]
     assert int(rows["points that failed (step limit)"]) == 1
     assert int(rows["points that failed (not converged)"]) == 1
+    assert int(rows["points not run (free fall)"]) == 1
