@@ -20,6 +20,9 @@ CONDITIONING_OUTPUTS = outputs.names("conditioning")
 #: Returned by default with ``model="contact"`` or ``"auto"`` (and only then): the slip and
 #: the regimes, by the contact model (:func:`.contact_model.contact_outputs`).
 SLIDE_OUTPUTS = outputs.names("contact_model")
+#: Returned only when ``outputs`` names them, with ``model="auto"``: Housner's decision and
+#: status of every row, which "auto" computes before the contact model answers some rows.
+ROCKING_OUTPUTS = outputs.names("rocking_only")
 
 
 #: long name and CF units of the inputs and outputs of :func:`simulate_batch`
@@ -59,7 +62,7 @@ def requested_outputs(outputs, model="rocking", friction=False):
     default :data:`OUTPUTS`, with ``friction`` the friction check (:data:`CONTACT_OUTPUTS`;
     under ``model="contact"`` its ``lift_off`` only: the demand needs Housner's model run
     with a history), and under the contact model :data:`SLIDE_OUTPUTS`."""
-    allowed = OUTPUTS + CONTACT_OUTPUTS + SLIDE_OUTPUTS + CONDITIONING_OUTPUTS
+    allowed = OUTPUTS + CONTACT_OUTPUTS + SLIDE_OUTPUTS + CONDITIONING_OUTPUTS + ROCKING_OUTPUTS
     if outputs is None:
         check = ("lift_off",) if model == "contact" else CONTACT_OUTPUTS
         slides = SLIDE_OUTPUTS if model != "rocking" else ()
@@ -73,6 +76,11 @@ def requested_outputs(outputs, model="rocking", friction=False):
         raise ValueError(
             f"outputs: {sorted(set(names) & set(SLIDE_OUTPUTS))} come from the contact model: "
             "give friction= and model='contact' or 'auto'"
+        )
+    if model != "auto" and set(names) & set(ROCKING_OUTPUTS):
+        raise ValueError(
+            f"outputs: {sorted(set(names) & set(ROCKING_OUTPUTS))} keep Housner's answer "
+            f"under model='auto', which runs it before the contact model, not model={model!r}"
         )
     if model != "rocking" and "conditioning" in names:
         raise ValueError(

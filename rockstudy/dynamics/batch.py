@@ -323,7 +323,9 @@ def simulate_batch(
         ``status`` 1 where its reference stopped at its cap of phases. Rows Housner's model
         answered have no slip (0; NaN, with ``first_slip_time``, where the block overturned:
         the fall's slip lies outside that model) and ``regime`` 0 or 2. ``conditioning`` is
-        refused with these models.
+        refused with these models. Under ``"auto"``, ``outputs`` may also name
+        ``overturned_rocking`` and ``status_rocking``: Housner's decision and its kernel's
+        status on every row, the rocking-only answer that "auto" computes first.
     orientation : float or array_like, optional
         The angle psi [rad] of each row's rocking plane, as :func:`rockstudy.simulate`'s (rows
         grouped by angle, a batch each; a dataset gains the ``orientation`` coordinate).
@@ -391,7 +393,7 @@ def simulate_batch(
         return _auto_rows(rows, motion, rtol, max_steps, linear_ok, demand)
 
     out, codes = _unsolved(n) if _contact_only(wanted, model) else solve(rows, check)
-    cols = _columns(out, codes)
+    cols = _columns(out, codes, housner=model == "auto")
     if "conditioning" in wanted:
         cols["conditioning"] = _conditioning(out, solve(_perturbed_rows(rows))[0])
     if check:
@@ -434,11 +436,16 @@ def _controls(method, rtol, max_steps, half_diagonal, frequency_parameter):
     return rtol, max_steps
 
 
-def _columns(out, codes) -> dict:
+def _columns(out, codes, housner=False) -> dict:
     """The kernels' rows ``out`` (:data:`.outputs.KERNEL_ROW`) and the model ``codes`` as
-    output arrays (copies: the contact model's pass overwrites rows)."""
+    output arrays (copies: the contact model's pass overwrites rows); with ``housner`` (under
+    ``model="auto"``) also Housner's answer as ``overturned_rocking`` and ``status_rocking``,
+    kept before the friction check and the contact model write over its rows."""
     cols = {name: np.array(out[name]) for name in out.dtype.names}
     cols["model"] = codes.copy()
+    if housner:
+        cols["overturned_rocking"] = cols["overturned"].astype(bool)
+        cols["status_rocking"] = cols["status"].copy()
     return cols
 
 

@@ -44,9 +44,10 @@ KERNEL_MODELS = MODELS[:4]
 #: Where an output is computed: in every batch kernel's row (``kernel``), by
 #: :func:`simulate_batch` around the kernels (``batch``), by its contact pass (``contact``: the
 #: friction check of Housner's model), by the contact model (``contact_model``: with
-#: ``model="contact"`` or ``"auto"``) or by its conditioning pass (``conditioning``), or by a
-#: study from another output (``study``).
-STAGES = ("kernel", "batch", "contact", "contact_model", "conditioning", "study")
+#: ``model="contact"`` or ``"auto"``) or by its conditioning pass (``conditioning``), by a
+#: study from another output (``study``), or kept of Housner's answer under ``model="auto"``
+#: before the contact model writes over its rows (``rocking_only``, asked for by name).
+STAGES = ("kernel", "batch", "contact", "contact_model", "conditioning", "study", "rocking_only")
 
 
 @dataclass(frozen=True)
@@ -245,6 +246,26 @@ OUTPUTS = {
             "i1",
             models=_SLIDING_MODELS,
             stage="contact_model",
+        ),
+        # Housner's answer of every row under model="auto" (which runs it first): opt-in
+        _int(
+            "overturned_rocking",
+            "bool",
+            "overturned (1) or survived (0) under Housner's rocking-only model, which "
+            "model='auto' runs first on every row",
+            "i1",
+            models=(*KERNEL_MODELS, "rest"),
+            stage="rocking_only",
+            in_study=False,
+        ),
+        _int(
+            "status_rocking",
+            "i8",
+            "status of Housner's rocking-only model on the row (its kernel's: 0 ok, 1 step "
+            "limit), which model='auto' runs first on every row",
+            models=(*KERNEL_MODELS, "rest"),
+            stage="rocking_only",
+            in_study=False,
         ),
         _f8(
             "conditioning",

@@ -34,12 +34,14 @@ import pandas as pd
 import xarray as xr
 
 from ...dynamics.batch import MODEL_CONTACT
+from ...dynamics.constants import STATUS_UNCONVERGED
 from ..designs.records import IDA_ROCKING_VARIABLES
 from ..spec.design_kinds import kind_of
 from . import record_fragility as rf
 from .risk import object_risk
 
 __all__ = [
+    "NOT_CONVERGED",
     "REGIME_NAMES",
     "contact_effect",
     "exceeds_slide",
@@ -53,6 +55,8 @@ __all__ = [
 
 #: The ``regime`` output of the contact model (the most involved regime a scene entered).
 REGIME_NAMES = {0: "rest", 1: "slide", 2: "rock", 3: "slide-rock", 4: "flight"}
+#: What :func:`regimes` says of a point whose contact model answer did not converge.
+NOT_CONVERGED = "not converged"
 
 
 def slide_limits(ds: xr.Dataset, limits=None) -> np.ndarray:
@@ -261,17 +265,21 @@ def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Data
 def regimes(ds: xr.Dataset) -> pd.DataFrame:
     """Which regime each record drove each object into: the ``regime`` output (the most
     involved regime entered, :data:`REGIME_NAMES`) as names, index (object, record), one
-    column (a cloud) or one per level (stripes); "not run" where a point did not run."""
+    column (a cloud) or one per level (stripes); "not converged" where the contact model's
+    answer did not converge with rtol (``status`` 4), "not run" where a point did not run
+    (or failed otherwise)."""
     if "regime" not in ds:
         raise ValueError("ds: holds no regime: run the design with the contact model")
     dims = [k for k in ("structure", "record", "level") if k in ds["regime"].dims]
     code = ds["regime"].where(ds["status"] == 0).transpose(*dims).values
+    unconverged = (ds["status"] == STATUS_UNCONVERGED).transpose(*dims).values
     text = np.vectorize(
         lambda c: "not run" if np.isnan(c) else REGIME_NAMES.get(int(c), "?"), otypes=[object]
     )
+    names = np.where(unconverged, NOT_CONVERGED, text(code))
     index = pd.MultiIndex.from_product(
         [ds["structure"].values, ds["record"].values], names=["structure", "record"]
     )
     columns = ds["level"].values if "level" in dims else ["regime"]
     n = len(index)
-    return pd.DataFrame(text(code).reshape(n, -1), index=index, columns=columns)
+    return pd.DataFrame(names.reshape(n, -1), index=index, columns=columns)

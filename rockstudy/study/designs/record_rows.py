@@ -197,11 +197,15 @@ def outputs(study) -> dict:
         for name in rd.MODEL_KEYS:
             o = _outputs.OUTPUTS[name]
             out[name] = (o.long_name, o.units, o.store_dtype, o.fill, None)
+    if study.run.model != "rocking":  # rd._friction_variables: the contact of each object
+        for name in ("friction_static", "friction_kinetic"):
+            out[name] = (name.replace("_", " ") + " coefficient", "1", "f8", np.nan, None)
     if study.run.model == "auto" and not kind.capacities:  # rd.ROCKING_KEYS
         long_name = "overturned (1) under Housner's rocking-only model; -1 if failed"
         out["overturned_rocking"] = (long_name, *_RUN["overturned"][1:], None)
     out["kernel_status"] = (
-        "0 ok; 1 a simulation hit the step limit; 2 not run: free fall",
+        "0 ok; 1 a simulation hit the step limit; 2 not run: free fall; 4 the contact model's "
+        "answer did not converge with rtol (an IDA: the OR of its points' codes)",
         "1",
         "i8",
         -1,
@@ -485,6 +489,14 @@ def _run_design(study, record, structures, levels, friction):
     return getattr(rd, kind.run)([record], structures, **kw)
 
 
+def _structure_friction(pairs, st_ids) -> tuple:
+    """(mu_s, mu_k) of the structures ``st_ids`` from the study's
+    :meth:`~rockstudy.study.spec.Study.friction_pairs` (one pair: the study's, as floats)."""
+    if pairs[0].size == 1:
+        return float(pairs[0][0]), float(pairs[1][0])
+    return pairs[0][st_ids], pairs[1][st_ids]
+
+
 def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     """Outputs of design rows (any subset of one or more records' rows): one design call per
     record on the structures and levels the rows name. Raises if a design call does."""
@@ -493,7 +505,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
     result = empty_rows(study, cols["sample"].size)
     on_levels = design_kind(study.design.kind).levels
     levels_all = study.motion.scale_to.levels() if on_levels else np.ones(1)
-    friction = study.friction_coefficients()
+    friction = study.friction_pairs()
     for r in np.unique(cols["record"]):
         rows = np.flatnonzero(cols["record"] == r)
         rec = design_motion(study, base_dir, int(r))
@@ -506,8 +518,7 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "uplift_acceleration": uplift_column(study, cols, first),
         }
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
-        mu = friction if friction is None or friction.size > 1 else float(friction[0])
-        mu = mu[st_ids] if isinstance(mu, np.ndarray) else mu
+        mu = None if friction is None else _structure_friction(friction, st_ids)
         ds = _run_design(study, rec, structures, levels_all[lev_ids], mu)
         _fill(result, outs, ds, rows, st_pos, lev_pos, width)
     return result

@@ -38,6 +38,7 @@ from ...dynamics import outputs as _outputs
 from ...dynamics import simulate_batch
 from ...dynamics._vertical import uplift_ratio
 from ...dynamics.batch import CONTACT_OUTPUTS, MODEL_CONTACT, SLIDE_OUTPUTS
+from ...dynamics.constants import STATUS_MAX_STEPS, STATUS_UNCONVERGED
 from ...dynamics.methods import MAX_STEPS
 from ...dynamics.simulate import check_friction
 from ...motions import Record
@@ -59,6 +60,8 @@ __all__ = [
     "CENSORED_REASONS",
     "cf_flags",
     "cloud",
+    "failed_points",
+    "FAILURES",
     "incremental_dynamic_analysis",
     "multiple_stripes",
     "record_labels",
@@ -201,6 +204,8 @@ def _friction_check(friction, contact, n: int) -> bool:
         )
     if friction is None:
         return bool(contact)
+    if isinstance(friction, tuple):  # (mu_s, mu_k): each checked as one mu (their order by
+        return all(_friction_check(f, None, n) for f in _friction_pair(friction))  # the model)
     if np.ndim(friction) == 0:
         check_friction(friction)
         return True
@@ -325,7 +330,9 @@ def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None,
     """simulate_batch on the structures ``idx`` (array) at ``scales`` (same length);
     ``model`` = (model, friction of each structure) runs the contact model
     (:func:`rockstudy.simulate_batch`'s ``model`` and ``friction``)."""
-    contact_model = {} if model is None else {"model": model[0], "friction": model[1][idx]}
+    contact_model = {}
+    if model is not None:
+        contact_model = {"model": model[0], "friction": (model[1][0][idx], model[1][1][idx])}
     return simulate_batch(
         frequency_parameter=structures["frequency_parameter"][idx],
         critical_rotation=structures["critical_rotation"][idx],
@@ -340,22 +347,55 @@ def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None,
     )
 
 
+def _friction_pair(friction) -> tuple:
+    """(mu_s, mu_k) of a design's ``friction``: a tuple (mu_s, mu_k) as
+    :func:`rockstudy.simulate_batch` takes it (each one or one per structure), else
+    (friction, friction)."""
+    if not isinstance(friction, tuple):
+        return friction, friction
+    if len(friction) != 2:
+        raise ValueError(f"friction: a tuple is (mu_s, mu_k), got {len(friction)} values")
+    return friction
+
+
 def _contact_model(model, friction, n):
-    """(model, friction of each of the n structures) for :func:`_run`, or None under
-    Housner's model (``model="rocking"``, where ``friction`` gives the friction check only);
-    a ValueError naming the argument otherwise (the contact model needs every mu)."""
+    """(model, (mu_s, mu_k) of each of the n structures: shape (2, n)) for :func:`_run`, or
+    None under Housner's model (``model="rocking"``, where ``friction`` gives the friction
+    check only); a ValueError naming the argument otherwise (the contact model needs every
+    mu, and mu_s >= mu_k)."""
     if model == "rocking":
         return None
     if model not in ("contact", "auto"):
         raise ValueError(f"model must be 'rocking', 'contact' or 'auto', got {model!r}")
     if friction is None:
         raise ValueError(f"model={model!r} runs the contact model, which needs friction=")
-    mu = np.asarray(friction, dtype=float)
-    if mu.ndim > 1 or mu.size not in (1, n):
-        raise ValueError(f"friction: give one coefficient or one per structure ({n})")
-    if np.isnan(mu).any():
-        raise ValueError(f"friction: model={model!r} needs a coefficient for every structure")
-    return model, np.broadcast_to(mu.ravel(), (n,))
+    pair = []
+    for mu in map(np.asarray, _friction_pair(friction)):
+        if mu.ndim > 1 or mu.size not in (1, n):
+            raise ValueError(f"friction: give one coefficient or one per structure ({n})")
+        if np.isnan(mu.astype(float)).any():
+            raise ValueError(f"friction: model={model!r} needs a coefficient for every structure")
+        pair.append(np.broadcast_to(mu.astype(float).ravel(), (n,)))
+    if np.any(pair[1] > pair[0]):
+        j = int(np.flatnonzero(pair[1] > pair[0])[0])
+        raise ValueError(
+            f"friction: structure {j}: the kinetic coefficient {pair[1][j]!r} exceeds the "
+            f"static {pair[0][j]!r} (give (mu_s, mu_k) with mu_s >= mu_k)"
+        )
+    return model, np.stack(pair)
+
+
+def _friction_variables(ds, model):
+    """``ds`` with ``friction_static`` and ``friction_kinetic`` (mu_s, mu_k of each structure)
+    under the contact model (``model`` of :func:`_contact_model`)."""
+    if model is not None:
+        for name, mu in zip(("friction_static", "friction_kinetic"), model[1], strict=True):
+            ds[name] = (
+                "structure",
+                np.array(mu),
+                {"units": "1", "long_name": name.replace("_", " ") + " coefficient"},
+            )
+    return ds
 
 
 #: What a design keeps of the contact model: the model of each point, its slip and regimes.
@@ -367,6 +407,8 @@ STEP_MODEL_VARIABLES = tuple(f"step_{k}" for k in MODEL_KEYS)
 #: Kept under ``model="auto"`` besides :data:`MODEL_KEYS`: Housner's overturning decision of
 #: every point (the rocking-only answer, which "auto" computes first).
 ROCKING_KEYS = ("overturned_rocking",)
+#: The batch outputs of Housner's answer under ``model="auto"`` (its decision and status).
+HOUSNER_OUTPUTS = ("overturned_rocking", "status_rocking")
 
 
 def _keys(contact, model):
@@ -374,22 +416,24 @@ def _keys(contact, model):
     :data:`MODEL_KEYS` under the contact model (``model`` not None) and :data:`ROCKING_KEYS`
     under ``"auto"``."""
     keys = _OUT + (CONTACT_OUTPUTS if contact else ()) + (() if model is None else MODEL_KEYS)
-    return keys + (ROCKING_KEYS if model is not None and model[0] == "auto" else ())
+    return keys + (ROCKING_KEYS if _auto(model) else ())
 
 
-def _rocking_decision(record, st, idx, scales, method, rtol, max_steps, run):
+def _auto(model) -> bool:
+    """Whether ``model`` (:func:`_contact_model`'s) is ``"auto"``."""
+    return model is not None and model[0] == "auto"
+
+
+def _rocking_decision(run):
     """Housner's ``overturned`` of each point of an ``"auto"`` run ``run`` (int8, -1 where
-    Housner's model failed: its status not 0): its own where Housner's model answered,
-    Housner's model run again on the points the contact model answered (``model`` 3, or 4
-    by its reference; the rocking kernel: a small cost beside the contact model's)."""
-    decision = np.asarray(run["overturned"], np.int8).copy()
+    Housner's model failed): the batch's ``overturned_rocking``, -1 where its
+    ``status_rocking`` is not 0 on a point the contact model answered (``model`` 3, or 4 by
+    its reference) and where the point's ``status`` is not 0 on the others (Housner's
+    answer, its friction check included)."""
+    decision = np.asarray(run["overturned_rocking"], np.int8).copy()
     answered = np.asarray(run["model"]) >= MODEL_CONTACT
-    decision[~answered & (np.asarray(run["status"]) != 0)] = -1
-    again = np.flatnonzero(answered)
-    if again.size:
-        wanted = ("overturned", "status")
-        out = _run(record, st, idx[again], scales[again], method, rtol, max_steps, wanted)
-        decision[again] = np.where(out["status"] != 0, -1, out["overturned"])
+    status = np.where(answered, run["status_rocking"], run["status"])
+    decision[status != 0] = -1
     return decision
 
 
@@ -397,6 +441,16 @@ _OUT = ("max_rotation", "overturned", "n_impacts", "overturn_time", "status")
 #: ``status`` of a stripe point not run: its scaled vertical reaches -g (free fall), where
 #: Housner's model does not apply; the point is censored (``censored``), the others run.
 STATUS_FREE_FALL = 2
+#: The failures a design's ``status`` names, by the bit of the code that says each (a point's
+#: status is its batch row's; an IDA's, per record and structure, the OR of its points').
+FAILURES = {STATUS_MAX_STEPS: "step limit", STATUS_UNCONVERGED: "not converged"}
+
+
+def failed_points(status) -> dict:
+    """{failure name of :data:`FAILURES`: the number of entries of ``status`` (a design's)
+    that carry it}."""
+    status = np.asarray(status, np.int64)
+    return {name: int(np.count_nonzero(status & code)) for code, name in FAILURES.items()}
 
 
 def _run_below_free_fall(
@@ -429,10 +483,10 @@ def _run_below_free_fall(
         wanted = None
         if contact or model is not None:
             wanted = tuple(k for k in keys if k not in ROCKING_KEYS)
+            wanted += HOUSNER_OUTPUTS if _auto(model) else ()
         run = _run(record, st, idx[ok], scales[ok], method, rtol, max_steps, wanted, model)
         if ROCKING_KEYS[0] in keys:
-            args = (method, rtol, max_steps, run)
-            run[ROCKING_KEYS[0]] = _rocking_decision(record, st, idx[ok], scales[ok], *args)
+            run[ROCKING_KEYS[0]] = _rocking_decision(run)
         for k in keys:
             out[k][ok] = run[k]
     return out
@@ -478,9 +532,12 @@ def cloud(
         Damping ratio of ``sa`` and the spectrum intensity.
     method, rtol, max_steps
         As in :func:`rockstudy.simulate_batch`.
-    friction : float or array_like, optional
+    friction : float or array_like or tuple, optional
         The friction coefficient mu in (0, 10] (one, or one per structure; NaN: none for that
-        structure), as ``simulate(friction=)`` and a study's ``friction``: the design then
+        structure), or a tuple (mu_s, mu_k) of them with mu_s >= mu_k (the contact model's
+        static and kinetic coefficients, stored as ``friction_static`` and
+        ``friction_kinetic`` on ``structure`` under it), as ``simulate(friction=)`` and a
+        study's ``friction``: the design then
         also gives ``friction_demand`` (max abs(F_h / F_v) at the contact; below uplift
         max abs(u_h'') / g) and ``lift_off`` of every point, as
         :attr:`rockstudy.RockingResult.friction_demand` (each point that lifts is run again
@@ -526,6 +583,7 @@ def cloud(
     for k in _keys(contact, model):
         ds[k] = (("record", "structure"), np.array([o[k] for o in outs]))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
+    ds = _friction_variables(ds, model)
     n_run = int((~ds["censored"]).sum())
     ds.attrs.update(design="cloud", method=method, rtol=rtol, n_simulations=n_run)
     return _with_states(ds, states)
@@ -611,6 +669,7 @@ def multiple_stripes(
     for k in _keys(contact, model):
         ds[k] = (dims, np.array([o[k] for o in outs]).reshape(len(records), n, levels.size))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
+    ds = _friction_variables(ds, model)
     ds.attrs.update(
         design="stripes",
         im=im,
@@ -744,7 +803,9 @@ def incremental_dynamic_analysis(
         capacity survived), ``highest_survival_scale`` (the highest such scale: the top of the
         switch band; NaN if none), ``switch_band_overturn_share`` (share of the simulated
         scales inside the switch band that overturn), ``rungs`` (ladder rungs simulated),
-        ``simulations`` and ``status`` (0 ok; 1 if a simulation hit the step limit). On
+        ``simulations`` and ``status`` (0 ok; else the OR of its points' batch codes: 1 a
+        simulation hit the step limit, 4 the contact model's answer did not converge, as
+        :data:`FAILURES` names them). On
         (record, structure, step), in increasing scale (NaN-padded): every simulated point,
         ``step_scale``, ``step_max_rotation``, ``step_overturned`` and ``step_kind``
         (:data:`STEP_KINDS`): the IDA curves; under the contact model also ``step_<name>``
@@ -778,15 +839,19 @@ def incremental_dynamic_analysis(
             records, st, ds, method, rtol, max_steps
         )
     ds["capacity"] = _capacity(ds["capacity_scale"], ds["censored"], measure, im)
-    if model is not None and model[0] == "auto":
+    if _auto(model):  # Housner's ladder, from the answers the "auto" points gave on the way
         housner = (options, method, rtol, max_steps, None, NO_LIMITS)
-        rocking = [_ida_record(r, st, *housner) for r in records]
+        rocking = [
+            _ida_record(r, st, *housner, known=res["housner"])
+            for r, res in zip(records, results, strict=True)
+        ]
         ds = _ida_rocking(ds, rocking, measure, im)
     if limits.size:
         ds = ida_slides.slide_tables(ds, results, limits, measure, _ms.power(im))
     if states:
         ds = ida_states.state_tables(ds, results, states, measure, _ms.power(im))
     ds["censored_reason"].attrs.update(cf_flags(CENSORED_REASONS))
+    ds = _friction_variables(ds, model)
     ds.attrs.update(
         design="ida",
         **options.attrs(),
@@ -921,7 +986,7 @@ def _rest_slope(st, model):
     linearized rest level alpha; under the contact model (``model``) also mu_s, below which
     the base cannot slip."""
     alpha = st["critical_rotation"]
-    return alpha if model is None else np.minimum(alpha, model[1])
+    return alpha if model is None else np.minimum(alpha, model[1][0])
 
 
 def _ladder(low, top, ceiling, q):
@@ -937,9 +1002,15 @@ def _ladder(low, top, ceiling, q):
 class _Points:
     """Runs batches of (structure, scale) points of one record and keeps every outcome: a
     row (scale, max_rotation, overturned, kind[, the contact model's :data:`MODEL_KEYS`])
-    per point (``model``: as :func:`_run`'s)."""
+    per point (``model``: as :func:`_run`'s).
 
-    def __init__(self, record, st, method, rtol, max_steps, model=None):
+    Under ``model="auto"`` it also keeps Housner's decision and status of each point
+    (:data:`HOUSNER_OUTPUTS`, computed by "auto" first) in :attr:`housner`: {scale:
+    (overturned, status)} per structure; Housner's ladder of the same record (``model``
+    None) is given them as ``known`` and runs only the points not among them (their
+    ``max_rotation``, which no caller of Housner's ladder reads, is NaN in its history)."""
+
+    def __init__(self, record, st, method, rtol, max_steps, model=None, known=None):
         n = st["critical_rotation"].size
         self.args = (record, st, method, rtol, max_steps)
         self.model = model
@@ -947,17 +1018,49 @@ class _Points:
         self.history = [[] for _ in range(n)]
         self.sims = np.zeros(n, np.int64)
         self.status = np.zeros(n, np.int64)
+        self.housner = [{} for _ in range(n)] if known is None else known
 
     def outcomes(self, idx, scales, kind) -> dict:
         """The outputs (:attr:`keys`) of the structures ``idx`` at ``scales``, kept."""
-        record, st, method, rtol, max_steps = self.args
-        out = _run(record, st, idx, scales, method, rtol, max_steps, self.keys, self.model)
+        out = self._housner_outcomes(idx, scales) if self.model is None else self._run(idx, scales)
         extra = [np.asarray(out[k], float) for k in self.keys[len(_IDA_OUT) :]]
         for r, (j, s) in enumerate(zip(idx, scales, strict=True)):
             point = (s, out["max_rotation"][r], float(out["overturned"][r]), kind)
             self.history[j].append(point + tuple(float(e[r]) for e in extra))
         np.add.at(self.sims, idx, 1)
-        self.status[idx] |= out["status"] != 0
+        np.bitwise_or.at(self.status, idx, np.asarray(out["status"], np.int64))
+        return out
+
+    def _run(self, idx, scales) -> dict:
+        """:func:`_run` on the points, keeping Housner's answer under ``"auto"``."""
+        record, st, method, rtol, max_steps = self.args
+        keys = self.keys + (HOUSNER_OUTPUTS if _auto(self.model) else ())
+        out = _run(record, st, idx, scales, method, rtol, max_steps, keys, self.model)
+        if _auto(self.model):
+            answers = zip(
+                idx, scales, out["overturned_rocking"], out["status_rocking"], strict=True
+            )
+            for j, s, over, status in answers:
+                self.housner[j][s] = (bool(over), int(status))
+        return out
+
+    def _housner_outcomes(self, idx, scales) -> dict:
+        """Housner's outputs of the points: those of :attr:`housner` as known, the others
+        run."""
+        record, st, method, rtol, max_steps = self.args
+        known = np.array([s in self.housner[j] for j, s in zip(idx, scales, strict=True)], bool)
+        out = {
+            "max_rotation": np.full(idx.size, np.nan),
+            "overturned": np.zeros(idx.size, bool),
+            "status": np.zeros(idx.size, np.int64),
+        }
+        for r in np.flatnonzero(known):
+            out["overturned"][r], out["status"][r] = self.housner[idx[r]][scales[r]]
+        if not known.all():
+            new = ~known
+            run = _run(record, st, idx[new], scales[new], method, rtol, max_steps, self.keys)
+            for k, values in out.items():
+                values[new] = run[k]
         return out
 
     def column(self, name) -> int:
@@ -1001,10 +1104,13 @@ def _climb(points, ladders, start=None, crossed=_overturned):
     return first, done
 
 
-def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits=(), states=()):
+def _ida_record(
+    record, st, options, method, rtol, max_steps, model=None, limits=(), states=(), known=None
+):
     """Ladder, bisection and scan of all structures under one record, the slide
     capacities of ``limits`` and those of the damage ``states`` (see the public function;
-    ``model`` as :func:`_run`'s)."""
+    ``model`` as :func:`_run`'s; ``known``: Housner's answers of ``"auto"`` points, as
+    :class:`_Points` takes them)."""
     n = st["critical_rotation"].size
     pga = record.peak
     if not pga > 0:
@@ -1013,7 +1119,7 @@ def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits
     top = options.max_pga_ratio * st["uplift_acceleration"] / pga
     low = np.broadcast_to(_rest_scale(record, _rest_slope(st, model), ceiling), (n,))
     ladders = [_ladder(low[j], top[j], ceiling, 1.0 + options.step) for j in range(n)]
-    points = _Points(record, st, method, rtol, max_steps, model)
+    points = _Points(record, st, method, rtol, max_steps, model, known)
     first, done = _climb(points, ladders)
     found = first >= 0
     hi, lo = np.full(n, np.nan), np.full(n, np.nan)
@@ -1052,6 +1158,7 @@ def _ida_record(record, st, options, method, rtol, max_steps, model=None, limits
         "history": points.history,
         "slide_capacity_scale": slides,
         "state_capacity_scale": damage,
+        "housner": points.housner,
     }
 
 

@@ -21,6 +21,7 @@ from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import BAND_COLUMNS, N_BOOT
 from ..analysis.sampled import fragility_curve
+from ..designs.records import STATUS_FREE_FALL, failed_points
 from ..spec.design_kinds import DESIGN_KINDS, design_kind, kind_of
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
 from . import floors
@@ -125,8 +126,11 @@ def _summary(page, ds, relabel=str):
         "records": int(ds.sizes["record"]),
         "structures": int(ds.sizes["structure"]),
         "simulations": int(ds.attrs.get("n_simulations", 0)),
-        "points that failed (step limit)": int((ds["status"].values != 0).sum()),
     }
+    for name, n in failed_points(ds["status"].values).items():
+        rows[f"points that failed ({name})"] = n
+    if not kind.capacities:  # a stripe point whose scaled vertical reaches -g is not run
+        rows["points not run (free fall)"] = int((ds["status"].values == STATUS_FREE_FALL).sum())
     if kind.scaled:
         rows["scaling measure"] = relabel(
             im_label(

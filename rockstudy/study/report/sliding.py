@@ -43,6 +43,7 @@ def section(page, ctx):
     if not (_contact(ctx) and ctx.objects):
         return
     page.heading("Sliding: fragility and annual rates per slide limit")
+    _friction(page, ctx)
     limits = _limits(ctx)
     if limits is None:
         page.text(
@@ -70,6 +71,28 @@ def section(page, ctx):
     page.table(_fragility_table(table, ctx.units), "slide_fragility", _FRAGILITY_CAPTION)
     if ctx.hazard is not None:
         _rates(page, ctx, limits)
+
+
+def _friction(page, ctx):
+    """The friction coefficients (mu_s, mu_k) of each object, as the design ran them."""
+    ds = ctx.ds
+    if "friction_static" not in ds:
+        return
+    columns = {"friction_static": "mu_s (static)", "friction_kinetic": "mu_k (kinetic)"}
+    frame = pd.DataFrame(
+        {
+            label: ds[name].max([d for d in ds[name].dims if d != "structure"]).values
+            for name, label in columns.items()
+        },
+        index=pd.Index([str(v) for v in ds["structure"].values], name="object"),
+    )
+    page.table(
+        frame,
+        "friction",
+        "The friction of each object's contact under the contact model: slip starts where "
+        "the friction force would exceed mu_s times the normal force, and the friction force "
+        "while it slips is mu_k times it",
+    )
 
 
 _FRAGILITY_CAPTION = "Fragility of sliding of each object per slide limit d (90 % bands)"
@@ -248,5 +271,6 @@ def regime_section(page, ctx):
         "regimes",
         "The most involved regime of the contact model each record drove each object into "
         "(rest < slide < rock < slide-rock < flight), per stripe level where the records are "
-        "scaled; 'not run': the point did not run",
+        "scaled; 'not converged': the contact model's answer did not converge with rtol (the "
+        "point is left out of the fits); 'not run': the point did not run or failed otherwise",
     )

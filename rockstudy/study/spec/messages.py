@@ -58,6 +58,7 @@ _MUST_BE = {
     "int_from_float": "an integer",
     "finite_number": "a finite number",
     "string_type": "a string",
+    "tuple_type": "a list of two numbers",
     "bool_type": "true or false",
     "list_type": "a list",
     "model_type": "a table",

@@ -16,7 +16,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, PrivateAttr, create_model, field_validator, model_validator
 
-from ...dynamics.simulate import MAX_FRICTION
+from .friction_spec import Friction, as_pair, coefficient, friction_pair, friction_value
 from .parameters import MAX_STUDY_BYTES, _a_name, _describe, _Model
 from .structures import KINDS, check_object, object_fields
 
@@ -35,10 +35,40 @@ class _ObjectBase(_Model):
 
     name: str = Field(min_length=1)
     kind: Literal[OBJECT_KINDS] = "block"
-    #: The friction coefficient mu of this object's contact (overrides the study's friction).
-    friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
+    #: The friction coefficient mu of this object's contact, or a pair [mu_s, mu_k]
+    #: (overrides the study's friction; :mod:`.friction_spec`).
+    friction: Friction | None = None
+    #: The kinetic coefficient mu_k beside a ``friction`` mu_s (an objects CSV file's way to
+    #: give the pair; needs the object's own ``friction``, a single number >= it).
+    friction_kinetic: float | None = None
     _params: tuple = PrivateAttr(default=None)
     _printable = field_validator("name")(lambda value: _a_name(value))
+    _pair = field_validator("friction", mode="before")(lambda value: as_pair(value))
+    _friction = field_validator("friction")(lambda value: friction_value(value))
+
+    @model_validator(mode="after")
+    def _kinetic(self):
+        """``friction_kinetic`` needs the object's ``friction`` as one number >= it."""
+        if self.friction_kinetic is not None:
+            if self.friction is None or isinstance(self.friction, tuple):
+                raise ValueError(
+                    "friction_kinetic (mu_k) needs the object's friction as one number (mu_s), "
+                    "not " + ("none" if self.friction is None else "a pair [mu_s, mu_k]")
+                )
+            kinetic = coefficient(self.friction_kinetic, "friction_kinetic (mu_k)")
+            if kinetic > self.friction:
+                raise ValueError(
+                    f"friction_kinetic (mu_k) {kinetic!r} exceeds the object's friction (mu_s) "
+                    f"{self.friction!r}: give mu_s >= mu_k"
+                )
+        return self
+
+    def friction_pair(self, default) -> tuple[float, float]:
+        """(mu_s, mu_k) of the object's contact: its own ``friction`` (with its
+        ``friction_kinetic``), else ``default`` (the study's; NaNs where neither gives one)."""
+        if self.friction_kinetic is not None:
+            return (self.friction, self.friction_kinetic)
+        return friction_pair(default if self.friction is None else self.friction)
 
     @model_validator(mode="after")
     def _shape(self):

@@ -19,7 +19,6 @@ from pydantic import BaseModel, Field, PrivateAttr, field_validator, model_valid
 
 from ... import _validate
 from ...constants import G
-from ...dynamics.simulate import MAX_FRICTION
 from ...motions import measures
 from ...motions.pulses import PERIOD_RANGE
 from ...structures.block import uplift_acceleration_block
@@ -27,6 +26,7 @@ from .design_kinds import design_kind
 from .design_spec import DesignSpec
 from .distributions import Distribution
 from .feasibility import draw_span as _draw_span
+from .friction_spec import Friction, as_pair, friction_pair, friction_value
 from .hazard_spec import HazardSpec
 from .motion_spec import MotionSpec
 from .parameters import _a_name, _largest, _Model, _smallest
@@ -56,10 +56,11 @@ class Study(_Model):
     design: DesignSpec | None = None
     hazard: HazardSpec | None = None
     run: RunSpec = RunSpec()
-    #: The friction coefficient mu of the contact (per object in an objects list): each scene
-    #: then stores ``friction_demand`` and ``lift_off``, and the scenes whose demand exceeds
-    #: mu (the block would slide) or that lift off are flagged, reported and warned about.
-    friction: float | None = Field(default=None, gt=0, le=MAX_FRICTION)
+    #: The friction coefficient mu of the contact, or a pair [mu_s, mu_k] (per object in an
+    #: objects list; :mod:`.friction_spec`): each scene then stores ``friction_demand`` and
+    #: ``lift_off``, and the scenes whose demand exceeds mu_s (the block would slide) or that
+    #: lift off are flagged, reported and warned about.
+    friction: Friction | None = None
     #: The study file's text as read (None for a study not read from text).
     _text: str | None = PrivateAttr(default=None)
     #: What will happen that the user should know before the run (not a problem): e.g. the
@@ -67,6 +68,8 @@ class Study(_Model):
     _notes: list = PrivateAttr(default_factory=list)
 
     _printable = field_validator("name")(lambda value: _a_name(value))
+    _pair = field_validator("friction", mode="before")(lambda value: as_pair(value))
+    _friction = field_validator("friction")(lambda value: friction_value(value))
 
     @property
     def source_text(self) -> str | None:
@@ -156,14 +159,22 @@ class Study(_Model):
             )
 
     def friction_coefficients(self) -> np.ndarray | None:
-        """The friction coefficient of each object (NaN where none is given), the study's
-        ``friction`` for sampled structures; None when no friction is given anywhere."""
+        """The (static) friction coefficient mu_s of each object (NaN where none is given),
+        the study's ``friction`` for sampled structures; None when no friction is given
+        anywhere. The friction check and ``"auto"``'s choice compare the demand with it."""
+        pairs = self.friction_pairs()
+        return None if pairs is None else pairs[0]
+
+    def friction_pairs(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(mu_s, mu_k) of each object (NaNs where none is given; :meth:`friction_coefficients`
+        for which), each array as long as that method's; None when no friction is given."""
         st = self.structure
         if st.kind == "objects":
-            mu = [self.friction if o.friction is None else o.friction for o in st.objects]
-            mu = np.array([np.nan if m is None else m for m in mu], float)
-            return None if np.isnan(mu).all() else mu
-        return None if self.friction is None else np.array([self.friction])
+            pairs = [o.friction_pair(self.friction) for o in st.objects]
+        else:
+            pairs = [friction_pair(self.friction)]
+        static, kinetic = (np.array(c, float) for c in zip(*pairs, strict=True))
+        return None if np.isnan(static).all() else (static, kinetic)
 
     @model_validator(mode="after")
     def _objects(self):
