@@ -41,6 +41,7 @@ from .objects import ReportContext, _fits, _section, _structure_title
 from .risk import section as risk_section
 from .sliding import contact_section, regime_section
 from .sliding import section as sliding_section
+from .two_body import section as two_body_section
 
 __all__ = [
     "DESIGNS",
@@ -583,6 +584,7 @@ SECTIONS = [
     ),
     ro.object_fragility,
     risk_section,
+    two_body_section,
     sliding_section,
     contact_section,
     _section(
