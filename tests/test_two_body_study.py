@@ -392,3 +392,42 @@ def test_compare_to_on_a_block_and_two_body_kinds_sampled_are_refused(tmp_path):
     )
     with pytest.raises(StudyError, match="structure.kind"):
         validate_text(sampled, base_dir=tmp_path)
+
+
+def test_stripes_run_the_isolated_object_at_each_scale_as_simulate_batch_does():
+    """The design's ``two_body`` column (as a study passes it): each stripe point of the
+    isolated object is simulate_batch(structure=) at the point's scale; the block beside it
+    keeps its own path and the two-body fills."""
+    from rockstudy.study.designs.records import multiple_stripes
+    from rockstudy.study.spec.structures import two_body_parameters
+
+    statue, _, isolator = _structures()
+    rec = unit_sine_record(2.0, half_diagonal=statue.half_diagonal)
+    rows = [
+        (statue.frequency_parameter, statue.slenderness, statue.restitution, G * 0.25),
+        two_body_parameters(isolator),
+    ]
+    p, theta, eta, a_up = np.array(rows).T
+    structures = dict(
+        frequency_parameter=p,
+        critical_rotation=theta,
+        restitution=eta,
+        uplift_acceleration=a_up,
+        two_body=[None, isolator],
+    )
+    ds = multiple_stripes([rec], structures, levels=[1.0, 3.0], im="pga")
+    scales = ds["scale"].isel(record=0, structure=1).values
+    run = simulate_batch(structure=isolator, record=rec, scale=scales, rtol=1e-8)
+    at = ds.isel(record=0, structure=1)
+    for k in ("max_rotation", "max_isolator_displacement", "overturned"):
+        np.testing.assert_allclose(at[k].values.astype(float), run[k].astype(float), rtol=1e-12)
+    block = ds.isel(record=0, structure=0)
+    assert np.isnan(block["max_isolator_displacement"]).all()
+    expected = simulate_batch(
+        frequency_parameter=p[0],
+        critical_rotation=theta[0],
+        restitution=eta[0],
+        record=rec,
+        scale=ds["scale"].isel(record=0, structure=0).values,
+    )
+    np.testing.assert_allclose(block["max_rotation"], expected["max_rotation"], rtol=1e-12)

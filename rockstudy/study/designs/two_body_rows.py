@@ -174,7 +174,7 @@ def ida_outputs(records, structures, ds, rtol, max_steps) -> dict:
 
 def ida_outputs_attributes() -> dict:
     """long_name and units of the two-body outputs of an IDA (at which scale each is)."""
-    where = {"overturned_body": "at capacity_scale (the first overturning)"}
+    where = {"overturned_body": "at capacity_scale (the first overturning; -1 if censored)"}
     return {
         k: {
             "long_name": f"{long_name}, {where.get(k, 'at capacity_scale_lower')}",
