@@ -20,12 +20,14 @@ from rockstudy.structures import (
     AsymmetricFrame,
     Block,
     ConicalShell,
+    IsolatedBlock,
     PointMassStrut,
     RockingWall,
+    StackedBlocks,
     SymmetricFrame,
 )
 from rockstudy.study.spec.schema import OBJECT_COLUMNS, OBJECT_KINDS, ObjectSpec, json_schema
-from rockstudy.study.spec.structures import KINDS
+from rockstudy.study.spec.structures import KINDS, TWO_BODY_KINDS
 
 #: kind -> (fields of a study object, the physics object built directly)
 EXAMPLES = {
@@ -45,6 +47,14 @@ EXAMPLES = {
         PointMassStrut(0.8, 0.25),
     ),
     "conical_shell": (dict(height=6.0, base_radius=1.0), ConicalShell(6.0, 1.0)),
+    "stacked": (
+        dict(width=0.4, height=1.6, plinth_width=0.8, plinth_height=1.0),
+        StackedBlocks(Block.from_dimensions(0.8, 1.0), Block.from_dimensions(0.4, 1.6)),
+    ),
+    "isolated": (
+        dict(width=0.4, height=1.6, period=2.0, damping=0.1, base_mass_ratio=1.0),
+        IsolatedBlock(Block.from_dimensions(0.4, 1.6), 1.0, 2.0, 0.1),
+    ),
 }
 
 
@@ -56,7 +66,7 @@ def _expected(structure):
 def test_every_kind_has_an_example_and_the_schema_takes_the_registry():
     assert set(EXAMPLES) == set(KINDS) == set(OBJECT_KINDS)
     fields = {f for k in KINDS.values() for f in k.fields}
-    assert set(OBJECT_COLUMNS) == fields | {"name", "kind", "friction", "friction_kinetic"}
+    assert set(OBJECT_COLUMNS) == fields | {"name", "kind", "friction", "friction_kinetic", "compare_to"}
     props = json_schema()["$defs"]["ObjectSpec"]["properties"]
     assert fields <= set(props)
 
@@ -132,8 +142,9 @@ def test_each_kind_in_a_design_has_the_parameters_of_the_papers_closed_forms(kin
 
 def test_every_kind_has_a_closed_form_but_the_arch():
     """The arch's equivalent block comes from its hinge search ([003] sec. 5.2 has no closed
-    form); its design columns are held to the physics class in the test below."""
-    assert set(CLOSED_FORMS) == set(KINDS) - {"arch"}
+    form); its design columns are held to the physics class in the test below. The two-body
+    kinds' are in test_two_body_study.py."""
+    assert set(CLOSED_FORMS) == set(KINDS) - {"arch", *TWO_BODY_KINDS}
 
 
 @pytest.mark.parametrize("kind", ["arch", "asymmetric_frame"])

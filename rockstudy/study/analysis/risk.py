@@ -349,7 +349,10 @@ def object_risk(
         uplift PGA: what the lognormal's lower tail adds, not what a simulation saw); and on
         (``structure``,
         ``interval``) ``deaggregation`` [1/yr], each interval's share of ``annual_rate``,
-        with the edges ``im_lower``/``im_upper`` [``hazard.units``]. Attributes: the hazard,
+        with the edges ``im_lower``/``im_upper`` [``hazard.units``]; on (``structure``,
+        ``resample``) ``annual_rate_resamples``, the rate of each resample of the band (the
+        same resampled records for every object: a ratio of two objects' rates has its band
+        from them, :func:`~rockstudy.study.analysis.two_body.pair_ratios`). Attributes: the hazard,
         ``years``, ``n_boot``, ``conf_level`` and ``seed``.
     """
     years = _validate.in_range(
@@ -482,6 +485,7 @@ def _risk_dataset(ds, rows, lowest, hazard, years, to_hazard, attrs, levels):
         coords={"structure": ds["structure"].values},
     )
     out["deaggregation"] = (("structure", "interval"), parts)
+    out["annual_rate_resamples"] = (("structure", "resample"), boot)  # paired: same records
     out = out.assign_coords(im_lower=("interval", edge_lo), im_upper=("interval", edge_hi))
     order = np.argsort(np.where(fitted, -rate, np.inf), kind="stable")
     out = out.isel(structure=order)

@@ -35,6 +35,7 @@ from ..spec.design_kinds import design_kind
 from ..spec.feasibility import record_pairs, second_file
 from . import ida_states
 from . import records as rd
+from . import two_body_rows
 
 __all__ = [
     "CONTACT_VARIABLES",
@@ -203,6 +204,10 @@ def outputs(study) -> dict:
     if study.run.model == "auto" and not kind.capacities:  # rd.ROCKING_KEYS
         long_name = "overturned (1) under Housner's rocking-only model; -1 if failed"
         out["overturned_rocking"] = (long_name, *_RUN["overturned"][1:], None)
+    if _two_body(study) is not None:  # two_body_rows: at the IDA's capacity, or each point
+        ida = two_body_rows.ida_outputs_attributes() if kind.capacities else {}
+        for name, (long_name, *rest) in two_body_rows.TWO_BODY_VARIABLES.items():
+            out[name] = (ida.get(name, {}).get("long_name", long_name), *rest, None)
     out["kernel_status"] = (
         "0 ok; 1 a simulation hit the step limit; 2 not run: free fall; 4 the contact model's "
         "answer did not converge with rtol (an IDA: the OR of its points' codes)",
@@ -517,11 +522,21 @@ def evaluate_rows(study, cols: dict, base_dir=None) -> dict:
             "restitution": cols["restitution"][first],
             "uplift_acceleration": uplift_column(study, cols, first),
         }
+        if _two_body(study) is not None:  # their scenes run the two-body system
+            structures["two_body"] = _two_body(study)[cols["structure"][first]]
         lev_ids, lev_pos = np.unique(cols["level_index"][rows], return_inverse=True)
         mu = None if friction is None else _structure_friction(friction, st_ids)
         ds = _run_design(study, rec, structures, levels_all[lev_ids], mu)
         _fill(result, outs, ds, rows, st_pos, lev_pos, width)
     return result
+
+
+def _two_body(study) -> np.ndarray | None:
+    """The two-body structure of each named object (None for the others), or None when the
+    study has no two-body object (:mod:`.two_body_rows`)."""
+    if study.structure.kind != "objects":
+        return None
+    return two_body_rows.two_body_column({"two_body": study.structure.two_body()})
 
 
 def _fill(result, outs, ds, rows, st_pos, lev_pos, width):

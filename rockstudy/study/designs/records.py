@@ -54,7 +54,7 @@ from ...structures.block import (
 )
 from ..spec.feasibility import free_fall_scale
 from ..spec.ida_options import IdaOptions
-from . import ida_slides, ida_states
+from . import ida_slides, ida_states, two_body_rows
 
 __all__ = [
     "CENSORED_REASONS",
@@ -120,7 +120,10 @@ def _structures(structures) -> dict:
     uplift acceleration [m/s^2] (:func:`rockstudy.structures.uplift_acceleration` of a
     structure; of a dict of arrays, its ``uplift_acceleration`` or else a block's g tan(alpha));
     and ``names`` (a list of str, or None) for a dict ``{name: structure}``."""
-    names = None
+    names, two_body = None, None
+    if isinstance(structures, dict) and "two_body" in structures:  # two_body_rows
+        structures = dict(structures)
+        two_body = two_body_rows.two_body_column({"two_body": structures.pop("two_body")})
     if isinstance(structures, dict) and not structures:
         raise ValueError("structures: give at least one structure")
     if isinstance(structures, dict) and any(_is_structure(v) for v in structures.values()):
@@ -177,6 +180,7 @@ def _structures(structures) -> dict:
         "half_diagonal": R,
         "uplift_acceleration": uplift,
         "names": names,
+        "two_body": two_body,
     }
 
 
@@ -278,7 +282,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
     data["vertical_component"] = ("record", np.array([r.vertical is not None for r in records]))
     for k, v in structures.items():
-        if k != "names":
+        if k not in ("names", "two_body"):
             data[k] = ("structure", v)
     data["slenderness"] = data["critical_rotation"]  # the block's name, kept
     names = structures.get("names")  # None: sampled structures, numbered
@@ -330,6 +334,13 @@ def _run(record, structures, idx, scales, method, rtol, max_steps, outputs=None,
     """simulate_batch on the structures ``idx`` (array) at ``scales`` (same length);
     ``model`` = (model, friction of each structure) runs the contact model
     (:func:`rockstudy.simulate_batch`'s ``model`` and ``friction``)."""
+    if two_body_rows.two_body_column(structures) is not None:  # their rows: structure=
+        single = {**structures, "two_body": None}
+        args = (method, rtol, max_steps, outputs, model)
+        blocks = lambda i, s: _run(record, single, i, s, *args)  # noqa: E731
+        return two_body_rows.run_points(
+            record, structures, idx, scales, rtol, max_steps, outputs, model, blocks
+        )
     contact_model = {}
     if model is not None:
         contact_model = {"model": model[0], "friction": (model[1][0][idx], model[1][1][idx])}
@@ -469,7 +480,8 @@ def _run_below_free_fall(
         "overturn_time": np.full(scales.size, np.nan),
         "status": np.full(scales.size, STATUS_FREE_FALL, np.int64),
     }
-    keys = _keys(contact, model)
+    keys = _keys(contact, model) + two_body_rows.keys(st)
+    out.update(two_body_rows.point_fills(st, scales.size))
     if contact:
         out.update(
             friction_demand=np.full(scales.size, np.nan), lift_off=np.zeros(scales.size, bool)
@@ -580,7 +592,7 @@ def cloud(
         _run_below_free_fall(r, st, idx, ones, method, rtol, max_steps, contact, model)
         for r in records
     ]
-    for k in _keys(contact, model):
+    for k in _keys(contact, model) + two_body_rows.keys(st):
         ds[k] = (("record", "structure"), np.array([o[k] for o in outs]))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     ds = _friction_variables(ds, model)
@@ -666,7 +678,7 @@ def multiple_stripes(
     dims = ("record", "structure", "level")
     ds = ds.assign_coords(level=levels)
     ds["scale"] = (dims, np.array(scales))
-    for k in _keys(contact, model):
+    for k in _keys(contact, model) + two_body_rows.keys(st):
         ds[k] = (dims, np.array([o[k] for o in outs]).reshape(len(records), n, levels.size))
     ds["censored"] = ds["status"] == STATUS_FREE_FALL
     ds = _friction_variables(ds, model)
@@ -839,6 +851,8 @@ def incremental_dynamic_analysis(
             records, st, ds, method, rtol, max_steps
         )
     ds["capacity"] = _capacity(ds["capacity_scale"], ds["censored"], measure, im)
+    if two_body_rows.keys(st):
+        ds = ds.assign(two_body_rows.ida_outputs(records, st, ds, rtol, max_steps))
     if _auto(model):  # Housner's ladder, from the answers the "auto" points gave on the way
         housner = (options, method, rtol, max_steps, None, NO_LIMITS)
         rocking = [

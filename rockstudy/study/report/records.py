@@ -44,6 +44,7 @@ from .risk import section as risk_section
 from .sliding import contact_section, regime_section
 from .sliding import section as sliding_section
 from .states import section as states_section
+from .two_body import section as two_body_section
 
 __all__ = [
     "DESIGNS",
@@ -589,6 +590,7 @@ SECTIONS = [
     ),
     ro.object_fragility,
     risk_section,
+    two_body_section,
     sliding_section,
     states_section,
     contact_section,

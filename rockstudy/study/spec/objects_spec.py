@@ -18,7 +18,7 @@ from pydantic import Field, PrivateAttr, create_model, field_validator, model_va
 
 from .friction_spec import Friction, as_pair, coefficient, friction_pair, friction_value
 from .parameters import MAX_STUDY_BYTES, _a_name, _describe, _Model
-from .structures import KINDS, check_object, object_fields
+from .structures import KINDS, TWO_BODY_KINDS, FieldError, check_object, object_fields
 
 __all__ = ["OBJECT_COLUMNS", "OBJECT_KINDS", "ObjectSpec", "ObjectsSpec"]
 
@@ -41,7 +41,11 @@ class _ObjectBase(_Model):
     #: The kinetic coefficient mu_k beside a ``friction`` mu_s (an objects CSV file's way to
     #: give the pair; needs the object's own ``friction``, a single number >= it).
     friction_kinetic: float | None = None
+    #: A two-body object's plain twin: the name of a block object of the same statue (its
+    #: width and height), which the report puts beside it ("what the plinth/isolator buys").
+    compare_to: str | None = Field(default=None, min_length=1)
     _params: tuple = PrivateAttr(default=None)
+    _structure: object = PrivateAttr(default=None)
     _printable = field_validator("name")(lambda value: _a_name(value))
     _pair = field_validator("friction", mode="before")(lambda value: as_pair(value))
     _friction = field_validator("friction")(lambda value: friction_value(value))
@@ -76,7 +80,30 @@ class _ObjectBase(_Model):
         structure, rocking = check_object(f"object {self.name!r}", self.kind, given)
         R = float(getattr(structure, "half_diagonal", np.nan))
         self._params = (*rocking, R)
+        self._structure = structure
+        if self.compare_to is not None and self.kind not in TWO_BODY_KINDS:
+            raise FieldError(
+                "compare_to",
+                f"object {self.name!r}: compare_to is for the kinds {list(TWO_BODY_KINDS)} "
+                f"(a statue on its plinth or isolator), not a {self.kind}",
+            )
         return self
+
+    def two_body(self):
+        """The :class:`~rockstudy.structures.StackedBlocks` or
+        :class:`~rockstudy.structures.IsolatedBlock` of a two-body object; None otherwise."""
+        return self._structure if self.kind in TWO_BODY_KINDS else None
+
+    def statue(self):
+        """The rocking body of the object (a :class:`~rockstudy.structures.Block`): the
+        statue of a stacked object, the block of an isolated one, the block itself; None for
+        another structure."""
+        s = self._structure
+        return (
+            getattr(s, "upper", None)
+            or getattr(s, "block", None)
+            or (s if self.kind == "block" else None)
+        )
 
     def geometry(self) -> tuple[float, float]:
         """(half-diagonal R [m], NaN for a structure without one; theta_cr [rad], the
@@ -122,7 +149,19 @@ class ObjectsSpec(_Model):
                     f"object {i} is named {o.name!r} like object {seen[o.name]}; names must differ"
                 )
             seen[o.name] = i
+        for i, o in enumerate(self.objects):
+            if o.compare_to is not None:
+                plain = self.objects[seen[o.compare_to]] if o.compare_to in seen else None
+                _check_pair(i, o, plain)
         return self
+
+    def pairs(self) -> list[tuple[str, str]]:
+        """(two-body object, its plain block object) of each ``compare_to``, in order."""
+        return [(o.name, o.compare_to) for o in self.objects if o.compare_to is not None]
+
+    def two_body(self) -> list:
+        """The two-body structure of each object (None for the others), in order."""
+        return [o.two_body() for o in self.objects]
 
     def rocking(self) -> np.ndarray:
         """(n, 3) array of (p [rad/s], theta_cr [rad], eta) of the objects, in order."""
@@ -131,6 +170,26 @@ class ObjectsSpec(_Model):
     def uplift(self) -> np.ndarray:
         """(n,) array of the objects' uplift accelerations [m/s^2] (:meth:`ObjectSpec.uplift`)."""
         return np.array([o.uplift() for o in self.objects], float)
+
+
+def _check_pair(i, obj, block) -> None:
+    """``compare_to`` of object ``i`` names a block object of its statue's width and height
+    (to 1e-9), or a ValueError naming the field."""
+    field = f"object {i} ({obj.name!r}): compare_to"
+    if block is None or block.kind != "block":
+        what = "no object" if block is None else f"a {block.kind}"
+        raise ValueError(
+            f"{field} must name a block object of the study; {obj.compare_to!r} is {what}"
+        )
+    a, b = obj.statue(), block.statue()
+    if not (
+        np.isclose(a.width, b.width, rtol=1e-9, atol=0)
+        and np.isclose(a.height, b.height, rtol=1e-9, atol=0)
+    ):
+        raise ValueError(
+            f"{field} names {block.name!r}, {b.width:.6g} x {b.height:.6g} m, not the same "
+            f"statue as its {a.width:.6g} x {a.height:.6g} m (width x height)"
+        )
 
 
 #: Columns of an objects CSV file (``[structure] kind = "objects"``, ``file = ...``).
@@ -219,7 +278,7 @@ def _object_row(line: int, cells: list[str], header: list[str]) -> dict:
             f"{len(cells)} cells, the header names {sum(map(bool, header))} columns)"
         )
     return {
-        header[i]: cell if header[i] in ("name", "kind") else _cell(cell)
+        header[i]: cell if header[i] in ("name", "kind", "compare_to") else _cell(cell)
         for i, cell in enumerate(cells)
         if cell
     }

@@ -23,13 +23,16 @@ from typing import Literal
 
 import numpy as np
 
+from ...constants import G
 from ...structures import (
     Arch,
     AsymmetricFrame,
     Block,
     ConicalShell,
+    IsolatedBlock,
     PointMassStrut,
     RockingWall,
+    StackedBlocks,
     SymmetricFrame,
     block_parameters,
     frequency_parameter,
@@ -37,6 +40,7 @@ from ...structures import (
     uplift_acceleration_block,
 )
 from ...structures.block import HALF_DIAGONAL_RANGE, MIN_SLENDERNESS
+from ...structures.isolated import MAX_BASE_MASS_RATIO, PERIOD_RANGE
 
 __all__ = [
     "check_all",
@@ -48,6 +52,8 @@ __all__ = [
     "object_fields",
     "SAMPLED_KINDS",
     "StructureKind",
+    "TWO_BODY_KINDS",
+    "two_body_parameters",
 ]
 
 
@@ -150,6 +156,9 @@ class StructureKind:
         [rad/s] and theta_cr [rad], and the structure's uplift acceleration a_up [m/s^2].
     slenderness_top : float
         The (open) upper end of the slenderness of a sampled kind [rad].
+    rocking : callable, optional
+        ``rocking(structure) -> (p, theta_cr, eta, a_up)`` for a kind without an equivalent
+        block (the two-body kinds: :func:`two_body_parameters`); else the equivalent block's.
     """
 
     name: str
@@ -161,6 +170,7 @@ class StructureKind:
     sampled: Callable | None = None
     slenderness_top: float = math.pi / 2
     doc: str = field(default="", compare=False)
+    rocking: Callable | None = None
 
     def make(self, values: dict):
         """The physics object of the given field values (a ValueError if the class refuses)."""
@@ -170,6 +180,8 @@ class StructureKind:
         """The physics object, its equivalent block's (p [rad/s], theta_cr [rad], eta) and its
         own uplift acceleration a_up [m/s^2] (:func:`rockstudy.structures.uplift_acceleration`)."""
         structure = self.make(values)
+        if self.rocking is not None:
+            return structure, self.rocking(structure)
         return structure, (*block_parameters(structure), uplift_acceleration(structure))
 
 
@@ -187,6 +199,48 @@ def _block_sampled(half_diagonal, slenderness):
 def _wall_sampled(half_diagonal, slenderness):
     p, theta_cr = RockingWall.equivalent_parameters(half_diagonal, slenderness)
     return p, theta_cr, RockingWall.uplift_acceleration_of(slenderness)
+
+
+def _stacked(width, height, plinth_width, plinth_height, density_ratio=1.0, offset=0.0):
+    """The statue (``width`` x ``height``) on its plinth: a :class:`StackedBlocks`."""
+    plinth = Block.from_dimensions(plinth_width, plinth_height)
+    return StackedBlocks(plinth, Block.from_dimensions(width, height), density_ratio, offset)
+
+
+def _isolated(width, height, period, damping, base_mass_ratio, isolator_capacity=None):
+    """The block (``width`` x ``height``) on its isolator: an :class:`IsolatedBlock`."""
+    block = Block.from_dimensions(width, height)
+    return IsolatedBlock(block, base_mass_ratio, period, damping, isolator_capacity)
+
+
+def _stacked_uplift(s: StackedBlocks) -> float:
+    """The ground acceleration that first lifts a stacked pair at rest [m/s^2]: the smaller
+    of the statue's uplift on its plinth, g b_u / h_u, and the pair's as one rigid body
+    about a corner of the plinth, g (m_l b_l + m_u (b_l - abs(e))) / (m_l h_l + m_u
+    (2 h_l + h_u)) (moments of gravity and of the inertia forces about the corner; e the
+    offset, the nearer corner the weaker side)."""
+    lo, up = s.lower, s.upper
+    b_l, h_l, b_u, h_u = lo.width / 2, lo.height / 2, up.width / 2, up.height / 2
+    m_l, m_u = s.lower_mass, s.upper_mass
+    pair = (m_l * b_l + m_u * (b_l - abs(s.offset))) / (m_l * h_l + m_u * (2 * h_l + h_u))
+    return G * min(b_u / h_u, pair)
+
+
+def two_body_parameters(structure) -> tuple[float, float, float, float]:
+    """(p [rad/s], theta_cr [rad], eta, a_up [m/s^2]) a record design uses for a two-body
+    object (its groups, its IDA ladder): a_up, the ground acceleration that first lifts it
+    at rest (a stacked pair: :func:`_stacked_uplift`; an isolated block: g tan(alpha), the
+    base's acceleration that lifts it, which the isolator may reach under a smaller ground
+    acceleration), theta_cr = arctan(a_up / g) (the ladder starts at g theta_cr), and the
+    rocking body's p and restitution (the statue's on its plinth; the isolated block's on
+    its base). The simulations themselves run the two-body system."""
+    if isinstance(structure, StackedBlocks):
+        a_up, body = _stacked_uplift(structure), structure.upper
+        eta = body.restitution
+    else:
+        a_up, body = structure.uplift_acceleration, structure.block
+        eta = structure.restitution
+    return body.frequency_parameter, math.atan(a_up / G), eta, a_up
 
 
 _MASS = FieldRange(0.0, math.inf, f"{_POSITIVE}", "mass (any consistent unit)")
@@ -298,8 +352,59 @@ KINDS: dict[str, StructureKind] = {
             "derived",
             doc="thin conical shell (a spire), Table I of [003]",
         ),
+        StructureKind(
+            "stacked",
+            StackedBlocks,
+            {
+                "width": _length("the statue's full width [m]"),
+                "height": _length("the statue's full height [m]"),
+                "plinth_width": _length("the plinth's full width [m]"),
+                "plinth_height": _length("the plinth's full height [m]"),
+                "density_ratio": FieldRange(0.0, math.inf, _POSITIVE, "rho_statue / rho_plinth"),
+                "offset": FieldRange(
+                    -math.inf, math.inf, "(-inf, inf) m", "the statue's axis from the plinth's"
+                ),
+            },
+            (("width", "height", "plinth_width", "plinth_height"),),
+            "derived",
+            build=_stacked,
+            rocking=two_body_parameters,
+            doc="a statue on a plinth that can rock (Psycharis 1990)",
+        ),
+        StructureKind(
+            "isolated",
+            IsolatedBlock,
+            {
+                "width": _length("the block's full width [m]"),
+                "height": _length("the block's full height [m]"),
+                "period": FieldRange(
+                    *PERIOD_RANGE,
+                    "[{:g}, {:g}] s".format(*PERIOD_RANGE),
+                    "the isolator's period T_b [s]",
+                    low_closed=True,
+                    high_closed=True,
+                ),
+                "damping": FieldRange(0.0, 1.0, "[0, 1]", "zeta_b", True, True),
+                "base_mass_ratio": FieldRange(
+                    0.0,
+                    MAX_BASE_MASS_RATIO,
+                    f"(0, {MAX_BASE_MASS_RATIO:g}]",
+                    "m_base / m_block",
+                    high_closed=True,
+                ),
+                "isolator_capacity": _length("the isolator's displacement capacity [m]"),
+            },
+            (("width", "height", "period", "damping", "base_mass_ratio"),),
+            "derived",
+            build=_isolated,
+            rocking=two_body_parameters,
+            doc="a block on a base isolator (Vassiliou & Makris 2012)",
+        ),
     )
 }
+
+#: The kinds of two bodies (no equivalent block): their scenes run the two-body system.
+TWO_BODY_KINDS = ("stacked", "isolated")
 
 #: The kinds a ``[structure]`` table samples from distributions of R and alpha.
 SAMPLED_KINDS = tuple(k for k, v in KINDS.items() if v.sampled is not None)

@@ -34,6 +34,7 @@ from .run_spec import CONTACT_OUTPUTS, SLIDE_OUTPUTS, STEPS_PER_CYCLE, RunSpec
 from .sampler_spec import SAMPLER_LAYOUTS, SamplerSpec, samplers_laid_out
 from .structure_spec import Structure
 from .structures import KINDS, FieldError
+from .two_body_spec import check_two_body
 
 __all__ = ["MAX_CHUNK_SIZE", "Study", "json_schema"]
 
@@ -113,6 +114,12 @@ class Study(_Model):
         added = CONTACT_OUTPUTS + (SLIDE_OUTPUTS if run.get("model") in ("contact", "auto") else ())
         missing = [n for n in added if n not in outputs]
         return {**data, "run": {**run, "outputs": list(outputs) + missing}}
+
+    @model_validator(mode="after")
+    def _two_body(self):
+        """What two-body objects cannot ask (:func:`.two_body_spec.check_two_body`)."""
+        check_two_body(self)
+        return self
 
     @model_validator(mode="after")
     def _contact_model(self):
