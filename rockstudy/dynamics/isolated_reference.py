@@ -175,10 +175,13 @@ def _x_event(scene, side, slide, t0):
     return _event(excess, True, 1.0)
 
 
-def _new_slide(scene, t, y, which_side):
-    """The base's regime after its stop or break-away at (t, y): :func:`slide_after_stop`."""
+def _new_slide(scene, t, y, which_side, slide):
+    """The base's regime after its stop (``slide`` != 0: :func:`slide_after_stop`) or its
+    break-away (it slides off in the direction of the friction it needs) at (t, y)."""
     state = np.array([y[0], 0.0, *(y[2:4] if len(y) > 2 else (0.0, 0.0))])
-    return slide_after_stop(state, scene.ground(t), which_side, scene.par)
+    if slide != 0.0:
+        return slide_after_stop(state, scene.ground(t), which_side, scene.par)
+    return math.copysign(1.0, demand(state, scene.ground(t), which_side, scene.par))
 
 
 def _rest_phase(scene, log, t, x, xd, slide):
@@ -216,7 +219,7 @@ def _rest_phase(scene, log, t, x, xd, slide):
         log.add_solution(sol, t_hit, True, true_state)
         y[1] = 0.0 if slide != 0.0 else y[1]
         log.add(t_hit, (y[0], y[1], 0.0, 0.0))
-        return t_hit, y[0], y[1], 0.0, _new_slide(scene, t_hit, y, 0.0)
+        return t_hit, y[0], y[1], 0.0, _new_slide(scene, t_hit, y, 0.0, slide)
     t_up = _first_lift_time(scene, sol, t_hit, slide)
     log.add_solution(sol, t_up, True, true_state)
     x, xd = sol.sol(t_up)
@@ -305,7 +308,7 @@ def _rock_phase(scene, log, t, y, side, slide):
         log.add_solution(sol, t_hit, False, true_state)
         y_hit[1] = 0.0 if slide != 0.0 else y_hit[1]
         log.add(t_hit, y_hit)
-        return t_hit, y_hit, side, _new_slide(scene, t_hit, y_hit, side), "slide"
+        return t_hit, y_hit, side, _new_slide(scene, t_hit, y_hit, side, slide), "slide"
     t_hit, y_hit = _newton_hit(rhs, t_hit, true_state(t_hit), which, side)
     log.add_solution(sol, t_hit, False, true_state)
     if which == 1:
