@@ -19,8 +19,9 @@ import numpy as np
 from numba import njit
 
 from ..constants import FALL_ROTATION, G
-from ..motions._kernels import ground_acceleration
+from ..motions._kernels import KIND_RECORD, ground_acceleration
 from ..structures.isolated import IsolatedBlock
+from ._taylor import NO_REFCOUNT
 from .constants import REST_FRACTION
 from .isolated import IsolatedBody, accelerations, friction_demand, impact_jump
 
@@ -47,11 +48,26 @@ def row_parameters(structure: IsolatedBlock) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
+def ground(mot, t, k):
+    """u_g''(t) [m/s^2] of the motion ``mot`` on record segment k, as
+    :func:`~rockstudy.motions._kernels.ground_acceleration` gives it. A record's linear
+    interpolation is written out here: that function counts references to the record's
+    arrays at each call, ~14 calls per step, which cost about half a step (measured)."""
+    kind, mp, times, samples = mot
+    if kind != KIND_RECORD:
+        return ground_acceleration(kind, mp, times, samples, t, k)
+    if t < 0.0 or t > mp[3]:
+        return 0.0
+    w = (t - times[k]) / (times[k + 1] - times[k])
+    return mp[0] * (samples[k] + w * (samples[k + 1] - samples[k]))
+
+
+@njit(cache=True, **NO_REFCOUNT)
 def rhs(t, y, par, mot, k, side, slide, out):
     """dy/dt of the state y = (x_b, x_b', theta, theta') into ``out``, under the motion
     ``mot`` = (kind, params, times, samples) on record segment k."""
-    a_g = ground_acceleration(mot[0], mot[1], mot[2], mot[3], t, k)
+    a_g = ground(mot, t, k)
     xdd, thdd = _accelerations(
         y[0], y[1], y[2], y[3], a_g, side, slide,
         par[P_R], par[P_ALPHA], par[P_M], par[P_OMEGA], par[P_ZETA], par[P_MU],
@@ -59,7 +75,7 @@ def rhs(t, y, par, mot, k, side, slide, out):
     out[0], out[1], out[2], out[3] = y[1], xdd, y[3], thdd
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def base_acceleration(x, xd, a_g, slide, par):
     """The base's absolute acceleration with the block at rest on it: the isolator's force
     while it slides (:func:`~rockstudy.dynamics.isolated.base_acceleration_at_rest`), the
@@ -70,7 +86,7 @@ def base_acceleration(x, xd, a_g, slide, par):
     return -(2.0 * par[P_ZETA] * w * xd + w * w * x + par[P_MU] * G * slide)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def lift_side(x, xd, a_g, slide, par):
     """The side a block at rest lifts onto (0: it stays), as
     :func:`~rockstudy.dynamics.isolated.uplift_side`."""
@@ -82,7 +98,7 @@ def lift_side(x, xd, a_g, slide, par):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def demand(y, a_g, side, par):
     """The friction a stuck base needs per unit isolated mass
     (:func:`~rockstudy.dynamics.isolated.friction_demand`)."""
@@ -91,7 +107,7 @@ def demand(y, a_g, side, par):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def slide_after_stop(y, a_g, side, par):
     """The base's regime when its velocity is 0 (y[1] = 0): stuck (0) while the friction it
     needs is at most mu g, else sliding in the direction of that need. A linear isolator
@@ -105,7 +121,7 @@ def slide_after_stop(y, a_g, side, par):
     return 1.0 if f > 0.0 else -1.0
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def slide_after_jump(y, a_g, side, par):
     """The base's regime after its velocity jumped (an impact, a settling): sliding in the
     direction of x_b', or :func:`slide_after_stop` if it is 0."""
@@ -116,7 +132,7 @@ def slide_after_jump(y, a_g, side, par):
     return slide_after_stop(y, a_g, side, par)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def settled(y, slide, max_x, par):
     """Whether a block at rest after the motion, the base at (x_b, x_b'), can never lift
     again nor the base pass ``max_x``: the free isolator's energy (x_b'^2 + omega^2 x_b^2)/2

@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..motions._kernels import KIND_RECORD, ground_acceleration, segment_index
+from ..motions._kernels import KIND_RECORD, segment_index
 from ._isolated_events import (
     EV_IMPACT,
     EV_LIFT,
@@ -29,6 +29,7 @@ from ._isolated_events import (
     EV_STOP,
     N_TERMINAL,
     active,
+    peak_root,
     refine,
     root,
     value,
@@ -42,6 +43,7 @@ from ._isolated_model import (
     P_REST,
     base_acceleration,
     demand,
+    ground,
     impact,
     lift_side,
     rhs,
@@ -50,6 +52,7 @@ from ._isolated_model import (
     slide_after_stop,
 )
 from ._isolated_step import dop853_step, error_norm, first_step, step_factor
+from ._taylor import NO_REFCOUNT
 
 #: Columns of a row's output: max ``|theta|``, overturned (0/1), max ``|x_b|``, the
 #: overturning time (NaN if none), the impact count, the status (0 ok, 1 cut short).
@@ -57,17 +60,17 @@ O_THETA, O_OVER, O_X, O_TIME, O_IMPACTS, O_STATUS = range(6)
 N_OUT = 6
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _sign(v):
     return 1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _ag(mot, t, k):
-    return ground_acceleration(mot[0], mot[1], mot[2], mot[3], t, k)
+    return ground(mot, t, k)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _stop(mot, t, k, t_end):
     """Where the step from t stops: the next record sample, the motion's end, then t_end."""
     dur = mot[1][3]
@@ -78,7 +81,7 @@ def _stop(mot, t, k, t_end):
     return dur
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _first_terminal(st, mot, k, side, slide, sgn_x, par, a0, a1):
     """(code, s) of the earliest event that ends the phase inside the step; (EV_NONE, 2)."""
     y0, y1 = st[2], st[4]
@@ -95,25 +98,25 @@ def _first_terminal(st, mot, k, side, slide, sgn_x, par, a0, a1):
     return best, s_best
 
 
-@njit(cache=True)
-def _peaks(st, s_end, work, par, mot, k, side, slide, sgn_x, a0, a1, acc, yev):
-    """Add the peaks of ``|theta|`` and ``|x_b|`` located in the step before s_end to the
-    maxima ``acc`` = (max ``|x_b|``, max ``|theta|``)."""
+@njit(cache=True, **NO_REFCOUNT)
+def _peak(code, st, s_end, work, par, mot, k, side, slide, sgn_x, a0, a1, acc, yev):
+    """Add the peak of event ``code`` (EV_PEAK_TH or EV_PEAK_X) located in the step before
+    s_end, if any, to the maxima ``acc`` = (max ``|x_b|``, max ``|theta|``)."""
+    if not active(code, side, slide, par):
+        return
     y0, y1 = st[2], st[4]
-    for code in (EV_PEAK_TH, EV_PEAK_X):
-        if not active(code, side, slide, par):
-            continue
-        v0 = value(code, y0[0], y0[1], y0[2], y0[3], a0, side, slide, sgn_x, par)
-        v1 = value(code, y1[0], y1[1], y1[2], y1[3], a1, side, slide, sgn_x, par)
-        if v0 <= 0.0 and v1 > 0.0:
-            s = root(code, st, mot, k, side, slide, sgn_x, par)
-            if s <= s_end:
-                refine(code, s, st, work, par, mot, k, side, slide, yev)
-                acc[0] = max(acc[0], abs(yev[0]))
-                acc[1] = max(acc[1], abs(yev[2]))
+    if value(code, y0[0], y0[1], y0[2], y0[3], a0, side, slide, sgn_x, par) > 0.0:
+        return
+    if not value(code, y1[0], y1[1], y1[2], y1[3], a1, side, slide, sgn_x, par) > 0.0:
+        return
+    s = peak_root(code, st)
+    if s <= s_end:
+        refine(code, s, st, work, par, mot, k, side, slide, yev)
+        acc[0] = max(acc[0], abs(yev[0]))
+        acc[1] = max(acc[1], abs(yev[2]))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _lift_at(t, y, f, mot, k, slide, par, tmp):
     """The first double from t [s] (a few ulps on at most) at which the block at rest lifts,
     the state carried there by its Taylor polynomial into y (the reference's first lifted
@@ -129,7 +132,7 @@ def _lift_at(t, y, f, mot, k, slide, par, tmp):
     return t, -_sign(base_acceleration(y[0], y[1], _ag(mot, t, k), slide, par))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _impact(y, side, par, acc):
     """The impact at y (theta = 0): the velocities after it, the block settled on the base
     below the rest speed. Returns the new side."""
@@ -143,7 +146,7 @@ def _impact(y, side, par, acc):
     return -side
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _on_event(code, t, y, f, side, slide, mot, k, par, acc, tmp):
     """The regime after event ``code`` at (t, y): (t, side, slide, overturned)."""
     if code == EV_OVER:
@@ -161,30 +164,37 @@ def _on_event(code, t, y, f, side, slide, mot, k, par, acc, tmp):
     return t, side, _sign(f_need), False
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
+def _copy(dst, src):
+    """dst[:] = src for 4 values (a slice assignment needs numba's reference counting)."""
+    for j in range(4):
+        dst[j] = src[j]
+
+
+@njit(cache=True, **NO_REFCOUNT)
 def _maxima(acc, y):
     acc[0] = max(acc[0], abs(y[0]))
     acc[1] = max(acc[1], abs(y[2]))
 
 
-@njit(cache=True)
-def _start(par, mot):
-    """The row's start: the block at rest on the base at rest (a friction pendulum's base
-    stuck unless the ground's first acceleration breaks it away): (y, slide)."""
-    y = np.zeros(4)
-    slide = slide_after_stop(y, _ag(mot, 0.0, 0), 0.0, par)
-    return y, slide
+@njit(cache=True, **NO_REFCOUNT)
+def _start(par, mot, y):
+    """The row's start: the block at rest on the base at rest, y = 0 (a friction pendulum's
+    base stuck unless the ground's first acceleration breaks it away): its slide."""
+    y[0] = y[1] = y[2] = y[3] = 0.0
+    return slide_after_stop(y, _ag(mot, 0.0, 0), 0.0, par)
 
 
-@njit(cache=True)
-def run_row(par, atol, mot, rtol, max_steps, max_impacts, out):
-    """One row's history (module docstring) into ``out`` (the columns O_*)."""
-    K, K2 = np.empty((13, 4)), np.empty((13, 4))
-    y1, tmp, yev, yt, tmp2 = np.empty(4), np.empty(4), np.empty(4), np.empty(4), np.empty(4)
-    acc = np.zeros(3)  # max |x_b|, max |theta|, impacts
+@njit(cache=True, **NO_REFCOUNT)
+def run_row(par, atol, mot, rtol, max_steps, max_impacts, out, K, K2, vec, acc):
+    """One row's history (module docstring) into ``out`` (the columns O_*); K, K2 (13, 4),
+    vec (6, 4) and acc (3,) are its scratch arrays (allocated by the caller: this kernel
+    counts no references)."""
+    y, y1, tmp, yev, yt, tmp2 = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5]
+    acc[0] = acc[1] = acc[2] = 0.0  # max |x_b|, max |theta|, impacts
     dur = mot[1][3]
     t_end = dur + 100.0 / par[P_P] + 200.0 * math.pi / par[P_OMEGA]
-    y, slide = _start(par, mot)
+    slide = _start(par, mot, y)
     t, k, side, h, status, t_ot = 0.0, 0, 0.0, np.nan, 1, np.nan
     rejected, fresh, steps = False, True, 0
     while steps < max_steps:
@@ -219,13 +229,14 @@ def run_row(par, atol, mot, rtol, max_steps, max_impacts, out):
         a0, a1 = _ag(mot, t, k), _ag(mot, t1, k)
         sgn_x = _sign(y[1]) if y[1] != 0.0 else _sign(K[0, 1])
         code, s = _first_terminal(st, mot, k, side, slide, sgn_x, par, a0, a1)
-        K2[0, :] = K[0, :]
+        _copy(K2[0], K[0])
         work = (K2, yt, tmp2)
-        _peaks(st, min(s, 1.0), work, par, mot, k, side, slide, sgn_x, a0, a1, acc, yev)
+        for code_pk in (EV_PEAK_TH, EV_PEAK_X):
+            _peak(code_pk, st, min(s, 1.0), work, par, mot, k, side, slide, sgn_x, a0, a1, acc, yev)
         if code == EV_NONE:
             t = t1
-            y[:] = y1
-            K[0, :] = K[12, :]
+            _copy(y, y1)
+            _copy(K[0], K[12])
             _maxima(acc, y)
             fresh = t >= t_stop  # f0 anew at a sample or the motion's end
             continue
@@ -255,7 +266,8 @@ def isolated_batch(pars, atols, kinds, mps, times, samples, offsets, rtol, max_s
     for i in prange(n):
         a, b = offsets[i], offsets[i + 1]
         mot = (kinds[i], mps[i], times[a:b], samples[a:b])
-        run_row(pars[i], atols[i], mot, rtol, max_steps, max_imp, out[i])
+        K, K2, vec, acc = np.empty((13, 4)), np.empty((13, 4)), np.empty((6, 4)), np.empty(3)
+        run_row(pars[i], atols[i], mot, rtol, max_steps, max_imp, out[i], K, K2, vec, acc)
     return out
 
 

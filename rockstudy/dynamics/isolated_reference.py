@@ -6,8 +6,9 @@ base, impacts with momentum exchange, overturning. Each regime is integrated by
 ``solve_ivp`` (DOP853) with events: the uplift (the base's absolute acceleration at rest
 passing g tan(alpha)), the impact (theta = 0), the overturning (``|theta|`` = pi/2) and the
 peaks of ``|x_b|`` and ``|theta|``. Phases stop at every sample of a record (where u_g'' has a
-kink) and at the end of the motion. This is the only solver of the model so far: no numba
-kernel yet.
+kink) and at the end of the motion. The friction pendulum's stop and break-away end phases
+too. It keeps the whole history; the batches run the numba kernel of the same model
+(:mod:`._isolated_scene`), which this reference checks.
 """
 
 from __future__ import annotations
@@ -468,7 +469,7 @@ def simulate_isolated(
     conditioning: bool = False,
 ) -> IsolatedResult:
     """Rock a block on an isolated base through a ground motion: the ``solve_ivp`` reference
-    (the scipy path; the numba kernel comes later), what
+    (the scipy path, with the whole history; ``simulate_batch`` runs the numba kernel), what
     ``rockstudy.simulate(IsolatedBlock(...), motion)`` runs.
 
     Parameters
