@@ -147,5 +147,5 @@ def settled(y, slide, max_x, par):
     return amp <= max_x and accel < par[P_LIMIT]
 
 
-#: |theta| at which the block has overturned [rad].
+#: ``|theta|`` at which the block has overturned [rad].
 FALL = FALL_ROTATION
