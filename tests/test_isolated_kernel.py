@@ -255,3 +255,13 @@ def test_peak_base_displacement_of_a_resting_block_is_the_closed_form():
     assert ref.max_rotation == 0.0 and rows["max_rotation"][0] == 0.0
     assert ref.max_isolator_displacement == pytest.approx(exact, rel=1e-12, abs=0)
     assert rows["max_isolator_displacement"][0] == pytest.approx(exact, rel=1e-12, abs=0)
+
+
+def test_a_row_cut_short_by_max_steps_is_marked():
+    """status 1 where a row reaches max_steps (its outputs cover only part of the history);
+    0 on the same row given the steps it needs."""
+    iso = IsolatedBlock(rs.Block(1.0, 0.2), 1.0, period=2.0, damping=0.1)
+    rec = _record(5, 3.0)
+    short = rs.simulate_batch(structure=iso, record=rec, rtol=1e-8, max_steps=20)
+    full = rs.simulate_batch(structure=iso, record=rec, rtol=1e-8)
+    assert short["status"][0] == 1 and full["status"][0] == 0
