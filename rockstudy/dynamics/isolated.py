@@ -30,13 +30,20 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from numba import njit
+
 from ..constants import G
 from ..structures.isolated import IsolatedBlock, isolated_restitution
 
 __all__ = [
     "IsolatedBody",
+    "accelerations",
     "base_acceleration_at_rest",
+    "friction_demand",
+    "housner_acceleration",
+    "impact_jump",
     "impact_velocities",
+    "isolator_acceleration",
     "rest_acceleration",
     "rocking_accelerations",
     "settling_velocity",
@@ -52,6 +59,7 @@ class IsolatedBody(NamedTuple):
     mass: float  #: M = 1 + gamma, the isolated mass over the block's [-]
     omega: float  #: omega_b = 2 pi / T_b [rad/s]
     zeta: float  #: zeta_b [-]
+    mu: float = 0.0  #: the friction pendulum's mu (0: a linear isolator) [-]
 
     @classmethod
     def of(cls, structure: IsolatedBlock) -> IsolatedBody:
@@ -63,30 +71,110 @@ class IsolatedBody(NamedTuple):
             1.0 + structure.base_mass_ratio,
             structure.isolator_frequency,
             structure.damping,
+            structure.friction_coefficient,
         )
 
+    @property
+    def core(self):
+        """(R, alpha, M, omega, zeta, mu): the scalar arguments of :func:`accelerations`."""
+        return tuple(self)
 
-def base_acceleration_at_rest(x_b, x_b_dot, omega, zeta):
-    r"""The base's absolute acceleration u_g'' + x_b'' [m/s^2] with the block at rest on it.
+
+@njit(cache=True)
+def isolator_acceleration(x_b, x_b_dot, slide, omega, zeta, mu):
+    r"""The isolator's force on the base per unit isolated mass [m/s^2], the base sliding in
+    the direction ``slide`` (+1 or -1; its sign is immaterial when mu = 0):
+
+    .. math:: 2 \zeta_b \omega_b \dot x_b + \omega_b^2 x_b + \mu g\, \mathrm{slide}
+
+    A linear isolator (mu = 0): spring and dashpot. A friction pendulum of radius R_fp:
+    omega_b^2 = g / R_fp (the pendulum's restoring force M g x_b / R_fp) and Coulomb's
+    friction mu M g against the sliding, the normal force taken as the isolated weight M g.
+    """
+    return 2.0 * zeta * omega * x_b_dot + omega * omega * x_b + mu * G * slide
+
+
+@njit(cache=True)
+def housner_acceleration(theta, a_base, side, radius, slenderness):
+    r"""theta'' [rad/s^2] of the block rocking on side s on a base of absolute acceleration
+    ``a_base``, the base's motion prescribed (Housner's eq. 2.2 of [000]):
+    theta'' = -(3 / 4R) (cos(phi) a_base + g sin(phi)), phi = s alpha - theta."""
+    phi = side * slenderness - theta
+    return -0.75 / radius * (math.cos(phi) * a_base + G * math.sin(phi))
+
+
+@njit(cache=True)
+def accelerations(x_b, x_b_dot, theta, theta_dot, a_g, side, slide, R, alpha, M, omega, zeta, mu):
+    r"""(x_b'', theta'') in every regime: the block at rest (side 0) or rocking on side s, the
+    base sliding in the direction ``slide`` or stuck (slide 0 with mu > 0: the friction
+    pendulum's stick, x_b'' = 0, the block rocking as Housner's on the ground).
+
+    The base sliding: :func:`rest_acceleration` at rest, the coupled Lagrange equations of
+    :func:`rocking_accelerations` while the block rocks. The scalar arguments (R, alpha, M,
+    omega, zeta, mu: :attr:`IsolatedBody.core`) let the numba kernel compile this function
+    as it is (it is compiled by numba: :mod:`._isolated_model` calls it).
+    """
+    if slide == 0.0 and mu > 0.0:
+        if side == 0.0:
+            return 0.0, 0.0
+        return 0.0, housner_acceleration(theta, a_g, side, R, alpha)
+    f_iso = isolator_acceleration(x_b, x_b_dot, slide, omega, zeta, mu)
+    if side == 0.0:
+        return -a_g - f_iso, 0.0
+    phi = side * alpha - theta
+    c, sn = R * math.cos(phi), R * math.sin(phi)
+    i0 = 4.0 / 3.0 * R * R
+    f_base = -M * (a_g + f_iso) - sn * theta_dot**2
+    f_block = -c * a_g - G * sn
+    det = M * i0 - c * c
+    return (i0 * f_base - c * f_block) / det, (M * f_block - c * f_base) / det
+
+
+@njit(cache=True)
+def friction_demand(x_b, theta, theta_dot, a_g, side, R, alpha, M, omega):
+    r"""The friction force a stuck base needs, per unit isolated mass [m/s^2]: the first
+    row of :func:`rocking_accelerations` with x_b'' = 0 and theta'' Housner's on the ground
+    (:func:`housner_acceleration`),
+
+    .. math:: F/M = -(\ddot u_g + \omega_b^2 x_b)
+                    - (R\cos\phi\, \ddot\theta + R\sin\phi\, \dot\theta^2) / M
+
+    (the block's inertia term vanishes at rest). The base stays stuck while ``|F|/M`` <= mu g
+    and slides off in the direction of F otherwise.
+    """
+    demand = -(a_g + omega * omega * x_b)
+    if side != 0.0:
+        phi = side * alpha - theta
+        thdd = housner_acceleration(theta, a_g, side, R, alpha)
+        demand -= R * (math.cos(phi) * thdd + math.sin(phi) * theta_dot**2) / M
+    return demand
+
+
+def base_acceleration_at_rest(x_b, x_b_dot, omega, zeta, mu=0.0, slide=1.0):
+    r"""The base's absolute acceleration u_g'' + x_b'' [m/s^2] with the block at rest on it and
+    the base sliding (in the direction ``slide`` when mu > 0).
 
     From the rest regime's equation (:func:`rest_acceleration`): the isolator's force over
-    the whole isolated mass,
+    the whole isolated mass (:func:`isolator_acceleration`),
 
-    .. math:: \ddot u_g + \ddot x_b = -(2 \zeta_b \omega_b \dot x_b + \omega_b^2 x_b)
+    .. math:: \ddot u_g + \ddot x_b = -(2 \zeta_b \omega_b \dot x_b + \omega_b^2 x_b
+              + \mu g\, \mathrm{slide})
 
-    (the ground's acceleration does not enter: it reaches the base through the isolator).
+    (the ground's acceleration does not enter: it reaches the base through the isolator; a
+    stuck base moves with the ground, its absolute acceleration is u_g'').
     """
-    return -(2.0 * zeta * omega * x_b_dot + omega * omega * x_b)
+    return -isolator_acceleration(x_b, x_b_dot, slide, omega, zeta, mu)
 
 
-def rest_acceleration(x_b, x_b_dot, a_g, omega, zeta):
-    r"""x_b'' [m/s^2] of the base with the block at rest on it: the linear SDOF
+def rest_acceleration(x_b, x_b_dot, a_g, omega, zeta, mu=0.0, slide=1.0):
+    r"""x_b'' [m/s^2] of the sliding base with the block at rest on it: the linear SDOF
 
     .. math:: \ddot x_b + 2 \zeta_b \omega_b \dot x_b + \omega_b^2 x_b = -\ddot u_g
 
-    (M x_b'' + c x_b' + k x_b = -M u_g'' divided by M = m + m_b, Vassiliou & Makris 2012).
+    (M x_b'' + c x_b' + k x_b = -M u_g'' divided by M = m + m_b, Vassiliou & Makris 2012),
+    with mu g slide more on the left for a friction pendulum.
     """
-    return base_acceleration_at_rest(x_b, x_b_dot, omega, zeta) - a_g
+    return base_acceleration_at_rest(x_b, x_b_dot, omega, zeta, mu, slide) - a_g
 
 
 def uplift_side(a_base, slenderness):
@@ -108,7 +196,7 @@ def uplift_side(a_base, slenderness):
     return 0.0
 
 
-def rocking_accelerations(x_b, x_b_dot, theta, theta_dot, a_g, side, body: IsolatedBody):
+def rocking_accelerations(x_b, x_b_dot, theta, theta_dot, a_g, side, body: IsolatedBody, slide=1.0):
     r"""(x_b'', theta'') [m/s^2, rad/s^2] of the block rocking on side s on the moving base.
 
     Lagrange's equations of T and V (module docstring), per unit block mass, with
@@ -122,16 +210,11 @@ def rocking_accelerations(x_b, x_b_dot, theta, theta_dot, a_g, side, body: Isola
 
     The second row is Housner's eq. (2.2) of [000] with the base's absolute acceleration
     u_g'' + x_b'' for the ground's; the first is the base's, loaded by the block's inertia.
-    The determinant R^2 (4 M / 3 - cos^2 phi) is > 0 for every M >= 1.
+    The determinant R^2 (4 M / 3 - cos^2 phi) is > 0 for every M >= 1. A friction
+    pendulum adds mu g slide to the isolator's force (:func:`isolator_acceleration`); its
+    stuck base (slide 0) leaves Housner's block on the ground (:func:`accelerations`).
     """
-    R, alpha, M, omega, zeta = body
-    phi = side * alpha - theta
-    c, sn = R * math.cos(phi), R * math.sin(phi)
-    i0 = 4.0 / 3.0 * R * R
-    f_base = -M * (a_g + 2.0 * zeta * omega * x_b_dot + omega * omega * x_b) - sn * theta_dot**2
-    f_block = -c * a_g - G * sn
-    det = M * i0 - c * c
-    return (i0 * f_base - c * f_block) / det, (M * f_block - c * f_base) / det
+    return accelerations(x_b, x_b_dot, theta, theta_dot, a_g, side, slide, *body.core)
 
 
 def impact_velocities(x_b_dot, theta_dot, body: IsolatedBody):
@@ -152,9 +235,18 @@ def impact_velocities(x_b_dot, theta_dot, body: IsolatedBody):
     x_b'+ = x_b'- - (h / M) (theta'+ - theta'-). The ground's velocity u_g' is continuous,
     so the relative x_b' jumps as the absolute one does.
     """
-    R, alpha, M = body.radius, body.slenderness, body.mass
-    after = isolated_restitution(alpha, M - 1.0) * theta_dot
-    return x_b_dot - R * math.cos(alpha) / M * (after - theta_dot), after
+    eta = isolated_restitution(body.slenderness, body.mass - 1.0)
+    return impact_jump(
+        x_b_dot, theta_dot, eta, body.radius * math.cos(body.slenderness) / body.mass
+    )
+
+
+@njit(cache=True)
+def impact_jump(x_b_dot, theta_dot, eta, h_over_m):
+    """(x_b', theta') after an impact (:func:`impact_velocities`) from the restitution eta and
+    h / M = R cos(alpha) / M, the scalar form the numba kernel compiles."""
+    after = eta * theta_dot
+    return x_b_dot - h_over_m * (after - theta_dot), after
 
 
 def settling_velocity(x_b_dot, theta_dot, body: IsolatedBody):

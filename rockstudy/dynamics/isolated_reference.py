@@ -6,8 +6,9 @@ base, impacts with momentum exchange, overturning. Each regime is integrated by
 ``solve_ivp`` (DOP853) with events: the uplift (the base's absolute acceleration at rest
 passing g tan(alpha)), the impact (theta = 0), the overturning (``|theta|`` = pi/2) and the
 peaks of ``|x_b|`` and ``|theta|``. Phases stop at every sample of a record (where u_g'' has a
-kink) and at the end of the motion. This is the only solver of the model so far: no numba
-kernel yet.
+kink) and at the end of the motion. The friction pendulum's stop and break-away end phases
+too. It keeps the whole history; the batches run the numba kernel of the same model
+(:mod:`._isolated_scene`), which this reference checks.
 """
 
 from __future__ import annotations
@@ -24,20 +25,21 @@ from .._warnings import IncompleteReferenceWarning
 from ..constants import FALL_ROTATION, G
 from ..motions import Motion, Record
 from ..structures.isolated import IsolatedBlock
-from .constants import REST_FRACTION
-from .isolated import (
-    IsolatedBody,
-    base_acceleration_at_rest,
-    impact_velocities,
-    rest_acceleration,
-    rocking_accelerations,
-    settling_velocity,
-    uplift_side,
+from ._isolated_model import (
+    base_acceleration,
+    demand,
+    lift_side,
+    row_parameters,
+    settled,
+    slide_after_jump,
+    slide_after_stop,
 )
+from .constants import REST_FRACTION
+from .isolated import IsolatedBody, accelerations, impact_velocities, settling_velocity
 from .isolated_result import IsolatedResult
 from .reference import _first_lift, _ground
 
-__all__ = ["ISOLATED_METHODS", "MAX_IMPACTS", "simulate_isolated"]
+__all__ = ["ISOLATED_METHODS", "MAX_IMPACTS", "absolute_tolerances", "simulate_isolated"]
 
 #: The ``simulate`` methods an IsolatedBlock takes: all run this ``solve_ivp`` reference.
 ISOLATED_METHODS = ("nonlinear", "scipy", "auto")
@@ -58,6 +60,11 @@ class _Scene:
     t_end: float  # t_max, or the tail cap
     t_max_given: bool
     omega_rest: float
+    par: np.ndarray  # the kernel's parameter vector (:func:`._isolated_model.row_parameters`)
+
+    def ground(self, t):
+        """u_g''(t) [m/s^2], 0 after the motion."""
+        return self.acc(t) if t <= self.duration else 0.0
 
     def stop(self, t):
         """Where a phase from t [s] stops: the next record sample or the motion's end, then
@@ -85,18 +92,19 @@ class _Log:
         self.max_x = max(self.max_x, abs(state[0]))
         self.max_theta = max(self.max_theta, abs(state[2]))
 
-    def add_solution(self, sol, t_cut, rest):
+    def add_solution(self, sol, t_cut, rest, true_state):
         """The steps of ``sol`` before t_cut [s] (an event's row is added by the caller) and
-        the peaks its non-terminal events located; its dense output as a segment."""
+        the peaks its non-terminal events located, valued by ``true_state(t)``
+        (:func:`_true_state`); its dense output as a segment."""
         for t, y in zip(sol.t[1:], sol.y.T[1:], strict=True):
             if t < t_cut:
                 self.add(t, (y[0], y[1], 0.0, 0.0) if rest else y)
-        peaks = sol.t_events[-1 if rest else -2]
-        for y in sol.y_events[-1 if rest else -2][peaks <= t_cut]:
-            self.max_x = max(self.max_x, abs(y[0]))
+        for t in sol.t_events[-1 if rest else -2]:
+            if t <= t_cut:
+                self.max_x = max(self.max_x, abs(true_state(t)[0]))
         if not rest:
-            for y in sol.y_events[-1][sol.t_events[-1] <= t_cut]:
-                self.max_theta = max(self.max_theta, abs(y[2]))
+            for t in sol.t_events[-1][sol.t_events[-1] <= t_cut]:
+                self.max_theta = max(self.max_theta, abs(true_state(t)[2]))
         dense = sol.sol
         if rest:
 
@@ -128,50 +136,106 @@ def _solve(scene, rhs, t0, t1, y0, events, atol):
     return sol
 
 
-def _lifted(scene, x, xd):
-    """The side a block at rest lifts onto with the base at (x_b, x_b') (0: stays)."""
-    a_b = base_acceleration_at_rest(x, xd, scene.body.omega, scene.body.zeta)
-    return uplift_side(a_b, scene.body.slenderness)
+def _true_state(scene, rhs, sol, t, atol):
+    """The state at t [s] integrated from the last step of ``sol`` before t (DOP853 steps
+    from there, not the dense output: at rtol 1e-12 the interpolant errs ~10 times more
+    than the steps, and the peaks and impacts are read here)."""
+    i = max(int(np.searchsorted(sol.t, t, side="left")) - 1, 0)
+    t0 = float(sol.t[i])
+    if not t > t0:
+        return sol.y[:, i]
+    run = solve_ivp(
+        rhs, (t0, t), sol.y[:, i], "DOP853", rtol=scene.rtol, atol=atol, first_step=t - t0
+    )
+    return run.y[:, -1]
 
 
-def _rest_phase(scene, log, t, x, xd):
-    """The block at rest from t until it lifts or the phase stops: returns
-    (t, x_b, x_b', side), side 0 if it still rests at the phase's end."""
-    body = scene.body
-    limit = G * math.tan(body.slenderness)
+def _lifted(scene, t, x, xd, slide):
+    """The side a block at rest lifts onto at t [s] with the base at (x_b, x_b') (0: stays);
+    a stuck base moves with the ground."""
+    return lift_side(x, xd, scene.ground(t), slide, scene.par)
+
+
+def _x_event(scene, side, slide, t0):
+    """The event of the base in a phase from t0 [s]: a linear isolator's turning points
+    (``|x_b|``'s peaks, non-terminal); a friction pendulum's stop (x_b' back to 0 against
+    the sliding; its function taken as 1 at t0, as the impact's) or break-away (the friction
+    the stuck base needs past mu g), terminal."""
+    mu = scene.body.mu
+    if mu == 0.0:
+        return _event(lambda t_, y: y[1], False, 0.0)
+    if slide != 0.0:
+        return _event(lambda t_, y: 1.0 if t_ == t0 else slide * y[1], True, -1.0)
+
+    def excess(t_, y):
+        th, thd = (y[2], y[3]) if side != 0.0 else (0.0, 0.0)
+        return abs(demand(np.array([y[0], 0.0, th, thd]), scene.ground(t_), side, scene.par)) - (
+            mu * G
+        )
+
+    return _event(excess, True, 1.0)
+
+
+def _new_slide(scene, t, y, which_side, slide):
+    """The base's regime after its stop (``slide`` != 0: :func:`slide_after_stop`) or its
+    break-away (it slides off in the direction of the friction it needs) at (t, y)."""
+    state = np.array([y[0], 0.0, *(y[2:4] if len(y) > 2 else (0.0, 0.0))])
+    if slide != 0.0:
+        return slide_after_stop(state, scene.ground(t), which_side, scene.par)
+    return math.copysign(1.0, demand(state, scene.ground(t), which_side, scene.par))
+
+
+def _rest_phase(scene, log, t, x, xd, slide):
+    """The block at rest from t until it lifts, the base stops or breaks away (a friction
+    pendulum) or the phase stops: returns (t, x_b, x_b', side, slide), side 0 if it still
+    rests at the phase's end."""
+    body, limit = scene.body, G * math.tan(scene.body.slenderness)
 
     def rhs(t_, y):
-        a_g = scene.acc(t_) if t_ <= scene.duration else 0.0
-        return [y[1], rest_acceleration(y[0], y[1], a_g, body.omega, body.zeta)]
+        xdd = accelerations(y[0], y[1], 0.0, 0.0, scene.ground(t_), 0.0, slide, *body.core)[0]
+        return [y[1], xdd]
 
-    def a_b(y):
-        return base_acceleration_at_rest(y[0], y[1], body.omega, body.zeta)
+    def a_b(t_, y):
+        return base_acceleration(y[0], y[1], scene.ground(t_), slide, scene.par)
 
     events = [
-        _event(lambda t_, y: a_b(y) + limit, True, -1.0),  # lifts onto the positive pivot
-        _event(lambda t_, y: a_b(y) - limit, True, 1.0),  # onto the negative one
-        _event(lambda t_, y: y[1], False, 0.0),  # a peak of ``|x_b|``
+        _event(lambda t_, y: a_b(t_, y) + limit, True, -1.0),  # lifts onto the positive pivot
+        _event(lambda t_, y: a_b(t_, y) - limit, True, 1.0),  # onto the negative one
+        _x_event(scene, 0.0, slide, t),
     ]
     sol = _solve(scene, rhs, t, _rest_window(scene, t), [x, xd], events, scene.atol[:2])
-    lifts = [float(sol.t_events[i][0]) for i in (0, 1) if sol.t_events[i].size]
-    if not lifts:
-        log.add_solution(sol, math.inf, rest=True)
-        return float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1]), 0.0
-    t_up = _first_lift_time(scene, sol, min(lifts))
-    log.add_solution(sol, t_up, rest=True)
+
+    def true_state(t_):
+        return _true_state(scene, rhs, sol, t_, scene.atol[:2])
+
+    hits = [(float(sol.t_events[i][0]), i) for i in (0, 1) if sol.t_events[i].size]
+    if events[2].terminal and sol.t_events[2].size:
+        hits.append((float(sol.t_events[2][0]), 2))
+    if not hits:
+        log.add_solution(sol, math.inf, True, true_state)
+        return float(sol.t[-1]), float(sol.y[0, -1]), float(sol.y[1, -1]), 0.0, slide
+    t_hit, which = min(hits)
+    if which == 2:  # the friction pendulum's base stops or breaks away
+        y = [float(v) for v in true_state(t_hit)]
+        log.add_solution(sol, t_hit, True, true_state)
+        y[1] = 0.0 if slide != 0.0 else y[1]
+        log.add(t_hit, (y[0], y[1], 0.0, 0.0))
+        return t_hit, y[0], y[1], 0.0, _new_slide(scene, t_hit, y, 0.0, slide)
+    t_up = _first_lift_time(scene, sol, t_hit, slide)
+    log.add_solution(sol, t_up, True, true_state)
     x, xd = sol.sol(t_up)
     log.add(t_up, (x, xd, 0.0, 0.0))
     log.uplifts.append(t_up)
-    return t_up, float(x), float(xd), _lifted(scene, x, xd)
+    return t_up, float(x), float(xd), _lifted(scene, t_up, x, xd, slide), slide
 
 
-def _first_lift_time(scene, sol, t_event):
+def _first_lift_time(scene, sol, t_event, slide):
     """The first double at which the block at rest lifts (on the dense output), at or just
     after the event's root ``t_event``: the bracket from the step before it, then bisection
     to adjacent doubles (:func:`.reference._first_lift`)."""
 
     def lift(t):
-        return 1.0 if _lifted(scene, *sol.sol(t)) else -1.0
+        return 1.0 if _lifted(scene, t, *sol.sol(t), slide) else -1.0
 
     hi, ulp = t_event, math.ulp(t_event)
     while lift(hi) < 0.0:
@@ -191,18 +255,7 @@ def _rest_window(scene, t):
     return end
 
 
-def _settled(scene, log, x, xd):
-    """Whether a block at rest after the motion, the base at (x_b, x_b'), can never lift again
-    nor the base pass its peak so far: the free isolator's energy E = (x_b'^2 + omega^2
-    x_b^2) / 2 does not grow, ``|x_b|`` <= sqrt(2 E) / omega and the base's acceleration
-    |2 zeta omega x_b' + omega^2 x_b| <= omega sqrt(1 + 4 zeta^2) sqrt(2 E) (Cauchy-Schwarz)."""
-    w, zeta = scene.body.omega, scene.body.zeta
-    amp = math.hypot(x, xd / w)
-    accel = w * w * math.sqrt(1.0 + 4.0 * zeta * zeta) * amp
-    return amp <= log.max_x and accel < G * math.tan(scene.body.slenderness)
-
-
-def _rocking_events(side, t0):
+def _rocking_events(scene, side, slide, t0):
     """The impact (theta back to 0, terminal), the overturning (``|theta|`` = pi/2, terminal),
     and the peaks of ``|x_b|`` and of ``|theta|`` (non-terminal) of a rocking phase on
     ``side`` from t0 [s].
@@ -213,34 +266,56 @@ def _rocking_events(side, t0):
     return [
         _event(lambda t_, y: 1.0 if t_ == t0 else side * y[2], True, -1.0),
         _event(lambda t_, y: side * y[2] - FALL_ROTATION, True, 1.0),
-        _event(lambda t_, y: y[1], False, 0.0),
+        _x_event(scene, side, slide, t0),
         _event(lambda t_, y: y[3], False, -side),
     ]
 
 
-def _rock_phase(scene, log, t, y, side):
-    """The block rocking on ``side`` from t [s] with y = (x_b, x_b', theta, theta') until an
-    impact, the overturning or the phase's end. Returns (t, y, side, what happened):
-    "impact" (y after it; side 0 if the block settled), "overturned" or "end"."""
+def _newton_hit(rhs, t, y, which, side):
+    """The impact (which 0: theta = 0) or the overturning (1: theta = s pi/2) at (t, y), the
+    true state near the located root, after one Newton correction of its time."""
+    target = 0.0 if which == 0 else side * FALL_ROTATION
+    f = rhs(t, y)
+    dl = -(y[2] - target) / y[3] if y[3] != 0.0 else 0.0
+    return t + dl, [float(v + d * dl) for v, d in zip(y, f, strict=True)]
+
+
+def _rock_phase(scene, log, t, y, side, slide):
+    """The block rocking on ``side`` from t [s] with y = (x_b, x_b', theta, theta'), the
+    base sliding in the direction ``slide`` (0: stuck), until an impact, the overturning, the
+    base's stop or break-away (a friction pendulum) or the phase's end. Returns (t, y, side,
+    slide, what happened): "impact" (y after it; side 0 if the block settled),
+    "overturned", "slide" or "end"."""
     body = scene.body
 
     def rhs(t_, s):
-        a_g = scene.acc(t_) if t_ <= scene.duration else 0.0
-        xdd, thdd = rocking_accelerations(s[0], s[1], s[2], s[3], a_g, side, body)
+        xdd, thdd = accelerations(s[0], s[1], s[2], s[3], scene.ground(t_), side, slide, *body.core)
         return [s[1], xdd, s[3], thdd]
 
-    sol = _solve(scene, rhs, t, scene.stop(t), y, _rocking_events(side, t), scene.atol)
-    hits = [(float(sol.t_events[i][0]), i) for i in (0, 1) if sol.t_events[i].size]
+    events = _rocking_events(scene, side, slide, t)
+    sol = _solve(scene, rhs, t, scene.stop(t), y, events, scene.atol)
+
+    def true_state(t_):
+        return _true_state(scene, rhs, sol, t_, scene.atol)
+
+    ends = (0, 1, 2) if events[2].terminal else (0, 1)
+    hits = [(float(sol.t_events[i][0]), i) for i in ends if sol.t_events[i].size]
     if not hits:
-        log.add_solution(sol, math.inf, rest=False)
-        return float(sol.t[-1]), [float(v) for v in sol.y[:, -1]], side, "end"
+        log.add_solution(sol, math.inf, False, true_state)
+        return float(sol.t[-1]), [float(v) for v in sol.y[:, -1]], side, slide, "end"
     t_hit, which = min(hits)
-    log.add_solution(sol, t_hit, rest=False)
-    y_hit = [float(v) for v in sol.y_events[which][0]]
+    if which == 2:
+        y_hit = [float(v) for v in true_state(t_hit)]
+        log.add_solution(sol, t_hit, False, true_state)
+        y_hit[1] = 0.0 if slide != 0.0 else y_hit[1]
+        log.add(t_hit, y_hit)
+        return t_hit, y_hit, side, _new_slide(scene, t_hit, y_hit, side, slide), "slide"
+    t_hit, y_hit = _newton_hit(rhs, t_hit, true_state(t_hit), which, side)
+    log.add_solution(sol, t_hit, False, true_state)
     if which == 1:
         y_hit[2] = side * FALL_ROTATION
         log.add(t_hit, y_hit)
-        return t_hit, y_hit, side, "overturned"
+        return t_hit, y_hit, side, slide, "overturned"
     y_hit[2] = 0.0
     log.add(t_hit, y_hit)
     log.impacts.append(t_hit)
@@ -251,29 +326,35 @@ def _rock_phase(scene, log, t, y, side):
         side = -side
     after = [y_hit[0], xd, 0.0, thd]
     log.add(t_hit, after)
-    return t_hit, after, side, "impact"
+    slide = slide_after_jump(np.array(after), scene.ground(t_hit), side, scene.par)
+    return t_hit, after, side, slide, "impact"
 
 
 def _run(scene, log, y, side):
     """The phases from t = 0 until the end: returns (overturn time or NaN, complete)."""
     t = 0.0
     log.add(t, y)
+    slide = slide_after_stop(np.array(y, dtype=float), scene.ground(0.0), side, scene.par)
     while True:
         if side == 0.0:
-            if t >= scene.duration and not scene.t_max_given and _settled(scene, log, *y[:2]):
+            if (
+                t >= scene.duration
+                and not scene.t_max_given
+                and settled(np.array(y, dtype=float), slide, log.max_x, scene.par)
+            ):
                 return math.nan, True
             if t >= scene.t_end:
                 return math.nan, scene.t_max_given
-            side = _lifted(scene, y[0], y[1])
+            side = _lifted(scene, t, y[0], y[1], slide)
             if side == 0.0:
-                t, x, xd, side = _rest_phase(scene, log, t, y[0], y[1])
+                t, x, xd, side, slide = _rest_phase(scene, log, t, y[0], y[1], slide)
                 y = [x, xd, 0.0, 0.0]
                 continue
             if not log.uplifts or log.uplifts[-1] != t:
                 log.uplifts.append(t)
         if t >= scene.t_end:
             return math.nan, scene.t_max_given
-        t, y, side, what = _rock_phase(scene, log, t, y, side)
+        t, y, side, slide, what = _rock_phase(scene, log, t, y, side, slide)
         if what == "overturned":
             return t, True
         if len(log.impacts) >= MAX_IMPACTS:
@@ -286,6 +367,17 @@ def _run(scene, log, y, side):
             return math.nan, False
 
 
+def absolute_tolerances(structure: IsolatedBlock, motion: Motion, rtol: float) -> np.ndarray:
+    """The absolute tolerances of (x_b, x_b', theta, theta'): rtol times the base's
+    displacement scale (peak + g tan(alpha)) / omega_b^2 and its rate, alpha and p alpha
+    (the reference's and the numba kernel's)."""
+    body = IsolatedBody.of(structure)
+    p = structure.block.frequency_parameter
+    scale = (float(getattr(motion, "peak", 0.0)) + G * math.tan(body.slenderness)) / body.omega**2
+    alpha = body.slenderness
+    return rtol * np.array([scale, scale * body.omega, alpha, p * alpha])
+
+
 def _scene(structure, motion, rtol, t_max):
     """The scene of a run: the tail after the motion without ``t_max`` is capped at 100 / p +
     100 T_b (an undamped isolator may lift the block for ever)."""
@@ -293,14 +385,21 @@ def _scene(structure, motion, rtol, t_max):
     p = structure.block.frequency_parameter
     acc, _ = _ground(motion)
     dur = float(motion.duration)
-    scale = (float(getattr(motion, "peak", 0.0)) + G * math.tan(body.slenderness)) / body.omega**2
-    alpha = body.slenderness
-    atol = rtol * np.array([scale, scale * body.omega, alpha, p * alpha])
+    atol = absolute_tolerances(structure, motion, rtol)
     cap = dur + 100.0 / p + 100.0 * structure.period
     breaks = np.asarray(motion.time) if isinstance(motion, Record) else None
     t_end = cap if t_max is None else float(t_max)
     return _Scene(
-        body, acc, dur, breaks, rtol, atol, t_end, t_max is not None, REST_FRACTION * p * alpha
+        body,
+        acc,
+        dur,
+        breaks,
+        rtol,
+        atol,
+        t_end,
+        t_max is not None,
+        REST_FRACTION * p * body.slenderness,
+        row_parameters(structure),
     )
 
 
@@ -370,7 +469,7 @@ def simulate_isolated(
     conditioning: bool = False,
 ) -> IsolatedResult:
     """Rock a block on an isolated base through a ground motion: the ``solve_ivp`` reference
-    (the scipy path; the numba kernel comes later), what
+    (the scipy path, with the whole history; ``simulate_batch`` runs the numba kernel), what
     ``rockstudy.simulate(IsolatedBlock(...), motion)`` runs.
 
     Parameters

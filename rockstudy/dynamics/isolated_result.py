@@ -36,7 +36,7 @@ class IsolatedResult:
     overturn_time : float
         When ``|theta|`` reached pi/2 [s]; NaN if the block survived.
     method : str
-        ``"scipy"``: the ``solve_ivp`` reference (no numba kernel yet).
+        ``"scipy"``: the ``solve_ivp`` reference (the numba kernel runs the batches only).
     info : dict
         What ran: the model, rtol, the restitution on the base, whether the history is
         complete (``complete``: False where the impact cap or the tail cap stopped it).

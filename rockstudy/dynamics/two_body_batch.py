@@ -107,9 +107,16 @@ def stacked_rows(structures, motions, rtol, max_steps) -> dict:
 
 
 def isolated_rows(structures, motions, rtol, max_steps) -> dict:
-    """The :data:`ISOLATED_OUTPUTS` of each (structure, motion) row."""
-    names = ISOLATED_OUTPUTS[:-2]
-    return _reference_rows(structures, motions, rtol, lambda r: {k: getattr(r, k) for k in names})
+    """The :data:`ISOLATED_OUTPUTS` of each (structure, motion) row, by the numba kernel
+    (:mod:`._isolated_scene`, the rows in parallel): the reference's model and events,
+    ``status`` 1 where a row reached ``max_steps`` steps, the reference's impact cap or its
+    tail cap after the motion."""
+    from ._isolated_scene import O_IMPACTS, O_OVER, O_STATUS, O_THETA, O_TIME, O_X, run_rows
+    from .isolated_reference import MAX_IMPACTS
+
+    out = run_rows(structures, motions, rtol, max_steps, MAX_IMPACTS)
+    columns = (O_THETA, O_OVER, O_X, O_TIME, O_IMPACTS, O_STATUS)
+    return _typed({k: out[:, c] for k, c in zip(ISOLATED_OUTPUTS, columns, strict=True)})
 
 
 _DTYPES = {"overturned": bool, "overturned_body": np.int8, "n_impacts": np.int64}
