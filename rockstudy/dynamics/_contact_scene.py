@@ -16,8 +16,9 @@ Every step stops at each record sample. After the motion the block moves on unti
 A scene's ``status``: 0 (ok), 1 (the step limit: the answer did not converge, e.g. a chatter
 that never settles), 3 (no solution: Painleve's paradox, mu_k > 4/3). A batch row whose
 status is not 0 must not be used as an answer, nor one whose ``converged`` is False
-(:func:`flag_unconverged`: its answer moves by more than 10 rtol at rtol / 100, or a
-friction decision whose outcome jumps lay within 10 rtol of its threshold).
+(:func:`flag_unconverged`: its answer moves by more than 10 rtol at rtol / 100, a
+friction decision whose outcome jumps lay within 10 rtol of its threshold, or the row is
+ill-conditioned: a twin run with the amplitude moved by 1e-9 moves it by more than 1e4 rtol).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
 from . import _contact_taylor as ct
 from . import slide_rock as sr
-from ._contact_flag import DECISION_BAND, flag_unconverged
+from ._contact_flag import DECISION_BAND, flag_unconverged, row_runner
 from ._contact_rest import _from_flat, _rest
 from ._contact_state import (
     S_CLEAN,
@@ -629,9 +630,16 @@ def contact_scene(
         hist, imps = np.empty((max(n, hist.shape[0]), 4)), np.empty(max(n_imp, imps.shape[0]))
     row = np.empty(1, CONTACT_ROW)
     _write(row, 0, ta, over)
+    p = math.sqrt(0.75 * G / blk.radius)
+    cols = tuple(np.array([x], float) for x in (p, alpha, eta, static, kinetic))
+    if t_max is None:  # the batch's flag: the twin runs follow the scene to its end
+        motion_rows = (mot[0], mot[1][None, :], *mot[2:])
+        runner = row_runner(cols, motion_rows, max_steps, contact_batch_serial)
+        flag_unconverged(row, cols, runner, float(rtol))
+    else:
+        jumps = row["decision_margin"] < DECISION_BAND * rtol and static > kinetic
+        row["converged"] &= ~jumps
     out = {name: row[name][0].item() for name in CONTACT_ROW.names}
-    jumps = out["decision_margin"] < DECISION_BAND * rtol and static > kinetic
-    out["converged"] = out["converged"] and not jumps
     out.update(t=hist[:n, 0], theta=hist[:n, 1], theta_dot=hist[:n, 2], slide=hist[:n, 3])
     out["impact_times"] = imps[:n_imp].copy()
     out["regime_times"] = {name: out.pop(f"time_{name}") for name in sr.REGIMES}
@@ -668,17 +676,9 @@ def contact_batch(
         for x in (p, alpha, eta, static, kinetic)
     )
     cols = tuple(cols)
-    mp, times, samples, vsamples = (
-        np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples)
-    )
+    arrays = (np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples))
     run = contact_batch_kernel if parallel else contact_batch_serial
-
-    def rows(index, tolerance):
-        """The kernel's rows ``index`` at ``tolerance``."""
-        picked = (c[index] for c in cols)
-        motion = (np.int64(kind), mp[index], times, samples, vsamples)
-        return run(*picked, *motion, tolerance, int(max_steps))
-
+    rows = row_runner(cols, (np.int64(kind), *arrays), max_steps, run)
     out = rows(slice(None), float(rtol))
     flag_unconverged(out, cols, rows, float(rtol))
     return out

@@ -419,7 +419,8 @@ def _contact_kernel(radius, alpha, eta, motion, friction, method, rtol, t_max, m
         warnings.warn(
             f"the contact model's answer did not converge with rtol={rtol:g}: a friction "
             "decision (stick or slip, mu_s > mu_k) lay within 10 rtol of its threshold, where "
-            "the answer jumps; method='scipy' at a tighter rtol, or mu_s = mu_k, decides it",
+            "the answer jumps, its answer moved at rtol / 100, or the scene is ill-conditioned "
+            "(its answer moves by more than 1e4 rtol when the amplitude moves by 1e-9)",
             AccuracyWarning,
             stacklevel=4,
         )

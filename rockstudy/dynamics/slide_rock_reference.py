@@ -351,6 +351,8 @@ def _contact_phase(scene, log, st):
     stop = scene.stop(st.t)
     if st.t >= stop:
         return "end"
+    if st.regime == sr.ROCK:
+        _slip_if_unheld(scene, st)
     regime, side, slip = st.regime, st.side, st.slip
     names, events = _contact_events(scene, regime, side, slip, st.t)
     sol = _solve(scene, _contact_rhs(scene, regime, side, slip), st.t, stop, st.y, events)
@@ -393,6 +395,17 @@ def _contact_phase(scene, log, st):
         else:
             st.slip = -math.copysign(1.0, f_h)
     return "on"
+
+
+def _slip_if_unheld(scene, st):
+    """Slide-rock, slipping against F, where a block entering rock on corner st.side presses
+    on the base (N > 0) with rocking forces outside the friction cone (``|F|`` > mu_s N):
+    after an impact whose impulse stayed inside the cone, the forces just after it need
+    not (the rock phase's slip events see only crossings after its start). N <= 0 is left
+    to the lift-off event."""
+    f_h, f_v = _forces(scene, sr.ROCK, st.side, st.slip, st.t, st.y)
+    if f_v > 0.0 and abs(f_h) > scene.static * f_v:
+        st.regime, st.slip = sr.SLIDE_ROCK, -math.copysign(1.0, f_h)
 
 
 def _impact(scene, log, st):
