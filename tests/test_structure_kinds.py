@@ -66,7 +66,8 @@ def _expected(structure):
 def test_every_kind_has_an_example_and_the_schema_takes_the_registry():
     assert set(EXAMPLES) == set(KINDS) == set(OBJECT_KINDS)
     fields = {f for k in KINDS.values() for f in k.fields}
-    assert set(OBJECT_COLUMNS) == fields | {"name", "kind", "friction", "friction_kinetic", "compare_to"}
+    given = {"name", "kind", "friction", "friction_kinetic", "compare_to"}
+    assert set(OBJECT_COLUMNS) == fields | given
     props = json_schema()["$defs"]["ObjectSpec"]["properties"]
     assert fields <= set(props)
 

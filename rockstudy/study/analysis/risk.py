@@ -6,10 +6,13 @@ integrated against the site's hazard curve (:func:`rockstudy.risk.annual_rate`, 
 2002): the mean annual rate of overturning lambda_OT and the probability of at least one
 overturning in a number of years, 1 - exp(-lambda_OT t). Where the intensity is PGA and no
 record has a vertical component, the fragility is 0 below each object's uplift PGA (the ground
-cannot lift it there, eq. 10 of [003]) and the fitted lognormal above it. The band of lambda_OT
-comes from resampling the records with replacement (the records are what the fragility is uncertain
-about), refitting the fragility and integrating again; the deaggregation
-(:func:`rockstudy.risk.rate_deaggregation`) says which intensity levels the rate comes from.
+cannot lift it there, eq. 10 of [003]) and the fitted lognormal above it; not where the
+objects feel another motion than the measured record (a floor motion, a rocking plane at an
+angle to the record's x component), nor for an object on an isolator, which can amplify the
+ground. The band of lambda_OT comes from resampling the records with replacement (the records
+are what the fragility is uncertain about), refitting the fragility and integrating again;
+the deaggregation (:func:`rockstudy.risk.rate_deaggregation`) says which intensity levels the
+rate comes from.
 
 What the records cannot say is marked, not invented (``status``):
 
@@ -202,12 +205,14 @@ def cut_levels(ds, im, units, uplift):
     block that the design simulates lifts off (lower for an arch): below both the ground
     lifts neither, so P(OT | PGA) = 0. ``uplift`` (the structures' own uplift PGA) and the
     result are in ``units``."""
-    if not (im == "pga" and horizontal(ds)):
+    if not (im == "pga" and horizontal(ds) and felt_as_measured(ds)):
         return np.full(ds.sizes["structure"], np.nan)
     level = uplift
     if "critical_rotation" in ds:
         lifts = G * np.tan(ds["critical_rotation"].transpose("structure").values.astype(float))
         level = np.fmin(uplift, lifts / to_si(im, units))
+    if "uplift_bounds" in ds:  # an isolator can amplify the ground: no bound below
+        level = np.where(ds["uplift_bounds"].transpose("structure").values, level, np.nan)
     return np.where(np.isfinite(level) & (level > 0), level, np.nan)
 
 
@@ -216,6 +221,14 @@ def cut_refused(level, first) -> np.ndarray:
     the round-off of the scales that produced it)."""
     with np.errstate(invalid="ignore"):
         return np.asarray(first < level * (1.0 - 1e-9))
+
+
+def felt_as_measured(ds) -> bool:
+    """False when the design says that its objects feel another motion than the record whose
+    measures it stores (``measured_motion`` False on ``record``: a floor motion, measured by
+    its ground record; a rocking plane at an angle psi to the x component): the stored PGA
+    then does not bound the acceleration that lifts them, and no fragility is cut below it."""
+    return "measured_motion" not in ds or bool(ds["measured_motion"].all())
 
 
 def horizontal(ds) -> bool:

@@ -33,9 +33,8 @@ from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
 from ..spec.design_kinds import design_kind
 from ..spec.feasibility import record_pairs, second_file
-from . import ida_states
+from . import ida_states, two_body_rows
 from . import records as rd
-from . import two_body_rows
 
 __all__ = [
     "CONTACT_VARIABLES",
@@ -639,6 +638,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         )
     files = json.loads(cube.attrs["record_files"])  # [horizontal, vertical] for a pair
     ds["vertical_component"] = ("record", np.array([isinstance(f, list) for f in files]))
+    ds = ds.assign(_felt_motion(study, n_rec, n_st))
     if "uplift_acceleration" not in ds:  # a cube written before the design carried it
         ds["uplift_acceleration"] = ("structure", _old_uplift(ds, study))
     attrs = {k: v for k, v in cube.attrs.items() if k != "grid_dims"} | _states_attr(study)
@@ -668,6 +668,23 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         attrs["n_simulations"] = int((~ds["censored"]).sum())
     ds.attrs = attrs
     return ds
+
+
+def _felt_motion(study: dict, n_rec: int, n_st: int) -> dict:
+    """``measured_motion`` on ``record`` (False where the objects feel a floor motion above
+    the ground or the record along an orientation: not the motion whose measures the design
+    stores) and ``uplift_bounds`` on ``structure`` (False for a block on an isolator), as
+    :func:`rockstudy.study.designs.records.incremental_dynamic_analysis` gives them, for
+    :func:`rockstudy.study.analysis.risk.cut_levels`."""
+    floors = study["motion"].get("floor") or 0
+    above = any(f > 0 for f in (floors if isinstance(floors, list) else [floors]))
+    oriented = study["design"].get("orientations") is not None
+    st = study["structure"]
+    kinds = [o.get("kind", "block") for o in st.get("objects") or []] or ["block"] * n_st
+    return {
+        "measured_motion": ("record", np.full(n_rec, not (above or oriented))),
+        "uplift_bounds": ("structure", np.array([k != "isolated" for k in kinds])),
+    }
 
 
 def motion_coords(attrs) -> dict:

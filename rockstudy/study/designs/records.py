@@ -281,6 +281,8 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
     data["vertical_component"] = ("record", np.array([r.vertical is not None for r in records]))
+    data["measured_motion"] = ("record", np.array([ground_record(r) is r for r in records]))
+    data["uplift_bounds"] = ("structure", two_body_rows.uplift_bounds(structures))
     for k, v in structures.items():
         if k not in ("names", "two_body"):
             data[k] = ("structure", v)

@@ -69,6 +69,17 @@ def two_body_column(structures) -> np.ndarray | None:
     return np.asarray(column, dtype=object)
 
 
+def uplift_bounds(structures) -> np.ndarray:
+    """Per structure, whether its uplift acceleration bounds the ground PGA below which it
+    cannot move: not for a block on an isolator, whose base can amplify the ground's
+    acceleration (:func:`rockstudy.study.analysis.risk.cut_levels`)."""
+    column = two_body_column(structures)
+    n = structures["critical_rotation"].size
+    if column is None:
+        return np.ones(n, bool)
+    return np.array([not isinstance(s, IsolatedBlock) for s in column])
+
+
 def keys(structures) -> tuple:
     """The outputs a design keeps beside its own for these structures: the two-body ones
     when some structure has two bodies."""

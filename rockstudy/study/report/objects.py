@@ -23,7 +23,7 @@ from ...motions import measures as _ms
 from ..analysis import record_fragility as rf
 from ..analysis import record_similarity as rsim
 from ..analysis.fragility_fit import LACK_OF_FIT_LEVEL, N_BOOT
-from ..analysis.risk import cut_levels, horizontal
+from ..analysis.risk import cut_levels, felt_as_measured, horizontal
 from ..analysis.sampled import fragility_curve
 from ..spec.design_kinds import DesignKind, design_kind
 from ..spec.feasibility import DEFAULT_MAX_SCALE_FACTOR
@@ -339,7 +339,7 @@ def object_fragility(page, ctx):
             "; under these horizontal records nothing can overturn below it, so the fragility "
             "in PGA is 0 there (dashed: the fitted lognormal's tail, which the annual rates "
             "leave out)"
-            if horizontal(ctx.ds)
+            if horizontal(ctx.ds) and felt_as_measured(ctx.ds)
             else ""
         ),
     )
