@@ -57,6 +57,7 @@ from . import ida_slides
 
 __all__ = [
     "CENSORED_REASONS",
+    "stored_measures",
     "cf_flags",
     "cloud",
     "incremental_dynamic_analysis",
@@ -256,9 +257,39 @@ def _scale_for(level, measure, im):
 # ------------------------------------------------------------------------------ tables
 
 
-def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
+def stored_measures(im=None, extra_measures=()) -> tuple[str, ...]:
+    """The measures of the registry a design stores per record besides the listed ones
+    (:func:`rockstudy.motions.measures.listed`): that of ``im`` (a scale target; none for a
+    ratio, whose measure is listed) and ``extra_measures`` (names of the registry), those
+    not listed, in order: e.g. ``pga_rotd50``, a measure of a pair of components."""
+    if isinstance(extra_measures, str):
+        extra_measures = (extra_measures,)
+    names = [] if im is None else [_ms.target(im).name]
+    names += [_ms.measure(k, "extra_measures").name for k in extra_measures]
+    return tuple(k for k in dict.fromkeys(names) if not _ms.MEASURES[k].listed)
+
+
+def _unlisted_values(grounds, names, periods, damping) -> dict:
+    """The variables of the measures ``names`` (:func:`stored_measures`) of the ground
+    records: on ``record``, and on ``period`` too for those that need one."""
+    data = {}
+    for k in names:
+        m = _ms.MEASURES[k]
+        if m.needs_period and not len(periods):
+            raise ValueError(f"extra_measures: {k!r} needs a period [s]: give it in periods")
+        if m.needs_period:
+            values = [[r.intensity_measure(k, t, damping) for t in periods] for r in grounds]
+            data[k] = (("record", "period"), np.array(values, float).reshape(-1, len(periods)))
+        else:
+            values = [r.intensity_measure(k, damping=damping) for r in grounds]
+            data[k] = ("record", np.array(values, float))
+    return data
+
+
+def _record_dataset(records, structures, periods, damping, unlisted=()) -> xr.Dataset:
     """Measures of the unscaled records (on ``record``; on ``period`` too for those that need
-    one) and their groups for each structure."""
+    one), those of ``unlisted`` (:func:`stored_measures`) too, and their groups for each
+    structure."""
     grounds = [ground_record(r) for r in records]  # a floor motion reports its ground's
     ims = [r.intensity_measures(periods=periods, damping=damping) for r in grounds]
     pulses = [r.pulse() for r in grounds]
@@ -268,6 +299,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
             ("record", "period"),
             np.array([m[k] for m in ims], float).reshape(len(ims), len(periods)),
         )
+    data.update(_unlisted_values(grounds, unlisted, periods, damping))
     data["pulse_period"] = ("record", np.array([q.period for q in pulses], float))
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
@@ -452,6 +484,7 @@ def cloud(
     friction=None,
     contact: bool | None = None,
     model: str = "rocking",
+    extra_measures=(),
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -496,6 +529,11 @@ def cloud(
         ``overturned_rocking``: Housner's decision of every point, the rocking-only answer
         of :func:`rockstudy.study.analysis.sliding.contact_effect`); "rocking"
         (default): Housner's model (with the friction check where ``friction`` is given).
+    extra_measures : sequence of str
+        Measures of the registry stored per record besides those it lists
+        (:func:`rockstudy.motions.measures.listed`), e.g. ``pga_rotd50`` (a measure of a
+        pair: every record needs two horizontal components) for a hazard curve in it; one
+        that needs a period is stored at ``periods``. A design stores its own ``im`` so.
 
     Returns
     -------
@@ -509,7 +547,7 @@ def cloud(
     st = _structures(structures)
     contact = _friction_check(friction, contact, st["critical_rotation"].size)
     _, periods = _target("pga", None, periods)
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(None, extra_measures))
     idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
     model = _contact_model(model, friction, idx.size)
@@ -542,6 +580,7 @@ def multiple_stripes(
     friction=None,
     contact: bool | None = None,
     model: str = "rocking",
+    extra_measures=(),
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -559,7 +598,7 @@ def multiple_stripes(
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
     records, structures, periods, damping, method, rtol, max_steps, friction, contact, model
-        As in :func:`cloud`.
+        As in :func:`cloud`; ``extra_measures`` too (``im`` is stored always).
 
     Returns
     -------
@@ -578,7 +617,7 @@ def multiple_stripes(
     levels = np.atleast_1d(np.asarray(levels, float))
     if levels.ndim != 1 or not levels.size or not np.all(np.isfinite(levels) & (levels > 0)):
         raise ValueError(f"levels must be one or more finite numbers > 0, got {levels!r}")
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(im, extra_measures))
     n = st["critical_rotation"].size
     idx = np.repeat(np.arange(n), levels.size)
     model = _contact_model(model, friction, n)
@@ -645,6 +684,7 @@ def incremental_dynamic_analysis(
     contact: bool | None = None,
     model: str = "rocking",
     slide_limits=(),
+    extra_measures=(),
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -711,6 +751,8 @@ def incremental_dynamic_analysis(
     slide_limits : sequence of float
         Slides d [m] (> 0, increasing; under the contact model only): ``slide_capacity``,
         the first scale at which ``max_slide`` > d (see :func:`.ida_slides.slide_scales`).
+    extra_measures : sequence of str
+        As in :func:`cloud` (``im`` is stored always: ``capacity`` is in it).
 
     Returns
     -------
@@ -739,7 +781,7 @@ def incremental_dynamic_analysis(
     model = _contact_model(model, friction, n)
     limits = ida_slides.slide_limits(slide_limits, model)
     period, periods = _target(im, period, periods)
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(im, extra_measures))
     measure = np.array(
         [_record_measure(ground_record(r), im, period, damping, st) for r in records]
     )
