@@ -10,6 +10,7 @@ of a lognormal fragility under a power-law hazard.
 import math
 
 import numpy as np
+import pandas as pd
 import pyrotd
 import pytest
 from _helpers import RECORD_STUDY_HEAD, write_at2
@@ -180,6 +181,9 @@ def test_a_cloud_with_a_rotd100_hazard_stores_the_pairs_rotd100(pairs, client, t
         assert got == pytest.approx(pyrotd_pga(pair_of(pairs, i), 100), rel=1e-3)
     make_report(out, tmp_path / "report")
     assert "PGA_ROTD100 hazard curve" in (tmp_path / "report" / "index.html").read_text()
+    table = pd.read_csv(tmp_path / "report" / "records.csv", index_col=0)
+    want = cube["pga_rotd100"].values / STANDARD_GRAVITY
+    np.testing.assert_allclose(table["PGA RotD100 [g]"].values, want, rtol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -202,3 +206,21 @@ def test_stripes_scaled_to_a_pair_measure_need_two_components(pairs, tmp_path):
     motion = 'scale_to = { im = "pga_rotd50", value = { dist = "grid", values = [1.0] } }'
     with pytest.raises(StudyError, match=r"motion.scale_to.im: 'pga_rotd50' is a measure of two"):
         study_file(pairs, tmp_path, motion, 'kind = "stripes"')
+
+
+def test_monte_carlo_rows_on_a_floor_scale_the_ground_pair_to_its_rotd50(pairs, tmp_path):
+    from _helpers import run_rows
+
+    text = RECORD_STUDY_HEAD.replace('kind = "lhs"\nn = 3', 'kind = "monte_carlo"\nn = 4') + (
+        f'[motion]\nkind = "record"\nfiles = "{pairs}"\n{H2}\n{SHEAR}\nfloor = 3\n'
+        'scale_to = { im = "pga_rotd50", units = "g", value = 0.4 }\n'
+        '[run]\noutputs = ["max_rotation", "overturned"]\n'
+    )
+    (tmp_path / "rows.toml").write_text(text)
+    study = load_study(tmp_path / "rows.toml")
+    design, out = run_rows(study, tmp_path)
+    for i, r in enumerate(design["record"].values):
+        pair = pair_of(pairs, int(r))
+        want = 0.4 * STANDARD_GRAVITY / pyrotd_pga(pair, 50)
+        assert out["scale"][i] == pytest.approx(want, rel=1e-3)
+        assert out["pga"][i] == pytest.approx(pair.peak * want, rel=1e-3)  # the ground's
