@@ -304,7 +304,7 @@ def test_a_study_on_a_floor_takes_a_ground_hazard_curve(suite, tmp_path):
         assert study.hazard is not None and study.motion.floor == floor
 
 
-def test_monte_carlo_rows_on_a_floor_scale_the_floor_motion(suite, tmp_path):
+def test_monte_carlo_rows_on_a_floor_scale_the_ground_record(suite, tmp_path):
     study = rows_study(suite, tmp_path, f"{SHEAR}\nfloor = 3\npga_ratio = 2.5")
     design, out = run_rows(study, tmp_path)
     files = sorted(suite.glob("*_H.AT2"))
@@ -313,5 +313,6 @@ def test_monte_carlo_rows_on_a_floor_scale_the_floor_motion(suite, tmp_path):
         ground = Record.from_at2(files[r])
         floor = lsim_floor(building, 3, ground.time, ground.acceleration)
         uplift = G * np.tan(design["critical_rotation"].values[i])
-        assert np.max(np.abs(floor)) * out["scale"][i] == pytest.approx(2.5 * uplift, rel=1e-9)
-        assert ground.peak * out["scale"][i] != pytest.approx(2.5 * uplift, rel=1e-2)
+        assert ground.peak * out["scale"][i] == pytest.approx(2.5 * uplift, rel=1e-9)
+        assert out["pga"][i] == pytest.approx(ground.peak * abs(out["scale"][i]), rel=1e-9)
+        assert np.max(np.abs(floor)) * out["scale"][i] != pytest.approx(2.5 * uplift, rel=1e-2)

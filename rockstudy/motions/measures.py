@@ -79,6 +79,9 @@ class Measure:
     needs_period: bool = False
     needs_damping: bool = False
     listed: bool = True
+    #: Whether the function needs a record of two horizontal components (``acceleration_y``:
+    #: the RotD measures of :mod:`rockstudy.motions.rotd`).
+    needs_pair: bool = False
     #: A registered measure's values are checked (a finite number >= 0, its exceptions named);
     #: not the built-in ones', which are NaN where undefined (the duration of a silent record).
     checked: bool = False
@@ -267,6 +270,7 @@ def register_measure(
     needs_damping: bool = False,
     listed: bool = True,
     replace: bool = False,
+    needs_pair: bool = False,
 ) -> Measure:
     """Add an intensity measure to the registry: one call, and every reader has it.
 
@@ -304,6 +308,10 @@ def register_measure(
         (``psv`` and ``sd`` are not: they follow from ``sa``).
     replace : bool
         Redefine an existing measure.
+    needs_pair : bool
+        Whether the function needs a record of two horizontal components (``acceleration_y``,
+        as RotD50): a study refuses it on records of one before the run. It is then tried on
+        the synthetic record with a second component (its own samples in reverse order).
 
     Returns
     -------
@@ -339,6 +347,7 @@ def register_measure(
         _flag("needs_period", needs_period),
         _flag("needs_damping", needs_damping),
         _flag("listed", listed),
+        _flag("needs_pair", needs_pair),
         checked=_PROBE_RECORD is not None,
     )
     if measure.checked:
@@ -363,8 +372,11 @@ def set_probe(record) -> None:
 def _probe(measure: Measure) -> None:
     """ValueError naming the measure if it fails, or is not a finite number >= 0, on the
     probe record."""
+    record = _PROBE_RECORD
+    if measure.needs_pair and record.acceleration_y is None:
+        record = record._replace(acceleration_y=record.acceleration[::-1].copy())
     try:
-        measure.of(_PROBE_RECORD, 1.0 if measure.needs_period else None, 0.05)
+        measure.of(record, 1.0 if measure.needs_period else None, 0.05)
     except ValueError as exc:
         raise ValueError(f"function: {exc}; the measure is not registered") from None
 
@@ -520,7 +532,7 @@ def _rotd_builtins(to_g: dict, spectral: dict) -> None:
     """RotD50 and RotD100 of PGA and Sa (:mod:`rockstudy.motions.rotd`): measures of a pair
     of horizontal components, so not listed (a record of one component has none of them)."""
     for which, words in (("rotd50", "RotD50"), ("rotd100", "RotD100")):
-        pair = {"unit": "m/s^2", "listed": False, **to_g}
+        pair = {"unit": "m/s^2", "listed": False, "needs_pair": True, **to_g}
         register_measure(
             f"pga_{which}", rotd.pga_rotd(which), power=1, label=f"PGA {words}", **pair
         )

@@ -28,7 +28,7 @@ import xarray as xr
 from ..._warnings import UpliftWarning
 from ...dynamics import outputs as _outputs
 from ...motions import measures
-from ...motions.building import with_ground
+from ...motions.building import ground_record, with_ground
 from ...motions.suites import read_pair
 from ...structures.block import uplift_acceleration_block
 from ..spec.design_kinds import design_kind
@@ -39,6 +39,7 @@ from . import records as rd
 __all__ = [
     "CONTACT_VARIABLES",
     "design_dataset",
+    "design_measures",
     "design_motion",
     "design_rows",
     "empty_rows",
@@ -169,6 +170,10 @@ def outputs(study) -> dict:
     for k in measures.listed(True):
         m = measures.MEASURES[k]
         out[k] = (f"{m.label}(T) of the unscaled record", m.unit, "f8", np.nan, "period")
+    for k in design_measures(study):
+        m = measures.MEASURES[k]
+        extra = "period" if m.needs_period else None
+        out[k] = (f"{m.label} of the unscaled record", m.unit, "f8", np.nan, extra)
     out.update({k: (*_float(*v), None) for k, v in GROUP_VARIABLES.items()})
     if kind.capacities:
         out.update({k: (*v, None) for k, v in _IDA.items()})
@@ -216,6 +221,18 @@ def outputs(study) -> dict:
         None,
     )
     return out
+
+
+def design_measures(study) -> tuple[str, ...]:
+    """The measures a design study stores per record besides the listed ones
+    (:func:`.records.stored_measures`): those of its scaling (``design.im`` of an IDA,
+    ``motion.scale_to.im`` of stripes) and of its ``[hazard]`` not listed, e.g. ``pga_rotd50``."""
+    kind = design_kind(study.design.kind)
+    im = study.design.ida().im if kind.capacities else None
+    if kind.levels:
+        im = study.motion.scale_to.im
+    hazard = () if study.hazard is None else (study.hazard.im,)
+    return rd.stored_measures(im, hazard)
 
 
 def ida_steps(study) -> int:
@@ -479,6 +496,7 @@ def _run_design(study, record, structures, levels, friction):
         max_steps=run.max_steps,
     )
     kw["friction"] = friction
+    kw["extra_measures"] = () if study.hazard is None else (study.hazard.im,)
     if run.model != "rocking":  # spec.Study._contact_model: every structure has its mu
         kw["model"] = run.model
         if kind.capacities:
@@ -581,7 +599,7 @@ def _folded(cube, kind, shape, m_dims) -> dict:
         extra = var.dims[1:]
         if name in STRUCTURE_VARIABLES:
             out[new] = (("structure",), values[(0, *first, slice(None), 0)], var.attrs)
-        elif name in record_variables() or name in measures.listed(True):
+        elif name in record_variables() or name in measures.MEASURES:
             out[new] = (("record",) + extra, values[(slice(None), *first, 0, 0)], var.attrs)
         elif name in GROUP_VARIABLES:
             ground = values[(slice(None), *first)][:, :, 0]
@@ -796,7 +814,10 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
     ones k = 1, Arias intensity 2, durations and periods 0; the pulse's amplitude 1, its period
     and indicator 0); groups as in
     :func:`rockstudy.similarity.record_groups` (PGA / a_up, PGV p / a_up, omega_p / p and
-    omega_p v_p / a_up, with ``uplift`` = a_up [m/s^2] the structures' uplift acceleration)."""
+    omega_p v_p / a_up, with ``uplift`` = a_up [m/s^2] the structures' uplift acceleration).
+    A floor motion is measured by its ground record's measures
+    (:func:`rockstudy.motions.building.ground_record`), as the designs measure it."""
+    record = ground_record(record)
     ims = {k: v for k, v in record.intensity_measures().items() if k in measures.listed(False)}
     pulse = record.pulse()
     ims.update(
@@ -818,7 +839,10 @@ def sample_measures(record, scale, frequency_parameter, uplift) -> dict:
 def scale_factors(study, record, cols, idx) -> np.ndarray:
     """The factor on ``record`` of the rows ``idx``: ``scale``; or the factor that brings
     its PGA to ``pga_ratio`` a_up (the structure's uplift acceleration, :func:`uplift_column`);
-    or its ``scale_to.im`` to ``target``."""
+    or its ``scale_to.im`` to ``target``. A floor motion is scaled by its ground record's
+    measure (:func:`rockstudy.motions.building.ground_record`: the building is linear, so the
+    ground record scaled by s gives the floor motion scaled by s), as the designs scale it."""
+    record = ground_record(record)
     alpha = cols["critical_rotation"][idx]
     uplift = uplift_column(study, cols, idx)
     if "scale" in cols:

@@ -58,6 +58,7 @@ from . import ida_slides, ida_states, two_body_rows
 
 __all__ = [
     "CENSORED_REASONS",
+    "stored_measures",
     "cf_flags",
     "cloud",
     "failed_points",
@@ -265,9 +266,39 @@ def _scale_for(level, measure, im):
 # ------------------------------------------------------------------------------ tables
 
 
-def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
+def stored_measures(im=None, extra_measures=()) -> tuple[str, ...]:
+    """The measures of the registry a design stores per record besides the listed ones
+    (:func:`rockstudy.motions.measures.listed`): that of ``im`` (a scale target; none for a
+    ratio, whose measure is listed) and ``extra_measures`` (names of the registry), those
+    not listed, in order: e.g. ``pga_rotd50``, a measure of a pair of components."""
+    if isinstance(extra_measures, str):
+        extra_measures = (extra_measures,)
+    names = [] if im is None else [_ms.target(im).name]
+    names += [_ms.measure(k, "extra_measures").name for k in extra_measures]
+    return tuple(k for k in dict.fromkeys(names) if not _ms.MEASURES[k].listed)
+
+
+def _unlisted_values(grounds, names, periods, damping) -> dict:
+    """The variables of the measures ``names`` (:func:`stored_measures`) of the ground
+    records: on ``record``, and on ``period`` too for those that need one."""
+    data = {}
+    for k in names:
+        m = _ms.MEASURES[k]
+        if m.needs_period and not len(periods):
+            raise ValueError(f"extra_measures: {k!r} needs a period [s]: give it in periods")
+        if m.needs_period:
+            values = [[r.intensity_measure(k, t, damping) for t in periods] for r in grounds]
+            data[k] = (("record", "period"), np.array(values, float).reshape(-1, len(periods)))
+        else:
+            values = [r.intensity_measure(k, damping=damping) for r in grounds]
+            data[k] = ("record", np.array(values, float))
+    return data
+
+
+def _record_dataset(records, structures, periods, damping, unlisted=()) -> xr.Dataset:
     """Measures of the unscaled records (on ``record``; on ``period`` too for those that need
-    one) and their groups for each structure."""
+    one), those of ``unlisted`` (:func:`stored_measures`) too, and their groups for each
+    structure."""
     grounds = [ground_record(r) for r in records]  # a floor motion reports its ground's
     ims = [r.intensity_measures(periods=periods, damping=damping) for r in grounds]
     pulses = [r.pulse() for r in grounds]
@@ -277,6 +308,7 @@ def _record_dataset(records, structures, periods, damping) -> xr.Dataset:
             ("record", "period"),
             np.array([m[k] for m in ims], float).reshape(len(ims), len(periods)),
         )
+    data.update(_unlisted_values(grounds, unlisted, periods, damping))
     data["pulse_period"] = ("record", np.array([q.period for q in pulses], float))
     data["pulse_amplitude"] = ("record", np.array([q.amplitude for q in pulses], float))
     data["pulse_indicator"] = ("record", np.array([q.indicator for q in pulses], float))
@@ -521,6 +553,7 @@ def cloud(
     contact: bool | None = None,
     model: str = "rocking",
     damage_states=None,
+    extra_measures=(),
 ) -> xr.Dataset:
     """Every structure under every record, unscaled (a cloud analysis).
 
@@ -572,6 +605,11 @@ def cloud(
         ``{name: limit}`` (see :mod:`.ida_states`): checked, and kept as
         ``attrs["damage_states"]`` for the fits of each state
         (:mod:`rockstudy.study.analysis.states`).
+    extra_measures : sequence of str
+        Measures of the registry stored per record besides those it lists
+        (:func:`rockstudy.motions.measures.listed`), e.g. ``pga_rotd50`` (a measure of a
+        pair: every record needs two horizontal components) for a hazard curve in it; one
+        that needs a period is stored at ``periods``. A design stores its own ``im`` so.
 
     Returns
     -------
@@ -585,7 +623,7 @@ def cloud(
     st = _structures(structures)
     contact = _friction_check(friction, contact, st["critical_rotation"].size)
     _, periods = _target("pga", None, periods)
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(None, extra_measures))
     idx = np.arange(st["critical_rotation"].size)
     ones = np.ones(idx.size)
     model = _contact_model(model, friction, idx.size)
@@ -628,6 +666,7 @@ def multiple_stripes(
     contact: bool | None = None,
     model: str = "rocking",
     damage_states=None,
+    extra_measures=(),
 ) -> xr.Dataset:
     """Multiple-stripe analysis: every record scaled to each intensity level, every structure.
 
@@ -645,8 +684,8 @@ def multiple_stripes(
     period : float, optional
         T [s] of ``sa``, ``psv``, ``sd`` (and of any measure that needs one).
     records, structures, periods, damping, method, rtol, max_steps, friction, contact, model
-    damage_states
-        As in :func:`cloud`.
+    damage_states, extra_measures
+        As in :func:`cloud` (``im`` is stored always).
 
     Returns
     -------
@@ -665,7 +704,7 @@ def multiple_stripes(
     levels = np.atleast_1d(np.asarray(levels, float))
     if levels.ndim != 1 or not levels.size or not np.all(np.isfinite(levels) & (levels > 0)):
         raise ValueError(f"levels must be one or more finite numbers > 0, got {levels!r}")
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(im, extra_measures))
     n = st["critical_rotation"].size
     idx = np.repeat(np.arange(n), levels.size)
     model = _contact_model(model, friction, n)
@@ -735,6 +774,7 @@ def incremental_dynamic_analysis(
     model: str = "rocking",
     slide_limits=(),
     damage_states=None,
+    extra_measures=(),
 ) -> xr.Dataset:
     """The first overturning intensity of each structure under each record, by a ladder.
 
@@ -806,6 +846,8 @@ def incremental_dynamic_analysis(
         in (0, 1], 1 = overturning) or, under the contact model, on the peak slide
         (``{"slide": d}``, d [m]): ``state_capacity``, the first scale at which each state is
         reached, bisected as the overturning capacity (see :mod:`.ida_states`).
+    extra_measures : sequence of str
+        As in :func:`cloud` (``im`` is stored always: ``capacity`` is in it).
 
     Returns
     -------
@@ -841,7 +883,7 @@ def incremental_dynamic_analysis(
     limits = ida_slides.slide_limits(slide_limits, model)
     states = ida_states.damage_states(damage_states, model is not None)
     period, periods = _target(im, period, periods)
-    ds = _record_dataset(records, st, periods, damping)
+    ds = _record_dataset(records, st, periods, damping, stored_measures(im, extra_measures))
     measure = np.array(
         [_record_measure(ground_record(r), im, period, damping, st) for r in records]
     )

@@ -157,14 +157,20 @@ def _summary(page, ds, relabel=str):
     page.table(pd.Series(rows, dtype=object).to_frame("value"), "summary", "The design")
 
 
+def _stored_measures(ds, period: bool) -> list[str]:
+    """The measures of the registry the design stores per record, with (``period=True``) or
+    without a period: the listed ones and those it was asked for (a RotD50 hazard's, ...)."""
+    return [k for k, m in _ms.MEASURES.items() if m.needs_period == period and k in ds]
+
+
 def _record_list(page, ds):
-    scalars = [k for k in _ms.listed(False) if k in ds]
+    scalars = _stored_measures(ds, False)
     cols = {im_label(k): ds[k].values * _ms.quoted(k)[1] for k in scalars}
     table = pd.DataFrame(cols, index=_names(ds))
     if "pga" in scalars:  # g next to m/s^2
         table.insert(table.columns.get_loc(im_label("pga")) + 1, "PGA [m/s^2]", ds["pga"].values)
     periods = np.asarray(ds["period"].values, float) if "period" in ds.coords else []
-    for name in (k for k in _ms.listed(True) if k in ds):
+    for name in _stored_measures(ds, True):
         for j, t in enumerate(periods):
             table[im_label(name, t)] = ds[name].values[:, j] * _ms.quoted(name)[1]
     table["pulse period T_p [s]"] = ds["pulse_period"].values

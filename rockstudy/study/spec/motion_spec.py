@@ -302,7 +302,8 @@ class RecordSpec(_Model):
     acceleration of that floor (:func:`rockstudy.motions.floor_motion`) before it is run. A
     design measures, scales and reports each record by its ground record's measures (those of
     the site's hazard curve: the building is linear, so the ground record scaled by s gives the
-    floor motion scaled by s); Monte Carlo rows scale the floor motion. A list of distinct
+    floor motion scaled by s); Monte Carlo rows too (``pga_ratio`` and ``scale_to`` bring the
+    ground record's measure to the target, and store its measures). A list of distinct
     floors (``floor = [1, 3, 5]``, a design only) is a dimension ``floor`` of the design:
     every design runs on every floor.
 

@@ -262,6 +262,32 @@ class Study(_Model):
         return self
 
     @model_validator(mode="after")
+    def _pair_measures(self):
+        """A measure of a pair of horizontal components (RotD50, ...) needs records of two."""
+        for field, im in self._measure_fields():
+            if measures.measure(im).needs_pair and getattr(self.motion, "h2", None) is None:
+                raise FieldError(
+                    field,
+                    f"{im!r} is a measure of two horizontal components, but the records have "
+                    "one: give motion.h2 = { match = '<regex>', replace = '<replacement>' } "
+                    "naming each record's second one",
+                )
+        return self
+
+    def _measure_fields(self) -> list[tuple[str, str]]:
+        """(field, measure) of the study's intensity measures: ``design.im`` of an IDA,
+        ``motion.scale_to.im`` (a ratio's base measure) and ``hazard.im``."""
+        out = []
+        if self.design is not None and design_kind(self.design.kind).capacities:
+            out.append(("design.im", self.design.ida().im))
+        target = getattr(self.motion, "scale_to", None)
+        if target is not None:
+            out.append(("motion.scale_to.im", target.im))
+        if self.hazard is not None:
+            out.append(("hazard.im", self.hazard.im))
+        return [(f, measures.target(im, f).name) for f, im in out]
+
+    @model_validator(mode="after")
     def _floor_list(self):
         """A list of floors is a dimension of a record design only."""
         if isinstance(getattr(self.motion, "floor", None), list) and self.design is None:
