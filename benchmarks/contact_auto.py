@@ -9,13 +9,16 @@ Three runs of the same scenes, in one process, after a warm-up (compilation apar
 
 The scenes: random blocks (R 0.3-3 m, alpha 0.1-0.3) under sine pulses (a_g / (g tan alpha)
 1.2-4, T_p 0.2-1 s), and under a synthetic record (scale 0.5-2). Prints and writes
-scenes/s and the ratios auto / rocking and auto / (rocking + check); the target is
+scenes/s (the median of interleaved repeats: the runs take turns, so that each sees the
+machine's load as it drifts) and the ratios auto / rocking and auto / (rocking + check), each
+the median of the repeats' own ratios; the target is
 auto >= 0.8 x rocking on the pure rocking scenes: those that ``auto`` leaves to Housner's model
 (the others, which overturn, lift off or need more friction, it runs again with the contact
 model), timed again on their own (``pure rocking: auto / rocking``).
 
-    python benchmarks/contact_auto.py            # n = 400 pulse rows, 100 record rows
-    python benchmarks/contact_auto.py --n 100    # a quick look
+    python benchmarks/contact_auto.py                      # n = 400 pulse rows, 100 record rows
+    python benchmarks/contact_auto.py --n 100 --repeats 5  # a quick look
+    python benchmarks/contact_auto.py --n 4000 --repeats 21  # a stable median
 
 Writes benchmarks/results/contact_auto.json.
 """
@@ -61,18 +64,26 @@ def scenes(n, seed=36):
     return {"sine pulses": pulses, "record": records}
 
 
-def throughput(kwargs, runs, repeat=5):
-    """({run: best scenes/s}, {run: outputs}) of the ``runs`` (name: extra arguments), each
-    timed ``repeat`` times, the runs interleaved (the machine's load, shared, drifts: each
-    run sees the same drift)."""
+def throughput(kwargs, runs, repeats):
+    """({run: median scenes/s}, {run: outputs}, {run: times [s] per repeat}) of the ``runs``
+    (name: extra arguments), each timed ``repeats`` times, the runs interleaved (the
+    machine's load, shared, drifts: the runs of one repeat see nearly the same load)."""
     n = np.size(kwargs["slenderness"])
-    best, outs = dict.fromkeys(runs, np.inf), {}
-    for _ in range(repeat):
+    times, outs = {run: [] for run in runs}, {}
+    for _ in range(repeats):
         for run, extra in runs.items():
             t0 = time.perf_counter()
             outs[run] = simulate_batch(**kwargs, **extra)
-            best[run] = min(best[run], time.perf_counter() - t0)
-    return {run: n / t for run, t in best.items()}, outs
+            times[run].append(time.perf_counter() - t0)
+    times = {run: np.array(t) for run, t in times.items()}
+    return {run: n / float(np.median(t)) for run, t in times.items()}, outs, times
+
+
+def ratio(times, run, base):
+    """The median over the repeats of the throughput ratio ``run`` / ``base`` (each repeat's
+    runs timed side by side), with its spread (the quartiles)."""
+    r = times[base] / times[run]
+    return float(np.median(r)), [float(q) for q in np.percentile(r, (25, 75))]
 
 
 def subset(kwargs, keep):
@@ -80,43 +91,47 @@ def subset(kwargs, keep):
     return {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in kwargs.items()}
 
 
-def pure_rocking(kwargs, auto):
-    """(scenes, rocking scenes/s, auto scenes/s) on the rows that ``auto`` (its outputs)
-    answered with Housner's model."""
+def pure_rocking(kwargs, auto, repeats):
+    """(scenes, {run: median scenes/s}, (median ratio auto / rocking, its quartiles)) on the
+    rows that ``auto`` (its outputs) answered with Housner's model."""
     pure = subset(kwargs, auto["model"] != 3)
-    rates = throughput(pure, {run: RUNS[run] for run in ("rocking", "auto")})[0]
-    return int(np.size(pure["slenderness"])), rates["rocking"], rates["auto"]
+    runs = {run: RUNS[run] for run in ("rocking", "auto")}
+    rates, _, times = throughput(pure, runs, repeats)
+    return int(np.size(pure["slenderness"])), rates, ratio(times, "auto", "rocking")
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=400)
+    parser.add_argument("--repeats", type=int, default=9, help="interleaved repeats per run")
     args = parser.parse_args(argv)
     results = {}
     for name, kwargs in scenes(args.n).items():
         warm = {k: (v[:2] if isinstance(v, np.ndarray) else v) for k, v in kwargs.items()}
         for extra in RUNS.values():  # compile outside the timing
             simulate_batch(**warm, **extra)
-        rates, outs = throughput(kwargs, RUNS)
+        rates, outs, times = throughput(kwargs, RUNS, args.repeats)
         contact_rows = int(np.sum(outs["auto"]["model"] == 3))
-        n_pure, pure_rocking_rate, pure_auto_rate = pure_rocking(kwargs, outs["auto"])
+        n_pure, pure_rates, (pure, pure_q) = pure_rocking(kwargs, outs["auto"], args.repeats)
         results[name] = {
             "scenes": int(np.size(kwargs["slenderness"])),
-            "scenes_per_s": rates,
-            "auto / rocking": rates["auto"] / rates["rocking"],
-            "auto / (rocking + check)": rates["auto"] / rates["rocking + check"],
+            "repeats": args.repeats,
+            "scenes_per_s (median)": rates,
+            "auto / rocking": ratio(times, "auto", "rocking")[0],
+            "auto / (rocking + check)": ratio(times, "auto", "rocking + check")[0],
             "rows run by the contact model under auto": contact_rows,
             "pure rocking scenes": n_pure,
-            "pure rocking: scenes_per_s": {"rocking": pure_rocking_rate, "auto": pure_auto_rate},
-            "pure rocking: auto / rocking": pure_auto_rate / pure_rocking_rate,
+            "pure rocking: scenes_per_s (median)": pure_rates,
+            "pure rocking: auto / rocking (median)": pure,
+            "pure rocking: auto / rocking (quartiles)": pure_q,
         }
         print(
             f"{name}: " + ", ".join(f"{k} {v:.0f} scenes/s" for k, v in rates.items()),
             f"| auto / rocking {results[name]['auto / rocking']:.3f}",
             f"| auto / (rocking + check) {results[name]['auto / (rocking + check)']:.3f}",
             f"| contact rows {contact_rows}",
-            f"| pure rocking ({n_pure} scenes): auto / rocking "
-            f"{results[name]['pure rocking: auto / rocking']:.3f}",
+            f"| pure rocking ({n_pure} scenes): auto / rocking median {pure:.3f} "
+            f"(quartiles {pure_q[0]:.3f}-{pure_q[1]:.3f}, {args.repeats} repeats)",
         )
     OUT.mkdir(exist_ok=True)
     (OUT / "contact_auto.json").write_text(json.dumps(results, indent=2) + "\n")

@@ -12,7 +12,8 @@ x = alpha s - theta, S = sin x, C = cos x, gamma = g + u_v'' and R theta_ddot = 
 
 On every accepted Taylor step the ratio ``|F_h|`` / F_v is evaluated on the step polynomial
 at :data:`INTERIOR` points and the step's end (its start too where a rocking phase starts: at
-uplift, after an impact); where the largest of a step's samples, or the vertex of the parabola
+uplift, after an impact), theta, theta_dot, S and C summed from the step's series (no sine or
+cosine per sample); where the largest of a step's samples, or the vertex of the parabola
 through it and its neighbours, reaches the largest ratio so far, it is refined by a golden
 section search (:data:`GOLDEN_ITERATIONS`) between its neighbours. The demand is the largest
 ratio, with the impulse ratio of the impacts, (1 - eta) / ((1 + eta) tan alpha), if the block
@@ -40,7 +41,12 @@ import numpy as np
 from numba import njit
 
 from ..constants import G
-from ..motions._kernels import KIND_RECORD, ground_acceleration, vertical_acceleration
+from ..motions._kernels import (
+    KIND_RECORD,
+    KIND_TRIG,
+    ground_acceleration,
+    vertical_acceleration,
+)
 from ._rhs import _record_acceleration
 from ._taylor import (
     FMA,
@@ -74,17 +80,11 @@ FREE_ROCKING_SLENDERNESS = 0.9
 _GOLD = 0.5 * (math.sqrt(5.0) - 1.0)
 
 
-@njit(cache=True, inline="always")
-def force_ratio(th, om, s, a_h, a_v, p, alpha):
-    """(``|F_h|`` / F_v, F_v / m) of a block rocking on side s at theta = th [rad], theta_dot
-    = om [rad/s] under the ground (a_h, a_v) [m/s^2]; the ratio inf where F_v <= 0."""
-    x = alpha * s - th
-    return _ratio(math.sin(x), math.cos(x), om, a_h, a_v, p)
-
-
 @njit(cache=True, fastmath=FMA, inline="always")
 def _ratio(sx, cx, om, a_h, a_v, p):
-    """:func:`force_ratio` from S = sin x, C = cos x (x = alpha s - theta)."""
+    """(``|F_h|`` / F_v, F_v / m) of a block rocking at theta_dot = om [rad/s] under the ground
+    (a_h, a_v) [m/s^2], from S = sin x, C = cos x (x = alpha s - theta, on side s); the ratio
+    inf where F_v <= 0."""
     gam = G + a_v
     r_acc = -0.75 * (gam * sx + a_h * cx)  # R theta_ddot
     r_om2 = 0.75 * G * (om / p) ** 2  # R theta_dot^2
@@ -106,20 +106,55 @@ def free_rocking_ratio(c, energy):
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _sample(w, ta, tau, step):
     """(ratio, F_v / m, u = s theta) at time tau [s] on the polynomial of the step that holds
-    it: the current one (``step`` = (t0, hs, n, k, s, p, alpha, mot), its polynomial in
-    w[ROW_C]) or, before t0, the step before (w[ROW_PREV], its t0, hs, n, k in ``ta``)."""
+    it: the current one (``step`` = (t0, hs, n, k, s, p, alpha, mot), its series in w:
+    :func:`_series_at`) or, before t0, the step before (w[ROW_PREV], its t0, hs, n, k in
+    ``ta``; S and C from theta)."""
     t0, hs, n, k, s, p, alpha, mot = step
-    row = ROW_C
     if tau < t0:
-        t0, hs, n, k, row = ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k, ROW_PREV
-    th, d, _ = poly_value(w[row], n, (tau - t0) / hs)
+        t0, hs, n, k = ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k
+        th, d, _ = poly_value(w[ROW_PREV], n, (tau - t0) / hs)
+        x = alpha * s - th
+        sx, cx = math.sin(x), math.cos(x)
+    else:
+        th, d, sx, cx = _series_at(w, n, (tau - t0) / hs)
     a_h = a_v = 0.0
     kind, mp, times, samples, vsamples = mot
     if t0 < mp[3]:  # the step lies within the motion
-        a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        a_h = _ground(kind, mp, times, samples, tau, k)
         a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
-    ratio, f_v = force_ratio(th, d / hs, s, a_h, a_v, p, alpha)
+    ratio, f_v = _ratio(sx, cx, d / hs, a_h, a_v, p)
     return ratio, f_v, s * th
+
+
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _ground(kind, mp, times, samples, tau, k):
+    """u_h'' [m/s^2] at tau [s] (record segment k), as
+    :func:`rockstudy.motions._kernels.ground_acceleration` gives it, without its call where
+    the arithmetic is short: a trigonometric pulse, and a record on one of its samples (where
+    the record's steps end: no interpolation)."""
+    if kind == KIND_TRIG:
+        return mp[0] * math.sin(mp[1] * tau + mp[2]) if 0.0 <= tau <= mp[3] else 0.0
+    if kind == KIND_RECORD:
+        return _record_acceleration(mp, times, samples, tau, k)
+    return ground_acceleration(kind, mp, times, samples, tau, k)
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _series_at(w, n, x):
+    """(theta, dtheta/dx, S, C) at unit step time x on the current step: theta's polynomial
+    of order n (w[ROW_C]) and the series of S = sin(alpha s - theta) and C = cos(alpha s -
+    theta) to order n - 2 (w[ROW_S], w[ROW_C_SERIES]; within the step's tolerance, as in
+    :func:`_sample_end`), summed by one Horner loop: no sine or cosine per sample."""
+    d = w[ROW_C, n]
+    v = d * x + w[ROW_C, n - 1]
+    sx = w[ROW_S, n - 2]
+    cx = w[ROW_C_SERIES, n - 2]
+    for j in range(n - 2, 0, -1):
+        d = d * x + v
+        v = v * x + w[ROW_C, j]
+        sx = sx * x + w[ROW_S, j - 1]
+        cx = cx * x + w[ROW_C_SERIES, j - 1]
+    return v * x + w[ROW_C, 0], d * x + v, sx, cx
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
@@ -141,10 +176,7 @@ def _sample_end(w, tau, end, step):
     kind, mp, times, samples, vsamples = mot
     a_h = a_v = 0.0
     if t0 < mp[3]:
-        if kind == KIND_RECORD:  # the step ends on a sample: no interpolation
-            a_h = _record_acceleration(mp, times, samples, tau, k)
-        else:
-            a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        a_h = _ground(kind, mp, times, samples, tau, k)
         a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
     ratio, f_v = _ratio(s0 + s1, c0 + c1, end[1], a_h, a_v, p)
     return ratio, f_v, s * end[0]
@@ -227,7 +259,7 @@ def _parabolic(w, ta, x, f, step):
             x2, f2 = xv, r
 
 
-@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _refine_window(w, ta, tc, fc, step):
     """Refine the middle sample of the grid's last three (a, b in ``ta``, c = (tc, fc)) where
     it is a local maximum, all three on one side of alpha, that may exceed the largest ratio
@@ -265,13 +297,15 @@ def _close(w, ta, step):
         _parabolic(w, ta, (t_a, near, tb), (fa, r, fb), step)
 
 
-@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _push(w, ta, tau, step, end=(np.nan, np.nan)):
     """Evaluate, count and add to the grid the sample at tau [s] (in time order), with the
     sample at ``|theta|`` = alpha before it where the two lie on either side of alpha (the
     end of the response that counts if the block falls from there); refine the grid's local
     maximum (:func:`_refine_window`). ``end``: (theta, theta_dot) where tau is the current
-    step's full end (:func:`_sample_end`), NaN elsewhere."""
+    step's full end (:func:`_sample_end`), NaN elsewhere. Inlined, as
+    :func:`_refine_window`: their calls, with the step's flattened arguments, cost a pulse's
+    demand about a third of its time (measured on single-thread CPU time)."""
     if end[0] == end[0]:
         r, f_v, u = _sample_end(w, tau, end, step)
     else:
