@@ -83,10 +83,11 @@ def orientation_summary(ds: xr.Dataset, which: str) -> xr.Dataset:
     of every object and record, in the design's own layout; ``summary`` in the attributes.
 
     An IDA keeps that capacity (``capacity``, ``capacity_scale``, ``capacity_scale_lower``,
-    ``censored``, ``status``; its other variables, the IDA curves, are those of the first
-    orientation); cloud and stripes keep ``overturned`` (at some orientation, or at half of
-    them or more; -1 if a point failed at one), ``max_rotation`` (the largest, or the
-    median) and ``status`` (the largest over the orientations).
+    ``censored``, ``status``; with damage states, ``state_capacity`` and
+    ``state_capacity_scale`` of each state likewise; its other variables, the IDA curves, are
+    those of the first orientation); cloud and stripes keep ``overturned`` (at some
+    orientation, or at half of them or more; -1 if a point failed at one), ``max_rotation``
+    (the largest, or the median) and ``status`` (the largest over the orientations).
     """
     _check(ds, which)
     out = ds.isel(orientation=0, drop=True)
@@ -117,5 +118,32 @@ def _ida_summary(ds, out, which):
     power = measures.power(ds.attrs["im"])
     measure = (ds["capacity"] / ds["capacity_scale"] ** power).max("orientation")
     out["capacity"] = (measure * out["capacity_scale"] ** power).assign_attrs(ds["capacity"].attrs)
+    if "state_capacity_scale" in ds:
+        scale = _state_summary(ds, which)
+        out["state_capacity_scale"] = scale.assign_attrs(ds["state_capacity_scale"].attrs)
+        per_state = ds["state_capacity"] / ds["state_capacity_scale"] ** power
+        state = np.fmax(measure, per_state.max(("orientation", "damage_state"))) * scale**power
+        out["state_capacity"] = state.assign_attrs(ds["state_capacity"].attrs)
     out.attrs["summary"] = which
     return out
+
+
+def _state_summary(ds, which) -> xr.DataArray:
+    """The damage states' capacity scales (``state_capacity_scale``, on damage_state) at the
+    worst orientation or the median over orientations (``which``), NaN where that summary
+    is censored (:func:`state_design` of :mod:`.states` then censors it at the summary's
+    ``capacity_scale_lower``).
+
+    A state not reached at an orientation is censored there at the highest rung, which
+    stood: that orientation's ``capacity_scale_lower``. A state is reached at or below
+    overturning, so a state's summary is censored only where overturning's is, and
+    overturning's censoring level is at or below the state's: the capacity lies above it.
+    The overturning state's summary is the summary's ``capacity_scale``."""
+    scale = ds["state_capacity_scale"]
+    dims = [d for d in scale.dims if d != "orientation"] + ["orientation"]
+    values = scale.transpose(*dims).values
+    lower = ds["capacity_scale_lower"].broadcast_like(scale).transpose(*dims).values
+    summary = {"worst": _worst, "median": _median}[which]
+    exact = summary(values, lower, np.isnan(values))[0]
+    coords = {k: v for k, v in scale.coords.items() if "orientation" not in v.dims}
+    return xr.DataArray(exact, dims=dims[:-1], coords=coords, name=scale.name)
