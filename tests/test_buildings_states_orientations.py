@@ -207,3 +207,40 @@ def test_stripes_on_a_floor_over_orientations_read_every_state_from_their_points
     page = make_report(out, tmp_path / "report").read_text()
     assert "Floor 3" in page and "8 orientations" not in page
     assert "Damage states" in (tmp_path / "report" / "design_worst" / "index.html").read_text()
+
+
+def test_slide_capacities_are_summarised_over_orientations_against_numpy():
+    """An IDA of the contact model over orientations: each slide limit's capacity scale at
+    the worst orientation and the median, as numpy's min and median of the lower of it and
+    overturning's at every orientation (a block that overturned has slid)."""
+    import xarray as xr
+
+    rng = np.random.default_rng(3)
+    shape = (3, 8, 2)  # (record, orientation, structure)
+    cap = rng.lognormal(size=shape)
+    slide = cap[None] * rng.uniform(0.3, 1.4, size=(2, *shape))  # above cap: overturned first
+    slide[1, 0, 3, 1] = np.nan  # not slid that far below overturning
+    dims = ("record", "orientation", "structure")
+    ds = xr.Dataset(
+        {
+            "capacity_scale": (dims, cap),
+            "capacity_scale_lower": (dims, cap / 1.01),
+            "censored": (dims, np.zeros(shape, bool)),
+            "status": (dims, np.zeros(shape, int)),
+            "capacity": (dims, 2.0 * cap),
+            "slide_capacity_scale": (("slide_limit", *dims), slide),
+            "slide_capacity": (("slide_limit", *dims), 2.0 * slide),
+        },
+        coords={"orientation": np.pi * np.arange(8) / 8, "slide_limit": [0.02, 0.1]},
+        attrs={"im": "pga"},
+    )
+    effective = np.fmin(slide, cap[None])
+    for which, reduce in (("worst", np.min), ("median", np.median)):
+        view = orientation_summary(ds, which)
+        got = view["slide_capacity_scale"].transpose("slide_limit", "record", "structure")
+        np.testing.assert_allclose(got.values, reduce(effective, axis=2), rtol=1e-15)
+        np.testing.assert_allclose(
+            view["slide_capacity"].transpose(*got.dims).values,
+            2.0 * reduce(effective, axis=2),
+            rtol=1e-15,
+        )
