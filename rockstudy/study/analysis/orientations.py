@@ -83,10 +83,12 @@ def orientation_summary(ds: xr.Dataset, which: str) -> xr.Dataset:
     of every object and record, in the design's own layout; ``summary`` in the attributes.
 
     An IDA keeps that capacity (``capacity``, ``capacity_scale``, ``capacity_scale_lower``,
-    ``censored``, ``status``; its other variables, the IDA curves, are those of the first
-    orientation); cloud and stripes keep ``overturned`` (at some orientation, or at half of
-    them or more; -1 if a point failed at one), ``max_rotation`` (the largest, or the
-    median) and ``status`` (the largest over the orientations).
+    ``censored``, ``status``; the capacities of damage states and slide limits,
+    ``state_capacity`` and ``slide_capacity`` and their scales, likewise per limit, each
+    the lower of it and overturning's at every orientation; its other variables, the IDA
+    curves, are those of the first orientation); cloud and stripes keep ``overturned`` (at some
+    orientation, or at half of them or more; -1 if a point failed at one), ``max_rotation``
+    (the largest, or the median) and ``status`` (the largest over the orientations).
     """
     _check(ds, which)
     out = ds.isel(orientation=0, drop=True)
@@ -117,5 +119,36 @@ def _ida_summary(ds, out, which):
     power = measures.power(ds.attrs["im"])
     measure = (ds["capacity"] / ds["capacity_scale"] ** power).max("orientation")
     out["capacity"] = (measure * out["capacity_scale"] ** power).assign_attrs(ds["capacity"].attrs)
+    for name, dim in (("state_capacity", "damage_state"), ("slide_capacity", "slide_limit")):
+        if f"{name}_scale" in ds:
+            scale = _limit_summary(ds, f"{name}_scale", which)
+            out[f"{name}_scale"] = scale.assign_attrs(ds[f"{name}_scale"].attrs)
+            per_limit = (ds[name] / ds[f"{name}_scale"] ** power).max(("orientation", dim))
+            capacity = np.fmax(measure, per_limit) * scale**power
+            out[name] = capacity.assign_attrs(ds[name].attrs)
     out.attrs["summary"] = which
     return out
+
+
+def _limit_summary(ds, name, which) -> xr.DataArray:
+    """The capacity scales ``name`` of limits short of overturning (``state_capacity_scale``
+    on damage_state, ``slide_capacity_scale`` on slide_limit) at the worst orientation or the
+    median over orientations (``which``), NaN where that summary is censored (the fits then
+    censor it at the summary's ``capacity_scale_lower``).
+
+    At each orientation the limit counts as reached at the lower of its capacity and the
+    overturning capacity (an overturned block has slid, and reached every state): a limit
+    neither reached nor overturned is censored there at the highest rung, which stood, that
+    orientation's ``capacity_scale_lower``. Such a limit's summary is censored only where
+    overturning's is, and overturning's censoring level is at or below the limit's: the
+    capacity lies above it. The overturning state's summary is the summary's
+    ``capacity_scale``."""
+    overturned = ds["capacity_scale"].where(ds["censored"] == 0)
+    scale = np.fmin(ds[name], overturned)
+    dims = [d for d in scale.dims if d != "orientation"] + ["orientation"]
+    values = scale.transpose(*dims).values
+    lower = ds["capacity_scale_lower"].broadcast_like(scale).transpose(*dims).values
+    summary = {"worst": _worst, "median": _median}[which]
+    exact = summary(values, lower, np.isnan(values))[0]
+    coords = {k: v for k, v in scale.coords.items() if "orientation" not in v.dims}
+    return xr.DataArray(exact, dims=dims[:-1], coords=coords, name=name)

@@ -642,7 +642,7 @@ def design_dataset(cube: xr.Dataset) -> xr.Dataset:
         for k, (var_dims, values, var_attrs) in list(out.items()):
             if var_dims[-1:] == ("slide_limit",):
                 out[k] = (dims, np.moveaxis(values, -1, 0), var_attrs)
-    _fold_states(out, coords, cube, study)  # an IDA's damage states, as the API orders them
+    _fold_states(out, coords, cube, study, m_dims)  # an IDA's states, as the API orders them
     if kind.levels:
         coords["level"] = cube["level"].values
     ds = xr.Dataset(out, coords=coords)
@@ -717,10 +717,10 @@ def motion_coords(attrs) -> dict:
     return axes
 
 
-def _fold_states(out, coords, cube, study: dict) -> None:
+def _fold_states(out, coords, cube, study: dict, m_dims=()) -> None:
     """With an IDA's damage states (``damage_state`` in the ``cube``), put their variables
-    of ``out`` on (damage_state, record, structure) and name the states in ``coords`` (from
-    the stored study's ``design.damage_states``)."""
+    of ``out`` on (damage_state, record[, the motion axes ``m_dims``], structure) and name
+    the states in ``coords`` (from the stored study's ``design.damage_states``)."""
     if "damage_state" not in cube.coords:
         return
     states = ida_states.damage_states(study["design"]["damage_states"], True)
@@ -728,7 +728,7 @@ def _fold_states(out, coords, cube, study: dict) -> None:
     for k, (var_dims, values, var_attrs) in list(out.items()):
         if var_dims[-1:] == ("damage_state",):
             out[k] = (
-                ("damage_state", "record", "structure"),
+                ("damage_state", "record", *m_dims, "structure"),
                 np.moveaxis(values, -1, 0),
                 var_attrs,
             )
