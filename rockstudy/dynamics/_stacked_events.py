@@ -12,6 +12,7 @@ between the ends of a step).
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from ..constants import FALL_ROTATION
@@ -26,9 +27,10 @@ from ._stacked_steps import (
     interface_data,
     state_at,
 )
+from ._taylor import NO_REFCOUNT
 
 #: Samples of the interpolant per step at which the impacts and peaks are sought.
-SAMPLES = 8
+SAMPLES = 4
 #: Halvings of a bracket of a step's fraction (to below 1e-18).
 BISECTIONS = 60
 #: Secant steps on true sub-steps that refine an uplift located on the interpolant.
@@ -37,7 +39,7 @@ SECANTS = 3
 EVENT_NONE, EVENT_IMPACT, EVENT_FALL, EVENT_UPLIFT = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _bisect_angle(k, s, level, lo, hi, h, y0, f0, y1, f1):
     """The fraction in (lo, hi] where s angle_k - level changes sign (> 0 at lo, <= 0 at hi
     for level 0; < 0 at lo, >= 0 at hi otherwise), by bisection."""
@@ -53,7 +55,7 @@ def _bisect_angle(k, s, level, lo, hi, h, y0, f0, y1, f1):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, falling):
     """The fraction in [lo, hi] where s angle_k' changes sign (from + to - if ``falling``,
     a peak; from - to + otherwise, a trough)."""
@@ -69,30 +71,34 @@ def _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, falling):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
-def impact_fraction(k, s, h, y0, f0, y1, f1):
+@njit(cache=True, **NO_REFCOUNT)
+def impact_fraction(k, s, h, y0, f0, y1, f1, rates):
     """The first fraction of the step at which interface k (rocking on side s) reaches zero:
     a short hop back to zero before the first sample (:func:`_early_return`), a sample at
-    or below zero, or a trough below zero between samples; 2.0 if none."""
+    or below zero, or a trough below zero between samples; 2.0 if none. The rates s angle'
+    at the samples it read go to ``rates`` (NaN from the first it did not read), for
+    :func:`step_peaks`."""
+    rates[:] = np.nan
     hop = _early_return(k, s, h, y0, f0, y1, f1)
     if hop <= 1.0:
         return hop
-    lo, u_lo, v_lo = 0.0, 1.0, s * interface_at(k, 0.0, h, y0, f0, y1, f1)[1]
+    lo, u_lo = 0.0, 1.0
+    rates[0] = s * interface_data(k, y0, f0)[1]
     for j in range(1, SAMPLES + 1):
         hi = j / SAMPLES
         x, v, _ = interface_at(k, hi, h, y0, f0, y1, f1)
-        u, v = s * x, s * v
+        u, rates[j] = s * x, s * v
         if u <= 0.0:
             return _bisect_angle(k, s, 0.0, lo, hi, h, y0, f0, y1, f1)
-        if v_lo < 0.0 <= v:  # a trough between the samples
+        if rates[j - 1] < 0.0 <= rates[j]:  # a trough between the samples
             mid = _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, False)
             if s * interface_at(k, mid, h, y0, f0, y1, f1)[0] <= 0.0 < u_lo:
                 return _bisect_angle(k, s, 0.0, lo, mid, h, y0, f0, y1, f1)
-        lo, u_lo, v_lo = hi, u, v
+        lo, u_lo = hi, u
     return 2.0
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _early_return(k, s, h, y0, f0, y1, f1):
     """The fraction at which interface k is back at zero after a hop shorter than the first
     sample: the return time of u = s angle on its quadratic from the step's start (u0 + v0 t
@@ -110,7 +116,7 @@ def _early_return(k, s, h, y0, f0, y1, f1):
     return _bisect_angle(k, s, 0.0, 0.0, hi, h, y0, f0, y1, f1)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def fall_fraction(k, s, h, y0, f0, y1, f1):
     """The fraction at which s angle_k reaches :data:`FALL_ROTATION` (2.0 if it does not by
     the step's end)."""
@@ -119,7 +125,7 @@ def fall_fraction(k, s, h, y0, f0, y1, f1):
     return _bisect_angle(k, s, FALL_ROTATION, 0.0, 1.0, h, y0, f0, y1, f1)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def uplift_fraction(g, regime, mot, t, h, y0, f0, y1, f1, j, margins, tmp, w):
     """The fraction of the step at which lock margin j (:func:`._stacked_model.lock_margins`
     order) turns negative, by bisection on the interpolated state, then secant steps on true
@@ -134,8 +140,8 @@ def uplift_fraction(g, regime, mot, t, h, y0, f0, y1, f1, j, margins, tmp, w):
         if mid <= lo or mid >= hi:
             break
         state_at(mid, h, y0, f0, y1, f1, tmp[:4])
-        m = lock_margins(g, tmp[:4], s1, s2, flat0, flat1, ground(mot, t + mid * h), tmp[4:])
-        if m[j] < 0.0:
+        lock_margins(g, tmp[:4], s1, s2, flat0, flat1, ground(mot, t + mid * h), tmp[4:])
+        if tmp[4 + j] < 0.0:
             hi = mid
         else:
             lo = mid
@@ -150,58 +156,58 @@ def uplift_fraction(g, regime, mot, t, h, y0, f0, y1, f1, j, margins, tmp, w):
     return min(max(b, 0.0), 1.0) if abs(m_b) < abs(margins[j]) else hi
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _true_margin(g, regime, mot, t, y0, f0, dt, j, tmp, w):
     """Lock margin j at t + dt on a true sub-step (:func:`true_state`)."""
     s1, s2, flat0, flat1 = regime
-    y, _ = true_state(g, regime, mot, t, y0, f0, dt, w)
-    return lock_margins(g, y, s1, s2, flat0, flat1, ground(mot, t + dt), tmp[4:])[j]
+    true_state(g, regime, mot, t, y0, f0, dt, w)
+    y = w[K_SUB]
+    lock_margins(g, y, s1, s2, flat0, flat1, ground(mot, t + dt), tmp[4:])
+    return tmp[4 + j]
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def true_state(g, regime, mot, t, y0, f0, dt, w):
-    """The state and its derivative after a true DOP853 step of length dt from (t, y0):
-    w[K_SUB], w[K_FSUB] (a step of length 0 copies the start)."""
+    """The state and its derivative after a true DOP853 step of length dt from (t, y0),
+    into w[K_SUB] and w[K_FSUB] (a step of length 0 copies the start)."""
     if dt == 0.0:
         for c in range(4):
             w[K_SUB, c], w[K_FSUB, c] = y0[c], f0[c]
-        return w[K_SUB], w[K_FSUB]
-    y = dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
-    return y, derivative(g, regime, mot, t + dt, y, w[K_FSUB])
+        return
+    dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
+    derivative(g, regime, mot, t + dt, w[K_SUB], w[K_FSUB])
 
 
-@njit(cache=True)
-def step_peaks(g, regime, mot, t, h, y0, f0, y1, f1, upto, peaks, w):
+@njit(cache=True, **NO_REFCOUNT)
+def step_peaks(g, regime, mot, t, h, y0, f0, y1, f1, upto, peaks, w, rates):
     """Raise ``peaks`` (|theta_1|, |phi|) to the maxima of |angle| of the rocking interfaces
-    inside the step before the fraction ``upto``: a maximum of s angle between samples
-    located on the interpolant, valued on a true sub-step and one Newton step on the rate
-    (skipped where the interpolant's value cannot raise the peak)."""
+    inside the step before the fraction ``upto``: a maximum of s angle between the samples
+    of :func:`impact_fraction` (their rates in ``rates[k]``) located on the interpolant,
+    valued on a true sub-step and one Newton step on the rate (skipped where the
+    interpolant's value cannot raise the peak)."""
     s1, s2, flat0, flat1 = regime
     for k in range(2):
         if (flat0, flat1)[k]:
             continue
         s = (s1, s2)[k]
-        lo, v_lo = 0.0, s * interface_at(k, 0.0, h, y0, f0, y1, f1)[1]
         for j in range(1, SAMPLES + 1):
-            hi = min(j / SAMPLES, upto)
-            v = s * interface_at(k, hi, h, y0, f0, y1, f1)[1]
-            if v_lo > 0.0 >= v:
-                mid = _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, True)
+            lo = (j - 1) / SAMPLES
+            if lo >= upto or not rates[k, j] == rates[k, j]:
+                break
+            if rates[k, j - 1] > 0.0 >= rates[k, j]:
+                mid = _bisect_rate(k, s, lo, j / SAMPLES, h, y0, f0, y1, f1, True)
                 x = abs(interface_at(k, mid, h, y0, f0, y1, f1)[0])
-                if x > peaks[k] - 1e-6 * g[A1 + k]:
+                if mid <= upto and x > peaks[k] - 1e-6 * g[A1 + k]:
                     _, ys, fs = _refined(g, regime, mot, t, y0, f0, mid * h, k, w)
                     peaks[k] = max(peaks[k], abs(ys))
-            if hi >= upto:
-                break
-            lo, v_lo = hi, v
-    return peaks
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _refined(g, regime, mot, t, y0, f0, dt, k, w):
     """Interface k's extremum near t + dt: x - v^2 / (2 a) of the true sub-step's angle x,
     rate v and acceleration a (one Newton step on the rate); returns (dt, value, a)."""
-    y, f = true_state(g, regime, mot, t, y0, f0, dt, w)
+    true_state(g, regime, mot, t, y0, f0, dt, w)
+    y, f = w[K_SUB], w[K_FSUB]
     if k == 0:
         x, v, a = y[0], y[2], f[2]
     else:
@@ -211,11 +217,12 @@ def _refined(g, regime, mot, t, y0, f0, dt, k, w):
     return dt, x - 0.5 * v * v / a, a
 
 
-@njit(cache=True)
-def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w):
+@njit(cache=True, **NO_REFCOUNT)
+def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w, rates):
     """The first event inside an accepted step: (fraction, kind, interface, corner), the
     fraction 2.0 and kind EVENT_NONE if none. ``margins`` holds the lock margins at the
-    step's end."""
+    step's end; ``rates`` (2, SAMPLES + 1) receives the rocking interfaces' sampled rates
+    (:func:`impact_fraction`)."""
     s1, s2, flat0, flat1 = regime
     best, kind, iface, corner = 2.0, EVENT_NONE, -1, 0
     for k in range(2):
@@ -228,7 +235,7 @@ def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w):
                 if sig < best:
                     best, kind, iface, corner = sig, EVENT_UPLIFT, k, 1 - 2 * j
             continue
-        sig = impact_fraction(k, s, h, y0, f0, y1, f1)
+        sig = impact_fraction(k, s, h, y0, f0, y1, f1, rates[k])
         if sig < best:
             best, kind, iface, corner = sig, EVENT_IMPACT, k, s
         sig = fall_fraction(k, s, h, y0, f0, y1, f1)
@@ -237,12 +244,13 @@ def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w):
     return best, kind, iface, corner
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def event_state(g, regime, mot, t, h, y0, f0, sigma, kind, k, w, out):
     """The state at an event at the fraction sigma of the step, into ``out``; returns its
     time. A true sub-step to it, then for an impact one Newton step onto the angle's zero
     (all components moved by the same dt, to second order)."""
-    y, f = true_state(g, regime, mot, t, y0, f0, sigma * h, w)
+    true_state(g, regime, mot, t, y0, f0, sigma * h, w)
+    y, f = w[K_SUB], w[K_FSUB]
     dl = 0.0
     if kind == EVENT_IMPACT:
         x, v = (y[0], y[2]) if k == 0 else (y[1] - y[0], y[3] - y[2])

@@ -153,8 +153,9 @@ def uplift_from_rest(g, mot, t0, tmp):
     :func:`_first_lift`; the time inf if nothing lifts before the motion ends."""
     zero = tmp[:4]
     zero[:] = 0.0
-    m0 = lock_margins(g, zero, 1, 1, True, True, 0.0, tmp[4:8]).copy()
-    m1 = lock_margins(g, zero, 1, 1, True, True, 1.0, tmp[8:12]).copy() - m0
+    lock_margins(g, zero, 1, 1, True, True, 0.0, tmp[4:8])
+    lock_margins(g, zero, 1, 1, True, True, 1.0, tmp[8:12])
+    m0, m1 = tmp[4:8].copy(), tmp[8:12] - tmp[4:8]
     t_up = math.inf
     if _rest_lift(m0, m1, mot, t0) > 0.0:
         t_up = t0

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 
 from ..constants import G
+from ._taylor import NO_REFCOUNT
 from .constants import REST_FRACTION
 
 #: Indices of :func:`pack_geometry`'s array: half-widths, half-heights, offset, masses,
@@ -66,7 +67,7 @@ def _columns(g, q1, q2, s1, s2):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def both_equations(g, q1, q2, w1, w2, s1, s2, ug):
     """M = (m00, m01, m11) and F = (f0, f1) of "both rocking" on the corners (s1, s2)
     (:func:`.stacked.mass_matrix`, :func:`.stacked.forcing`) under u_g'' = ug [m/s^2]."""
@@ -88,7 +89,7 @@ def both_equations(g, q1, q2, w1, w2, s1, s2, ug):
     return m00, m01, m11, f0, f1
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def acceleration(g, y, s1, s2, flat0, flat1, ug):
     """(theta_1'', theta_2'') of the regime (flat0, flat1) (:func:`.stacked.
     regime_acceleration`, mapped back through S): "lower" keeps theta_2'' = theta_1'',
@@ -108,7 +109,7 @@ def _row_multiplier(m00, m01, m11, r0, r1, k):
     return -(y0 * r0 + y1 * r1) / (g0 * y0 + g1 * y1)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def multipliers(m00, m01, m11, r0, r1, flat0, flat1):
     """(Lambda_ground, Lambda_upper) of the closed interfaces (NaN for an open one):
     :func:`.stacked._multipliers`; with both closed, -G^-T r = -(r0 + r1, r1)."""
@@ -129,7 +130,7 @@ def _pivots(j, s1, s2, flat0, flat1):
     return s, (s if flat0 else s1), (s if flat1 else s2)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def lock_margins(g, y, s1, s2, flat0, flat1, ug, out):
     """The closed interfaces' lock margins s Lambda(s) / moment scale, written to out =
     (ground +1, ground -1, upper +1, upper -1); +inf for an open interface
@@ -140,7 +141,6 @@ def lock_margins(g, y, s1, s2, flat0, flat1, ug, out):
         lam0, lam1 = multipliers(m00, m01, m11, f0, f1, flat0, flat1)
         out[j] = s * lam0 / g[MOM1] if flat0 else np.inf
         out[2 + j] = s * lam1 / g[MOM2] if flat1 else np.inf
-    return out
 
 
 @njit(cache=True, inline="always")
@@ -160,7 +160,6 @@ def body_velocities(g, q1, q2, w1, w2, s1, s2, v):
     a1x, a1y, adx, ady, a2x, a2y = _columns(g, q1, q2, s1, s2)
     v[0], v[1], v[2] = a1x * w1, a1y * w1, w1
     v[3], v[4], v[5] = adx * w1 + a2x * w2, ady * w1 + a2y * w2, w2
-    return v
 
 
 @njit(cache=True)

@@ -25,6 +25,7 @@ from ._stacked_events import (
     EVENT_IMPACT,
     EVENT_NONE,
     EVENT_UPLIFT,
+    SAMPLES,
     event_state,
     first_event,
     step_peaks,
@@ -40,6 +41,7 @@ from ._stacked_steps import (
     step_error,
     work_array,
 )
+from ._taylor import NO_REFCOUNT
 from .constants import (
     FIRST_STEP,
     STATUS_MAX_STEPS,
@@ -70,7 +72,7 @@ STATUS_MAX_STEPS), max |theta_1| and max |phi| [rad], whether a body fell, its c
 (BODY_NONE...), when [s] (NaN if none) and the number of impacts."""
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _next_stop(mot, t, t_end):
     """(the time the step from t must stop at, the record segment of t): the next record
     sample or the motion's end; ``t_end`` after the motion."""
@@ -84,7 +86,7 @@ def _next_stop(mot, t, t_end):
     return min(stop, dur, t_end), seg
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _accepted(g, hs, y0, y1, w, tol, h, last):
     """(accepted, next step) of a DOP853 step of length hs (Hairer's step control)."""
     err = step_error(g, w, hs, y0, y1, tol)
@@ -95,23 +97,24 @@ def _accepted(g, hs, y0, y1, w, tol, h, last):
     return True, (max(h, hs * grow) if last else hs * grow)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def _raise_peaks(y, peaks):
     peaks[0] = max(peaks[0], abs(y[0]))
     peaks[1] = max(peaks[1], abs(y[1] - y[0]))
 
 
-@njit(cache=True)
-def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp):
+@njit(cache=True, **NO_REFCOUNT)
+def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates):
     """One regime from the state (st = (t, h, t_end, record segment), y, iv) to its first
     event or ``t_end``: returns (kind, interface, corner), the state moved to the event (or
-    the end)."""
+    the end). ``rates``: the work array of :func:`._stacked_events.first_event`."""
     regime = (iv[2], iv[3], iv[0] != 0, iv[1] != 0)
     t, h, t_end = st[0], st[1], st[2]
     cap = STEP_CAP / max(g[P1], g[P2])
     seg = mot[4]
     mot = (mot[0], mot[1], mot[2], mot[3], seg)
-    f0 = derivative(g, regime, mot, t, y, tmp[12:16])
+    f0 = tmp[12:16]
+    derivative(g, regime, mot, t, y, f0)
     for _ in range(max_steps):
         stop, seg = _next_stop(mot, t, t_end)
         if t >= stop:
@@ -121,16 +124,20 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp):
         last = min(h, cap) >= stop - t
         hs = stop - t if last else min(h, cap)
         t1 = stop if last else t + hs
-        y1 = dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
-        f1 = derivative(g, regime, mot, t1, y1, w[K_FEND])
+        dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
+        y1 = w[K_END]
+        f1 = w[K_FEND]
+        derivative(g, regime, mot, t1, y1, f1)
         for c in range(4):
             w[12, c] = f1[c]
         ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
         if not ok:
             continue
         lock_margins(g, y1, iv[2], iv[3], regime[2], regime[3], ground(mot, t1), margins)
-        sig, kind, k, corner = first_event(g, regime, mot, t, hs, y, f0, y1, f1, margins, tmp, w)
-        step_peaks(g, regime, mot, t, hs, y, f0, y1, f1, min(sig, 1.0), peaks, w)
+        sig, kind, k, corner = first_event(
+            g, regime, mot, t, hs, y, f0, y1, f1, margins, tmp, w, rates
+        )
+        step_peaks(g, regime, mot, t, hs, y, f0, y1, f1, min(sig, 1.0), peaks, w, rates)
         if kind == EVENT_NONE:
             t = t1
             for c in range(4):
@@ -175,6 +182,7 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
     """Two stacked blocks from rest through one motion: (status, max |theta_1|, max |phi|,
     overturned, body code, overturn time, impacts): a :data:`StackedOutcome`."""
     w, tmp, margins = work_array(), np.empty(24), np.empty(4)
+    rates = np.empty((2, SAMPLES + 1))
     y, iv, peaks = np.zeros(4), np.array([1, 1, 1, 1]), np.zeros(2)
     st = np.array([0.0, FIRST_STEP / max(g[P1], g[P2]), t_end, 0.0])
     mot = (kind, mp, times, samples, 0)
@@ -195,7 +203,7 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
         if (iv[0] != 0 or iv[1] != 0) and _release_violated(g, mot, iv, y, t, margins):
             continue
         ev, k, corner = run_phase(
-            g, mot, iv, y, st, TOL_SAFETY * rtol, max_steps, peaks, w, margins, tmp
+            g, mot, iv, y, st, TOL_SAFETY * rtol, max_steps, peaks, w, margins, tmp, rates
         )
         if ev == PHASE_MAX_STEPS:
             status = STATUS_MAX_STEPS

@@ -19,6 +19,7 @@ from scipy.integrate import DOP853 as _DOP853
 from ..motions._kernels import ground_acceleration
 from ._dop853 import hermite5
 from ._stacked_model import A1, A2, P1, P2, acceleration
+from ._taylor import NO_REFCOUNT
 from .constants import ATOL_FRACTION
 
 _A = np.ascontiguousarray(_DOP853.A[:12, :12], dtype=float)
@@ -38,26 +39,25 @@ def work_array():
     return np.empty((18, 4))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def ground(mot, t):
     """u_g''(t) [m/s^2] of the motion ``mot`` (zero outside it)."""
     return ground_acceleration(mot[0], mot[1], mot[2], mot[3], t, mot[4])
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def derivative(g, regime, mot, t, y, out):
     """y' = (theta_1', theta_2', theta_1'', theta_2'') of the regime ``regime`` = (s1, s2,
     flat0, flat1) at (t, y), into ``out``."""
     s1, s2, flat0, flat1 = regime
     a1, a2 = acceleration(g, y, s1, s2, flat0, flat1, ground(mot, t))
     out[0], out[1], out[2], out[3] = y[2], y[3], a1, a2
-    return out
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def dop853_step(g, regime, mot, t, y, f, h, w, end):
     """One DOP853 step of length h from (t, y) with y' = f there: the stage derivatives into
-    w[0:12], the new state into w[end] (returned). The caller puts the derivative at the new
+    w[0:12], the new state into w[end]. The caller puts the derivative at the new
     point into w[12] before :func:`step_error`."""
     for c in range(4):
         w[0, c] = f[c]
@@ -73,10 +73,9 @@ def dop853_step(g, regime, mot, t, y, f, h, w, end):
         for i in range(12):
             acc += _B[i] * w[i, c]
         w[end, c] = y[c] + h * acc
-    return w[end]
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def step_error(g, w, h, y0, y1, tol):
     """Hairer's combined 5th/3rd-order error norm of the last step (<= 1 accepts), with the
     scales tol (ATOL_FRACTION alpha_min + |theta|) and tol (ATOL_FRACTION p_max alpha_min +
@@ -106,7 +105,7 @@ def interface_data(k, y, f):
     return y[1] - y[0], y[3] - y[2], f[3] - f[2]
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def interface_at(k, sigma, h, y0, f0, y1, f1):
     """Interface k's (angle, rate, acceleration) at the fraction sigma of a step of length
     h, on the quintic Hermite interpolant of its ends."""
@@ -115,10 +114,9 @@ def interface_at(k, sigma, h, y0, f0, y1, f1):
     return hermite5(sigma, h, x0, v0, a0, x1, v1, a1)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNT)
 def state_at(sigma, h, y0, f0, y1, f1, out):
     """The full state at the fraction sigma of a step on the Hermite interpolant, into out."""
     th1 = hermite5(sigma, h, y0[0], y0[2], f0[2], y1[0], y1[2], f1[2])
     th2 = hermite5(sigma, h, y0[1], y0[3], f0[3], y1[1], y1[3], f1[3])
     out[0], out[1], out[2], out[3] = th1[0], th2[0], th1[1], th2[1]
-    return out
