@@ -245,17 +245,19 @@ def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w, rates):
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def event_state(g, regime, mot, t, h, y0, f0, sigma, kind, k, w, out):
+def event_state(g, regime, mot, t, h, y0, f0, sigma, kind, k, side, w, out):
     """The state at an event at the fraction sigma of the step, into ``out``; returns its
-    time. A true sub-step to it, then for an impact one Newton step onto the angle's zero
-    (all components moved by the same dt, to second order)."""
+    time. A true sub-step to it, then for an impact or a fall of interface k (rocking on
+    ``side``) one Newton step onto the angle's zero or side pi/2 (all components moved by
+    the same dt, to second order)."""
     true_state(g, regime, mot, t, y0, f0, sigma * h, w)
     y, f = w[K_SUB], w[K_FSUB]
     dl = 0.0
-    if kind == EVENT_IMPACT:
+    if kind == EVENT_IMPACT or kind == EVENT_FALL:
+        target = 0.0 if kind == EVENT_IMPACT else side * FALL_ROTATION
         x, v = (y[0], y[2]) if k == 0 else (y[1] - y[0], y[3] - y[2])
         if v != 0.0:
-            dl = min(max(-x / v, -sigma * h), (1.0 - sigma) * h)
+            dl = min(max((target - x) / v, -sigma * h), (1.0 - sigma) * h)
     for c in range(2):
         out[c] = y[c] + dl * (y[2 + c] + 0.5 * dl * f[2 + c])
         out[2 + c] = y[2 + c] + dl * f[2 + c]
