@@ -2,8 +2,9 @@
 The museum's statues on their plinths and one on an isolator
 ============================================================
 
-Two marble statues of the museum (:doc:`/auto_examples/plot_10_museum`) stand on marble
-plinths that can rock themselves, and the curators consider a base isolator for the Kouros.
+Two marble statues of the museum
+(:ref:`the museum example <sphx_glr_auto_examples_plot_10_museum.py>`) stand on marble plinths
+that can rock themselves, and the curators consider a base isolator for the Kouros.
 Does the plinth raise or lower the annual rate of overturning against the statue on rigid
 ground, and what would the isolator buy? The study file ``studies/museum_plinths.toml``
 holds the job; this example runs it and reads the cube:
