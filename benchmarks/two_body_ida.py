@@ -1,9 +1,10 @@
 """Wall time of an incremental dynamic analysis of two-body objects: 8 records x 6 statues on
 rocking plinths (:class:`~rockstudy.structures.StackedBlocks`), and the same 6 statues on base
 isolators (:class:`~rockstudy.structures.IsolatedBlock`), through the design function a study
-runs, :func:`rockstudy.study.designs.records.incremental_dynamic_analysis`, with the
-``two_body`` column a study gives it (its scenes go to ``simulate_batch(structure=...)``, the
-numba kernels, rows in parallel).
+runs, :func:`rockstudy.study.designs.records.incremental_dynamic_analysis`, given the list of
+structures (whose columns, :func:`rockstudy.study.designs.two_body_rows.design_columns`, are
+those a study gives it; its scenes go to ``simulate_batch(structure=...)``, the numba kernels,
+rows in parallel).
 
 Records (horizontal components, whole): ``--records shipped`` (default) the eight synthetic
 near-fault records shipped with rockstudy; ``--records mixed`` the real ones of shared/records
@@ -23,13 +24,11 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
 from contact_accuracy import records
 
 from rockstudy.motions import Record
 from rockstudy.structures import Block, IsolatedBlock, StackedBlocks
 from rockstudy.study.designs.records import incremental_dynamic_analysis
-from rockstudy.study.spec.structures import two_body_parameters
 
 #: (statue width, height; plinth width, height) [m] of the six objects.
 STATUES = (
@@ -57,19 +56,6 @@ def objects(kind: str) -> list:
     return out
 
 
-def design_structures(structures) -> dict:
-    """The structures' columns as a study passes them to a record design (its groups and
-    ladder from :func:`two_body_parameters`, its scenes by the ``two_body`` column)."""
-    p, theta, eta, a_up = np.array([two_body_parameters(s) for s in structures]).T
-    return dict(
-        frequency_parameter=p,
-        critical_rotation=theta,
-        restitution=eta,
-        uplift_acceleration=a_up,
-        two_body=list(structures),
-    )
-
-
 def suite(which: str, n: int) -> list[Record]:
     """``n`` horizontal records: the shipped ones, or the shared real ones first."""
     recs = records(1e9)
@@ -92,8 +78,8 @@ def main(argv=None):
     kw = dict(step=args.step, tolerance=args.tolerance, scan=args.scan, rtol=args.rtol)
     print(f"{len(recs)} records ({args.records}): {', '.join(r.name for r in recs)}")
     for kind in args.kinds:
-        structures = design_structures(objects(kind))
-        incremental_dynamic_analysis(recs[:1], design_structures(objects(kind)[:1]), **kw)
+        structures = objects(kind)  # the design's two_body column, as a study gives it
+        incremental_dynamic_analysis(recs[:1], structures[:1], **kw)
         t0 = time.perf_counter()
         ds = incremental_dynamic_analysis(recs, structures, **kw)
         seconds = time.perf_counter() - t0
