@@ -52,15 +52,17 @@ def _largest(ds, name, j) -> float:
 
 
 def _outputs(page, ctx, objects):
-    """One row per two-body object: how many scenes overturned which body, the largest
-    rotations and isolator displacement."""
+    """One row per two-body object: how many scenes overturned which body (of a statue on a
+    plinth; empty for a block on an isolator), the largest rotations and isolator
+    displacement."""
     ds, ida = ctx.ds, ctx.kind.capacities
     rows = {}
     for j in objects:
         body = ds["overturned_body"].isel(structure=j).values if "overturned_body" in ds else []
         row = {"scenes": int(np.size(body))}
+        plinth = np.isfinite(_largest(ds, "max_rotation_lower", j))  # no plinth: no bodies
         for code, words in BODY_NAMES.items():
-            row[f"overturned: {words}"] = int(np.sum(np.asarray(body) == code))
+            row[f"overturned: {words}"] = int(np.sum(np.asarray(body) == code)) if plinth else None
         row["largest rotation of the plinth [rad]"] = _largest(ds, "max_rotation_lower", j)
         row["largest rotation of the statue on it [rad]"] = _largest(ds, "max_rotation_upper", j)
         row["largest isolator displacement [m]"] = _largest(ds, "max_isolator_displacement", j)
