@@ -1,6 +1,6 @@
-"""Two stacked rocking blocks integrated by ``scipy.integrate.solve_ivp``: the reference (and,
-until the event-driven numba kernel exists, the only) path of
-:class:`~rockstudy.structures.StackedBlocks`.
+"""Two stacked rocking blocks integrated by ``scipy.integrate.solve_ivp``: the reference path of
+:class:`~rockstudy.structures.StackedBlocks`, with its full history (:func:`rockstudy.simulate`
+runs it; the batches run the event-driven numba kernel of the same model, :mod:`._stacked_scene`).
 
 Event-driven over the regimes of :mod:`.stacked`: each regime is integrated (DOP853, rtol
 down to 1e-12) in its own coordinates until one of its events, located by scipy (Brent's
@@ -525,7 +525,7 @@ def _pack(scene, state, log, fell, phases) -> StackedResult:
         np.array(log.interfaces, dtype=str),
         "scipy",
         {
-            "solver": "solve_ivp DOP853 (stacked_reference; no numba kernel yet)",
+            "solver": "solve_ivp DOP853 (stacked_reference)",
             "rtol": scene.rtol,
             "phases": phases + 1,
             "energy_lost": float(log.lost),

@@ -16,6 +16,7 @@ from ..motions.pulses import PULSES
 from ..motions.records import Record
 from ..structures.isolated import IsolatedBlock
 from ..structures.stacked import StackedBlocks
+from ._stacked_batch import kernel_rows
 
 __all__ = [
     "ISOLATED_OUTPUTS",
@@ -95,15 +96,11 @@ def _reference_rows(structures, motions, rtol, read) -> dict:
 
 
 def stacked_rows(structures, motions, rtol, max_steps) -> dict:
-    """The :data:`STACKED_OUTPUTS` of each (structure, motion) row."""
-    names = STACKED_OUTPUTS[:-2]
-
-    def read(res):
-        row = {name: getattr(res, name) for name in names}
-        row["overturned_body"] = OVERTURNED_BODY[res.overturned_body]
-        return row
-
-    return _reference_rows(structures, motions, rtol, read)
+    """The :data:`STACKED_OUTPUTS` of each (structure, motion) row, by the event-driven
+    numba kernel (:mod:`._stacked_scene`, rows in parallel): the model and the history of
+    the ``solve_ivp`` reference :func:`.stacked_reference.simulate_stacked`; ``status`` 1
+    where a phase reached ``max_steps`` steps (the row's outputs are then incomplete)."""
+    return kernel_rows(structures, motions, rtol, max_steps)
 
 
 def isolated_rows(structures, motions, rtol, max_steps) -> dict:

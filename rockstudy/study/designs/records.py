@@ -96,7 +96,11 @@ def _records(records) -> list[Record]:
 
 
 def _is_structure(value) -> bool:
-    return hasattr(value, "equivalent_block") or hasattr(value, "frequency_parameter")
+    return (
+        hasattr(value, "equivalent_block")
+        or hasattr(value, "frequency_parameter")
+        or two_body_rows.is_two_body(value)
+    )
 
 
 def _named(structures: dict) -> tuple[list[str], list]:
@@ -129,6 +133,10 @@ def _structures(structures) -> dict:
         raise ValueError("structures: give at least one structure")
     if isinstance(structures, dict) and any(_is_structure(v) for v in structures.values()):
         names, structures = _named(structures)
+    columns = two_body_rows.design_columns(structures)
+    if columns is not None:  # structures with a plinth or an isolator: their columns
+        two_body = two_body_rows.two_body_column({"two_body": columns.pop("two_body")})
+        structures = columns
     if isinstance(structures, dict):
         unknown = set(structures) - set(_STRUCTURE_KEYS)
         if unknown:

@@ -16,10 +16,14 @@ import numpy as np
 
 from ...dynamics import simulate_batch
 from ...structures import IsolatedBlock, StackedBlocks
+from ...structures.block import block_parameters, uplift_acceleration
+from ..spec.structures import two_body_parameters
 
 __all__ = [
+    "design_columns",
     "ida_outputs",
     "ida_outputs_attributes",
+    "is_two_body",
     "keys",
     "point_fills",
     "run_points",
@@ -78,6 +82,33 @@ def uplift_bounds(structures) -> np.ndarray:
     if column is None:
         return np.ones(n, bool)
     return np.array([not isinstance(s, IsolatedBlock) for s in column])
+
+
+def is_two_body(structure) -> bool:
+    """Whether ``structure`` has two bodies (a statue on a plinth, a block on an isolator)."""
+    return isinstance(structure, (StackedBlocks, IsolatedBlock))
+
+
+def design_columns(structures) -> dict | None:
+    """The columns a record design takes for a list of structures of which some have two
+    bodies (as a study gives them): ``frequency_parameter``, ``critical_rotation``,
+    ``restitution`` and ``uplift_acceleration`` of each (a two-body structure's by
+    :func:`~rockstudy.study.spec.structures.two_body_parameters`, another's as a block's) and
+    the ``two_body`` column; None for a list without a two-body structure (or not a list)."""
+    if not isinstance(structures, (list, tuple)) or not any(map(is_two_body, structures)):
+        return None
+    rows = [
+        two_body_parameters(s) if is_two_body(s) else (*block_parameters(s), uplift_acceleration(s))
+        for s in structures
+    ]
+    p, theta, eta, a_up = np.array(rows, float).T
+    return dict(
+        frequency_parameter=p,
+        critical_rotation=theta,
+        restitution=eta,
+        uplift_acceleration=a_up,
+        two_body=[s if is_two_body(s) else None for s in structures],
+    )
 
 
 def keys(structures) -> tuple:

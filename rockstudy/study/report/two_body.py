@@ -19,16 +19,15 @@ BODY_NAMES = {1: "the plinth", 2: "the statue", 3: "both"}
 
 
 def _two_body(ds) -> list[int]:
-    """The indices of the objects with a plinth or an isolator (their two-body outputs)."""
-    plinth = ds["overturned_body"] >= 0 if "overturned_body" in ds else None
-    iso = ds["max_isolator_displacement"].notnull() if "max_isolator_displacement" in ds else None
-    if plinth is None and iso is None:
-        return []
-    seen = [
-        v.any([d for d in v.dims if d != "structure"]).values
-        for v in (plinth, iso)
-        if v is not None
+    """The indices of the objects with a plinth or an isolator: those with a two-body output
+    anywhere (an overturned body, a rotation of the plinth, an isolator displacement; an
+    IDA's object that never overturned has ``overturned_body`` -1 but its rotations)."""
+    marks = [
+        ds["overturned_body"] >= 0 if "overturned_body" in ds else None,
+        ds["max_rotation_lower"].notnull() if "max_rotation_lower" in ds else None,
+        ds["max_isolator_displacement"].notnull() if "max_isolator_displacement" in ds else None,
     ]
+    seen = [v.any([d for d in v.dims if d != "structure"]).values for v in marks if v is not None]
     return [j for j in range(ds.sizes["structure"]) if any(s[j] for s in seen)]
 
 
@@ -53,15 +52,17 @@ def _largest(ds, name, j) -> float:
 
 
 def _outputs(page, ctx, objects):
-    """One row per two-body object: how many scenes overturned which body, the largest
-    rotations and isolator displacement."""
+    """One row per two-body object: how many scenes overturned which body (of a statue on a
+    plinth; empty for a block on an isolator), the largest rotations and isolator
+    displacement."""
     ds, ida = ctx.ds, ctx.kind.capacities
     rows = {}
     for j in objects:
         body = ds["overturned_body"].isel(structure=j).values if "overturned_body" in ds else []
         row = {"scenes": int(np.size(body))}
+        plinth = np.isfinite(_largest(ds, "max_rotation_lower", j))  # no plinth: no bodies
         for code, words in BODY_NAMES.items():
-            row[f"overturned: {words}"] = int(np.sum(np.asarray(body) == code))
+            row[f"overturned: {words}"] = int(np.sum(np.asarray(body) == code)) if plinth else None
         row["largest rotation of the plinth [rad]"] = _largest(ds, "max_rotation_lower", j)
         row["largest rotation of the statue on it [rad]"] = _largest(ds, "max_rotation_upper", j)
         row["largest isolator displacement [m]"] = _largest(ds, "max_isolator_displacement", j)

@@ -1,0 +1,248 @@
+"""The event-driven kernel of two stacked blocks (private): one scene from rest through one
+ground motion (:func:`stacked_scene`) and many in parallel (:func:`stacked_batch`).
+
+The same model and the same history as :func:`.stacked_reference.simulate_stacked`: rest
+until an interface lifts (:func:`._stacked_impact.uplift_from_rest`), then phases of one
+regime stepped by DOP853 (:mod:`._stacked_steps`) to their first event
+(:mod:`._stacked_events`): an impact (:func:`._stacked_impact.resolve_impact`), an uplift, or
+a fall, which ends the run; a closed interface whose lock margin is negative at a phase's
+start opens first. The steps stop at every record sample (u_g'' has a kink there) and at the
+end of the motion; the history ends at rest after the motion or at a fall.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit, prange
+
+from ..constants import FALL_ROTATION
+from ..motions._kernels import KIND_RECORD, segment_index
+from ._stacked_events import (
+    EVENT_FALL,
+    EVENT_IMPACT,
+    EVENT_NONE,
+    EVENT_UPLIFT,
+    SAMPLES,
+    event_state,
+    first_event,
+    step_peaks,
+)
+from ._stacked_impact import resolve_impact, uplift_from_rest
+from ._stacked_model import P1, P2, lock_margins
+from ._stacked_steps import (
+    K_END,
+    K_FEND,
+    derivative,
+    dop853_step,
+    ground,
+    step_error,
+    work_array,
+)
+from ._taylor import NO_REFCOUNT
+from .constants import (
+    FIRST_STEP,
+    STATUS_MAX_STEPS,
+    STATUS_OK,
+    STEP_GROW_LIMIT,
+    STEP_SAFETY,
+    STEP_SHRINK_LIMIT,
+)
+from .stacked_reference import MAX_PHASES
+
+#: Local error target as a fraction of rtol (the rocking kernels' TOL_SAFETY is 0.1): near an
+#: overturning the two bodies' unstable motion amplifies local errors more than one block's
+#: (a scene of the accuracy test erred by 25 rtol at 0.1, and the reference by 120 rtol at
+#: rtol 1e-11).
+TOL_FRACTION = 0.01
+
+#: Longest step, in units of 1/p_max: the events of a step are sought on its interpolant.
+STEP_CAP = 0.5
+
+#: A phase's ends besides its events (:data:`._stacked_events.EVENT_NONE`...).
+PHASE_END, PHASE_MAX_STEPS = 10, 11
+
+#: ``overturned_body`` codes of a scene (as :data:`.two_body_batch.OVERTURNED_BODY`).
+BODY_NONE, BODY_LOWER, BODY_UPPER, BODY_BOTH = 0, 1, 2, 3
+
+
+_FIELDS = "status max_rotation_lower max_rotation_upper overturned overturned_body"
+StackedOutcome = namedtuple("StackedOutcome", _FIELDS + " overturn_time n_impacts")
+
+
+StackedOutcome.__doc__ = """The outcome of a :func:`stacked_scene`: status (STATUS_OK or
+STATUS_MAX_STEPS), max |theta_1| and max |phi| [rad], whether a body fell, its code
+(BODY_NONE...), when [s] (NaN if none) and the number of impacts."""
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _next_stop(mot, t, t_end):
+    """(the time the step from t must stop at, the record segment of t): the next record
+    sample or the motion's end; ``t_end`` after the motion."""
+    dur, seg = mot[1][3], mot[4]
+    if t >= dur:
+        return t_end, seg
+    if mot[0] != KIND_RECORD:
+        return min(dur, t_end), seg
+    seg = segment_index(mot[2], t, seg)
+    stop = mot[2][seg + 1] if seg + 1 < mot[2].shape[0] else dur
+    return min(stop, dur, t_end), seg
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _accepted(g, hs, y0, y1, w, tol, h, last):
+    """(accepted, next step) of a DOP853 step of length hs (Hairer's step control)."""
+    err = step_error(g, w, hs, y0, y1, tol)
+    if not err <= 1.0:  # rejected (or NaN)
+        shrink = max(STEP_SHRINK_LIMIT, STEP_SAFETY * err ** (-0.125)) if err == err else 0.2
+        return False, hs * shrink
+    grow = STEP_GROW_LIMIT if err == 0.0 else min(STEP_GROW_LIMIT, STEP_SAFETY * err ** (-0.125))
+    return True, (max(h, hs * grow) if last else hs * grow)
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _raise_peaks(y, peaks):
+    peaks[0] = max(peaks[0], abs(y[0]))
+    peaks[1] = max(peaks[1], abs(y[1] - y[0]))
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates):
+    """One regime from the state (st = (t, h, t_end, record segment), y, iv) to its first
+    event or ``t_end``: returns (kind, interface, corner), the state moved to the event (or
+    the end). ``rates``: the work array of :func:`._stacked_events.first_event`."""
+    regime = (iv[2], iv[3], iv[0] != 0, iv[1] != 0)
+    t, h, t_end = st[0], st[1], st[2]
+    cap = STEP_CAP / max(g[P1], g[P2])
+    seg = mot[4]
+    mot = (mot[0], mot[1], mot[2], mot[3], seg)
+    f0 = tmp[12:16]
+    derivative(g, regime, mot, t, y, f0)
+    for _ in range(max_steps):
+        stop, seg = _next_stop(mot, t, t_end)
+        if t >= stop:
+            st[0], st[1], st[3] = t, h, seg
+            return PHASE_END, -1, 0
+        mot = (mot[0], mot[1], mot[2], mot[3], seg)
+        last = min(h, cap) >= stop - t
+        hs = stop - t if last else min(h, cap)
+        t1 = stop if last else t + hs
+        dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
+        y1 = w[K_END]
+        f1 = w[K_FEND]
+        derivative(g, regime, mot, t1, y1, f1)
+        for c in range(4):
+            w[12, c] = f1[c]
+        ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
+        if not ok:
+            continue
+        lock_margins(g, y1, iv[2], iv[3], regime[2], regime[3], ground(mot, t1), margins)
+        sig, kind, k, corner = first_event(
+            g, regime, mot, t, hs, y, f0, y1, f1, margins, tmp, w, rates
+        )
+        step_peaks(g, regime, mot, t, hs, y, f0, y1, f1, min(sig, 1.0), peaks, w, rates)
+        if kind == EVENT_NONE:
+            t = t1
+            for c in range(4):
+                y[c], f0[c] = y1[c], f1[c]
+            _raise_peaks(y, peaks)
+            continue
+        t = event_state(g, regime, mot, t, hs, y, f0, sig, kind, k, corner, w, tmp[16:20])
+        for c in range(4):
+            y[c] = tmp[16 + c]
+        _raise_peaks(y, peaks)
+        st[0], st[1], st[3] = t, h, seg
+        return kind, k, corner
+    st[0], st[1], st[3] = t, h, seg
+    return PHASE_MAX_STEPS, -1, 0
+
+
+@njit(cache=True)
+def _release_violated(g, mot, iv, y, t, margins):
+    """Open a closed interface whose lock margin is already below -1e-12 at a phase's start,
+    about the corner of the most negative margin; returns whether one opened."""
+    lock_margins(g, y, iv[2], iv[3], iv[0] != 0, iv[1] != 0, ground(mot, t), margins)
+    worst, j_worst = -1e-12, -1
+    for j in range(4):
+        if iv[j // 2] != 0 and margins[j] < worst:
+            worst, j_worst = margins[j], j
+    if j_worst < 0:
+        return False
+    iv[j_worst // 2], iv[2 + j_worst // 2] = 0, 1 - 2 * (j_worst % 2)
+    return True
+
+
+@njit(cache=True)
+def _fallen(k, iv):
+    """The body code of a fall of interface k."""
+    if k == 1:
+        return BODY_UPPER
+    return BODY_BOTH if iv[1] != 0 else BODY_LOWER
+
+
+@njit(cache=True)
+def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
+    """Two stacked blocks from rest through one motion: (status, max |theta_1|, max |phi|,
+    overturned, body code, overturn time, impacts): a :data:`StackedOutcome`."""
+    w, tmp, margins = work_array(), np.empty(24), np.empty(4)
+    rates = np.empty((2, SAMPLES + 1))
+    y, iv, peaks = np.zeros(4), np.array([1, 1, 1, 1]), np.zeros(2)
+    st = np.array([0.0, FIRST_STEP / max(g[P1], g[P2]), t_end, 0.0])
+    mot = (kind, mp, times, samples, 0)
+    dur, n_imp, status, body, t_over = mp[3], 0, STATUS_OK, BODY_NONE, math.nan
+    for _ in range(MAX_PHASES):
+        t = st[0]
+        mot = (kind, mp, times, samples, int(st[3]))
+        if t >= t_end:
+            break
+        if iv[0] != 0 and iv[1] != 0:
+            if t >= dur:
+                break
+            t_up, k, corner = uplift_from_rest(g, mot, t, tmp)
+            if not t_up <= t_end:
+                break
+            st[0], iv[k], iv[2 + k] = t_up, 0, corner
+            continue
+        if (iv[0] != 0 or iv[1] != 0) and _release_violated(g, mot, iv, y, t, margins):
+            continue
+        ev, k, corner = run_phase(
+            g, mot, iv, y, st, TOL_FRACTION * rtol, max_steps, peaks, w, margins, tmp, rates
+        )
+        if ev == PHASE_MAX_STEPS:
+            status = STATUS_MAX_STEPS
+            break
+        if ev == EVENT_UPLIFT:
+            iv[k], iv[2 + k] = 0, corner
+        elif ev == EVENT_IMPACT:
+            n_imp += 1
+            if not resolve_impact(g, y, iv, k, tmp[:6], margins):
+                status = STATUS_MAX_STEPS
+                break
+            _raise_peaks(y, peaks)
+        elif ev == EVENT_FALL:
+            body, t_over = _fallen(k, iv), st[0]
+            peaks[1 if body == BODY_UPPER else 0] = FALL_ROTATION
+            break
+    else:
+        status = STATUS_MAX_STEPS
+    return StackedOutcome(status, peaks[0], peaks[1], body != BODY_NONE, body, t_over, n_imp)
+
+
+@njit(cache=True, parallel=True)
+def stacked_batch(
+    geoms, kinds, params, times, samples, offsets, rtol, max_steps, t_end, out, codes
+):
+    """Many scenes in parallel: row i is geoms[i] under the motion (kinds[i], params[i],
+    times/samples[offsets[i]:offsets[i + 1]]), to rest after the motion, a fall or t_end [s].
+    out[i] = (max |theta_1|, max |phi|, overturn
+    time); codes[i] = (status, overturned, body code, impacts)."""
+    for i in prange(geoms.shape[0]):
+        a, b = offsets[i], offsets[i + 1]
+        r = stacked_scene(
+            geoms[i], kinds[i], params[i], times[a:b], samples[a:b], rtol, max_steps, t_end
+        )
+        out[i, 0], out[i, 1] = r.max_rotation_lower, r.max_rotation_upper
+        out[i, 2], codes[i, 0], codes[i, 1] = r.overturn_time, r.status, r.overturned
+        codes[i, 2], codes[i, 3] = r.overturned_body, r.n_impacts

@@ -1,0 +1,122 @@
+"""The steps of the two-block kernel (private): DOP853 on the state (theta_1, theta_2,
+theta_1', theta_2') of a regime of :mod:`._stacked_model`, its error norm, and the quintic
+Hermite interpolant of an interface's angle on a step, on which the kernel locates its events.
+
+The Butcher tableau and error weights are scipy's (``scipy.integrate.DOP853``, Hairer, Norsett
+& Wanner, *Solving ODEs I*, II.10), as in :mod:`._dop853`, here with a loop over the stages
+(four components). The motion travels as ``mot = (kind, params, times, samples, segment)`` of
+:mod:`rockstudy.motions._kernels` (the record segment of the step's start).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.integrate import DOP853 as _DOP853
+
+from ..motions._kernels import ground_acceleration
+from ._dop853 import hermite5
+from ._stacked_model import A1, A2, P1, P2, acceleration
+from ._taylor import NO_REFCOUNT
+from .constants import ATOL_FRACTION
+
+_A = np.ascontiguousarray(_DOP853.A[:12, :12], dtype=float)
+_B = np.ascontiguousarray(_DOP853.B, dtype=float)
+_C = np.ascontiguousarray(_DOP853.C[:12], dtype=float)
+_E3 = np.ascontiguousarray(_DOP853.E3, dtype=float)
+_E5 = np.ascontiguousarray(_DOP853.E5, dtype=float)
+
+#: Rows of the work array of a scene (:func:`work_array`): the 13 stage derivatives, a
+#: stage's state, the step's end, the derivative there, and the state of a true sub-step.
+K_TMP, K_END, K_FEND, K_SUB, K_FSUB = 13, 14, 15, 16, 17
+
+
+@njit(cache=True)
+def work_array():
+    """The work array of one scene: (18, 4) floats (rows :data:`K_TMP`...)."""
+    return np.empty((18, 4))
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def ground(mot, t):
+    """u_g''(t) [m/s^2] of the motion ``mot`` (zero outside it)."""
+    return ground_acceleration(mot[0], mot[1], mot[2], mot[3], t, mot[4])
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def derivative(g, regime, mot, t, y, out):
+    """y' = (theta_1', theta_2', theta_1'', theta_2'') of the regime ``regime`` = (s1, s2,
+    flat0, flat1) at (t, y), into ``out``."""
+    s1, s2, flat0, flat1 = regime
+    a1, a2 = acceleration(g, y, s1, s2, flat0, flat1, ground(mot, t))
+    out[0], out[1], out[2], out[3] = y[2], y[3], a1, a2
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def dop853_step(g, regime, mot, t, y, f, h, w, end):
+    """One DOP853 step of length h from (t, y) with y' = f there: the stage derivatives into
+    w[0:12], the new state into w[end]. The caller puts the derivative at the new
+    point into w[12] before :func:`step_error`."""
+    for c in range(4):
+        w[0, c] = f[c]
+    for i in range(1, 12):
+        for c in range(4):
+            acc = 0.0
+            for j in range(i):
+                acc += _A[i, j] * w[j, c]
+            w[K_TMP, c] = y[c] + h * acc
+        derivative(g, regime, mot, t + _C[i] * h, w[K_TMP], w[i])
+    for c in range(4):
+        acc = 0.0
+        for i in range(12):
+            acc += _B[i] * w[i, c]
+        w[end, c] = y[c] + h * acc
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def step_error(g, w, h, y0, y1, tol):
+    """Hairer's combined 5th/3rd-order error norm of the last step (<= 1 accepts), with the
+    scales tol (ATOL_FRACTION alpha_min + |theta|) and tol (ATOL_FRACTION p_max alpha_min +
+    |theta'|) of the rocking kernels."""
+    a_min, p_max = min(g[A1], g[A2]), max(g[P1], g[P2])
+    n5 = n3 = 0.0
+    for c in range(4):
+        e5 = e3 = 0.0
+        for j in range(13):
+            e5 += _E5[j] * w[j, c]
+            e3 += _E3[j] * w[j, c]
+        floor = ATOL_FRACTION * a_min * (1.0 if c < 2 else p_max)
+        sc = tol * (floor + max(abs(y0[c]), abs(y1[c])))
+        n5 += (e5 / sc) ** 2
+        n3 += (e3 / sc) ** 2
+    if n5 == 0.0:
+        return 0.0
+    return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * 4.0)
+
+
+@njit(cache=True, inline="always")
+def interface_data(k, y, f):
+    """Interface k's angle, rate and acceleration in the state y with derivative f: theta_1
+    (k = 0) or phi = theta_2 - theta_1 (k = 1)."""
+    if k == 0:
+        return y[0], y[2], f[2]
+    return y[1] - y[0], y[3] - y[2], f[3] - f[2]
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def interface_at(k, sigma, h, y0, f0, y1, f1):
+    """Interface k's (angle, rate, acceleration) at the fraction sigma of a step of length
+    h, on the quintic Hermite interpolant of its ends."""
+    x0, v0, a0 = interface_data(k, y0, f0)
+    x1, v1, a1 = interface_data(k, y1, f1)
+    return hermite5(sigma, h, x0, v0, a0, x1, v1, a1)
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def state_at(sigma, h, y0, f0, y1, f1, out):
+    """The full state at the fraction sigma of a step on the Hermite interpolant, into out."""
+    th1 = hermite5(sigma, h, y0[0], y0[2], f0[2], y1[0], y1[2], f1[2])
+    th2 = hermite5(sigma, h, y0[1], y0[3], f0[3], y1[1], y1[3], f1[3])
+    out[0], out[1], out[2], out[3] = th1[0], th2[0], th1[1], th2[1]
