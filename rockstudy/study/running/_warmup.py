@@ -224,6 +224,30 @@ def _batch_calls_serial():
         _batch_calls_of(("nonlinear", "linear", "auto"))
 
 
+def _two_body_calls():
+    """:func:`rockstudy.simulate_batch` of a statue on a plinth and of a block on an isolator
+    (linear and friction pendulum) under a pulse and a record, in parallel and on one thread
+    (their kernels: :mod:`rockstudy.dynamics.two_body_batch`)."""
+    import numba
+
+    from ...dynamics import simulate_batch
+    from ...motions import stochastic_record
+    from ...structures import Block, IsolatedBlock, StackedBlocks
+
+    statue = Block(0.5, 0.2)
+    systems = (
+        StackedBlocks(Block(1.0, 0.4), statue),
+        IsolatedBlock(statue, base_mass_ratio=1.0, period=2.0, damping=0.1),
+        IsolatedBlock(statue, 1.0, isolator="friction_pendulum", radius=2.0, friction=0.05),
+    )
+    record = stochastic_record(peak=3.0, duration=2.0, dt=0.01, seed=0)
+    for n in sorted({numba.get_num_threads(), 1}):
+        with _threads(n):
+            for system in systems:
+                simulate_batch(structure=system, amplitude=[2.0, 6.0], period=0.5)
+                simulate_batch(structure=system, record=record, scale=[1.0, 2.0])
+
+
 #: The warm-up's groups of calls, in the order they start: ``make demo``'s kernels first, then
 #: the longest groups.
 GROUPS = {
@@ -233,6 +257,7 @@ GROUPS = {
     "batch-serial": _batch_calls_serial,
     "records": _record_measure_calls,
     "closedforms": _closedform_calls,  # a sampled study's report draws the closed forms
+    "two-body": _two_body_calls,
 }
 
 
