@@ -283,3 +283,48 @@ def test_nested_bands_come_from_resampled_records():
         table["theta"] <= table["theta_hi"]
     )
     assert np.all(table["beta_lo"] <= table["beta"]) and np.all(table["beta"] <= table["beta_hi"])
+
+
+def test_the_report_shows_the_nested_fit_and_flags_the_separate_fits_that_cross(tmp_path):
+    """An IDA (4 generated records) whose smaller slide limit has nearly equal capacities
+    and whose larger one is the overturning capacity (wide): fitted apart the curves cross.
+    The report's table gives the fits apart with their flag and the nested medians and
+    beta, its rates are those of the nested fit, and its page says so and warns."""
+    import pandas as pd
+
+    import rockstudy as rs
+    from rockstudy.study.designs.records import incremental_dynamic_analysis
+    from rockstudy.study.report import record_report
+
+    records = [
+        rs.motions.synthetic_near_fault(pulse_period=tp, pga=2.0, seed=20 + i, duration=4.0)
+        for i, tp in enumerate((0.4, 0.6, 0.9, 1.2))
+    ]
+    blocks = {"Vase": rs.Block(half_diagonal=0.4, slenderness=0.25)}
+    ds = incremental_dynamic_analysis(records, blocks, step=0.1, tolerance=0.05, scan=0)
+    cap = ds["capacity"].values
+    narrow = np.exp(np.mean(np.log(cap)) - 0.1) * (1 + 0.01 * np.arange(cap.size))[:, None]
+    ds["slide_capacity"] = (
+        ("slide_limit", "record", "structure"),
+        np.stack([np.minimum(narrow, cap), cap * np.nan]),
+    )
+    ds = ds.assign_coords(slide_limit=[0.01, 0.05])
+    ds.attrs["slide_limits"] = [0.01, 0.05]
+    hazard = rs.risk.HazardCurve.power_law(2e-4, 2.3, "pga", "g")
+    apart = sliding.slide_fragility(ds, im="pga", n_boot=0)
+    assert apart["crossed"].any()  # the case this test builds
+    nested = sliding.slide_fragility(ds, im="pga", n_boot=0, nested=True)
+    page = record_report(ds, tmp_path, n_boot=0, hazard=hazard).read_text()
+    assert "The figure and the annual rates show the nested fit" in page
+    assert "Fitted apart, the curves of a milder and a worse slide limit d cross" in page
+    table = pd.read_csv(tmp_path / "slide_fragility.csv", index_col=[0, 1])
+    for (d, obj), row in table.iterrows():
+        assert row["fits apart cross"] == apart.loc[(d, obj), "crossed"]
+        assert row["median PGA [g]"] == pytest.approx(apart.loc[(d, obj), "theta"])
+        assert row["nested median PGA [g]"] == pytest.approx(nested.loc[(d, obj), "theta"])
+        assert row["nested beta (common)"] == pytest.approx(nested.loc[(d, obj), "beta"])
+    rates = pd.read_csv(tmp_path / "annual_sliding.csv", index_col=[0, 1])
+    want = sliding.slide_risk(ds, hazard, n_boot=0, nested=True)
+    for (d, obj), row in rates.iterrows():
+        got = row["lambda(max_slide > d) [1/yr]"]
+        assert got == pytest.approx(float(want["annual_rate"].sel(slide_limit=d, structure=obj)))
