@@ -12,9 +12,12 @@ object, each state keeps its median theta_k, and (ln theta_k, ln beta) maximise 
 log-likelihood of all the states' data (the censored lognormal likelihood of IDA capacities,
 or the binomial one of stripes and clouds; Baker 2015) under the constraint that a worse
 state's median is at least that of each milder state it implies. Curves with a common beta
-and ordered medians never cross. The constraint is the parametrisation ln theta_milder =
-ln theta_worse - d with d >= 0 (L-BFGS-B bounds): where the data disagree with the order, the
-two medians are pooled (d = 0), the constrained maximum likelihood.
+and ordered medians never cross. The constraint is met by pooling adjacent violators: the
+free joint fit (BFGS) first; while a state's median lies above that of a worse state it
+implies, the worst such pair shares one median and the fit is made again. Where the data
+disagree with the order the two medians are thus pooled: for a fixed beta each state's
+likelihood is log-concave in its ln theta, for which pooling adjacent violators gives the
+constrained maximum (checked against a constrained optimiser in the tests).
 
 The states are tied by ``above``: ``above[k]`` is the index of the next worse state that
 state k's event is implied by (-1: none), a forest. Only the states whose own fit exists
@@ -91,54 +94,50 @@ def _outcome_terms(mu, b, x, y):
 _TERMS = {CAPACITIES: _capacity_terms, OUTCOMES: _outcome_terms}
 
 
-def _topological(above) -> list[int]:
-    """The states of the forest ``above``, each after the state above it."""
-    order, placed = [], set()
-    while len(order) < len(above):
-        for k, a in enumerate(above):
-            if k not in placed and (a < 0 or a in placed):
-                order.append(k)
-                placed.add(k)
-    return order
-
-
-def _medians(p, above, order):
-    """ln theta of each state from the parameters ``p`` (roots: ln theta; others: the
-    decrement d >= 0 below the state above), in the order ``order``."""
-    mu = np.empty(len(above))
-    for i, k in enumerate(order):
-        mu[k] = p[i] if above[k] < 0 else mu[above[k]] - p[i]
-    return mu
-
-
-def _joint_nll(p, kind, data, above, order, m):
-    """The summed negative log-likelihood of all states (per point) and its gradient in the
-    parameters of :func:`_medians` and ln beta (the last)."""
-    mu, b = _medians(p[:-1], above, order), np.exp(p[-1])
-    f, g_mu, g_s = 0.0, np.zeros(len(above)), 0.0
+def _joint_nll(p, kind, data, group, m):
+    """The summed negative log-likelihood of all states (per point) and its gradient at
+    p = (ln theta of each group of states sharing a median, ln beta); ``group`` the group
+    of each state."""
+    b = np.exp(p[-1])
+    f, g_mu, g_s = 0.0, np.zeros(len(data)), 0.0
     for k, (a, z) in enumerate(data):
-        fk, gk, sk = _TERMS[kind](mu[k], b, a, z)
-        f, g_mu[k], g_s = f + fk, gk, g_s + sk
-    below = g_mu.copy()  # the gradient summed over each state's subtree
-    for k in reversed(order):
-        if above[k] >= 0:
-            below[above[k]] += below[k]
-    grad = np.array([below[k] if above[k] < 0 else -below[k] for k in order] + [g_s])
+        fk, g_mu[k], sk = _TERMS[kind](p[group[k]], b, a, z)
+        f, g_s = f + fk, g_s + sk
+    grad = np.append(np.bincount(group, weights=g_mu, minlength=p.size - 1), g_s)
     return f / m, grad / m
 
 
-def _start(separate, above, order):
-    """Parameters from the states' own fits: their medians, each lowered to the one above
-    it where higher, and the geometric mean of their betas."""
-    mu = np.log(np.array([t for t, _ in separate], float))
-    p = []
-    for k in order:
-        if above[k] < 0:
-            p.append(mu[k])
-        else:
-            mu[k] = min(mu[k], mu[above[k]])
-            p.append(mu[above[k]] - mu[k])
-    return np.array(p + [np.mean(np.log([b for _, b in separate]))])
+def _grouped_fit(kind, data, group, mu, beta, m):
+    """(ln theta of each state, beta): the joint MLE with the states of a group (``group``)
+    sharing one median, from the medians ``mu`` (their mean per group) and ``beta``."""
+    n = int(group.max()) + 1
+    start = np.bincount(group, weights=mu, minlength=n) / np.bincount(group, minlength=n)
+    res = optimize.minimize(
+        _joint_nll,
+        np.append(start, np.log(beta)),
+        args=(kind, data, group, m),
+        jac=True,
+        method="BFGS",
+        options={"gtol": 1e-9},
+    )
+    return res.x[:-1][group], float(np.exp(res.x[-1]))
+
+
+def _ordered_fit(kind, data, above, mu, beta, m):
+    """(ln theta, beta) of the states maximising the joint likelihood with ln theta of each
+    state at most that of the state above it: the free joint MLE, then, while a state's
+    median lies above that of the state above it, the worst such pair pooled (one median)
+    and the fit made again (pool adjacent violators)."""
+    group = np.arange(len(data))
+    while True:
+        group = np.unique(group, return_inverse=True)[1]
+        mu, beta = _grouped_fit(kind, data, group, mu, beta, m)
+        tied = np.array([a >= 0 and group[k] != group[a] for k, a in enumerate(above)])
+        gap = np.where(tied, mu - mu[np.maximum(above, 0)], -np.inf)
+        if not gap.size or gap.max() <= 1e-10:
+            return mu, beta
+        k = int(np.argmax(gap))
+        group = np.where(group == group[k], group[above[k]], group)
 
 
 def _fitted(separate) -> np.ndarray:
@@ -187,27 +186,16 @@ def fit_nested(kind, data, above, separate) -> tuple[np.ndarray, np.ndarray]:
     if keep.sum() < 2:
         return theta, beta
     index = np.flatnonzero(keep)
-    sub_above = _restricted(list(above), keep)
-    order = _topological(sub_above)
+    sub_above = np.array(_restricted(list(above), keep), int)
     second = np.log if kind == CAPACITIES else np.asarray  # log levels, or the outcomes
     logs = [
         (np.log(np.asarray(data[k][0], float)), second(np.asarray(data[k][1], float)))
         for k in index
     ]
     m = sum(a.size + (z.size if kind == CAPACITIES else 0) for a, z in logs)
-    p0 = _start([separate[k] for k in index], sub_above, order)
-    bounds = [(None, None) if sub_above[k] < 0 else (0.0, None) for k in order] + [(None, None)]
-    res = optimize.minimize(
-        _joint_nll,
-        p0,
-        args=(kind, logs, sub_above, order, m),
-        jac=True,
-        method="L-BFGS-B",
-        bounds=bounds,
-        options={"ftol": 1e-15, "gtol": 1e-11, "maxiter": 2000},
-    )
-    theta[index] = np.exp(_medians(res.x[:-1], sub_above, order))
-    beta[index] = np.exp(res.x[-1])
+    start = np.mean(np.log(beta[index]))
+    mu, common = _ordered_fit(kind, logs, sub_above, np.log(theta[index]), np.exp(start), m)
+    theta[index], beta[index] = np.exp(mu), common
     return theta, beta
 
 
