@@ -328,3 +328,53 @@ def test_the_report_shows_the_nested_fit_and_flags_the_separate_fits_that_cross(
     for (d, obj), row in rates.iterrows():
         got = row["lambda(max_slide > d) [1/yr]"]
         assert got == pytest.approx(float(want["annual_rate"].sel(slide_limit=d, structure=obj)))
+
+
+def test_states_nest_on_each_demand_and_under_overturning():
+    from rockstudy.study.spec.damage_states import DamageState
+
+    states = [
+        DamageState("displaced", "rotation_ratio", 0.5),
+        DamageState("fall_off", "slide", 0.1),
+        DamageState("chipped", "rotation_ratio", 0.25),
+        DamageState("overturned", "rotation_ratio", 1.0),
+        DamageState("slipped", "slide", 0.02),
+    ]
+    # chipped -> displaced -> overturned; slipped -> fall_off -> overturned
+    assert st.state_above(states) == [3, 3, 0, -1, 1]
+
+
+def test_nested_stripes_states_are_the_ordered_joint_binomial_mle():
+    """Stripes of two objects at 8 PGA levels (25 records): each state's points reached it
+    where the rotation ratio alpha x / C reached its limit or the block overturned (x > C);
+    the nested fit of each object is the maximum of the summed binomial likelihood of its
+    three states under ln theta_1 <= ln theta_2 <= ln theta_3 (SLSQP here)."""
+    levels = np.array([0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0, 1.3])
+    n_rec, limits = 25, {"chipped": 0.25, "displaced": 0.5, "overturned": 1.0}
+    c = 0.5 * np.exp(0.45 * np.random.default_rng(3).standard_normal((n_rec, 2)))
+    x = np.broadcast_to(levels, (n_rec, 2, levels.size)).copy()
+    ratio = x / c[:, :, None]
+    dims = ("record", "structure", "level")
+    ds = xr.Dataset(
+        {
+            "pga": ("record", np.full(n_rec, STANDARD_GRAVITY)),
+            "scale": (dims, x),
+            "max_rotation": (dims, np.where(ratio > 1, np.pi / 2, 0.2 * ratio)),
+            "overturned": (dims, ratio > 1),
+            "status": (dims, np.zeros(x.shape, int)),
+            "critical_rotation": ("structure", [0.2, 0.2]),
+        },
+        coords={"record": np.arange(n_rec), "structure": NAMES, "level": levels},
+        attrs={"design": "stripes", "im": "pga", "im_period": np.nan},
+    )
+    ds.attrs["damage_states"] = json.dumps(limits)
+    table = st.state_fragility(ds, n_boot=0, nested=True)
+    for j, name in enumerate(NAMES):
+        xs = x[:, j].ravel()
+        data = [(xs, ((ratio[:, j] >= lim) | (ratio[:, j] > 1)).ravel()) for lim in limits.values()]
+        data = [(a, z.astype(float)) for a, z in data]
+        start = [np.log(0.12), np.log(0.25), np.log(0.5), np.log(0.5)]
+        want_theta, want_beta = _oracle(data, nf.OUTCOMES, start, ordered=True)
+        row = table.xs(name, level=1)
+        np.testing.assert_allclose(row["theta"], want_theta, rtol=1e-5)
+        np.testing.assert_allclose(row["beta"], want_beta, rtol=1e-5)
