@@ -7,7 +7,9 @@ intensity measures; ``record_similarity`` checks whether block sizes collapse on
 object's fragility and a site's hazard curve into its annual rate of overturning; ``sliding``
 fits the fragility of sliding P(max_slide > d) of designs under the contact model, its annual
 rate, and the ratio of the annual rates of overturning of the contact and rocking-only models;
-``states`` fits the fragility of each damage state short of overturning and its annual rate.
+``states`` fits the fragility of each damage state short of overturning and its annual rate;
+``nested_fit`` fits nested slide limits and damage states with one beta and ordered medians,
+so that their curves never cross.
 """
 
 from .sampled import (

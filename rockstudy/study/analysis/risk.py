@@ -297,6 +297,7 @@ def object_risk(
     seed: int = SEED,
     min_overturning: int = 5,
     uplift_cut: bool = True,
+    refit=None,
 ) -> xr.Dataset:
     """Per object: the fragility in the hazard's IM, lambda_OT, P(OT in ``years``) and bands.
 
@@ -335,6 +336,11 @@ def object_risk(
         object's uplift PGA (see ``truncated_at_uplift`` below). False: the whole lognormal,
         for a demand that needs no uplift (sliding: a block slides below its uplift PGA,
         :func:`~rockstudy.study.analysis.sliding.slide_risk`).
+    refit : callable, optional
+        ``refit(j, rows) -> (theta, beta)``, in the quoted units of the hazard's IM: the fit
+        of object ``j`` on the records ``rows`` (an index array) in place of the design's
+        own, for the point estimate and each resample (the nested fits of
+        :mod:`~rockstudy.study.analysis.nested_fit`).
 
     Returns
     -------
@@ -380,6 +386,8 @@ def object_risk(
         warnings.warn(f"hazard: {off}; check the units of both", UnitsWarning, stacklevel=2)
     unit = rf.quoted(im)[0]
     fitter = globals()[kind.risk_fitter](ds, im, period)
+    if refit is not None:
+        fitter = (refit, *fitter[1:])
     n_rec = ds.sizes["record"]
     rng = bootstrap_rng(seed)
     boot_rows = [rng.integers(0, n_rec, n_rec) for _ in range(n_boot)]

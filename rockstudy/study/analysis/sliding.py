@@ -38,6 +38,7 @@ from ...dynamics.constants import STATUS_UNCONVERGED
 from ..designs.records import IDA_ROCKING_VARIABLES
 from ..spec.design_kinds import kind_of
 from . import record_fragility as rf
+from .nested_fit import nested_above, rates_crossed, risk_frames, shown_table
 from .risk import object_risk
 
 __all__ = [
@@ -163,7 +164,13 @@ def _n_overturned(design) -> xr.DataArray:
 
 
 def slide_fragility(
-    ds: xr.Dataset, limits=None, im: str | None = None, period=None, by="structure", **kw
+    ds: xr.Dataset,
+    limits=None,
+    im: str | None = None,
+    period=None,
+    by="structure",
+    nested: bool = False,
+    **kw,
 ) -> pd.DataFrame:
     """Lognormal fragility of sliding, P(max_slide > d | IM), for each slide limit d.
 
@@ -178,17 +185,23 @@ def slide_fragility(
         As the design's overturning fitter
         (:func:`~rockstudy.study.analysis.record_fragility.fragility_of`); one curve per
         structure by default.
+    nested : bool
+        False (default): each limit fitted apart. True: the nested fit
+        (:mod:`~rockstudy.study.analysis.nested_fit`), one beta for all limits of a group
+        and medians increasing with d, so that the curves never cross.
 
     Returns
     -------
     pandas.DataFrame
-        The fitter's table with an outer index level ``slide_limit`` [m].
+        The fitter's table with an outer index level ``slide_limit`` [m], ``fit``
+        ("separate" or "nested") and ``crossed`` (True at a limit whose curve lies below a
+        larger limit's somewhere in the observed range: the fits made apart cross there);
+        a nested table has ``crossed_separate``, the flag of the fits made apart.
     """
-    tables = {}
-    for d in slide_limits(ds, limits):
-        view = limit_design(ds, d)
-        tables[float(d)] = rf.fragility_of(view)(view, im=im, period=period, by=by, **kw)
-    return pd.concat(tables, names=["slide_limit"])
+    d = slide_limits(ds, limits)
+    views = [limit_design(ds, x) for x in d]
+    keys, above = [float(x) for x in d], nested_above(d)
+    return shown_table(ds, views, keys, above, "slide_limit", nested, im, period, by, **kw)
 
 
 def _concat_objects(frames, dim, values, order):
@@ -198,37 +211,58 @@ def _concat_objects(frames, dim, values, order):
     return xr.concat(frames, dim=pd.Index(values, name=dim), combine_attrs="drop_conflicts")
 
 
-def slide_risk(ds: xr.Dataset, hazard, limits=None, years: float = 50.0, **kw) -> xr.Dataset:
+def slide_risk(
+    ds: xr.Dataset, hazard, limits=None, years: float = 50.0, nested: bool = False, **kw
+) -> xr.Dataset:
     """The annual rate of exceeding each slide limit d at the site of ``hazard``, per object.
 
     :func:`~rockstudy.study.analysis.risk.object_risk` of :func:`limit_design` at each d,
-    with the whole lognormal (``uplift_cut=False``: a block slides below its uplift PGA).
-    Its variables on (``slide_limit``, ``structure``), the structures in the design's
-    order; ``n_overturning`` is named ``n_exceeding`` (records under which the object slid
-    more than d or overturned) and ``status`` reads "exceeded d" for "overturned";
-    ``crossed`` is True at a limit whose rate lies below that of a larger limit (the fits of
-    nested exceedances, made apart, cross there: read the two rates as about equal). ``kw``:
-    ``n_boot``, ``conf_level``, ``seed``, ``min_overturning`` (the records that must exceed
-    d for "ok").
+    with the whole lognormal (``uplift_cut=False``: a block slides below its uplift PGA);
+    with ``nested`` of the nested fits (:mod:`~rockstudy.study.analysis.nested_fit`: one
+    beta for all limits of an object, medians increasing with d; ``attrs["fit"]`` says
+    which). Its variables on (``slide_limit``, ``structure``), the structures in the
+    design's order; ``n_overturning`` is named ``n_exceeding`` (records under which the
+    object slid more than d or overturned) and ``status`` reads "exceeded d" for
+    "overturned"; ``crossed`` is True at a limit whose rate lies below that of a larger
+    limit (the fits of nested exceedances, made apart, cross there: read the two rates as
+    about equal; never for the nested fits, whose ``crossed_separate`` is the flag of the
+    fits made apart). ``kw``: ``n_boot``, ``conf_level``, ``seed``, ``min_overturning``
+    (the records that must exceed d for "ok").
     """
     d = slide_limits(ds, limits)
-    frames = [object_risk(limit_design(ds, x), hazard, years, uplift_cut=False, **kw) for x in d]
-    out = _concat_objects(frames, "slide_limit", d, ds["structure"].values)
+    views = [limit_design(ds, x) for x in d]
+    cuts = [False] * d.size
+    out = _nested_risk(
+        ds, views, "slide_limit", d, nested_above(d), hazard, years, cuts, nested, kw
+    )
     out["slide_limit"].attrs.update(units="m", long_name="slide limit d of P(max_slide > d)")
-    out["crossed"] = _crossed(out["annual_rate"])
     return out.rename(n_overturning="n_exceeding")
 
 
-def _crossed(rate: xr.DataArray) -> xr.DataArray:
-    """True where the rate of exceeding a limit is above that of a smaller limit: the data
-    nest (a slide past the larger d is past the smaller), but the two lognormals are fitted
-    apart and may cross; read such rates as about equal."""
-    values = rate.transpose("slide_limit", "structure").values
-    finite = np.where(np.isfinite(values), values, -np.inf)
-    larger = np.fmax.accumulate(finite[::-1], axis=0)[::-1]  # max over this limit and above
-    above_larger = np.zeros(values.shape, bool)
-    above_larger[:-1] = values[:-1] < larger[1:]  # a larger limit's rate is higher
-    return xr.DataArray(above_larger, dims=("slide_limit", "structure"), coords=rate.coords)
+def _nested_risk(ds, views, dim, values, above, hazard, years, cuts, nested, kw):
+    """The per-state risks of the design views ``views`` on ``dim`` (coordinate
+    ``values``), with ``crossed`` (and with ``nested`` ``crossed_separate``, of the fits
+    made apart) and ``attrs["fit"]``."""
+    frames = risk_frames(views, above, hazard, years, cuts, nested, **kw)
+    out = _concat_objects(frames, dim, values, ds["structure"].values)
+    out["crossed"] = _crossed(out["annual_rate"], dim, above)
+    if nested:
+        alone = risk_frames(views, above, hazard, years, cuts, False, **{**kw, "n_boot": 0})
+        rates = _concat_objects(alone, dim, values, ds["structure"].values)["annual_rate"]
+        out["crossed_separate"] = _crossed(rates, dim, above)
+    out.attrs["fit"] = "nested" if nested else "separate"
+    return out
+
+
+def _crossed(rate: xr.DataArray, dim, above) -> xr.DataArray:
+    """True where the rate of a state is below that of a worse state (of ``above``): the
+    data nest (a slide past the larger d is past the smaller), but lognormals fitted apart
+    may cross; read such rates as about equal."""
+    values = rate.transpose(dim, "structure").values
+    flags = rates_crossed(values, above)
+    return xr.DataArray(
+        flags, dims=(dim, "structure"), coords=rate.transpose(dim, "structure").coords
+    )
 
 
 def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Dataset:

@@ -31,13 +31,13 @@ import xarray as xr
 
 from ..spec.damage_states import SLIDE, DamageState, damage_states
 from ..spec.design_kinds import kind_of
-from . import record_fragility as rf
-from .risk import object_risk
-from .sliding import _concat_objects, exceeds_slide
+from .nested_fit import nested_above, shown_table
+from .sliding import _nested_risk, exceeds_slide
 
 __all__ = [
     "design_states",
     "reached",
+    "state_above",
     "state_design",
     "state_fragility",
     "state_risk",
@@ -101,41 +101,71 @@ def state_design(ds: xr.Dataset, state: DamageState) -> xr.Dataset:
     return view
 
 
+def state_above(states) -> list[int]:
+    """The nesting of ``states`` (:mod:`~rockstudy.study.analysis.nested_fit`): on each
+    demand a state is implied by the next larger limit, and the top of each demand by
+    overturning (which reaches every state) where it is among ``states``."""
+    above = nested_above([s.limit for s in states], [s.demand for s in states])
+    top = [k for k, s in enumerate(states) if s.overturning]
+    for k, s in enumerate(states):
+        if above[k] < 0 and top and not s.overturning:
+            above[k] = top[0]
+    return above
+
+
 def state_fragility(
-    ds: xr.Dataset, states=None, im: str | None = None, period=None, by="structure", **kw
+    ds: xr.Dataset,
+    states=None,
+    im: str | None = None,
+    period=None,
+    by="structure",
+    nested: bool = False,
+    **kw,
 ) -> pd.DataFrame:
     """Lognormal fragility of each damage state, P(state reached | IM): the table of
     the design's overturning fitter
     (:func:`~rockstudy.study.analysis.record_fragility.fragility_of`, with ``im``,
     ``period``, ``by`` and ``kw``; one curve per structure by default) of
     :func:`state_design` for each of the states named in ``states`` (default all, in the
-    design's order), with an outer index level ``damage_state`` (the names)."""
-    tables = {}
-    for state in design_states(ds, states):
-        view = state_design(ds, state)
-        tables[state.name] = rf.fragility_of(view)(view, im=im, period=period, by=by, **kw)
-    return pd.concat(tables, names=["damage_state"])
+    design's order), with an outer index level ``damage_state`` (the names); with
+    ``nested`` the nested fit (:mod:`~rockstudy.study.analysis.nested_fit`: one beta for all
+    states of a group, medians ordered as the states nest, :func:`state_above`), whose
+    curves never cross. ``fit`` says which ("separate" or "nested"), ``crossed`` is True at
+    a state whose curve lies below that of a worse state somewhere in the observed range
+    (the fits made apart cross there), and a nested table has ``crossed_separate``, the
+    flag of the fits made apart."""
+    chosen = design_states(ds, states)
+    views = [state_design(ds, s) for s in chosen]
+    above = state_above(chosen)
+    names = [s.name for s in chosen]
+    return shown_table(ds, views, names, above, "damage_state", nested, im, period, by, **kw)
 
 
-def state_risk(ds: xr.Dataset, hazard, states=None, years: float = 50.0, **kw) -> xr.Dataset:
+def state_risk(
+    ds: xr.Dataset, hazard, states=None, years: float = 50.0, nested: bool = False, **kw
+) -> xr.Dataset:
     """The annual rate of reaching each damage state at the site of ``hazard``, per object.
 
     :func:`~rockstudy.study.analysis.risk.object_risk` of :func:`state_design` for each
-    state (a state on the slide with the whole lognormal, ``uplift_cut=False``). Its
-    variables on (``damage_state``, ``structure``), the structures in the design's order,
-    with ``damage_demand`` and ``damage_limit`` on ``damage_state``; ``n_overturning`` is
-    named ``n_reaching`` (records under which the object reached the state; ``status``
-    as :data:`~rockstudy.study.analysis.risk.STATUSES`, of the state). ``kw``:
-    ``n_boot``, ``conf_level``, ``seed``, ``min_overturning`` (the records that must reach
-    the state for "ok").
+    state (a state on the slide with the whole lognormal, ``uplift_cut=False``); with
+    ``nested`` of the nested fits (:mod:`~rockstudy.study.analysis.nested_fit`: one beta
+    for all states of an object, medians ordered as the states nest, :func:`state_above`;
+    ``attrs["fit"]`` says which). Its variables on (``damage_state``, ``structure``), the
+    structures in the design's order, with ``damage_demand`` and ``damage_limit`` on
+    ``damage_state``; ``n_overturning`` is named ``n_reaching`` (records under which the
+    object reached the state; ``status`` as :data:`~rockstudy.study.analysis.risk.STATUSES`,
+    of the state); ``crossed`` is True at a state whose rate lies below that of a worse
+    state (the fits made apart cross there: read the two rates as about equal; never for
+    the nested fits, whose ``crossed_separate`` is the flag of the fits made apart).
+    ``kw``: ``n_boot``, ``conf_level``, ``seed``, ``min_overturning`` (the records that
+    must reach the state for "ok").
     """
     chosen = design_states(ds, states)
-    frames = [
-        object_risk(state_design(ds, s), hazard, years, uplift_cut=s.demand != SLIDE, **kw)
-        for s in chosen
-    ]
+    views = [state_design(ds, s) for s in chosen]
+    cuts = [s.demand != SLIDE for s in chosen]
     names = [s.name for s in chosen]
-    out = _concat_objects(frames, "damage_state", names, ds["structure"].values)
+    above = state_above(chosen)
+    out = _nested_risk(ds, views, "damage_state", names, above, hazard, years, cuts, nested, kw)
     out = out.assign_coords(
         damage_demand=("damage_state", [s.demand for s in chosen]),
         damage_limit=("damage_state", [s.limit for s in chosen]),

@@ -6,17 +6,19 @@ The ladder of the overturning capacity (:func:`.records.incremental_dynamic_anal
 climbs on past the first overturning, rung by rung, until ``max_slide`` exceeds the largest
 d (or the ladder ends); for each d the first rung whose ``max_slide`` exceeds it and the
 rung below bracket the capacity, bisected geometrically on ``max_slide > d`` until their
-ratio is at most ``1 + tolerance``: the capacity is the upper end. ``max_slide`` need not
-grow with the scale (a block that slides at one scale can rock without slip at a higher
-one): the capacity is that of the first crossing seen on the rungs, bisected inside that
-rung's bracket; a crossing narrower than a rung below it can be missed, as an overturning
-window can. NaN where no rung up to the largest exceeds d.
+ratio is at most ``1 + tolerance`` (the bisection of :mod:`.ida_states`): the capacity is
+the upper end. ``max_slide`` need not grow with the scale (a block that slides at one
+scale can rock without slip at a higher one): the capacity is that of the first crossing
+seen on the rungs, bisected inside that rung's bracket; a crossing narrower than a rung
+below it can be missed, as an overturning window can. NaN where no rung up to the largest exceeds d.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+
+from . import ida_states
 
 __all__ = ["slide_limits", "slide_scales", "slide_tables"]
 
@@ -63,8 +65,9 @@ def slide_scales(points, ladders, done, limits, tolerance, climb) -> np.ndarray:
     _, reached = climb(points, ladders, start, lambda o: np.asarray(o[_SLIDE]) > top)
     climbed = start < np.array([r.size for r in ladders])
     done[climbed] = reached[climbed]
-    lo, hi, cell = _brackets(points, ladders, limits)
-    out[cell[:, 0], cell[:, 1]] = _bisect(points, lo, hi, cell, limits, tolerance)
+    tests = [_slid_more(d) for d in limits]
+    lo, hi, cell = ida_states.brackets(points, ladders, tests)
+    out[cell[:, 0], cell[:, 1]] = ida_states.bisect(points, lo, hi, cell, tests, tolerance)
     return out
 
 
@@ -74,34 +77,9 @@ def _rung_slides(points, j) -> np.ndarray:
     return np.array([h[column] for h in points.history[j] if h[3] == 0], float)
 
 
-def _brackets(points, ladders, limits):
-    """(lower scale, upper scale, (limit, structure) index) of each first crossing of a
-    limit on the rungs; the lower end NaN where the lowest rung crossed."""
-    lo, hi, cell = [], [], []
-    for j in range(len(ladders)):
-        slides = _rung_slides(points, j)
-        for c, limit in enumerate(limits):
-            crossed = np.flatnonzero(slides > limit)
-            if crossed.size:
-                k = int(crossed[0])
-                hi.append(ladders[j][k])
-                lo.append(ladders[j][k - 1] if k > 0 else np.nan)
-                cell.append((c, j))
-    return np.array(lo, float), np.array(hi, float), np.array(cell, np.int64).reshape(-1, 2)
-
-
-def _bisect(points, lo, hi, cell, limits, tolerance) -> np.ndarray:
-    """The upper ends of the brackets [lo, hi] of the cells (limit, structure), bisected
-    geometrically on max_slide > d until hi <= lo (1 + tolerance)."""
-    d, structure = limits[cell[:, 0]], cell[:, 1]
-    while True:
-        active = np.flatnonzero(np.isfinite(lo) & (hi > lo * (1.0 + tolerance)))
-        if not active.size:
-            return hi
-        s = np.sqrt(lo[active] * hi[active])
-        above = np.asarray(points.outcomes(structure[active], s, 1)[_SLIDE]) > d[active]
-        hi[active[above]] = s[above]
-        lo[active[~above]] = s[~above]
+def _slid_more(d):
+    """The test of :func:`.ida_states.brackets` "slid more than ``d``"."""
+    return lambda j, out: np.asarray(out[_SLIDE], float) > d
 
 
 def slide_tables(ds, results, limits, measure, power) -> xr.Dataset:

@@ -37,6 +37,8 @@ __all__ = [
     "damage_states",
     "states_attr",
     "LONG_NAMES",
+    "bisect",
+    "brackets",
     "state_coords",
     "state_scales",
     "state_tables",
@@ -64,17 +66,18 @@ def _rung_outputs(points, j) -> dict:
     return out
 
 
-def _brackets(points, ladders, states, alpha):
-    """(lower scale, upper scale, (state, structure) index) of the first rung of each
-    structure that reaches each state short of overturning; the lower end NaN where the
-    lowest rung reached it."""
+def brackets(points, ladders, tests):
+    """(lower scale, upper scale, (class, structure) index) of the first rung of each
+    structure that passes each test of ``tests`` (``test(j, outputs)`` -> bool per point of
+    structure(s) ``j``, outputs as :func:`_rung_outputs`; None: no bracket of that class);
+    the lower end NaN where the lowest rung passed it."""
     lo, hi, cell = [], [], []
     for j, ladder in enumerate(ladders):
         rungs = _rung_outputs(points, j)
-        for c, state in enumerate(states):
-            if state.overturning:
+        for c, test in enumerate(tests):
+            if test is None:
                 continue
-            k = np.flatnonzero(_reached(state, alpha[j], rungs))
+            k = np.flatnonzero(test(j, rungs))
             if k.size:
                 hi.append(ladder[k[0]])
                 lo.append(ladder[k[0] - 1] if k[0] > 0 else np.nan)
@@ -82,9 +85,10 @@ def _brackets(points, ladders, states, alpha):
     return np.array(lo, float), np.array(hi, float), np.array(cell, np.int64).reshape(-1, 2)
 
 
-def _bisect(points, lo, hi, cell, states, alpha, tolerance) -> np.ndarray:
-    """The upper ends of the brackets [lo, hi] of the cells (state, structure), bisected
-    geometrically on "reaches the state" until hi <= lo (1 + tolerance)."""
+def bisect(points, lo, hi, cell, tests, tolerance) -> np.ndarray:
+    """The upper ends of the brackets [lo, hi] of the cells (class, structure) of
+    :func:`brackets`, bisected geometrically on the class's test until hi <= lo
+    (1 + tolerance)."""
     while True:
         active = np.flatnonzero(np.isfinite(lo) & (hi > lo * (1.0 + tolerance)))
         if not active.size:
@@ -96,9 +100,19 @@ def _bisect(points, lo, hi, cell, states, alpha, tolerance) -> np.ndarray:
         for c in np.unique(cell[active, 0]):
             mine = cell[active, 0] == c
             sub = {k: np.asarray(v)[mine] for k, v in out.items() if np.ndim(v) == 1}
-            above[mine] = _reached(states[c], alpha[structure[mine]], sub)
+            above[mine] = tests[c](structure[mine], sub)
         hi[active[above]] = s[above]
         lo[active[~above]] = s[~above]
+
+
+def _state_tests(states, alpha) -> list:
+    """The tests of :func:`brackets` of the ``states`` short of overturning: "reaches the
+    state" (None for the overturning state)."""
+
+    def reaches(state):
+        return lambda j, out: _reached(state, alpha[j], out)
+
+    return [None if state.overturning else reaches(state) for state in states]
 
 
 def state_scales(points, ladders, states, alpha, capacity_scale, tolerance) -> np.ndarray:
@@ -114,9 +128,10 @@ def state_scales(points, ladders, states, alpha, capacity_scale, tolerance) -> n
     for c, state in enumerate(states):
         if state.overturning:
             out[c] = capacity_scale
-    lo, hi, cell = _brackets(points, ladders, states, alpha)
+    tests = _state_tests(states, alpha)
+    lo, hi, cell = brackets(points, ladders, tests)
     if cell.size:
-        out[cell[:, 0], cell[:, 1]] = _bisect(points, lo, hi, cell, states, alpha, tolerance)
+        out[cell[:, 0], cell[:, 1]] = bisect(points, lo, hi, cell, tests, tolerance)
     return out
 
 

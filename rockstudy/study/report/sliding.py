@@ -10,11 +10,22 @@ import numpy as np
 import pandas as pd
 
 from ..analysis import sliding
+from ..analysis.fragility_fit import BAND_COLUMNS
 from ..analysis.sampled import fragility_curve
 from ._page import _plt, shown_separation
-from .objects import FONT, quoted_to_report, si_to_report
+from .objects import FONT, _panels, quoted_to_report, si_to_report
 
-__all__ = ["contact_section", "regime_section", "section"]
+__all__ = [
+    "NESTED_NOTE",
+    "STYLES",
+    "both_fits",
+    "contact_section",
+    "fragility_panels",
+    "nested_view",
+    "regime_section",
+    "section",
+    "warn_crossed",
+]
 
 #: How the report counts an overturned point against a slide limit.
 _OVERTURNED_NOTE = (
@@ -52,22 +63,23 @@ def section(page, ctx):
         )
         return
     try:
-        with shown_separation():  # the table says which fits are separated
-            table = sliding.slide_fragility(ctx.ds, limits, im="pga", n_boot=ctx.n_boot)
+        table = both_fits(sliding.slide_fragility, ctx, limits)
     except ValueError as err:
         page.text(f"No fragility of sliding: {err}")
         return
-    f = quoted_to_report(ctx.units, "pga")
-    for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
-        table[col] = table[col] * f
     page.text(
         "The fragility of sliding P(max_slide > d | PGA) of each object, for each slide limit "
         "d, fitted as the design fits overturning ("
         + ctx.kind.text["fit"]
         + "). "
         + _OVERTURNED_NOTE
+        + " "
+        + NESTED_NOTE.format(states="slide limits", order="increasing with d")
     )
-    _fragility_figure(page, ctx, table, limits)
+    warn_crossed(page, table, "slide limit d")
+    titles = [f"d = {d:g} m" for d in limits]
+    keys = [float(d) for d in limits]
+    fragility_panels(page, ctx, nested_view(table), "slide_limit", keys, _FIGURE, titles)
     page.table(_fragility_table(table, ctx.units), "slide_fragility", _FRAGILITY_CAPTION)
     if ctx.hazard is not None:
         _rates(page, ctx, limits)
@@ -96,67 +108,139 @@ def _friction(page, ctx):
 
 
 _FRAGILITY_CAPTION = "Fragility of sliding of each object per slide limit d (90 % bands)"
+#: The figure of the fragility of sliding: (name, caption, y label).
+_FIGURE = (
+    "slide_fragility",
+    "Fragility of sliding of each object, one panel per slide limit d: the nested lognormal "
+    "fit of P(max_slide > d | PGA) (one beta for all limits of an object; an overturning "
+    "counts as exceeding d), 90 % pointwise band from resampled records",
+    "P(max_slide > d) [-]",
+)
+
+
+#: What the report says of the fits it shows.
+NESTED_NOTE = (
+    "The figure and the annual rates show the nested fit: one dispersion beta for all "
+    "{states} of an object and medians {order} (a joint maximum likelihood of all of them), "
+    "so that the curve of a worse one never lies above that of a milder one; the table gives "
+    "each fitted apart (median, band, beta) beside the nested median and beta."
+)
+
+
+def both_fits(fitter, ctx, *args) -> pd.DataFrame:
+    """The table of ``fitter`` (:func:`~rockstudy.study.analysis.sliding.slide_fragility`
+    or :func:`~rockstudy.study.analysis.states.state_fragility`) fitted apart, with the
+    nested fit's ``nested_theta``, ``nested_beta`` and band columns beside (``nested_*``),
+    the intensities in the report's units."""
+    with shown_separation():  # the table says which fits are separated
+        apart = fitter(ctx.ds, *args, im="pga", n_boot=ctx.n_boot)
+        nested = fitter(ctx.ds, *args, im="pga", n_boot=ctx.n_boot, nested=True)
+    f = quoted_to_report(ctx.units, "pga")
+    for table in (apart, nested):
+        for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
+            table[col] = table[col] * f
+    shown = ["theta", "beta", "theta_lo", "theta_hi", *BAND_COLUMNS]
+    return apart.join(nested[shown].add_prefix("nested_"))
+
+
+def nested_view(table) -> pd.DataFrame:
+    """The nested fit of a table of :func:`both_fits` under the fitter's column names."""
+    nested = [c for c in table.columns if c.startswith("nested_")]
+    out = table.drop(columns=[c.removeprefix("nested_") for c in nested])
+    return out.rename(columns={c: c.removeprefix("nested_") for c in nested})
+
+
+def warn_crossed(page, table, what):
+    """A warning where the fits made apart cross (``crossed``) in a table of
+    :func:`both_fits`."""
+    if bool(table["crossed"].any()):
+        page.warning(
+            f"Fitted apart, the curves of a milder and a worse {what} cross in the observed "
+            "range for some objects (column 'fits apart cross'): the worse would read as more "
+            "likely there. The figure and the annual rates show the nested fit, which cannot "
+            "cross."
+        )
 
 
 def _fragility_table(table, units) -> pd.DataFrame:
-    """The fits of :func:`~rockstudy.study.analysis.sliding.slide_fragility` as shown."""
-    shown = table[["theta", "theta_lo", "theta_hi", "beta", "n", "separated", "no_rise"]]
-    shown = shown.rename(
-        columns={
-            "theta": f"median PGA [{units}]",
-            "theta_lo": "median, lower",
-            "theta_hi": "median, upper",
-            "beta": "beta (MLE)",
-            "n": "points",
-            "separated": "outcomes separated (no fit)",
-            "no_rise": "no rise with the intensity (no fit)",
-        }
-    )
+    """The fits of :func:`both_fits` as shown."""
+    columns = {
+        "theta": f"median PGA [{units}]",
+        "theta_lo": "median, lower",
+        "theta_hi": "median, upper",
+        "beta": "beta (MLE)",
+        "n": "points",
+        "separated": "outcomes separated (no fit)",
+        "no_rise": "no rise with the intensity (no fit)",
+        "crossed": "fits apart cross",
+        "nested_theta": f"nested median PGA [{units}]",
+        "nested_beta": "nested beta (common)",
+    }
+    shown = table[list(columns)].rename(columns=columns)
     shown.index = shown.index.set_names(["slide limit d [m]", "object"])
     return shown
 
 
-def _fragility_figure(page, ctx, table, limits):
-    """One panel per slide limit: each object's fitted P(max_slide > d | PGA) and band."""
+#: The line styles of the states of a panel per object, in order (then repeated).
+STYLES = ("-", "--", "-.", ":")
+
+
+def fragility_panels(page, ctx, table, level, keys, figure, titles=None):
+    """The fitted curves P(x) of ``table`` (outer index level ``level``, the states
+    ``keys``; inner the objects) with their pointwise bands, as a figure of ``page``:
+    one panel per state titled ``titles`` with a curve per object (its colour), or
+    (``titles`` None) one panel per object with a curve per state (:data:`STYLES`).
+    ``figure`` = (name, caption, y label); no figure without a fit or an intensity range."""
     low, high = np.nanmin(table["im_min"]), np.nanmax(table["im_max"])
     if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
         return
-    plt = _plt()
-    fig, axes = plt.subplots(1, len(limits), figsize=(4.6 * len(limits), 3.8), squeeze=False)
     grid = np.geomspace(low / 1.2, high * 1.2, 200)
-    for ax, d in zip(axes[0], limits, strict=True):
-        fits = table.xs(float(d), level="slide_limit")
-        curve = fragility_curve(fits, grid)
-        for g in curve.group.values:
-            c = curve.sel(group=g)
+    curves = [fragility_curve(table.xs(k, level=level), grid) for k in keys]
+    if titles is None:
+        objects = [str(o) for o in ctx.ds["structure"].values]
+        styles = [STYLES[k % len(STYLES)] for k in range(len(keys))]
+        lines = [
+            [(c, o, s, ctx.text(str(k))) for c, s, k in zip(curves, styles, keys, strict=True)]
+            for o in objects
+        ]
+        titles = [ctx.text(o) for o in objects]
+    else:
+        lines = [[(c, g, "-", ctx.text(str(g))) for g in c.group.values] for c in curves]
+    fig, axes = _panels(len(titles))
+    for ax, title, panel in zip(axes, titles, lines, strict=True):
+        for curve, group, style, label in panel:
+            c = curve.sel(group=group)
             if not np.isfinite(c.probability.values).any():
                 continue
-            color = ctx.colors[str(g)]
-            ax.plot(grid, c.probability, "-", color=color, label=ctx.text(str(g)))
+            color = ctx.colors[str(group)]
+            ax.plot(grid, c.probability, style, color=color, label=label)
             ax.fill_between(grid, c.lower, c.upper, alpha=0.15, color=color)
-        ax.set(xscale="log", ylim=(-0.02, 1.02), title=f"d = {d:g} m")
-        ax.set_xlabel(f"PGA [{ctx.units}]", fontsize=FONT + 1)
-        ax.set_ylabel("P(max_slide > d) [-]", fontsize=FONT + 1)
-        ctx.log_ticks(ax)
-        ax.tick_params(labelsize=FONT)
-        if ax.lines:
-            ax.legend(fontsize=FONT, loc="lower right")
-    if not any(ax.lines for ax in axes[0]):  # no fit at any limit: the table says why
-        plt.close(fig)
+        _axes(ax, ctx, title, figure[2])
+    if not any(ax.lines for ax in axes):  # no fit at all: the table says why
+        _plt().close(fig)
         return
     fig.tight_layout()
-    page.figure(
-        fig,
-        "slide_fragility",
-        "Fragility of sliding of each object, one panel per slide limit d: the lognormal fit "
-        "of P(max_slide > d | PGA) (an overturning counts as exceeding d), 90 % pointwise band",
-    )
+    page.figure(fig, figure[0], figure[1])
+
+
+def _axes(ax, ctx, title, ylabel):
+    """A fragility panel's scales, labels, ticks and legend."""
+    ax.set(xscale="log", ylim=(-0.02, 1.02))
+    ax.set_title(title, fontsize=FONT + 1)
+    ax.set_xlabel(f"PGA [{ctx.units}]", fontsize=FONT + 1)
+    ax.set_ylabel(ylabel, fontsize=FONT + 1)
+    ctx.log_ticks(ax)
+    ax.tick_params(labelsize=FONT)
+    if ax.lines:
+        ax.legend(fontsize=FONT, loc="lower right")
 
 
 def _rates(page, ctx, limits):
     """The annual rate of exceeding each slide limit, per object, with its band."""
     try:
-        out = sliding.slide_risk(ctx.ds, ctx.hazard, limits, ctx.years, n_boot=ctx.n_boot)
+        out = sliding.slide_risk(
+            ctx.ds, ctx.hazard, limits, ctx.years, n_boot=ctx.n_boot, nested=True
+        )
     except ValueError as err:
         page.text(f"No annual rates of sliding: {err}")
         return
@@ -167,24 +251,25 @@ def _rates(page, ctx, limits):
         "annual_rate_lo": "lambda, 5 %",
         "annual_rate_hi": "lambda, 95 %",
         "probability": f"P({ctx.years:g} yr)",
-        "crossed": "below a larger d's rate (the fits cross)",
+        "crossed_separate": "fitted apart: below a larger d's rate",
     }
     frame = out[list(columns)].to_dataframe()[list(columns)].rename(columns=columns)
     frame.index = pd.MultiIndex.from_tuples(
         [(d, str(o)) for d, o in frame.index], names=["slide limit d [m]", "object"]
     )
-    if bool(out["crossed"].any()):
+    if bool(out["crossed_separate"].any()):
         page.warning(
-            "The rate of exceeding a slide limit lies below that of a larger limit for some "
-            "objects (column 'below a larger d's rate'): every slide past the larger d is past "
-            "the smaller one, but the two lognormals are fitted apart and cross; read both "
-            "rates as about equal (more records narrow them)."
+            "Fitted apart, the rate of exceeding a slide limit lies below that of a larger "
+            "limit for some objects (column 'fitted apart: below a larger d's rate'): every "
+            "slide past the larger d is past the smaller one, but the two lognormals fitted "
+            "apart cross. The rates shown are those of the nested fit, which cannot."
         )
     page.table(
         frame,
         "annual_sliding",
         "Annual rate of exceeding each slide limit d per object: the fragility of sliding "
-        "integrated against the site's hazard curve (Cornell et al. 2002), the whole lognormal "
+        "(the nested fit) integrated against the site's hazard curve (Cornell et al. 2002), the "
+        "whole lognormal "
         "(a block slides below its uplift PGA); statuses as for overturning, 'overturned' "
         "read as 'exceeded d'",
     )

@@ -5,14 +5,10 @@ curve, its annual rate of reaching each state (:mod:`rockstudy.study.analysis.st
 
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from ..analysis import states as an
-from ..analysis.sampled import fragility_curve
 from . import sliding as sliding_report
-from ._page import _plt, shown_separation
-from .objects import FONT, _panels, quoted_to_report
 
 __all__ = ["section"]
 
@@ -23,8 +19,6 @@ _STATES_NOTE = (
     "slid more than the state's slide; a point that overturned has reached every state, and "
     "the state of ratio 1 is overturning itself."
 )
-#: The line styles of the states, in the design's order (then repeated).
-_STYLES = ("-", "--", "-.", ":")
 
 
 def _states(ctx):
@@ -50,14 +44,10 @@ def section(page, ctx):
         return
     page.heading("Damage states: fragility and annual rates per state")
     try:
-        with shown_separation():  # the table says which fits are separated
-            table = an.state_fragility(ctx.ds, im="pga", n_boot=ctx.n_boot)
+        table = sliding_report.both_fits(an.state_fragility, ctx)
     except ValueError as err:
         page.text(f"No fragility of the damage states: {err}")
         return
-    f = quoted_to_report(ctx.units, "pga")
-    for col in ("theta", "theta_lo", "theta_hi", "im_min", "im_max"):
-        table[col] = table[col] * f
     page.text(
         "The fragility P(state reached | PGA) of each object for each damage state ("
         + "; ".join(f"{s.name}: {_definition(s)}" for s in states)
@@ -65,14 +55,29 @@ def section(page, ctx):
         + ctx.kind.text["fit"]
         + "). "
         + _STATES_NOTE
+        + " "
+        + sliding_report.NESTED_NOTE.format(states="states", order=_ORDER)
     )
-    _figure(page, ctx, table, states)
+    sliding_report.warn_crossed(page, table, "state")
+    names = [s.name for s in states]
+    view = sliding_report.nested_view(table)
+    sliding_report.fragility_panels(page, ctx, view, "damage_state", names, _FIGURE)
     page.table(_fragility_table(table, ctx.units), "state_fragility", _CAPTION)
     if ctx.hazard is not None:
         _rates(page, ctx)
 
 
 _CAPTION = "Fragility of each damage state of each object (90 % bands)"
+#: How the nested fit orders the states' medians.
+_ORDER = "ordered as the states nest (on each demand by its limit, overturning above every state)"
+#: The figure of the states' fragility: (name, caption, y label).
+_FIGURE = (
+    "state_fragility",
+    "Fragility of the damage states, one panel per object and one curve per state: the "
+    "nested lognormal fit of P(state reached | PGA) (one beta for all states of an object; "
+    "an overturning reaches every state), 90 % pointwise band from resampled records",
+    "P(state reached) [-]",
+)
 
 
 def _fragility_table(table, units) -> pd.DataFrame:
@@ -83,49 +88,10 @@ def _fragility_table(table, units) -> pd.DataFrame:
     return shown
 
 
-def _figure(page, ctx, table, states):
-    """One panel per object: its fitted P(state | PGA) for every state, with bands."""
-    low, high = np.nanmin(table["im_min"]), np.nanmax(table["im_max"])
-    if not (np.isfinite(low) and np.isfinite(high) and high >= low > 0):
-        return
-    objects = [str(o) for o in ctx.ds["structure"].values]
-    fig, axes = _panels(len(objects))
-    grid = np.geomspace(low / 1.2, high * 1.2, 200)
-    curves = [fragility_curve(table.xs(s.name, level="damage_state"), grid) for s in states]
-    for ax, name in zip(axes, objects, strict=True):
-        color = ctx.colors[name]
-        for k, (state, curve) in enumerate(zip(states, curves, strict=True)):
-            c = curve.sel(group=name)
-            if not np.isfinite(c.probability.values).any():
-                continue
-            style = _STYLES[k % len(_STYLES)]
-            ax.plot(grid, c.probability, style, color=color, label=ctx.text(state.name))
-            ax.fill_between(grid, c.lower, c.upper, alpha=0.12, color=color)
-        ax.set(xscale="log", ylim=(-0.02, 1.02))
-        ax.set_title(ctx.text(name), fontsize=FONT + 1)
-        ax.set_xlabel(f"PGA [{ctx.units}]", fontsize=FONT + 1)
-        ax.set_ylabel("P(state reached) [-]", fontsize=FONT + 1)
-        ctx.log_ticks(ax)
-        ax.tick_params(labelsize=FONT)
-        if ax.lines:
-            ax.legend(fontsize=FONT, loc="lower right")
-    if not any(ax.lines for ax in axes):  # no fit of any state: the table says why
-        _plt().close(fig)
-        return
-    fig.tight_layout()
-    page.figure(
-        fig,
-        "state_fragility",
-        "Fragility of the damage states, one panel per object and one curve per state: the "
-        "lognormal fit of P(state reached | PGA) (an overturning reaches every state), 90 % "
-        "pointwise band",
-    )
-
-
 def _rates(page, ctx):
     """The annual rate of reaching each damage state, per object, with its band."""
     try:
-        out = an.state_risk(ctx.ds, ctx.hazard, years=ctx.years, n_boot=ctx.n_boot)
+        out = an.state_risk(ctx.ds, ctx.hazard, years=ctx.years, n_boot=ctx.n_boot, nested=True)
     except ValueError as err:
         page.text(f"No annual rates of the damage states: {err}")
         return
@@ -137,6 +103,7 @@ def _rates(page, ctx):
         "annual_rate_hi": "lambda, 95 %",
         "probability": f"P({ctx.years:g} yr)",
         "return_period": "return period [yr]",
+        "crossed_separate": "fitted apart: below a worse state's rate",
     }
     frame = out[list(columns)].to_dataframe()[list(columns)].rename(columns=columns)
     frame.index = pd.MultiIndex.from_tuples(
@@ -145,9 +112,9 @@ def _rates(page, ctx):
     page.table(
         frame,
         "annual_states",
-        "Annual rate of reaching each damage state per object: the state's fragility "
-        "integrated against the site's hazard curve (Cornell et al. 2002); a state on the "
-        "rotation cut at the uplift PGA as overturning is, a state on the slide not (a block "
-        "slides below its uplift PGA); statuses as for overturning, 'overturned' read as "
+        "Annual rate of reaching each damage state per object: the state's fragility (the "
+        "nested fit) integrated against the site's hazard curve (Cornell et al. 2002); a state "
+        "on the rotation cut at the uplift PGA as overturning is, a state on the slide not (a "
+        "block slides below its uplift PGA); statuses as for overturning, 'overturned' read as "
         "'reached the state'",
     )
