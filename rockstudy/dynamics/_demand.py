@@ -54,6 +54,7 @@ from ._taylor import (
     OF_VALUE,
     ROW_C,
     ROW_C_SERIES,
+    ROW_F,
     ROW_PREV,
     ROW_S,
     poly_root,
@@ -77,6 +78,10 @@ START_OFFSET = 1e-3
 #: energies and rotations: the ratio peaks at 0.75 tan alpha for small alpha and reaches
 #: tan alpha near alpha = 0.96); beyond it a mapped free rocking leaves the demand uncomputed.
 FREE_ROCKING_SLENDERNESS = 0.9
+#: Relative margins of the bound of a step's ratio over its samples' rounding
+#: (:func:`_below_best`) and of a pulse's ground over its value from the step's series.
+BOUND_MARGIN = 1e-9
+GROUND_MARGIN = 1e-9
 _GOLD = 0.5 * (math.sqrt(5.0) - 1.0)
 
 
@@ -340,20 +345,132 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
     (theta, theta_dot) at t_end where it is the step's end, NaN where it is an event. Inlined
     into the phase loop (a call with its flattened arguments costs a record step ~10 %)."""
     step = (t, hs, n, k, s, p, alpha, mot)
-    if ta.d_fresh != 0:  # a rocking phase starts: a new grid
-        _close(w, ta, step)
-        _push(w, ta, t, step)
-    kind, mp = mot[0], mot[1]
-    inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
-    for j in range(1, inside + 1):
-        _push(w, ta, t + (t_end - t) * j / (inside + 1), step)
-    _push(w, ta, t_end, step, end)
-    if end[0] != end[0]:  # an impact or the overturning ends the phase
-        _close(w, ta, step)
+    fresh = 0
+    if end[0] == end[0] and _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
+        _close(w, ta, step)  # the grid ends at the step's start
+        _keep_over(ta)  # the block is below alpha
+        fresh = 1  # the next step sampled starts a new grid
+    else:
+        if ta.d_fresh != 0:  # a rocking phase starts: a new grid
+            _close(w, ta, step)
+            _push(w, ta, t, step)
+        kind, mp = mot[0], mot[1]
+        inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
+        for j in range(1, inside + 1):
+            _push(w, ta, t + (t_end - t) * j / (inside + 1), step)
+        _push(w, ta, t_end, step, end)
+        if end[0] != end[0]:  # an impact or the overturning ends the phase
+            _close(w, ta, step)
     for j in range(n + 1):
         w[ROW_PREV, j] = w[ROW_C, j]
     ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k = t, hs, n, k
-    ta.d_fresh = 0
+    ta.d_fresh = fresh
+
+
+@njit(cache=True, inline="always")
+def _product(al, ah, bl, bh):
+    """The interval of the products of [al, ah] and [bl, bh]."""
+    p1, p2, p3, p4 = al * bl, al * bh, ah * bl, ah * bh
+    return min(min(p1, p2), min(p3, p4)), max(max(p1, p2), max(p3, p4))
+
+
+@njit(cache=True, inline="always")
+def _square(lo, hi):
+    """The interval of the squares of [lo, hi]."""
+    low = 0.0 if lo <= 0.0 <= hi else min(lo * lo, hi * hi)
+    return low, max(lo * lo, hi * hi)
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _ground_range(w, t, t_end, hs, p, mot, k):
+    """(lo, hi) of u_h'' and of u_v'' [m/s^2] as the samples see them over the step from t
+    to t_end [s] (:func:`_ground`; 0 beyond the motion): a record's segment k is linear, so
+    are its vertical samples; a trigonometric pulse a sin(omega t + phase) lies within
+    GROUND_MARGIN of its start value and slope (a0 + a1 x from the step's ground series
+    w[ROW_F], as scaled by :func:`._taylor.taylor_coefficients_trig`) plus |a| (omega h)^2 / 2,
+    and within +-|a|. NaN for the other motions."""
+    kind, mp, times, samples, vsamples = mot
+    if t >= mp[3]:
+        return 0.0, 0.0, 0.0, 0.0
+    vl = vh = 0.0
+    if kind == KIND_RECORD:
+        a0, a1 = mp[0] * samples[k], mp[0] * samples[k + 1]
+        lo, hi = min(a0, a1), max(a0, a1)
+        if vsamples.shape[0] != 0:
+            v0, v1 = abs(mp[0]) * vsamples[k], abs(mp[0]) * vsamples[k + 1]
+            vl, vh = min(v0, v1), max(v0, v1)
+    elif kind == KIND_TRIG and vsamples.shape[0] == 0:
+        amp = abs(mp[0])
+        scale = G / -((p * hs) ** 2)  # the series' factor q / g undone
+        a0, a1 = w[ROW_F, 0] * scale, w[ROW_F, 1] * scale
+        r = 0.5 * amp * (mp[1] * hs) ** 2 + GROUND_MARGIN * amp
+        lo = max(a0 + min(a1, 0.0) - r, -amp)
+        hi = min(a0 + max(a1, 0.0) + r, amp)
+    else:
+        return np.nan, np.nan, np.nan, np.nan
+    if t_end > mp[3]:  # the samples after the motion's end see no ground
+        lo, hi, vl, vh = min(lo, 0.0), max(hi, 0.0), min(vl, 0.0), max(vh, 0.0)
+    return lo, hi, vl, vh
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _series_ranges(w, n, hs, p):
+    """Over the current step (unit step time x in [0, 1]): theta's start value and radius,
+    and the intervals of S, C and R theta_dot^2 = (3/4) g (theta_dot / p)^2 (theta_dot =
+    (dtheta/dx) / hs), as their series bound them: ``|sum c_k x^k - c_0|`` <= sum ``|c_k|``
+    (k >= 1)."""
+    r_th, r_d = abs(w[ROW_C, 1]), 0.0
+    for j in range(2, n + 1):
+        a = abs(w[ROW_C, j])
+        r_th += a
+        r_d += j * a
+    r_s = r_c = 0.0
+    for j in range(1, n - 1):
+        r_s += abs(w[ROW_S, j])
+        r_c += abs(w[ROW_C_SERIES, j])
+    d0 = w[ROW_C, 1]
+    dl, dh = _square(d0 - r_d, d0 + r_d)
+    q = 0.75 * G / (p * hs) ** 2
+    s0, c0 = w[ROW_S, 0], w[ROW_C_SERIES, 0]
+    return (w[ROW_C, 0], r_th), (s0 - r_s, s0 + r_s), (c0 - r_c, c0 + r_c), (q * dl, q * dh)
+
+
+@njit(cache=True, inline="always")
+def _ratio_bound(ground, sn, cs, q):
+    """An upper bound of ``|F_h|`` / F_v (inf where F_v may reach 0) from intervals of the
+    ground (u_h'', u_v''), S, C and R theta_dot^2 (:func:`_ratio`'s forces, regrouped so
+    that each of u_h'' and S enters ``|F_h|`` once):
+    F_h / m = u_h'' (1 - 3 C^2 / 4) + S (R theta_dot^2 - 3 gamma C / 4),
+    F_v / m = gamma (1 - 3 S^2 / 4) - C (3 u_h'' S / 4 + R theta_dot^2)."""
+    al, ah, vl, vh = ground
+    (sl, sh), (cl, ch), (ql, qh) = sn, cs, q
+    gl, gh = G + vl, G + vh
+    c2l, c2h = _square(cl, ch)
+    h1l, h1h = _product(al, ah, 1.0 - 0.75 * c2h, 1.0 - 0.75 * c2l)
+    gcl, gch = _product(gl, gh, cl, ch)
+    h2l, h2h = _product(sl, sh, ql - 0.75 * gch, qh - 0.75 * gcl)
+    s2l, s2h = _square(sl, sh)
+    v1l = _product(gl, gh, 1.0 - 0.75 * s2h, 1.0 - 0.75 * s2l)[0]
+    asl, ash = _product(al, ah, sl, sh)
+    f_v = v1l - _product(cl, ch, 0.75 * asl + ql, 0.75 * ash + qh)[1]
+    return max(-(h1l + h2l), h1h + h2h) / f_v if f_v > 0.0 else np.inf
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
+    """Whether no sample of the current step can count: theta stays below alpha on side s,
+    F_v above 0 and the ratio below the largest so far, by the bounds of the ratio over the
+    step (:func:`_ratio_bound`, with a relative BOUND_MARGIN for the rounding of the
+    samples)."""
+    if not ta.d_best > 0.0:
+        return False
+    ground = _ground_range(w, t, t_end, hs, p, mot, k)
+    if ground[0] != ground[0]:
+        return False
+    (th0, r_th), sn, cs, q = _series_ranges(w, n, hs, p)
+    if s * th0 + r_th >= alpha:
+        return False
+    return _ratio_bound(ground, sn, cs, q) * (1.0 + BOUND_MARGIN) < ta.d_best
 
 
 @njit(cache=True)
