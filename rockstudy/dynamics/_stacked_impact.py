@@ -142,6 +142,17 @@ def _grid_point(mot, i):
 
 
 @njit(cache=True)
+def _grid_start(mot, t0):
+    """The last scan point at or before t0 (0 before the motion): the scan of a rest that
+    begins late in a record (after an impact that came to rest) reads on from there."""
+    if t0 <= 0.0:
+        return 0
+    if mot[0] == KIND_RECORD:
+        return segment_index(mot[2], min(t0, mot[1][3]), mot[4])
+    return min(int(t0 / (mot[1][3] / PULSE_GRID)), PULSE_GRID)
+
+
+@njit(cache=True)
 def _grid_size(mot):
     return mot[2].shape[0] if mot[0] == KIND_RECORD else PULSE_GRID + 1
 
@@ -161,7 +172,7 @@ def uplift_from_rest(g, mot, t0, tmp):
         t_up = t0
     else:
         lo = t0
-        for i in range(_grid_size(mot) + 1):
+        for i in range(_grid_start(mot, t0), _grid_size(mot) + 1):
             hi = _grid_point(mot, i) if i < _grid_size(mot) else mot[1][3]
             if hi <= lo and i < _grid_size(mot):
                 continue

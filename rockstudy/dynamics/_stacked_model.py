@@ -135,6 +135,10 @@ def lock_margins(g, y, s1, s2, flat0, flat1, ug, out):
     """The closed interfaces' lock margins s Lambda(s) / moment scale, written to out =
     (ground +1, ground -1, upper +1, upper -1); +inf for an open interface
     (:func:`.stacked.lock_margins`, normalised as the reference's events)."""
+    if not (flat0 or flat1):  # both rocking: no margin to compute
+        for j in range(4):
+            out[j] = np.inf
+        return
     for j in range(2):
         s, p1, p2 = _pivots(j, s1, s2, flat0, flat1)
         m00, m01, m11, f0, f1 = both_equations(g, y[0], y[1], y[2], y[3], p1, p2, ug)

@@ -38,10 +38,12 @@ from ._stacked_steps import (
     derivative,
     dop853_step,
     ground,
+    one_body_form,
+    one_body_step,
     step_error,
     work_array,
 )
-from ._taylor import NO_REFCOUNT
+from ._taylor import NO_REFCOUNT, work_arrays
 from .constants import (
     FIRST_STEP,
     STATUS_MAX_STEPS,
@@ -49,6 +51,8 @@ from .constants import (
     STEP_GROW_LIMIT,
     STEP_SAFETY,
     STEP_SHRINK_LIMIT,
+    TAYLOR_TOL_FRACTION,
+    TOL_SAFETY,
 )
 from .stacked_reference import MAX_PHASES
 
@@ -57,6 +61,12 @@ from .stacked_reference import MAX_PHASES
 #: (a scene of the accuracy test erred by 25 rtol at 0.1, and the reference by 120 rtol at
 #: rtol 1e-11).
 TOL_FRACTION = 0.01
+
+#: Local error target of a one-body regime's Taylor step, as a fraction of rtol: the
+#: single-block kernel's record step (TAYLOR_TOL_FRACTION of TOL_SAFETY rtol). Its bound on
+#: the truncation error is no norm of a 5th/3rd-order pair: at TOL_FRACTION a scene whose
+#: statue fell after a long free phase erred by 10 rtol in its plinth's angle.
+TAYLOR_TOL = TAYLOR_TOL_FRACTION * TOL_SAFETY
 
 #: Longest step, in units of 1/p_max: the events of a step are sought on its interpolant.
 STEP_CAP = 0.5
@@ -91,6 +101,15 @@ def _next_stop(mot, t, t_end):
     return min(stop, dur, t_end), seg
 
 
+@njit(cache=True, inline="always")
+def _segment_of(kind, times, dur, t, seg):
+    """The record segment of t (from the hint seg; of the motion's end after it): a phase
+    starts at an uplift from rest or an event anywhere in the record."""
+    if kind != KIND_RECORD:
+        return seg
+    return segment_index(times, min(t, dur), seg)
+
+
 @njit(cache=True, **NO_REFCOUNT)
 def _accepted(g, hs, y0, y1, w, tol, h, last):
     """(accepted, next step) of a DOP853 step of length hs (Hairer's step control)."""
@@ -103,16 +122,40 @@ def _accepted(g, hs, y0, y1, w, tol, h, last):
 
 
 @njit(cache=True, **NO_REFCOUNT)
+def _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1):
+    """:func:`._stacked_steps.one_body_step` from t to t1 (= t + hs) on a record's segment (u_g''
+    linear there; its acceleration f0 at t) or after the motion (no ground motion: the
+    derivative carried from the motion's last instant does not hold)."""
+    tol *= TAYLOR_TOL / TOL_FRACTION
+    if t >= mot[1][3]:
+        return one_body_step(g, form, y, hs, 0.0, 0.0, np.nan, tol, tw, y1)
+    dd0 = f0[2 + form[0]]
+    return one_body_step(g, form, y, hs, ground(mot, t), ground(mot, t1), dd0, tol, tw, y1)
+
+
+@njit(cache=True, inline="always")
+def _taylor_accepted(err, hs, h, last):
+    """(accepted, next step) of a Taylor step of length hs (the single-block kernel's
+    control: halved on rejection, doubled otherwise)."""
+    if not err <= 1.0:  # rejected (or NaN)
+        return False, 0.5 * hs
+    return True, (max(h, 2.0 * hs) if last else 2.0 * hs)
+
+
+@njit(cache=True, **NO_REFCOUNT)
 def _raise_peaks(y, peaks):
     peaks[0] = max(peaks[0], abs(y[0]))
     peaks[1] = max(peaks[1], abs(y[1] - y[0]))
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates):
+def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates, tw):
     """One regime from the state (st = (t, h, t_end, record segment), y, iv) to its first
     event or ``t_end``: returns (kind, interface, corner), the state moved to the event (or
-    the end). ``rates``: the work array of :func:`._stacked_events.first_event`."""
+    the end). ``rates``: the work array of :func:`._stacked_events.first_event`; ``tw``
+    the Taylor work array of a one-body regime's steps (:func:`._taylor.work_arrays`):
+    those step by Taylor series on a record's segments and after the motion, the others
+    (and pulses) by DOP853."""
     regime = (iv[2], iv[3], iv[0] != 0, iv[1] != 0)
     t, h, t_end = st[0], st[1], st[2]
     cap = STEP_CAP / max(g[P1], g[P2])
@@ -120,6 +163,7 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates):
     mot = (mot[0], mot[1], mot[2], mot[3], seg)
     f0 = tmp[12:16]
     derivative(g, regime, mot, t, y, f0)
+    form, dur = one_body_form(g, regime), mot[1][3]
     for _ in range(max_steps):
         stop, seg = _next_stop(mot, t, t_end)
         if t >= stop:
@@ -129,13 +173,17 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates):
         last = min(h, cap) >= stop - t
         hs = stop - t if last else min(h, cap)
         t1 = stop if last else t + hs
-        dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
-        y1 = w[K_END]
-        f1 = w[K_FEND]
-        derivative(g, regime, mot, t1, y1, f1)
-        for c in range(4):
-            w[12, c] = f1[c]
-        ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
+        y1, f1 = w[K_END], w[K_FEND]
+        if form[0] >= 0 and (mot[0] == KIND_RECORD or t >= dur):
+            err = _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1)
+            derivative(g, regime, mot, t1, y1, f1)
+            ok, h = _taylor_accepted(err, hs, h, last)
+        else:
+            dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
+            derivative(g, regime, mot, t1, y1, f1)
+            for c in range(4):
+                w[12, c] = f1[c]
+            ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
         if not ok:
             continue
         lock_margins(g, y1, iv[2], iv[3], regime[2], regime[3], ground(mot, t1), margins)
@@ -186,7 +234,7 @@ def _fallen(k, iv):
 def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
     """Two stacked blocks from rest through one motion: (status, max |theta_1|, max |phi|,
     overturned, body code, overturn time, impacts): a :data:`StackedOutcome`."""
-    w, tmp, margins = work_array(), np.empty(24), np.empty(4)
+    w, tmp, margins, tw = work_array(), np.empty(24), np.empty(4), work_arrays()
     rates = np.empty((2, SAMPLES + 1))
     y, iv, peaks = np.zeros(4), np.array([1, 1, 1, 1]), np.zeros(2)
     st = np.array([0.0, FIRST_STEP / max(g[P1], g[P2]), t_end, 0.0])
@@ -194,7 +242,7 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
     dur, n_imp, status, body, t_over = mp[3], 0, STATUS_OK, BODY_NONE, math.nan
     for _ in range(MAX_PHASES):
         t = st[0]
-        mot = (kind, mp, times, samples, int(st[3]))
+        mot = (kind, mp, times, samples, _segment_of(kind, times, mp[3], t, int(st[3])))
         if t >= t_end:
             break
         if iv[0] != 0 and iv[1] != 0:
@@ -208,7 +256,7 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
         if (iv[0] != 0 or iv[1] != 0) and _release_violated(g, mot, iv, y, t, margins):
             continue
         ev, k, corner = run_phase(
-            g, mot, iv, y, st, TOL_FRACTION * rtol, max_steps, peaks, w, margins, tmp, rates
+            g, mot, iv, y, st, TOL_FRACTION * rtol, max_steps, peaks, w, margins, tmp, rates, tw
         )
         if ev == PHASE_MAX_STEPS:
             status = STATUS_MAX_STEPS

@@ -16,10 +16,11 @@ import numpy as np
 from numba import njit
 from scipy.integrate import DOP853 as _DOP853
 
+from ..constants import G
 from ..motions._kernels import ground_acceleration
 from ._dop853 import hermite5
 from ._stacked_model import A1, A2, P1, P2, acceleration
-from ._taylor import NO_REFCOUNT
+from ._taylor import MODEL_NONLINEAR, NO_REFCOUNT, poly_end, taylor_coefficients
 from .constants import ATOL_FRACTION
 
 _A = np.ascontiguousarray(_DOP853.A[:12, :12], dtype=float)
@@ -120,3 +121,48 @@ def state_at(sigma, h, y0, f0, y1, f1, out):
     th1 = hermite5(sigma, h, y0[0], y0[2], f0[2], y1[0], y1[2], f1[2])
     th2 = hermite5(sigma, h, y0[1], y0[3], f0[3], y1[1], y1[3], f1[3])
     out[0], out[1], out[2], out[3] = th1[0], th2[0], th1[1], th2[1]
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def one_body_form(g, regime):
+    """(index, P, beta) of a one-body regime, whose angle theta = y[index] (theta_1 of the
+    assembly locked on the ground, theta_2 of the upper block alone on the resting lower)
+    obeys Housner's equation theta'' = -P [sin(beta - theta) + (u_g''/g) cos(beta - theta)]
+    of a rigid body about a fixed pivot: P (its p^2) and beta (its side times its alpha,
+    the angle of its centre of mass from the pivot's vertical) read off the regime's own
+    acceleration at theta = 0 under u_g'' = 0 and g. Index -1 in the other regimes."""
+    s1, s2, flat0, flat1 = regime
+    if flat0 == flat1:
+        return -1, 0.0, 0.0
+    k = 1 if flat0 else 0
+    zero = (0.0, 0.0, 0.0, 0.0)
+    a0 = acceleration(g, zero, s1, s2, flat0, flat1, 0.0)[k]
+    ag = acceleration(g, zero, s1, s2, flat0, flat1, G)[k]
+    return k, math.hypot(a0, ag - a0), math.atan2(-a0, a0 - ag)
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def one_body_step(g, form, y, h, a0, a1, dd0, tol, tw, out):
+    """One Taylor step of length h of a one-body regime (:func:`one_body_form`) under
+    u_g'' linear from a0 to a1 [m/s^2] (:func:`._taylor.taylor_coefficients`, the
+    single-block kernel's record step): its end state into ``out``; returns the ratio of its
+    truncation-error bound to the scales tol (ATOL_FRACTION alpha_min + ...) of
+    :func:`step_error` (<= 1 accepts). ``dd0``: the angle's acceleration at the start as
+    the regime computes it (so that a body lifting from rest rises as its lift test said;
+    NaN: the series' own)."""
+    k, big_p, beta = form
+    th, om = y[k], y[2 + k]
+    a_min, p_max = min(g[A1], g[A2]), max(g[P1], g[P2])
+    sc_x = tol * (ATOL_FRACTION * a_min + abs(th) + abs(om) * h)
+    sc_v = tol * (ATOL_FRACTION * p_max * a_min + abs(om) + abs(th) * big_p * h)
+    p = math.sqrt(big_p)
+    n, err = taylor_coefficients(
+        tw, th, om, 1.0, p, beta, MODEL_NONLINEAR, h, a0, a1, 0.0, 0.0, sc_x, sc_v, dd0
+    )
+    x, dx, _ = poly_end(tw[0], n)
+    for c in range(4):
+        out[c] = y[c]
+    out[k], out[2 + k] = x, dx / h
+    if k == 0:
+        out[1], out[3] = x, dx / h
+    return err
