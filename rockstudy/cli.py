@@ -686,6 +686,7 @@ def _refused(exc) -> int:
 #: The groups of ``rockstudy compile --group`` (those of ``rockstudy.study.running._warmup``,
 #: written out so that the parser loads no numba; a test holds them equal).
 _COMPILE_GROUPS = ("demo", "simulate", "batch-parallel", "batch-serial", "records", "closedforms")
+_COMPILE_GROUPS += ("two-body",)
 #: Commands that may compile numba kernels (and save them to numba's cache).
 _COMPILING = ("simulate", "run", "compile", "report", "verify", "figures", "demo")
 

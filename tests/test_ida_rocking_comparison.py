@@ -65,9 +65,13 @@ def test_capacity_rocking_is_the_capacity_of_a_rocking_ida(idas):
     )
 
 
-def _cornell(capacities):
-    """Cornell et al.'s annual rate of a lognormal fragility (MLE of ``capacities``) on the
-    power-law hazard K0 x^-K."""
+def _cornell(capacities, status=None):
+    """Cornell et al.'s annual rate of a lognormal fragility (MLE of ``capacities``, those of
+    the points that did not fail: ``status`` 0, as the fit takes them) on the power-law
+    hazard K0 x^-K."""
+    capacities = np.ravel(capacities)
+    if status is not None:
+        capacities = capacities[np.ravel(status) == 0]
     ln = np.log(capacities)
     theta, beta = np.exp(ln.mean()), ln.std()
     return K0 * theta**-K * np.exp(0.5 * (K * beta) ** 2)
@@ -79,7 +83,9 @@ def test_the_ratio_of_rates_is_cornells_on_the_two_capacity_sets(idas):
     out = sliding.contact_effect(auto, hazard, n_boot=0)
     pgv = auto["pgv"].values[:, None]  # the records' PGV [m/s], capacities in it
     for j, name in enumerate(BLOCKS):
-        contact = _cornell(auto["capacity_scale"].values[:, j : j + 1] * pgv)
+        contact = _cornell(
+            auto["capacity_scale"].values[:, j : j + 1] * pgv, auto["status"].values[:, j]
+        )
         housner = _cornell(rocking["capacity_scale"].values[:, j : j + 1] * pgv)
         row = out.sel(structure=name)
         assert float(row["annual_rate_contact"]) == pytest.approx(contact, rel=1e-6)
@@ -158,7 +164,9 @@ def test_an_auto_ida_study_reports_the_ratio_per_object(tmp_path, idas):
     table = pd.read_csv(folder / "contact_vs_rocking.csv", index_col="object")
     pgv = ds["pgv"].values[:, None]
     for j, name in enumerate(BLOCKS):
-        contact = _cornell(ds["capacity_scale"].values[:, j : j + 1] * pgv)
+        contact = _cornell(
+            ds["capacity_scale"].values[:, j : j + 1] * pgv, ds["status"].values[:, j]
+        )
         housner = _cornell(ds["capacity_scale_rocking"].values[:, j : j + 1] * pgv)
         row = table.loc[name]
         assert row["ratio contact / rocking-only"] == pytest.approx(contact / housner, rel=1e-6)

@@ -18,6 +18,7 @@ import pandas as pd
 
 from ...motions.suites import read_pair
 from ..analysis import record_fragility as rf
+from ..analysis.fragility_fit import N_BOOT
 from ..analysis.orientations import ORIENTATION_SUMMARIES, orientation_summary
 from ._page import _Page, _plt
 
@@ -142,7 +143,7 @@ def _slices(ds):
     ]
 
 
-def dimension_report(ds, out, report, title, n_boot, **options):
+def dimension_report(ds, out, report, title, *, n_boot=N_BOOT, **options):
     """Write the page of a design over floors or orientations into ``out`` (see the module):
     ``report`` (:func:`~rockstudy.study.report.records.record_report`) writes a full report
     per floor and summary into a folder beside it, with ``options``. Returns index.html."""

@@ -734,7 +734,7 @@ def record_report(
         options = dict(description=description, appendix=appendix, units=units, study=study)
         options.update(max_scale_factor=max_scale_factor, friction=friction, hazard=hazard)
         return floors.dimension_report(
-            ds, out, record_report, title, n_boot, years=years, **options
+            ds, out, record_report, title, n_boot=n_boot, years=years, **options
         )
     page = _Page(out)
     ctx = ReportContext(ds, n_boot, compare, REPORT_UNITS[units], float(max_scale_factor))
