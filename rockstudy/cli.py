@@ -450,7 +450,10 @@ class _Help(argparse.HelpFormatter):
 
 def main(argv=None) -> int:
     """Entry point of the ``rockstudy`` command: Ctrl-C at any point (also while a command's
-    modules load) is one line and exit 130; zarr's IO thread is stopped before exit."""
+    modules load) is one line and exit 130; zarr's IO thread is stopped before exit. A
+    handler that fails to log (out of memory in a thread of the cluster) prints no traceback:
+    the command says what happened in its own line."""
+    logging.raiseExceptions = False
     try:
         return _dispatch(_parser().parse_args(argv))
     except KeyboardInterrupt:
