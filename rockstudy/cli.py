@@ -448,12 +448,20 @@ class _Help(argparse.HelpFormatter):
         return text
 
 
+def _no_out_of_memory_traceback(record) -> bool:
+    """False for a log record carrying a MemoryError (an event loop's callback of the cluster
+    that ran out of memory): the command says so in its own line instead."""
+    exc = record.exc_info[1] if record.exc_info else None
+    return not isinstance(exc, MemoryError)
+
+
 def main(argv=None) -> int:
     """Entry point of the ``rockstudy`` command: Ctrl-C at any point (also while a command's
     modules load) is one line and exit 130; zarr's IO thread is stopped before exit. A
-    handler that fails to log (out of memory in a thread of the cluster) prints no traceback:
-    the command says what happened in its own line."""
+    handler that fails to log, or an event loop's callback, out of memory in a thread of the
+    cluster, prints no traceback: the command says what happened in its own line."""
     logging.raiseExceptions = False
+    logging.getLogger("asyncio").addFilter(_no_out_of_memory_traceback)
     try:
         return _dispatch(_parser().parse_args(argv))
     except KeyboardInterrupt:

@@ -5,6 +5,7 @@ file (and line) or the argument and what was expected, never the contents of a f
 Oracles: the documented ranges and file rules, and the messages' own promises (no file
 content, no traceback)."""
 
+import logging
 import math
 import os
 import resource
@@ -283,6 +284,22 @@ def test_out_of_memory_is_one_line_and_leaves_no_half_made_store(tmp_path):
         assert "continue with:" in line and store.read_marker(out)["template_complete"]
     else:
         assert "nothing was saved" in line
+
+
+def test_an_event_loop_callback_out_of_memory_logs_no_traceback(caplog):
+    """asyncio logs a callback's MemoryError itself (a cluster's thread out of memory); the
+    command's own line says it, so that record is dropped and other errors still show."""
+    from rockstudy import cli
+
+    cli.main(["schema"])  # installs the filter
+    log = logging.getLogger("asyncio")
+    for exc in (MemoryError(), ValueError("a real bug")):
+        try:
+            raise exc
+        except Exception:
+            log.error("Exception in callback", exc_info=True)
+    kinds = [r.exc_info[0] for r in caplog.records if r.name == "asyncio"]
+    assert kinds == [ValueError]
 
 
 def _read_or_empty(path) -> str:
