@@ -18,8 +18,11 @@ from numba import njit
 from ..constants import FALL_ROTATION
 from ._stacked_model import A1, lock_margins
 from ._stacked_steps import (
+    DENSE_NONE,
     K_FSUB,
+    K_INFO,
     K_SUB,
+    dense_state,
     derivative,
     dop853_step,
     ground,
@@ -168,13 +171,18 @@ def _true_margin(g, regime, mot, t, y0, f0, dt, j, tmp, w):
 
 @njit(cache=True, **NO_REFCOUNT)
 def true_state(g, regime, mot, t, y0, f0, dt, w):
-    """The state and its derivative after a true DOP853 step of length dt from (t, y0),
-    into w[K_SUB] and w[K_FSUB] (a step of length 0 copies the start)."""
+    """The state and its derivative at t + dt inside the last accepted step (from (t, y0)),
+    into w[K_SUB] and w[K_FSUB]: on the step's dense output after a DOP853 step
+    (:func:`._stacked_steps.dense_state`), else after a true DOP853 step of length dt (a
+    step of length 0 copies the start)."""
     if dt == 0.0:
         for c in range(4):
             w[K_SUB, c], w[K_FSUB, c] = y0[c], f0[c]
         return
-    dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
+    if w[K_INFO, 0] != DENSE_NONE:
+        dense_state(g, regime, mot, t, y0, dt / w[K_INFO, 1], w, w[K_SUB])
+    else:
+        dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
     derivative(g, regime, mot, t + dt, w[K_SUB], w[K_FSUB])
 
 

@@ -30,11 +30,14 @@ from ._stacked_events import (
     first_event,
     step_peaks,
 )
-from ._stacked_impact import resolve_impact, uplift_from_rest
+from ._stacked_impact import REST_BISECTIONS, resolve_impact, scan_cell_end, uplift_from_rest
 from ._stacked_model import P1, P2, lock_margins
 from ._stacked_steps import (
+    DENSE_NONE,
+    DENSE_STAGES,
     K_END,
     K_FEND,
+    K_INFO,
     derivative,
     dop853_step,
     ground,
@@ -178,12 +181,14 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates, 
             err = _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1)
             derivative(g, regime, mot, t1, y1, f1)
             ok, h = _taylor_accepted(err, hs, h, last)
+            w[K_INFO, 0] = DENSE_NONE
         else:
             dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
             derivative(g, regime, mot, t1, y1, f1)
             for c in range(4):
                 w[12, c] = f1[c]
             ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
+            w[K_INFO, 0], w[K_INFO, 1] = DENSE_STAGES, hs
         if not ok:
             continue
         lock_margins(g, y1, iv[2], iv[3], regime[2], regime[3], ground(mot, t1), margins)
@@ -223,6 +228,40 @@ def _release_violated(g, mot, iv, y, t, margins):
 
 
 @njit(cache=True)
+def _rises(g, mot, iv, y, k, t, f):
+    """Whether interface k, just opened (iv) at t from rest, rises under its regime's own
+    acceleration, computed as its phase's first step computes it (the motion's segment of
+    t, :func:`._stacked_steps.derivative`)."""
+    mot = (mot[0], mot[1], mot[2], mot[3], _segment_of(mot[0], mot[2], mot[1][3], t, mot[4]))
+    derivative(g, (iv[2], iv[3], iv[0] != 0, iv[1] != 0), mot, t, y, f)
+    return iv[2 + k] * (f[2] if k == 0 else f[3] - f[2]) > 0.0
+
+
+@njit(cache=True)
+def _rise_start(g, mot, iv, y, k, t_up, f):
+    """(start, lifted) of the phase of interface k opened from rest at t_up: t_up if it rises
+    there (:func:`_rises`); else, within rounding of its uplift level where the lift test and
+    the regime's equation disagree, the first double of the scan cell of t_up where it
+    rises (by bisection), or the cell's end with ``lifted`` False (it stays at rest: a body
+    the test lifts but its equation holds down would fall back at once, be put to rest and
+    be lifted again at the same instant without end)."""
+    if _rises(g, mot, iv, y, k, t_up, f):
+        return t_up, True
+    lo, hi = t_up, scan_cell_end(mot, t_up)
+    if not _rises(g, mot, iv, y, k, hi, f):
+        return hi, False
+    for _ in range(REST_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if _rises(g, mot, iv, y, k, mid, f):
+            hi = mid
+        else:
+            lo = mid
+    return hi, True
+
+
+@njit(cache=True)
 def _fallen(k, iv):
     """The body code of a fall of interface k."""
     if k == 1:
@@ -251,7 +290,10 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
             t_up, k, corner = uplift_from_rest(g, mot, t, tmp)
             if not t_up <= t_end:
                 break
-            st[0], iv[k], iv[2 + k] = t_up, 0, corner
+            side, iv[k], iv[2 + k] = iv[2 + k], 0, corner
+            st[0], lifted = _rise_start(g, mot, iv, y, k, t_up, tmp[12:16])
+            if not lifted:
+                iv[k], iv[2 + k] = 1, side
             continue
         if (iv[0] != 0 or iv[1] != 0) and _release_violated(g, mot, iv, y, t, margins):
             continue
