@@ -19,6 +19,7 @@ from ..constants import FALL_ROTATION
 from ._stacked_model import A1, lock_margins
 from ._stacked_steps import (
     DENSE_NONE,
+    DENSE_TAYLOR,
     K_FSUB,
     K_INFO,
     K_SUB,
@@ -30,6 +31,7 @@ from ._stacked_steps import (
     interface_data,
     state_at,
 )
+from ._stacked_taylor import both_state
 from ._taylor import NO_REFCOUNT
 
 #: Samples of the interpolant per step at which the impacts and peaks are sought.
@@ -172,14 +174,17 @@ def _true_margin(g, regime, mot, t, y0, f0, dt, j, tmp, w):
 @njit(cache=True, **NO_REFCOUNT)
 def true_state(g, regime, mot, t, y0, f0, dt, w):
     """The state and its derivative at t + dt inside the last accepted step (from (t, y0)),
-    into w[K_SUB] and w[K_FSUB]: on the step's dense output after a DOP853 step
+    into w[K_SUB] and w[K_FSUB]: on the step's polynomials after a both-rocking Taylor step
+    (:func:`._stacked_taylor.both_state`), on its dense output after a DOP853 step
     (:func:`._stacked_steps.dense_state`), else after a true DOP853 step of length dt (a
     step of length 0 copies the start)."""
     if dt == 0.0:
         for c in range(4):
             w[K_SUB, c], w[K_FSUB, c] = y0[c], f0[c]
         return
-    if w[K_INFO, 0] != DENSE_NONE:
+    if w[K_INFO, 0] == DENSE_TAYLOR:
+        both_state(w, int(w[K_INFO, 2]), dt / w[K_INFO, 1], w[K_INFO, 1], w[K_SUB])
+    elif w[K_INFO, 0] != DENSE_NONE:
         dense_state(g, regime, mot, t, y0, dt / w[K_INFO, 1], w, w[K_SUB])
     else:
         dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)

@@ -35,6 +35,7 @@ from ._stacked_model import P1, P2, lock_margins
 from ._stacked_steps import (
     DENSE_NONE,
     DENSE_STAGES,
+    DENSE_TAYLOR,
     K_END,
     K_FEND,
     K_INFO,
@@ -46,6 +47,7 @@ from ._stacked_steps import (
     step_error,
     work_array,
 )
+from ._stacked_taylor import both_step
 from ._taylor import NO_REFCOUNT, work_arrays
 from .constants import (
     FIRST_STEP,
@@ -136,6 +138,19 @@ def _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1):
     return one_body_step(g, form, y, hs, ground(mot, t), ground(mot, t1), dd0, tol, tw, y1)
 
 
+@njit(cache=True, **NO_REFCOUNT)
+def _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w):
+    """A Taylor step from t to t1 (= t + hs) on a record's segment or after the motion, its
+    end into w[K_END]: (error ratio, order) of a both-rocking step
+    (:func:`._stacked_taylor.both_step`, its series kept in w), (error ratio, -1) of a
+    one-body one (:func:`_one_body_step`)."""
+    if form[0] >= 0:
+        return _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, w[K_END]), -1
+    u0, u1 = (ground(mot, t), ground(mot, t1)) if t < mot[1][3] else (0.0, 0.0)
+    tol *= TAYLOR_TOL / TOL_FRACTION
+    return both_step(g, y, hs, regime[0], regime[1], u0, u1, tol, w, w[K_END])
+
+
 @njit(cache=True, inline="always")
 def _taylor_accepted(err, hs, h, last):
     """(accepted, next step) of a Taylor step of length hs (the single-block kernel's
@@ -177,11 +192,11 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates, 
         hs = stop - t if last else min(h, cap)
         t1 = stop if last else t + hs
         y1, f1 = w[K_END], w[K_FEND]
-        if form[0] >= 0 and (mot[0] == KIND_RECORD or t >= dur):
-            err = _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1)
+        if mot[0] == KIND_RECORD or t >= dur:
+            err, n = _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w)
             derivative(g, regime, mot, t1, y1, f1)
             ok, h = _taylor_accepted(err, hs, h, last)
-            w[K_INFO, 0] = DENSE_NONE
+            w[K_INFO, 0], w[K_INFO, 1], w[K_INFO, 2] = DENSE_NONE if n < 0 else DENSE_TAYLOR, hs, n
         else:
             dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
             derivative(g, regime, mot, t1, y1, f1)

@@ -20,7 +20,7 @@ from ..constants import G
 from ..motions._kernels import ground_acceleration
 from ._dop853 import hermite5
 from ._stacked_model import A1, A2, P1, P2, acceleration
-from ._taylor import MODEL_NONLINEAR, NO_REFCOUNT, poly_end, taylor_coefficients
+from ._taylor import MAX_ORDER, MODEL_NONLINEAR, NO_REFCOUNT, poly_end, taylor_coefficients
 from .constants import ATOL_FRACTION
 
 _A = np.ascontiguousarray(_DOP853.A[:12, :12], dtype=float)
@@ -38,15 +38,19 @@ _D = np.ascontiguousarray(_DOP853.D, dtype=float)
 #: the dense output's 7 coefficient rows, and (kind, h) of the last accepted step
 #: (:data:`DENSE_NONE`...).
 K_TMP, K_END, K_FEND, K_SUB, K_FSUB, K_DENSE, K_INFO = 16, 17, 18, 19, 20, 21, 28
-#: Kinds of the last accepted step in w[K_INFO, 0]: not a DOP853 step (its inner states come
-#: from true sub-steps), a DOP853 step, one whose dense output is computed.
-DENSE_NONE, DENSE_STAGES, DENSE_READY = 0.0, 1.0, 2.0
+#: The first of the 14 rows of the both-rocking Taylor step (:mod:`._stacked_taylor`).
+K_BOTH = 29
+#: Kinds of the last accepted step in w[K_INFO, 0] (its length in w[K_INFO, 1]): a one-body
+#: Taylor step (its inner states come from true sub-steps), a DOP853 step, one whose dense
+#: output is computed, a both-rocking Taylor step (its order in w[K_INFO, 2]).
+DENSE_NONE, DENSE_STAGES, DENSE_READY, DENSE_TAYLOR = 0.0, 1.0, 2.0, 3.0
 
 
 @njit(cache=True)
 def work_array():
-    """The work array of one scene: (29, 4) floats (rows :data:`K_TMP`...)."""
-    return np.zeros((29, 4))
+    """The work array of one scene: (K_BOTH + 14, MAX_ORDER + 3) floats (rows
+    :data:`K_TMP`...; the DOP853 rows use their first 4 columns)."""
+    return np.zeros((K_BOTH + 14, MAX_ORDER + 3))
 
 
 @njit(cache=True, **NO_REFCOUNT)
