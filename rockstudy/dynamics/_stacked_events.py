@@ -1,7 +1,8 @@
 """The events of the two-block kernel on an accepted step (private): impacts and falls of
 the rocking interfaces, uplifts of the closed ones (a lock margin through zero), and the
 peaks of |angle|; located on the step's quintic Hermite interpolant
-(:func:`._stacked_steps.interface_at`), then refined on a true DOP853 sub-step.
+(:func:`._stacked_steps.interface_at`) by safeguarded Newton steps, then refined on the
+state inside the step (:func:`true_state`: the step's polynomials or dense output).
 
 An interface's angle u = s angle (s its pivot side) is sampled at :data:`SAMPLES` points of
 the step: an impact is its first sample at or below zero, or a minimum below zero between
@@ -15,11 +16,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._roots import newton_bisect
 from ..constants import FALL_ROTATION
 from ._stacked_model import A1, lock_margins
 from ._stacked_steps import (
+    DENSE_NONE,
+    DENSE_TAYLOR,
     K_FSUB,
+    K_INFO,
     K_SUB,
+    dense_state,
     derivative,
     dop853_step,
     ground,
@@ -27,11 +33,12 @@ from ._stacked_steps import (
     interface_data,
     state_at,
 )
-from ._taylor import NO_REFCOUNT
+from ._stacked_taylor import both_state
+from ._taylor import NO_REFCOUNT, ROOT_ITERATIONS, ROOT_TOL
 
 #: Samples of the interpolant per step at which the impacts and peaks are sought.
 SAMPLES = 4
-#: Halvings of a bracket of a step's fraction (to below 1e-18).
+#: Halvings of the bracket of an uplift (a lock margin through zero) on the interpolant.
 BISECTIONS = 60
 #: Secant steps on true sub-steps that refine an uplift located on the interpolant.
 SECANTS = 3
@@ -39,36 +46,44 @@ SECANTS = 3
 EVENT_NONE, EVENT_IMPACT, EVENT_FALL, EVENT_UPLIFT = 0, 1, 2, 3
 
 
-@njit(cache=True, **NO_REFCOUNT)
-def _bisect_angle(k, s, level, lo, hi, h, y0, f0, y1, f1):
-    """The fraction in (lo, hi] where s angle_k - level changes sign (> 0 at lo, <= 0 at hi
-    for level 0; < 0 at lo, >= 0 at hi otherwise), by bisection."""
-    for _ in range(BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        u = s * interface_at(k, mid, h, y0, f0, y1, f1)[0] - level
-        if (u > 0.0) == (level == 0.0):
-            lo = mid
-        else:
-            hi = mid
-    return hi
+@njit(cache=True, inline="always")
+def _angle_fdf(x, args):
+    """s angle_k - level at the fraction x of the step and its x-derivative (the
+    interpolant's)."""
+    k, s, level, h, y0, f0, y1, f1 = args
+    u, v, _ = interface_at(k, x, h, y0, f0, y1, f1)
+    return s * u - level, s * v * h
+
+
+@njit(cache=True, inline="always")
+def _rate_fdf(x, args):
+    """s angle_k' at the fraction x of the step and its x-derivative (the interpolant's)."""
+    k, s, h, y0, f0, y1, f1 = args
+    _, v, a = interface_at(k, x, h, y0, f0, y1, f1)
+    return s * v, s * a * h
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, falling):
+def _angle_root(k, s, level, lo, hi, h, y0, f0, y1, f1):
+    """The fraction in [lo, hi] where s angle_k - level changes sign (> 0 at lo, <= 0 at hi
+    for level 0; < 0 at lo, >= 0 at hi otherwise), by safeguarded Newton steps on the
+    interpolant (:func:`rockstudy._roots.newton_bisect`, to ROOT_TOL of the step)."""
+    args = (k, s, level, h, y0, f0, y1, f1)
+    sign_lo = 1.0 if level == 0.0 else -1.0
+    return newton_bisect(
+        _angle_fdf, args, lo, hi, 0.5 * (lo + hi), sign_lo, ROOT_TOL, ROOT_ITERATIONS
+    )
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _rate_root(k, s, lo, hi, h, y0, f0, y1, f1, falling):
     """The fraction in [lo, hi] where s angle_k' changes sign (from + to - if ``falling``,
-    a peak; from - to + otherwise, a trough)."""
-    for _ in range(BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        if mid <= lo or mid >= hi:
-            break
-        v = s * interface_at(k, mid, h, y0, f0, y1, f1)[1]
-        if (v > 0.0) == falling:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    a peak; from - to + otherwise, a trough), as :func:`_angle_root`."""
+    args = (k, s, h, y0, f0, y1, f1)
+    sign_lo = 1.0 if falling else -1.0
+    return newton_bisect(
+        _rate_fdf, args, lo, hi, 0.5 * (lo + hi), sign_lo, ROOT_TOL, ROOT_ITERATIONS
+    )
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -89,11 +104,11 @@ def impact_fraction(k, s, h, y0, f0, y1, f1, rates):
         x, v, _ = interface_at(k, hi, h, y0, f0, y1, f1)
         u, rates[j] = s * x, s * v
         if u <= 0.0:
-            return _bisect_angle(k, s, 0.0, lo, hi, h, y0, f0, y1, f1)
+            return _angle_root(k, s, 0.0, lo, hi, h, y0, f0, y1, f1)
         if rates[j - 1] < 0.0 <= rates[j]:  # a trough between the samples
-            mid = _bisect_rate(k, s, lo, hi, h, y0, f0, y1, f1, False)
+            mid = _rate_root(k, s, lo, hi, h, y0, f0, y1, f1, False)
             if s * interface_at(k, mid, h, y0, f0, y1, f1)[0] <= 0.0 < u_lo:
-                return _bisect_angle(k, s, 0.0, lo, mid, h, y0, f0, y1, f1)
+                return _angle_root(k, s, 0.0, lo, mid, h, y0, f0, y1, f1)
         lo, u_lo = hi, u
     return 2.0
 
@@ -113,7 +128,7 @@ def _early_return(k, s, h, y0, f0, y1, f1):
     hi = 1.5 * tau / h
     if not hi < 1.0 / SAMPLES or s * interface_at(k, hi, h, y0, f0, y1, f1)[0] > 0.0:
         return 2.0
-    return _bisect_angle(k, s, 0.0, 0.0, hi, h, y0, f0, y1, f1)
+    return _angle_root(k, s, 0.0, 0.0, hi, h, y0, f0, y1, f1)
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -122,7 +137,7 @@ def fall_fraction(k, s, h, y0, f0, y1, f1):
     the step's end)."""
     if s * interface_at(k, 1.0, h, y0, f0, y1, f1)[0] < FALL_ROTATION:
         return 2.0
-    return _bisect_angle(k, s, FALL_ROTATION, 0.0, 1.0, h, y0, f0, y1, f1)
+    return _angle_root(k, s, FALL_ROTATION, 0.0, 1.0, h, y0, f0, y1, f1)
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -168,13 +183,21 @@ def _true_margin(g, regime, mot, t, y0, f0, dt, j, tmp, w):
 
 @njit(cache=True, **NO_REFCOUNT)
 def true_state(g, regime, mot, t, y0, f0, dt, w):
-    """The state and its derivative after a true DOP853 step of length dt from (t, y0),
-    into w[K_SUB] and w[K_FSUB] (a step of length 0 copies the start)."""
+    """The state and its derivative at t + dt inside the last accepted step (from (t, y0)),
+    into w[K_SUB] and w[K_FSUB]: on the step's polynomials after a both-rocking Taylor step
+    (:func:`._stacked_taylor.both_state`), on its dense output after a DOP853 step
+    (:func:`._stacked_steps.dense_state`), else after a true DOP853 step of length dt (a
+    step of length 0 copies the start)."""
     if dt == 0.0:
         for c in range(4):
             w[K_SUB, c], w[K_FSUB, c] = y0[c], f0[c]
         return
-    dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
+    if w[K_INFO, 0] == DENSE_TAYLOR:
+        both_state(w, int(w[K_INFO, 2]), dt / w[K_INFO, 1], w[K_INFO, 1], w[K_SUB])
+    elif w[K_INFO, 0] != DENSE_NONE:
+        dense_state(g, regime, mot, t, y0, dt / w[K_INFO, 1], w, w[K_SUB])
+    else:
+        dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
     derivative(g, regime, mot, t + dt, w[K_SUB], w[K_FSUB])
 
 
@@ -195,7 +218,7 @@ def step_peaks(g, regime, mot, t, h, y0, f0, y1, f1, upto, peaks, w, rates):
             if lo >= upto or not rates[k, j] == rates[k, j]:
                 break
             if rates[k, j - 1] > 0.0 >= rates[k, j]:
-                mid = _bisect_rate(k, s, lo, j / SAMPLES, h, y0, f0, y1, f1, True)
+                mid = _rate_root(k, s, lo, j / SAMPLES, h, y0, f0, y1, f1, True)
                 x = abs(interface_at(k, mid, h, y0, f0, y1, f1)[0])
                 if mid <= upto and x > peaks[k] - 1e-6 * g[A1 + k]:
                     _, ys, fs = _refined(g, regime, mot, t, y0, f0, mid * h, k, w)

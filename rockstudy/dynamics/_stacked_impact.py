@@ -153,6 +153,16 @@ def _grid_start(mot, t0):
 
 
 @njit(cache=True)
+def scan_cell_end(mot, t):
+    """The end of the scan cell of t (< the motion's duration): the next scan point after
+    t, at most the duration."""
+    dur = mot[1][3]
+    i = _grid_start(mot, t) + 1
+    hi = _grid_point(mot, min(i, _grid_size(mot) - 1)) if i < _grid_size(mot) else dur
+    return min(hi, dur) if hi > t else dur
+
+
+@njit(cache=True)
 def _grid_size(mot):
     return mot[2].shape[0] if mot[0] == KIND_RECORD else PULSE_GRID + 1
 

@@ -30,11 +30,15 @@ from ._stacked_events import (
     first_event,
     step_peaks,
 )
-from ._stacked_impact import resolve_impact, uplift_from_rest
+from ._stacked_impact import REST_BISECTIONS, resolve_impact, scan_cell_end, uplift_from_rest
 from ._stacked_model import P1, P2, lock_margins
 from ._stacked_steps import (
+    DENSE_NONE,
+    DENSE_STAGES,
+    DENSE_TAYLOR,
     K_END,
     K_FEND,
+    K_INFO,
     derivative,
     dop853_step,
     ground,
@@ -43,6 +47,7 @@ from ._stacked_steps import (
     step_error,
     work_array,
 )
+from ._stacked_taylor import both_step
 from ._taylor import NO_REFCOUNT, work_arrays
 from .constants import (
     FIRST_STEP,
@@ -133,6 +138,19 @@ def _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1):
     return one_body_step(g, form, y, hs, ground(mot, t), ground(mot, t1), dd0, tol, tw, y1)
 
 
+@njit(cache=True, **NO_REFCOUNT)
+def _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w):
+    """A Taylor step from t to t1 (= t + hs) on a record's segment or after the motion, its
+    end into w[K_END]: (error ratio, order) of a both-rocking step
+    (:func:`._stacked_taylor.both_step`, its series kept in w), (error ratio, -1) of a
+    one-body one (:func:`_one_body_step`)."""
+    if form[0] >= 0:
+        return _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, w[K_END]), -1
+    u0, u1 = (ground(mot, t), ground(mot, t1)) if t < mot[1][3] else (0.0, 0.0)
+    tol *= TAYLOR_TOL / TOL_FRACTION
+    return both_step(g, y, hs, regime[0], regime[1], u0, u1, tol, w, w[K_END])
+
+
 @njit(cache=True, inline="always")
 def _taylor_accepted(err, hs, h, last):
     """(accepted, next step) of a Taylor step of length hs (the single-block kernel's
@@ -174,16 +192,18 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates, 
         hs = stop - t if last else min(h, cap)
         t1 = stop if last else t + hs
         y1, f1 = w[K_END], w[K_FEND]
-        if form[0] >= 0 and (mot[0] == KIND_RECORD or t >= dur):
-            err = _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1)
+        if mot[0] == KIND_RECORD or t >= dur:
+            err, n = _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w)
             derivative(g, regime, mot, t1, y1, f1)
             ok, h = _taylor_accepted(err, hs, h, last)
+            w[K_INFO, 0], w[K_INFO, 1], w[K_INFO, 2] = DENSE_NONE if n < 0 else DENSE_TAYLOR, hs, n
         else:
             dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
             derivative(g, regime, mot, t1, y1, f1)
             for c in range(4):
                 w[12, c] = f1[c]
             ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
+            w[K_INFO, 0], w[K_INFO, 1] = DENSE_STAGES, hs
         if not ok:
             continue
         lock_margins(g, y1, iv[2], iv[3], regime[2], regime[3], ground(mot, t1), margins)
@@ -223,6 +243,40 @@ def _release_violated(g, mot, iv, y, t, margins):
 
 
 @njit(cache=True)
+def _rises(g, mot, iv, y, k, t, f):
+    """Whether interface k, just opened (iv) at t from rest, rises under its regime's own
+    acceleration, computed as its phase's first step computes it (the motion's segment of
+    t, :func:`._stacked_steps.derivative`)."""
+    mot = (mot[0], mot[1], mot[2], mot[3], _segment_of(mot[0], mot[2], mot[1][3], t, mot[4]))
+    derivative(g, (iv[2], iv[3], iv[0] != 0, iv[1] != 0), mot, t, y, f)
+    return iv[2 + k] * (f[2] if k == 0 else f[3] - f[2]) > 0.0
+
+
+@njit(cache=True)
+def _rise_start(g, mot, iv, y, k, t_up, f):
+    """(start, lifted) of the phase of interface k opened from rest at t_up: t_up if it rises
+    there (:func:`_rises`); else, within rounding of its uplift level where the lift test and
+    the regime's equation disagree, the first double of the scan cell of t_up where it
+    rises (by bisection), or the cell's end with ``lifted`` False (it stays at rest: a body
+    the test lifts but its equation holds down would fall back at once, be put to rest and
+    be lifted again at the same instant without end)."""
+    if _rises(g, mot, iv, y, k, t_up, f):
+        return t_up, True
+    lo, hi = t_up, scan_cell_end(mot, t_up)
+    if not _rises(g, mot, iv, y, k, hi, f):
+        return hi, False
+    for _ in range(REST_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        if _rises(g, mot, iv, y, k, mid, f):
+            hi = mid
+        else:
+            lo = mid
+    return hi, True
+
+
+@njit(cache=True)
 def _fallen(k, iv):
     """The body code of a fall of interface k."""
     if k == 1:
@@ -251,7 +305,10 @@ def stacked_scene(g, kind, mp, times, samples, rtol, max_steps, t_end):
             t_up, k, corner = uplift_from_rest(g, mot, t, tmp)
             if not t_up <= t_end:
                 break
-            st[0], iv[k], iv[2 + k] = t_up, 0, corner
+            side, iv[k], iv[2 + k] = iv[2 + k], 0, corner
+            st[0], lifted = _rise_start(g, mot, iv, y, k, t_up, tmp[12:16])
+            if not lifted:
+                iv[k], iv[2 + k] = 1, side
             continue
         if (iv[0] != 0 or iv[1] != 0) and _release_violated(g, mot, iv, y, t, margins):
             continue

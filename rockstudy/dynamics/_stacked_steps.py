@@ -20,7 +20,7 @@ from ..constants import G
 from ..motions._kernels import ground_acceleration
 from ._dop853 import hermite5
 from ._stacked_model import A1, A2, P1, P2, acceleration
-from ._taylor import MODEL_NONLINEAR, NO_REFCOUNT, poly_end, taylor_coefficients
+from ._taylor import MAX_ORDER, MODEL_NONLINEAR, NO_REFCOUNT, poly_end, taylor_coefficients
 from .constants import ATOL_FRACTION
 
 _A = np.ascontiguousarray(_DOP853.A[:12, :12], dtype=float)
@@ -28,16 +28,29 @@ _B = np.ascontiguousarray(_DOP853.B, dtype=float)
 _C = np.ascontiguousarray(_DOP853.C[:12], dtype=float)
 _E3 = np.ascontiguousarray(_DOP853.E3, dtype=float)
 _E5 = np.ascontiguousarray(_DOP853.E5, dtype=float)
+_A_EXTRA = np.ascontiguousarray(_DOP853.A_EXTRA, dtype=float)
+_C_EXTRA = np.ascontiguousarray(_DOP853.C_EXTRA, dtype=float)
+_D = np.ascontiguousarray(_DOP853.D, dtype=float)
 
-#: Rows of the work array of a scene (:func:`work_array`): the 13 stage derivatives, a
-#: stage's state, the step's end, the derivative there, and the state of a true sub-step.
-K_TMP, K_END, K_FEND, K_SUB, K_FSUB = 13, 14, 15, 16, 17
+#: Rows of the work array of a scene (:func:`work_array`): the 13 stage derivatives and the
+#: 3 extra stages of the dense output, a stage's state, the step's end, the derivative
+#: there, the state at an instant inside the step (:func:`._stacked_events.true_state`),
+#: the dense output's 7 coefficient rows, and (kind, h) of the last accepted step
+#: (:data:`DENSE_NONE`...).
+K_TMP, K_END, K_FEND, K_SUB, K_FSUB, K_DENSE, K_INFO = 16, 17, 18, 19, 20, 21, 28
+#: The first of the 14 rows of the both-rocking Taylor step (:mod:`._stacked_taylor`).
+K_BOTH = 29
+#: Kinds of the last accepted step in w[K_INFO, 0] (its length in w[K_INFO, 1]): a one-body
+#: Taylor step (its inner states come from true sub-steps), a DOP853 step, one whose dense
+#: output is computed, a both-rocking Taylor step (its order in w[K_INFO, 2]).
+DENSE_NONE, DENSE_STAGES, DENSE_READY, DENSE_TAYLOR = 0.0, 1.0, 2.0, 3.0
 
 
 @njit(cache=True)
 def work_array():
-    """The work array of one scene: (18, 4) floats (rows :data:`K_TMP`...)."""
-    return np.empty((18, 4))
+    """The work array of one scene: (K_BOTH + 14, MAX_ORDER + 3) floats (rows
+    :data:`K_TMP`...; the DOP853 rows use their first 4 columns)."""
+    return np.zeros((K_BOTH + 14, MAX_ORDER + 3))
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -74,6 +87,46 @@ def dop853_step(g, regime, mot, t, y, f, h, w, end):
         for i in range(12):
             acc += _B[i] * w[i, c]
         w[end, c] = y[c] + h * acc
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def dense_state(g, regime, mot, t, y0, sigma, w, out):
+    """The state at the fraction sigma of the last accepted DOP853 step (from (t, y0), its
+    stages in w[0:13], its end in w[K_END], its length in w[K_INFO, 1]) on the step's
+    7th-order dense output (scipy's ``Dop853DenseOutput``: 3 more stages, computed once
+    per step), into ``out``."""
+    if w[K_INFO, 0] != DENSE_READY:
+        _dense_coefficients(g, regime, mot, t, y0, w)
+    for c in range(4):
+        v = 0.0
+        for i in range(7):
+            v += w[K_DENSE + 6 - i, c]
+            v *= sigma if i % 2 == 0 else 1.0 - sigma
+        out[c] = y0[c] + v
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _dense_coefficients(g, regime, mot, t, y0, w):
+    """The extra stages and the 7 coefficient rows of the dense output of the last DOP853
+    step (scipy's ``DOP853._dense_output_impl``), into w[13:16] and w[K_DENSE:]."""
+    h = w[K_INFO, 1]
+    for s in range(13, 16):
+        for c in range(4):
+            acc = 0.0
+            for j in range(s):
+                acc += _A_EXTRA[s - 13, j] * w[j, c]
+            w[K_TMP, c] = y0[c] + h * acc
+        derivative(g, regime, mot, t + _C_EXTRA[s - 13] * h, w[K_TMP], w[s])
+    for c in range(4):
+        dy = w[K_END, c] - y0[c]
+        w[K_DENSE, c], w[K_DENSE + 1, c] = dy, h * w[0, c] - dy
+        w[K_DENSE + 2, c] = 2.0 * dy - h * (w[12, c] + w[0, c])
+        for i in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += _D[i, j] * w[j, c]
+            w[K_DENSE + 3 + i, c] = h * acc
+    w[K_INFO, 0] = DENSE_READY
 
 
 @njit(cache=True, **NO_REFCOUNT)
