@@ -151,6 +151,22 @@ def test_object_risk_per_floor_and_orientation_keeps_the_design_order(cube):
         )
 
 
+def test_a_design_over_floors_alone_is_fitted_per_floor(cube):
+    floors = cube.isel(orientation=0, drop=True)
+    rates = object_risk(floors, CURVE, n_boot=N_BOOT)
+    states = state_risk(floors, CURVE, n_boot=N_BOOT, nested=True)
+    assert rates["annual_rate"].dims == ("floor", "structure")
+    for f in floors["floor"].values:
+        alone = floors.sel(floor=f, drop=True)
+        xr.testing.assert_identical(
+            rates.sel(floor=f, drop=True),
+            object_risk(alone, CURVE, n_boot=N_BOOT).sel(structure=floors["structure"].values),
+        )
+        xr.testing.assert_identical(
+            states.sel(floor=f, drop=True), state_risk(alone, CURVE, n_boot=N_BOOT, nested=True)
+        )
+
+
 def test_the_accessor_fits_every_floor_and_orientation_or_a_summary(cube):
     table = cube.rocking.fragility(by="structure", n_boot=N_BOOT)
     pd.testing.assert_frame_equal(table, ida_fragility(cube, by="structure", n_boot=N_BOOT))
