@@ -394,6 +394,27 @@ def _compile(args) -> int:
     return compile_main(args.group)
 
 
+def _design_size(study, base_dir) -> str:
+    """The folded size of a record design, as ``rockstudy validate`` prints it: records x
+    floors (a list of floors) x orientations (``[design] orientations``) x structures (x
+    levels of stripes); a single floor of a building is named."""
+    from .study.designs.record_rows import motion_axes
+    from .study.spec.design_kinds import design_kind
+    from .study.spec.feasibility import record_pairs
+
+    floors, angles = motion_axes(study)
+    parts = [f"{len(record_pairs(study.motion, base_dir))} records"]
+    if isinstance(getattr(study.motion, "floor", None), list):
+        parts.append(f"{len(floors)} floors {floors}")
+    if angles is not None:
+        parts.append(f"{len(angles)} orientations")
+    parts.append(f"{study.samples() // study.levels()} structures")
+    if not design_kind(study.design.kind).capacities:
+        parts.append(f"{study.levels()} levels")
+    where = f" on floor {floors[0]}" if floors != [0] and len(floors) == 1 else ""
+    return f"{study.design.kind} design{where}: " + " x ".join(parts)
+
+
 def _validate(args) -> int:
     from .study import StudyError, load_study
 
@@ -403,16 +424,7 @@ def _validate(args) -> int:
             study = load_study(path)
             size = f"{study.samples()} samples"
             if study.design is not None:
-                from .study.spec.design_kinds import design_kind
-                from .study.spec.feasibility import record_pairs
-
-                records = len(record_pairs(study.motion, Path(path).resolve().parent))
-                capacities = design_kind(study.design.kind).capacities
-                size = (
-                    f"{study.design.kind} design: {records} records x "
-                    f"{study.samples() // study.levels()} structures"
-                    + ("" if capacities else f" x {study.levels()} levels")
-                )
+                size = _design_size(study, Path(path).resolve().parent)
             print(
                 f"{path}: ok ({study.sampler.kind}, {size}, "
                 f"{len(study.parameters())} distributed parameters, sha256 {study.sha256()[:12]})"

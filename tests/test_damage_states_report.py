@@ -109,7 +109,7 @@ def test_the_page_shows_the_states_figure_and_rates_with_names_escaped(report):
     assert (folder / "state_fragility.png").exists()
     rates = pd.read_csv(folder / "annual_states.csv", index_col=[0, 1])
     assert set(rates.index.get_level_values(1)) == {"Amphora", NAME}
-    finite = rates["lambda(state) [1/yr]"].dropna()
+    finite = rates["lambda(state), nested fit [1/yr]"].dropna()
     assert finite.size >= 3 and (finite > 0).all()
     assert "<chipped>" not in page and html.escape("<chipped>") in page
     assert NAME not in page

@@ -11,6 +11,12 @@ A record study's cube read with ``xarray.open_zarr`` is in the store's layout (o
 scene, on ``sample``); the accessor folds it into the layout of the record designs
 (:func:`~rockstudy.study.designs.record_rows.design_dataset`, as
 :func:`~rockstudy.study.open_result` does) before it analyses it.
+
+A record design over floors (``[motion] floor = [..]``) or orientations (``[design]
+orientations``) is fitted on every floor and orientation apart, the result carrying the
+dimensions ``floor`` and ``orientation`` (:mod:`~rockstudy.study.analysis.motion_axes`);
+``orientation="worst"`` or ``"median"`` fits the worst orientation or the median over
+orientations instead (:func:`~rockstudy.study.analysis.orientations.orientation_summary`).
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ from ..designs.record_rows import design_dataset
 from ..spec.design_kinds import DESIGN_KINDS, design_kind
 from ..spec.schema import Study
 from . import contact, record_fragility, record_similarity, risk, sampled
+from .orientations import ORIENTATION_SUMMARIES, orientation_summary
 
 __all__ = ["RECORD_DESIGNS", "RockingAccessor"]
 
@@ -143,6 +150,26 @@ class RockingAccessor:
         """The fragility fit of a record design: of IDA capacities, or of stripes' points."""
         return getattr(record_fragility, design_kind(self.kind).fragility)
 
+    def _oriented(self, method: str, orientation) -> xr.Dataset:
+        """The cube, or with ``orientation`` ("worst" or "median") its summary over the
+        orientations (:func:`~rockstudy.study.analysis.orientations.orientation_summary`);
+        a ValueError naming ``method`` for another value or a cube without orientations."""
+        if orientation is None:
+            return self._ds
+        if orientation not in ORIENTATION_SUMMARIES:
+            raise ValueError(
+                f"ds.rocking.{method}: orientation: must be one of "
+                f"{list(ORIENTATION_SUMMARIES)} (or None: one fit per orientation), got "
+                f"{orientation!r}"
+            )
+        if "orientation" not in self._ds.dims:
+            raise ValueError(
+                f"ds.rocking.{method}: orientation={orientation!r}: the cube has no "
+                "'orientation' dimension (a record design with [design] orientations); leave "
+                "orientation out"
+            )
+        return orientation_summary(self._ds, orientation)
+
     def _sampled(self, method: str, record_analysis: str) -> str:
         """The sampler kind of a sampled cube, or a ValueError naming ``method``."""
         if self.kind in RECORD_DESIGNS:
@@ -154,7 +181,7 @@ class RockingAccessor:
 
     # -------------------------------------------------------------------------- fragility
 
-    def fragility(self, im: str | None = None, by=None, **kw):
+    def fragility(self, im: str | None = None, by=None, orientation=None, **kw):
         """Lognormal fragility of the cube, by the fit its kind calls for.
 
         - a sampled study (Monte Carlo, LHS, Sobol'): the Bernoulli MLE of every sample
@@ -175,6 +202,11 @@ class RockingAccessor:
             One curve per value (or per bin, with ``bins``) of this variable: on ``sample``
             for a sampled cube, ``"structure"`` or a variable on ``structure`` for a record
             design.
+        orientation : {None, "worst", "median"}
+            A record design over orientations: None (default) fits every orientation
+            apart (the dimension an outer level of the result, as ``floor`` is); "worst"
+            or "median" fits the worst orientation or the median over orientations
+            (:func:`~rockstudy.study.analysis.orientations.orientation_summary`).
         **kw
             The other keywords of the fit: ``bins``, ``n_boot``, ``conf_level``, ``seed``;
             ``outcome`` and ``failed`` (sampled only); ``period`` (record designs only). A
@@ -185,7 +217,9 @@ class RockingAccessor:
         pandas.DataFrame
             One row per group: ``theta``, ``beta`` (the MLE), their intervals, ``n``, the
             observed range and the band columns of
-            :func:`~rockstudy.study.analysis.fragility_fit.fragility_row`.
+            :func:`~rockstudy.study.analysis.fragility_fit.fragility_row`; over floors and
+            orientations, one per floor and orientation too (outer index levels ``floor``,
+            ``orientation``).
 
         Examples
         --------
@@ -194,9 +228,10 @@ class RockingAccessor:
         """
         if self.kind in RECORD_DESIGNS:
             _keywords("fragility", self.kind, self._record_fit, kw)
-            return self._record_fit(self._ds, im=im, by=by, **kw)
+            return self._record_fit(self._oriented("fragility", orientation), im=im, by=by, **kw)
         takes = _takes(sampled.fragility, {"intensity": "im"})
         _keywords("fragility", self.kind, sampled.fragility, kw, takes)
+        self._oriented("fragility", orientation)  # a sampled cube has no orientations
         if im is None:
             outputs = set(self.study.run.outputs) | {"status", "kernel_status", "error"}
             inputs = [
@@ -211,7 +246,7 @@ class RockingAccessor:
         sampled.check_variables(self._ds, im=im)
         return sampled.fragility(self._ds, im, by=by, **kw)
 
-    def efficiency(self, candidates=None, by=None, **kw):
+    def efficiency(self, candidates=None, by=None, orientation=None, **kw):
         """Which intensity measure predicts overturning best, on a record design
         (:func:`rockstudy.study.im_efficiency`): the dispersion of each, per scaling power.
 
@@ -220,7 +255,7 @@ class RockingAccessor:
         candidates : sequence, optional
             Measures (``"sa"`` expands to every stored period) or ``(name, period)`` pairs;
             default every stored measure that scales, the ratios and the pulse group.
-        by : str, optional
+        by, orientation : str, optional
             As in :meth:`fragility`.
         **kw
             ``bins``, ``n_boot``, and the fit's ``conf_level`` and ``seed``.
@@ -239,9 +274,10 @@ class RockingAccessor:
             self._record_fit, leave=("im", "period", "by", "bins", "n_boot")
         )
         _keywords("efficiency", kind, record_fragility.im_efficiency, kw, takes)
-        return record_fragility.im_efficiency(self._ds, candidates, by=by, **kw)
+        ds = self._oriented("efficiency", orientation)
+        return record_fragility.im_efficiency(ds, candidates, by=by, **kw)
 
-    def risk(self, hazard=None, **kw):
+    def risk(self, hazard=None, orientation=None, **kw):
         """Each object's annual rate and probability of overturning at a site
         (:func:`rockstudy.study.object_risk`), on a record design.
 
@@ -249,13 +285,16 @@ class RockingAccessor:
         ----------
         hazard : rockstudy.risk.HazardCurve, optional
             The site's hazard curve; default the study's ``[hazard]`` (and its ``years``).
+        orientation : {None, "worst", "median"}
+            As in :meth:`fragility`.
         **kw
             ``years``, ``n_boot``, ``conf_level``, ``seed``, ``min_overturning``.
 
         Returns
         -------
         xarray.Dataset
-            On ``structure``, ranked by ``annual_rate``.
+            On ``structure``, ranked by ``annual_rate``; over floors and orientations, also on
+            ``floor`` and ``orientation``, the structures in the design's order.
 
         Examples
         --------
@@ -272,7 +311,7 @@ class RockingAccessor:
                 )
             hazard = spec.curve()
             kw.setdefault("years", spec.years)
-        return risk.object_risk(self._ds, hazard, **kw)
+        return risk.object_risk(self._oriented("risk", orientation), hazard, **kw)
 
     # -------------------------------------------------------------------------- sensitivity
 

@@ -49,6 +49,7 @@ from .fragility_fit import (
     wald_intervals,
     warn_if_separated,
 )
+from .motion_axes import per_motion
 
 __all__ = [
     "GROUPS",
@@ -236,6 +237,7 @@ def _measure(ds, im, period):
     return im, period
 
 
+@per_motion
 def stripe_fragility(
     ds: xr.Dataset,
     im: str | None = None,
@@ -353,6 +355,7 @@ def _warn_equal_capacities(label, theta, n, unit):
     )
 
 
+@per_motion
 def ida_fragility(
     ds: xr.Dataset,
     im: str | None = None,
@@ -473,6 +476,7 @@ def _specs(ds, candidates):
     return specs
 
 
+@per_motion
 def im_efficiency(
     ds: xr.Dataset, candidates=None, by=None, bins=None, *, n_boot: int = N_BOOT, **kw
 ) -> pd.DataFrame:

@@ -27,6 +27,7 @@ import xarray as xr
 from ...motions import measures
 from ..spec.design_kinds import kind_of
 from .fragility_fit import CONF_LEVEL, N_BOOT, NO_MAXIMUM, SEED, fit_binomial_limit, separation
+from .motion_axes import per_motion
 from .record_fragility import fit_capacities, ida_arrays, quoted, stripe_arrays
 
 __all__ = ["FREQUENCY_GROUP", "size_class_medians", "size_classes", "size_edges", "size_label"]
@@ -149,6 +150,7 @@ def _median_fitter(ds, im, period):
     return fit, quoted(im)[0]
 
 
+@per_motion
 def size_class_medians(
     ds: xr.Dataset,
     im: str,

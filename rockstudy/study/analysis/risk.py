@@ -75,6 +75,7 @@ from .fragility_fit import (
     fit_binomial_limit,
     separation,
 )
+from .motion_axes import per_motion
 
 __all__ = ["STATUSES", "object_risk", "records_measure", "share_below"]
 
@@ -287,6 +288,7 @@ def _one_object(j, fitter, n_rec, boot_rows, hazard, unit, capacities, min_overt
     return theta, beta, n_over, status, rate, boot, whole
 
 
+@per_motion
 def object_risk(
     ds: xr.Dataset,
     hazard: risk.HazardCurve,
@@ -346,7 +348,10 @@ def object_risk(
     -------
     xarray.Dataset
         On ``structure``, ranked by ``annual_rate`` (highest first, objects without a rate
-        last): ``theta`` (median, in ``hazard.units``) and ``beta`` of the fragility,
+        last; a design over floors and orientations, on ``floor`` and ``orientation`` too,
+        each fitted apart, keeps the design's order,
+        :mod:`~rockstudy.study.analysis.motion_axes`): ``theta`` (median, in
+        ``hazard.units``) and ``beta`` of the fragility,
         ``n_records``, ``n_overturning`` (records under which it overturned), ``status``
         (:data:`STATUSES`), ``annual_rate`` [1/yr] with ``annual_rate_lo``/``_hi`` (the band),
         ``probability`` in ``years`` with ``probability_lo``/``_hi``, ``return_period`` [yr],

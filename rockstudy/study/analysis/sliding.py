@@ -38,6 +38,7 @@ from ...dynamics.constants import STATUS_UNCONVERGED
 from ..designs.records import IDA_ROCKING_VARIABLES
 from ..spec.design_kinds import kind_of
 from . import record_fragility as rf
+from .motion_axes import per_motion
 from .nested_fit import nested_above, rates_crossed, risk_frames, shown_table
 from .risk import object_risk
 
@@ -163,6 +164,7 @@ def _n_overturned(design) -> xr.DataArray:
     return over.where(design["status"] == 0, False).sum([k for k in over.dims if k != "structure"])
 
 
+@per_motion
 def slide_fragility(
     ds: xr.Dataset,
     limits=None,
@@ -211,6 +213,7 @@ def _concat_objects(frames, dim, values, order):
     return xr.concat(frames, dim=pd.Index(values, name=dim), combine_attrs="drop_conflicts")
 
 
+@per_motion
 def slide_risk(
     ds: xr.Dataset, hazard, limits=None, years: float = 50.0, nested: bool = False, **kw
 ) -> xr.Dataset:
@@ -241,8 +244,9 @@ def slide_risk(
 
 def _nested_risk(ds, views, dim, values, above, hazard, years, cuts, nested, kw):
     """The per-state risks of the design views ``views`` on ``dim`` (coordinate
-    ``values``), with ``crossed`` (and with ``nested`` ``crossed_separate``, of the fits
-    made apart) and ``attrs["fit"]``."""
+    ``values``), with ``crossed`` (and with ``nested`` ``crossed_separate`` and
+    ``annual_rate_separate``, the flag and the rate of the fits made apart) and
+    ``attrs["fit"]``."""
     frames = risk_frames(views, above, hazard, years, cuts, nested, **kw)
     out = _concat_objects(frames, dim, values, ds["structure"].values)
     out["crossed"] = _crossed(out["annual_rate"], dim, above)
@@ -250,6 +254,7 @@ def _nested_risk(ds, views, dim, values, above, hazard, years, cuts, nested, kw)
         alone = risk_frames(views, above, hazard, years, cuts, False, **{**kw, "n_boot": 0})
         rates = _concat_objects(alone, dim, values, ds["structure"].values)["annual_rate"]
         out["crossed_separate"] = _crossed(rates, dim, above)
+        out["annual_rate_separate"] = rates
     out.attrs["fit"] = "nested" if nested else "separate"
     return out
 
@@ -265,6 +270,7 @@ def _crossed(rate: xr.DataArray, dim, above) -> xr.DataArray:
     )
 
 
+@per_motion
 def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Dataset:
     """Per object: the annual rate of overturning under the contact model (the design's
     answer) and under Housner's rocking-only model (``overturned_rocking`` of

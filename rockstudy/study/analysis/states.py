@@ -21,6 +21,10 @@ the hazard curve (:func:`~rockstudy.study.analysis.risk.object_risk`, with its b
 band): a state on the rotation keeps the cut of the fragility at the uplift PGA (nothing
 rotates below it without a vertical component), a state on the slide does not (a block
 slides below its uplift PGA).
+
+A design over floors and orientations (dimensions ``floor``, ``orientation``) is fitted on
+every floor and orientation apart, the result carrying them
+(:mod:`~rockstudy.study.analysis.motion_axes`).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ import xarray as xr
 
 from ..spec.damage_states import SLIDE, DamageState, damage_states
 from ..spec.design_kinds import kind_of
+from .motion_axes import per_motion
 from .nested_fit import nested_above, shown_table
 from .sliding import _nested_risk, exceeds_slide
 
@@ -113,6 +118,7 @@ def state_above(states) -> list[int]:
     return above
 
 
+@per_motion
 def state_fragility(
     ds: xr.Dataset,
     states=None,
@@ -141,6 +147,7 @@ def state_fragility(
     return shown_table(ds, views, names, above, "damage_state", nested, im, period, by, **kw)
 
 
+@per_motion
 def state_risk(
     ds: xr.Dataset, hazard, states=None, years: float = 50.0, nested: bool = False, **kw
 ) -> xr.Dataset:
@@ -156,7 +163,10 @@ def state_risk(
     object reached the state; ``status`` as :data:`~rockstudy.study.analysis.risk.STATUSES`,
     of the state); ``crossed`` is True at a state whose rate lies below that of a worse
     state (the fits made apart cross there: read the two rates as about equal; never for
-    the nested fits, whose ``crossed_separate`` is the flag of the fits made apart).
+    the nested fits, whose ``crossed_separate`` and ``annual_rate_separate`` are the flag
+    and the rate of the fits made apart: the overturning state's is
+    :func:`~rockstudy.study.analysis.risk.object_risk`'s rate, its nested rate is not, for
+    it shares its beta with the other states).
     ``kw``: ``n_boot``, ``conf_level``, ``seed``, ``min_overturning`` (the records that
     must reach the state for "ok").
     """

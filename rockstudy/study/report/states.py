@@ -98,9 +98,10 @@ def _rates(page, ctx):
     columns = {
         "status": "status",
         "n_reaching": "records reaching the state",
-        "annual_rate": "lambda(state) [1/yr]",
-        "annual_rate_lo": "lambda, 5 %",
-        "annual_rate_hi": "lambda, 95 %",
+        "annual_rate": "lambda(state), nested fit [1/yr]",
+        "annual_rate_lo": "lambda, nested fit, 5 %",
+        "annual_rate_hi": "lambda, nested fit, 95 %",
+        "annual_rate_separate": "lambda(state), fitted apart [1/yr]",
         "probability": f"P({ctx.years:g} yr)",
         "return_period": "return period [yr]",
         "crossed_separate": "fitted apart: below a worse state's rate",
@@ -112,9 +113,18 @@ def _rates(page, ctx):
     page.table(
         frame,
         "annual_states",
-        "Annual rate of reaching each damage state per object: the state's fragility (the "
-        "nested fit) integrated against the site's hazard curve (Cornell et al. 2002); a state "
-        "on the rotation cut at the uplift PGA as overturning is, a state on the slide not (a "
-        "block slides below its uplift PGA); statuses as for overturning, 'overturned' read as "
-        "'reached the state'",
+        "Annual rate of reaching each damage state per object: the state's fragility "
+        "integrated against the site's hazard curve (Cornell et al. 2002); a state on the "
+        "rotation cut at the uplift PGA as overturning is, a state on the slide not (a block "
+        "slides below its uplift PGA); statuses as for overturning, 'overturned' read as "
+        "'reached the state'. " + _ESTIMATORS,
     )
+
+
+#: How the two rates of the states' table differ (and which one the overturning table gives).
+_ESTIMATORS = (
+    "Two estimators: 'nested fit' (with its band) fits all states of an object at once, with "
+    "one beta, so that a worse state's rate never exceeds a milder one's; 'fitted apart' fits "
+    "each state alone. The overturning row fitted apart is the rate of the table of "
+    "overturning; its nested rate differs from it by the shared beta."
+)
