@@ -14,13 +14,15 @@ machine's load as it drifts) and the ratios auto / rocking and auto / (rocking +
 the median of the repeats' own ratios; the target is
 auto >= 0.8 x rocking on the pure rocking scenes: those that ``auto`` leaves to Housner's model
 (the others, which overturn, lift off or need more friction, it runs again with the contact
-model), timed again on their own (``pure rocking: auto / rocking``).
+model), timed again on their own (``pure rocking: auto / rocking``; beside it the same median ratio
+of CPU times, all threads, which a shared machine's load disturbs least).
 
     python benchmarks/contact_auto.py                      # n = 400 pulse rows, 100 record rows
     python benchmarks/contact_auto.py --n 100 --repeats 5  # a quick look
     python benchmarks/contact_auto.py --n 4000 --repeats 21  # a stable median
+    python benchmarks/contact_auto.py --motions record     # the record rows only
 
-Writes benchmarks/results/contact_auto.json.
+Writes benchmarks/results/contact_auto.json (``--motions``: replaces those scenes' entries).
 """
 
 from __future__ import annotations
@@ -65,18 +67,21 @@ def scenes(n, seed=36):
 
 
 def throughput(kwargs, runs, repeats):
-    """({run: median scenes/s}, {run: outputs}, {run: times [s] per repeat}) of the ``runs``
-    (name: extra arguments), each timed ``repeats`` times, the runs interleaved (the
-    machine's load, shared, drifts: the runs of one repeat see nearly the same load)."""
+    """({run: median scenes/s}, {run: outputs}, {run: times [s] per repeat}, {run: CPU
+    times [s] per repeat, all threads}) of the ``runs`` (name: extra arguments), each timed
+    ``repeats`` times, the runs interleaved (the machine's load, shared, drifts: the runs of
+    one repeat see nearly the same load; the CPU times see it least)."""
     n = np.size(kwargs["slenderness"])
-    times, outs = {run: [] for run in runs}, {}
+    times, cpu, outs = {run: [] for run in runs}, {run: [] for run in runs}, {}
     for _ in range(repeats):
         for run, extra in runs.items():
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             outs[run] = simulate_batch(**kwargs, **extra)
             times[run].append(time.perf_counter() - t0)
+            cpu[run].append(time.process_time() - c0)
     times = {run: np.array(t) for run, t in times.items()}
-    return {run: n / float(np.median(t)) for run, t in times.items()}, outs, times
+    cpu = {run: np.array(t) for run, t in cpu.items()}
+    return {run: n / float(np.median(t)) for run, t in times.items()}, outs, times, cpu
 
 
 def ratio(times, run, base):
@@ -92,27 +97,36 @@ def subset(kwargs, keep):
 
 
 def pure_rocking(kwargs, auto, repeats):
-    """(scenes, {run: median scenes/s}, (median ratio auto / rocking, its quartiles)) on the
-    rows that ``auto`` (its outputs) answered with Housner's model."""
+    """(scenes, {run: median scenes/s}, (median ratio auto / rocking, its quartiles), the
+    same ratio of CPU times) on the rows that ``auto`` (its outputs) answered with Housner's
+    model."""
     pure = subset(kwargs, auto["model"] != 3)
     runs = {run: RUNS[run] for run in ("rocking", "auto")}
-    rates, _, times = throughput(pure, runs, repeats)
-    return int(np.size(pure["slenderness"])), rates, ratio(times, "auto", "rocking")
+    rates, _, times, cpu = throughput(pure, runs, repeats)
+    n = int(np.size(pure["slenderness"]))
+    return n, rates, ratio(times, "auto", "rocking"), ratio(cpu, "auto", "rocking")[0]
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=400)
     parser.add_argument("--repeats", type=int, default=9, help="interleaved repeats per run")
+    parser.add_argument(
+        "--motions", choices=("all", "sine pulses", "record"), default="all", help="scenes to time"
+    )
     args = parser.parse_args(argv)
     results = {}
     for name, kwargs in scenes(args.n).items():
+        if args.motions not in ("all", name):
+            continue
         warm = {k: (v[:2] if isinstance(v, np.ndarray) else v) for k, v in kwargs.items()}
         for extra in RUNS.values():  # compile outside the timing
             simulate_batch(**warm, **extra)
-        rates, outs, times = throughput(kwargs, RUNS, args.repeats)
+        rates, outs, times, _ = throughput(kwargs, RUNS, args.repeats)
         contact_rows = int(np.sum(outs["auto"]["model"] == 3))
-        n_pure, pure_rates, (pure, pure_q) = pure_rocking(kwargs, outs["auto"], args.repeats)
+        n_pure, pure_rates, (pure, pure_q), pure_cpu = pure_rocking(
+            kwargs, outs["auto"], args.repeats
+        )
         results[name] = {
             "scenes": int(np.size(kwargs["slenderness"])),
             "repeats": args.repeats,
@@ -124,6 +138,7 @@ def main(argv=None):
             "pure rocking: scenes_per_s (median)": pure_rates,
             "pure rocking: auto / rocking (median)": pure,
             "pure rocking: auto / rocking (quartiles)": pure_q,
+            "pure rocking: auto / rocking (median, CPU time)": pure_cpu,
         }
         print(
             f"{name}: " + ", ".join(f"{k} {v:.0f} scenes/s" for k, v in rates.items()),
@@ -131,10 +146,13 @@ def main(argv=None):
             f"| auto / (rocking + check) {results[name]['auto / (rocking + check)']:.3f}",
             f"| contact rows {contact_rows}",
             f"| pure rocking ({n_pure} scenes): auto / rocking median {pure:.3f} "
-            f"(quartiles {pure_q[0]:.3f}-{pure_q[1]:.3f}, {args.repeats} repeats)",
+            f"(quartiles {pure_q[0]:.3f}-{pure_q[1]:.3f}, {args.repeats} repeats; "
+            f"CPU time {pure_cpu:.3f})",
         )
     OUT.mkdir(exist_ok=True)
-    (OUT / "contact_auto.json").write_text(json.dumps(results, indent=2) + "\n")
+    path = OUT / "contact_auto.json"
+    kept = json.loads(path.read_text()) if path.exists() and args.motions != "all" else {}
+    path.write_text(json.dumps({**kept, **results}, indent=2) + "\n")
 
 
 if __name__ == "__main__":

