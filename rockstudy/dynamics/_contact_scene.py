@@ -33,7 +33,7 @@ from ..motions._kernels import KIND_RECORD, segment_index
 from . import _contact_steps as cs
 from . import _contact_taylor as ct
 from . import slide_rock as sr
-from ._contact_flag import DECISION_BAND, flag_unconverged, row_runner
+from ._contact_flag import DECISION_BAND, flag_unconverged, housner_runner, row_runner
 from ._contact_rest import _from_flat, _rest
 from ._contact_state import (
     S_CLEAN,
@@ -635,7 +635,8 @@ def contact_scene(
     if t_max is None:  # the batch's flag: the twin runs follow the scene to its end
         motion_rows = (mot[0], mot[1][None, :], *mot[2:])
         runner = row_runner(cols, motion_rows, max_steps, contact_batch_serial)
-        flag_unconverged(row, cols, runner, float(rtol))
+        housner = housner_runner(cols, motion_rows, max_steps, parallel=False)
+        flag_unconverged(row, cols, runner, float(rtol), housner)
     else:
         jumps = row["decision_margin"] < DECISION_BAND * rtol and static > kinetic
         row["converged"] &= ~jumps
@@ -678,7 +679,9 @@ def contact_batch(
     cols = tuple(cols)
     arrays = (np.ascontiguousarray(x, dtype=float) for x in (mp, times, samples, vsamples))
     run = contact_batch_kernel if parallel else contact_batch_serial
-    rows = row_runner(cols, (np.int64(kind), *arrays), max_steps, run)
+    motion = (np.int64(kind), *arrays)
+    rows = row_runner(cols, motion, max_steps, run)
     out = rows(slice(None), float(rtol))
-    flag_unconverged(out, cols, rows, float(rtol))
+    housner = housner_runner(cols, motion, max_steps, parallel)
+    flag_unconverged(out, cols, rows, float(rtol), housner)
     return out
