@@ -36,7 +36,9 @@ def structure_table(structure, n: int = 4001):
     tabs = [mechanism_table(m, n) for m in mechs]
     fall = min(t[1] for t in tabs)
     tabs = [mechanism_table(m, n, fall) for m in mechs] if tabs[0][1] != tabs[1][1] else tabs
-    return np.ascontiguousarray(np.stack([t[0] for t in tabs])), fall
+    table = np.ascontiguousarray(np.stack([t[0] for t in tabs]))
+    table.flags.writeable = False  # cached; and the kernels' type of a table (as NO_TABLE)
+    return table, fall
 
 
 def mechanism_table(mechanism, n: int = 4001, phi_fall: float | None = None):

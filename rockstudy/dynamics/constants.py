@@ -61,6 +61,9 @@ MODEL_TABLE = 2  # a mechanism, eq. (8) of [003], from tabulated I, G, B (struct
 #: Columns of a mechanism table, on a uniform grid of the amplitude phi in [0, fall].
 TAB_PHI, TAB_I, TAB_DI, TAB_G, TAB_DG, TAB_B, TAB_DB, TAB_V, TAB_DV = range(9)
 NO_TABLE = np.empty((2, 0, 9))  # [direction + (0), direction - (1)], node, column
+# read-only, as numba types a global array inside a kernel: a kernel called from Python with
+# it and from a kernel (the batch kernels) then compiles once, not for both array types
+NO_TABLE.flags.writeable = False
 
 PH_END = 0
 PH_REST = 1

@@ -112,16 +112,13 @@ def _kernel(
 def _scene_variant(kind, model, vsamples, tab):
     """The scene kernel for a motion and model, and its table argument: a block model under a
     trigonometric pulse without a vertical component runs :func:`._rocking.scene_trig` (the
-    same steps, compiled in half the time) on the read-only :data:`._rocking.NO_TABLE`, the
-    signature a study's batch kernel compiles it for, so that the kernel cached by a study
-    serves ``simulate`` too; anything else the general :func:`._rocking.scene`."""
+    same steps, compiled in half the time); anything else the general :func:`._rocking.scene`.
+    The tables (:data:`._rocking.NO_TABLE`, a structure's) are read-only, the type a study's
+    batch kernel compiles the scenes for, so that the kernels cached by a study serve
+    ``simulate`` too."""
     if kind == mk.KIND_TRIG and model != _rocking.MODEL_TABLE and not vsamples.size:
-        return _rocking.scene_trig, _READONLY_NO_TABLE
+        return _rocking.scene_trig, _rocking.NO_TABLE
     return _rocking.scene, tab
-
-
-_READONLY_NO_TABLE = _rocking.NO_TABLE.view()
-_READONLY_NO_TABLE.flags.writeable = False
 
 
 def _check_end(t_eval, end):
