@@ -181,7 +181,9 @@ def test_the_report_and_the_risk_of_every_state_on_every_floor(ida):
             nested = state_risk(view, hazard, n_boot=50, nested=True)
             lam = nested["annual_rate"].sel(structure="Statue")
             # the report's rates are the summary's nested fit (analysis.nested_fit)
-            np.testing.assert_allclose(rates["lambda(state), nested fit [1/yr]"].values, lam.values, rtol=1e-12)
+            np.testing.assert_allclose(
+                rates["lambda(state), nested fit [1/yr]"].values, lam.values, rtol=1e-12
+            )
             apart = state_risk(view, hazard, n_boot=50)["annual_rate"].sel(structure="Statue")
             # fitted apart, the overturning state is overturning's own rate
             np.testing.assert_allclose(
