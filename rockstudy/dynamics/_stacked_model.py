@@ -52,11 +52,20 @@ def _arms(g, s1, s2):
 
 
 @njit(cache=True, inline="always")
-def _columns(g, q1, q2, s1, s2):
+def _trig(q1, q2):
+    """(cos q1, sin q1, cos q2, sin q2): computed once per state and shared by the
+    equations of both corners (:func:`lock_margins`, :func:`post_impact`). (Shortcuts for a
+    resting plinth, q1 = 0, or a locked pair, q2 = q1, measured slower: their branches cost
+    more than the sines they save.)"""
+    return math.cos(q1), math.sin(q1), math.cos(q2), math.sin(q2)
+
+
+@njit(cache=True, inline="always")
+def _columns(g, trig, s1, s2):
     """The Jacobian's velocity columns dRot(theta) v of r_1 and d (theta_1) and of r_2
-    (theta_2), as six floats."""
+    (theta_2) at the angles of ``trig`` (:func:`_trig`), as six floats."""
     r1x, r1y, dx, dy, r2x, r2y = _arms(g, s1, s2)
-    c1, n1, c2, n2 = math.cos(q1), math.sin(q1), math.cos(q2), math.sin(q2)
+    c1, n1, c2, n2 = trig
     return (
         -r1x * n1 + r1y * c1,
         -r1x * c1 - r1y * n1,
@@ -71,10 +80,16 @@ def _columns(g, q1, q2, s1, s2):
 def both_equations(g, q1, q2, w1, w2, s1, s2, ug):
     """M = (m00, m01, m11) and F = (f0, f1) of "both rocking" on the corners (s1, s2)
     (:func:`.stacked.mass_matrix`, :func:`.stacked.forcing`) under u_g'' = ug [m/s^2]."""
+    return _equations(g, _trig(q1, q2), w1, w2, s1, s2, ug)
+
+
+@njit(cache=True, inline="always")
+def _equations(g, trig, w1, w2, s1, s2, ug):
+    """:func:`both_equations` at the angles of ``trig`` (:func:`_trig`)."""
     r1x, r1y, dx, dy, r2x, r2y = _arms(g, s1, s2)
-    c1, n1, c2, n2 = math.cos(q1), math.sin(q1), math.cos(q2), math.sin(q2)
+    c1, n1, c2, n2 = trig
     m1, m2 = g[M1], g[M2]
-    a1x, a1y, adx, ady, a2x, a2y = _columns(g, q1, q2, s1, s2)
+    a1x, a1y, adx, ady, a2x, a2y = _columns(g, trig, s1, s2)
     m00 = m1 * (r1x * r1x + r1y * r1y) + g[I1] + m2 * (dx * dx + dy * dy)
     m01 = m2 * (adx * a2x + ady * a2y)
     m11 = m2 * (r2x * r2x + r2y * r2y) + g[I2]
@@ -139,20 +154,21 @@ def lock_margins(g, y, s1, s2, flat0, flat1, ug, out):
         for j in range(4):
             out[j] = np.inf
         return
+    trig = _trig(y[0], y[1])
     for j in range(2):
         s, p1, p2 = _pivots(j, s1, s2, flat0, flat1)
-        m00, m01, m11, f0, f1 = both_equations(g, y[0], y[1], y[2], y[3], p1, p2, ug)
+        m00, m01, m11, f0, f1 = _equations(g, trig, y[2], y[3], p1, p2, ug)
         lam0, lam1 = multipliers(m00, m01, m11, f0, f1, flat0, flat1)
         out[j] = s * lam0 / g[MOM1] if flat0 else np.inf
         out[2 + j] = s * lam1 / g[MOM2] if flat1 else np.inf
 
 
 @njit(cache=True, inline="always")
-def _momenta(g, q1, q2, p1, p2, v):
+def _momenta(g, trig, p1, p2, v):
     """M at pivots (p1, p2) and the generalised momenta A^T W V of the bodies' velocities v
-    (6,) about them."""
-    m00, m01, m11, _, _ = both_equations(g, q1, q2, 0.0, 0.0, p1, p2, 0.0)
-    a1x, a1y, adx, ady, a2x, a2y = _columns(g, q1, q2, p1, p2)
+    (6,) about them, at the angles of ``trig`` (:func:`_trig`)."""
+    m00, m01, m11, _, _ = _equations(g, trig, 0.0, 0.0, p1, p2, 0.0)
+    a1x, a1y, adx, ady, a2x, a2y = _columns(g, trig, p1, p2)
     mom0 = g[M1] * (a1x * v[0] + a1y * v[1]) + g[I1] * v[2] + g[M2] * (adx * v[3] + ady * v[4])
     mom1 = g[M2] * (a2x * v[3] + a2y * v[4]) + g[I2] * v[5]
     return m00, m01, m11, mom0, mom1
@@ -161,7 +177,7 @@ def _momenta(g, q1, q2, p1, p2, v):
 @njit(cache=True)
 def body_velocities(g, q1, q2, w1, w2, s1, s2, v):
     """V = A q' (6,) of the bodies (:func:`.stacked.body_velocities`), into v."""
-    a1x, a1y, adx, ady, a2x, a2y = _columns(g, q1, q2, s1, s2)
+    a1x, a1y, adx, ady, a2x, a2y = _columns(g, _trig(q1, q2), s1, s2)
     v[0], v[1], v[2] = a1x * w1, a1y * w1, w1
     v[3], v[4], v[5] = adx * w1 + a2x * w2, ady * w1 + a2y * w2, w2
 
@@ -173,9 +189,10 @@ def post_impact(g, q1, q2, v, s1, s2, flat0, flat1, margins):
     impulse margins into ``margins`` (as :func:`lock_margins`, not normalised; NaN for an
     open interface): :func:`.stacked.post_impact_velocity`."""
     w1 = w2 = 0.0
+    trig = _trig(q1, q2)
     for j in range(2):
         s, p1, p2 = _pivots(j, s1, s2, flat0, flat1)
-        m00, m01, m11, mom0, mom1 = _momenta(g, q1, q2, p1, p2, v)
+        m00, m01, m11, mom0, mom1 = _momenta(g, trig, p1, p2, v)
         if j == 0:
             w1, w2 = reduced_solve(m00, m01, m11, mom0, mom1, flat0, flat1)
         lam0, lam1 = multipliers(m00, m01, m11, mom0, mom1, flat0, flat1)
