@@ -35,8 +35,12 @@ def client():
     local cluster of threads in the test process, so that ``run_study(..., client=client)``
     starts no worker process. The tests of the worker processes themselves (kills, Ctrl-C,
     lost workers) start their own clusters or real ``rockstudy run`` processes."""
+    import dask
     from distributed import Client
 
+    from rockstudy.study.running.runner import NO_PROFILER
+
+    dask.config.set(NO_PROFILER)  # the profiler's thread can crash CPython 3.11 (runner.py)
     with Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=":0") as c:
         yield c
 

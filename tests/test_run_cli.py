@@ -274,11 +274,20 @@ def test_a_failing_write_is_one_error_line_and_resume_finishes(tmp_path):
 # ------------------------------------------------------------------ clusters
 
 
-def test_local_cluster_opens_no_dashboard():
+def test_local_cluster_opens_no_dashboard_and_runs_no_profiler():
+    """No dashboard; and no statistical profiler, whose thread reads the other threads'
+    frames (it crashed CPython 3.11 in a test's cluster), whatever dask's config says."""
+    import dask
+    import distributed  # noqa: F401 - its config defaults, before they are changed
+
     from rockstudy.study.running.runner import _client
 
-    client, cluster = _client(workers=1)
+    with dask.config.set({"distributed.worker.profile.enabled": True}):
+        client, cluster = _client(workers=1)
     try:
+        callbacks = client.run(lambda dask_worker: sorted(dask_worker.periodic_callbacks))
+        (names,) = callbacks.values()
+        assert "heartbeat" in names and "profile" not in names
         port = cluster.scheduler.http_server._sockets  # noqa: SLF001
         ports = {sock.getsockname()[1] for sock in port.values()}
         assert 8787 not in ports

@@ -277,6 +277,14 @@ def _remote_client(scheduler, scheduler_file, security, timeout):
     return client
 
 
+#: dask's statistical profiler samples every thread's frames (``sys._current_frames``) from
+#: a thread of its own, which can crash CPython 3.11 when a sampled thread's frame goes away
+#: under it (a segmentation fault in ``distributed/profile.py``, seen in the tests' in-process
+#: cluster); it feeds only the dashboard's profile page, which rockstudy's clusters do not
+#: serve, and sees nothing inside the numba kernels: it is off.
+NO_PROFILER = {"distributed.worker.profile.enabled": False}
+
+
 def _local_cluster(workers):
     """A local cluster on loopback, without a dashboard, whose workers ignore Ctrl-C (the
     client handles it: one message, then the cluster is closed)."""
@@ -292,7 +300,7 @@ def _local_cluster(workers):
         # no HTTP routes anywhere: the scheduler's and the workers' servers (which dask always
         # starts) answer 404 to everything, /metrics and /health included
         routes = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
-        with dask.config.set(routes):
+        with dask.config.set({**routes, **NO_PROFILER}):
             return LocalCluster(
                 n_workers=workers or 2,
                 threads_per_worker=1,
