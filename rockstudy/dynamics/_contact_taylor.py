@@ -10,12 +10,16 @@ events on the contact forces, slip (``|F|`` = mu_s N) and lift-off (N = 0), on t
 :func:`.slide_rock.contact_forces` along the polynomial (theta, theta_dot and theta_ddot
 from its value and derivatives, the ground interpolated linearly).
 
-The force events are screened on three points of the step (its ends and its middle): where
-every g = mu_s N - ``|F|`` and N there exceeds :data:`FORCE_MARGIN` times its spread over
-them, no crossing is looked for; otherwise (and on the first step of a regime, where the
-regime's start may violate a force condition at once) g is sampled at the DOP853 steps'
-points (:data:`._contact_steps.EVENT_POINTS`, and :data:`._contact_steps.FRESH_POINTS` on a
-first step) and its first crossing bisected on the polynomial to the ulp of the step.
+The force events are first bounded over the whole step from its series, without a sine, a
+cosine or an evaluation of the polynomial (:func:`_forces_away`): where every g = mu_s N -
+``|F|`` and N stays above 0 throughout, no crossing can exist and none is looked for (the
+outcome the evaluations below would give, to the bit). Otherwise they are screened on three
+points of the step (its ends and its middle): where every g there exceeds
+:data:`FORCE_MARGIN` times its spread over them, no crossing is looked for; otherwise (and
+on the first step of a regime, where the regime's start may violate a force condition at
+once) g is sampled at the DOP853 steps' points (:data:`._contact_steps.EVENT_POINTS`, and
+:data:`._contact_steps.FRESH_POINTS` on a first step) and its first crossing bisected on the
+polynomial to the ulp of the step.
 """
 
 from __future__ import annotations
@@ -29,10 +33,15 @@ from ..constants import FALL_ROTATION, G
 from ..motions._kernels import KIND_RECORD
 from . import _contact_steps as cs
 from . import slide_rock as sr
+from ._demand import BOUND_MARGIN, _product, _square
 from ._taylor import (
+    FMA,
     MODEL_NONLINEAR,
     NO_REFCOUNT,
     OF_VALUE,
+    ROW_C,
+    ROW_C_SERIES,
+    ROW_S,
     poly_end,
     poly_root,
     poly_value,
@@ -69,6 +78,64 @@ def rock_force_events(c, n, x, hs, side, static, radius, alpha, gr):
     a_v = gr[2] + x * (gr[3] - gr[2])
     f_h, f_v = sr.contact_forces(th, d / hs, dd / (hs * hs), 0.0, a_h, a_v, side, radius, alpha)
     return static * f_v - f_h, static * f_v + f_h, f_v
+
+
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _series_spans(c, n):
+    """Over the step (x in [0, 1]): the radius of theta about c_0, and the (lo, hi) of the
+    polynomial's first and second x-derivatives, each term c_k x^k (k >= 1) of its sign
+    between 0 and its value at x = 1."""
+    r_th = abs(c[1])
+    d_lo = d_hi = c[1]
+    dd_lo = dd_hi = 2.0 * c[2]
+    for k in range(2, n + 1):
+        ck = c[k]
+        r_th += abs(ck)
+        dk = k * ck
+        d_lo, d_hi = d_lo + min(dk, 0.0), d_hi + max(dk, 0.0)
+        if k >= 3:
+            ddk = (k - 1) * dk
+            dd_lo, dd_hi = dd_lo + min(ddk, 0.0), dd_hi + max(ddk, 0.0)
+    return r_th, d_lo, d_hi, dd_lo, dd_hi
+
+
+@njit(cache=True, inline="always")
+def _trig_span(a, b, r):
+    """The interval of a cos(d) + b sin(d) over ``|d|`` <= r (the sine or cosine of an angle
+    within r of one whose sine and cosine are a and b): a +- (``|a|`` r^2 / 2 + ``|b|`` r)."""
+    e = 0.5 * abs(a) * r * r + abs(b) * r
+    return a - e, a + e
+
+
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _forces_away(w, n, hs, blk, gr):
+    """Whether every force event's g (:func:`rock_force_events`) stays above 0 throughout
+    the step, by a bound over it (no evaluation, no sine or cosine): intervals of theta_dot^2
+    and theta_ddot from the polynomial's coefficients (:func:`_series_spans`), of S = sin x
+    and C = cos x (x = alpha s - theta; s sin(phi) = S, cos(phi) = C in
+    :func:`.slide_rock.contact_forces`) about their values at the start (w[ROW_S, 0],
+    w[ROW_C_SERIES, 0]), and of the ground between its ends; each g's lower bound must
+    exceed :data:`._demand.BOUND_MARGIN` times the forces' size (the rounding of the
+    evaluations it stands for)."""
+    c = w[ROW_C]
+    r_th, d_lo, d_hi, dd_lo, dd_hi = _series_spans(c, n)
+    s0, c0 = w[ROW_S, 0], w[ROW_C_SERIES, 0]
+    sl, sh = _trig_span(s0, c0, r_th)
+    cl, ch = _trig_span(c0, s0, r_th)
+    q = blk.radius / (hs * hs)
+    tl, th = q * dd_lo, q * dd_hi  # R theta_ddot
+    wl, wh = _square(d_lo, d_hi)
+    wl, wh = q * wl, q * wh  # R theta_dot^2
+    a_h0, a_h1, a_v0, a_v1 = gr
+    tc, ws = _product(tl, th, cl, ch), _product(wl, wh, sl, sh)
+    h_lo = min(a_h0, a_h1) + tc[0] + ws[0]
+    h_hi = max(a_h0, a_h1) + tc[1] + ws[1]
+    ts, wc = _product(tl, th, sl, sh), _product(wl, wh, cl, ch)
+    v_lo = G + min(a_v0, a_v1) + ts[0] - wc[1]
+    v_hi = G + max(a_v0, a_v1) + ts[1] - wc[0]
+    mu = blk.static
+    size = BOUND_MARGIN * (max(-h_lo, h_hi) + (1.0 + mu) * max(-v_lo, v_hi))
+    return v_lo > size and mu * v_lo - h_hi > size and mu * v_lo + h_lo > size
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -175,7 +242,10 @@ def rock_step(w, prev, blk, gr, th, om, side, hs, tol, fresh):
         ev, s_ev = cs.EV_IMPACT, s_imp
     elif side * th1 >= FALL_ROTATION:
         ev, s_ev = cs.EV_FALL, poly_root(c, n, side * FALL_ROTATION, -side, OF_VALUE, 0.0, 1.0)
-    ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev, prev)
+    if fresh or not _forces_away(w, n, hs, blk, gr):
+        ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev, prev)
+    else:
+        ev_f, s_f = cs.EV_NONE, 2.0
     if s_f <= s_ev:
         ev, s_ev = ev_f, s_f
     du_end = side * (poly_value(c, n, s_ev)[1] if s_ev < 1.0 else dth1)
