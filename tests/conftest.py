@@ -16,7 +16,7 @@ import pytest
 
 from rockstudy._numba_cache import serialize_cache_writes
 
-# The tests run in two processes (pytest-xdist): their numba cache saves must not race.
+# The tests run in several processes (pytest-xdist): their numba cache saves must not race.
 serialize_cache_writes()
 
 RECORDS = Path(
