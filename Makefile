@@ -58,11 +58,10 @@ demo: $(BASE)
 	  report=$$!; $(BIN)/rockstudy demo --out results/demo; demo=$$?; \
 	  wait $$report && exit $$demo
 
-# The tests run in three processes (pytest-xdist), a test file to each at a time: many tests
-# wait on subprocesses and clusters, and a third process fills those waits (552 s against 588 s
-# with two, on 2 cores)
+# The tests run in two processes (pytest-xdist), a test file to each at a time, the longest
+# files first (tests/conftest.py)
 test: $(KERNELS) debian docs
-	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q -n 3 --dist loadfile --durations=15
+	ROCKSTUDY_DOCS_HTML=$(CURDIR)/docs/_build/html $(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=15
 
 # The documentation site (Sphinx, numpydoc, sphinx-gallery; examples executed), warnings as
 # errors, into docs/_build/html

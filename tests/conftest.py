@@ -19,6 +19,23 @@ from rockstudy._numba_cache import serialize_cache_writes
 # The tests run in several processes (pytest-xdist): their numba cache saves must not race.
 serialize_cache_writes()
 
+#: The test files that take longest, run first: the two processes take files in the order
+#: collected, so a long file collected late would leave one process working alone at the end.
+LONGEST_FIRST = (
+    "test_first_result.py",
+    "test_study.py",
+    "test_run_cli.py",
+    "test_contact_kernel.py",
+)
+
+
+def pytest_collection_modifyitems(items):
+    """Put the items of :data:`LONGEST_FIRST` first (a stable sort: the rest keep their
+    order)."""
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
+
+
 RECORDS = Path(
     os.environ.get("ROCKSTUDY_RECORDS")
     or Path(__file__).resolve().parents[1].parent / "shared" / "records"
