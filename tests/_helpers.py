@@ -25,6 +25,7 @@ import xarray as xr
 from rockstudy import simulate_batch
 from rockstudy.constants import STANDARD_GRAVITY
 from rockstudy.constants import STANDARD_GRAVITY as G_UNIT
+from rockstudy.motions import synthetic_near_fault
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The installed ``rockstudy`` command (for the few tests that need a real process).
@@ -256,10 +257,27 @@ def write_at2(path, record):
     path.write_text("\n".join(lines) + "\n")
 
 
+def write_ground_pairs(folder, n, x, y, duration):
+    """``n`` ground pairs of synthetic near-fault pulses in ``folder``: ``p{i}_X.AT2`` and
+    ``p{i}_Y.AT2`` for i = 0 .. n - 1.
+
+    ``x`` and ``y`` describe the two components as ``(period, step, pga, seed)``: pair i's
+    component is the pulse of period ``period + step * i`` s, that ``pga`` (in g) and seed
+    ``seed + i``, ``duration`` s long.
+    """
+    for i in range(n):
+        for part, (period, step, pga, seed) in (("X", x), ("Y", y)):
+            rec = synthetic_near_fault(
+                pulse_period=period + step * i, pga=pga, seed=seed + i, duration=duration
+            )
+            write_at2(folder / f"p{i}_{part}.AT2", rec)
+    return folder
+
+
 def write_near_fault_pairs(folder):
     """Three synthetic near-fault records in ``folder``: horizontal ``nf{i}_H.AT2`` and
     vertical ``nf{i}_UP.AT2`` files."""
-    from rockstudy.motions import Record, synthetic_near_fault
+    from rockstudy.motions import Record
 
     for i, tp in enumerate((0.5, 0.8, 1.2)):
         rec = synthetic_near_fault(
@@ -272,8 +290,6 @@ def write_near_fault_pairs(folder):
 
 def write_two_records(folder):
     """Two small synthetic near-fault records ``r0.AT2``, ``r1.AT2`` in ``folder``."""
-    from rockstudy.motions import synthetic_near_fault
-
     for i, tp in enumerate((0.5, 1.0)):
         rec = synthetic_near_fault(pulse_period=tp, pga=3.0, seed=20 + i, duration=4.0)
         write_at2(folder / f"r{i}.AT2", rec)

@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from _helpers import write_at2
+from _helpers import write_ground_pairs
 
-from rockstudy.motions import Building, Record, floor_motion, synthetic_near_fault
+from rockstudy.motions import Building, Record, floor_motion
 from rockstudy.motions.building import with_ground
 from rockstudy.study import load_study, run_study
 from rockstudy.study.analysis.orientations import orientation_summary
@@ -61,12 +61,7 @@ value = { dist = "grid", values = [1.0, 2.5] }"""
 def pairs(tmp_path_factory):
     """Two ground pairs of different near-fault pulses (x, y), as AT2 files."""
     folder = tmp_path_factory.mktemp("pairs")
-    for i in range(2):
-        x = synthetic_near_fault(pulse_period=0.5 + 0.3 * i, pga=2.5, seed=60 + i, duration=3.0)
-        y = synthetic_near_fault(pulse_period=0.7 + 0.2 * i, pga=3.5, seed=70 + i, duration=3.0)
-        write_at2(folder / f"p{i}_X.AT2", x)
-        write_at2(folder / f"p{i}_Y.AT2", y)
-    return folder
+    return write_ground_pairs(folder, 2, x=(0.5, 0.3, 2.5, 60), y=(0.7, 0.2, 3.5, 70), duration=3.0)
 
 
 def _study(folder, where, floor, design):

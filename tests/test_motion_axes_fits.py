@@ -16,9 +16,8 @@ import numpy as np
 import pandas as pd
 import pytest
 import xarray as xr
-from _helpers import cli, write_at2
+from _helpers import cli, write_ground_pairs
 
-from rockstudy.motions import synthetic_near_fault
 from rockstudy.risk import HazardCurve
 from rockstudy.study import load_study, run_study
 from rockstudy.study.analysis.orientations import orientation_summary
@@ -63,12 +62,7 @@ def study_file(folder, where, design=DESIGN, floor="[0, 2]"):
 def pairs(tmp_path_factory):
     """Three ground pairs of near-fault pulses (x, y) as AT2 files."""
     folder = tmp_path_factory.mktemp("pairs")
-    for i in range(3):
-        x = synthetic_near_fault(pulse_period=0.6 + 0.3 * i, pga=2.5, seed=40 + i, duration=4.0)
-        y = synthetic_near_fault(pulse_period=0.8 + 0.2 * i, pga=4.0, seed=50 + i, duration=4.0)
-        write_at2(folder / f"p{i}_X.AT2", x)
-        write_at2(folder / f"p{i}_Y.AT2", y)
-    return folder
+    return write_ground_pairs(folder, 3, x=(0.6, 0.3, 2.5, 40), y=(0.8, 0.2, 4.0, 50), duration=4.0)
 
 
 @pytest.fixture(scope="module")

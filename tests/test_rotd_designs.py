@@ -13,10 +13,10 @@ import numpy as np
 import pandas as pd
 import pyrotd
 import pytest
-from _helpers import RECORD_STUDY_HEAD, write_at2
+from _helpers import RECORD_STUDY_HEAD, write_ground_pairs
 
 from rockstudy.constants import STANDARD_GRAVITY
-from rockstudy.motions import Record, synthetic_near_fault
+from rockstudy.motions import Record
 from rockstudy.study import StudyError, load_study, run_study
 from rockstudy.study.analysis.record_fragility import ida_fragility
 from rockstudy.study.analysis.risk import object_risk
@@ -36,11 +36,7 @@ def pairs(tmp_path_factory):
     """Two records of two components, p{i}_X.AT2 and p{i}_Y.AT2 (the y one of another
     pulse, the stronger)."""
     folder = tmp_path_factory.mktemp("rotd_pairs")
-    for i, (tx, ty) in enumerate(((0.7, 0.9), (1.0, 1.1))):
-        for part, period, pga, seed in (("X", tx, 2.5, 60 + i), ("Y", ty, 4.0, 70 + i)):
-            rec = synthetic_near_fault(pulse_period=period, pga=pga, seed=seed, duration=4.0)
-            write_at2(folder / f"p{i}_{part}.AT2", rec)
-    return folder
+    return write_ground_pairs(folder, 2, x=(0.7, 0.3, 2.5, 60), y=(0.9, 0.2, 4.0, 70), duration=4.0)
 
 
 def pair_of(folder, i):

@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 import xarray as xr
-from _helpers import RECORD_STUDY_HEAD, write_at2
+from _helpers import RECORD_STUDY_HEAD, write_ground_pairs
 
 import rockstudy as rs
-from rockstudy.motions import Building, Record, floor_motion, synthetic_near_fault
+from rockstudy.motions import Building, Record, floor_motion
 from rockstudy.study import load_study, run_study
 from rockstudy.study.analysis.orientations import orientation_capacities, orientation_summary
 from rockstudy.study.report.sampled import make_report
@@ -23,21 +23,11 @@ H2 = 'h2 = { match = "_X\\\\.AT2$", replace = "_Y.AT2" }'
 ANGLES = [0.0, math.pi / 2, math.pi]
 
 
-def components(i):
-    """The x and y components of record i (different pulses: the y one the stronger)."""
-    x = synthetic_near_fault(pulse_period=0.6 + 0.3 * i, pga=2.5, seed=40 + i, duration=4.0)
-    y = synthetic_near_fault(pulse_period=0.8 + 0.2 * i, pga=4.0, seed=50 + i, duration=4.0)
-    return x, y
-
-
 @pytest.fixture(scope="module")
 def pairs(tmp_path_factory):
+    """Two ground pairs of near-fault pulses (x, y; the y one the stronger) as AT2 files."""
     folder = tmp_path_factory.mktemp("pairs")
-    for i in range(2):
-        x, y = components(i)
-        write_at2(folder / f"p{i}_X.AT2", x)
-        write_at2(folder / f"p{i}_Y.AT2", y)
-    return folder
+    return write_ground_pairs(folder, 2, x=(0.6, 0.3, 2.5, 40), y=(0.8, 0.2, 4.0, 50), duration=4.0)
 
 
 def study_file(folder, where, motion, design, extra=""):
