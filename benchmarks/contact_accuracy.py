@@ -2,8 +2,8 @@
 reference on random record and pulse scenes.
 
 Sources: the five real records of shared/records (``ROCKSTUDY_RECORDS`` to move it; those
-absent are left out), the eight synthetic near-fault records shipped with rockstudy
-(:mod:`rockstudy.motions.shipped`, with their vertical components), each cut to
+absent are left out and named on stderr), the eight synthetic near-fault records shipped
+with rockstudy (:mod:`rockstudy.motions.shipped`, with their vertical components), each cut to
 ``--window`` seconds from 2 s before its peak (the reference's cost grows with the samples
 it crosses in motion), and sine, cosine and half-sine pulses (period 0.2-2 s). Scene i
 takes source i mod 16 and draws R 0.3-3 m, alpha 0.05-0.5, mu 0.1-1.0 and a peak of
@@ -36,9 +36,11 @@ flagged.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import os
+import sys
 import tempfile
 import time
 import warnings
@@ -87,16 +89,38 @@ def window(t, a_h, a_v, seconds):
     return t[cut] - t[k0], a_h[cut], None if a_v is None else a_v[cut]
 
 
+@functools.cache
+def shared_paths():
+    """The paths of the shared records (:data:`SHARED`) found in :data:`RECORDS`; those
+    absent are named on stderr, once, with the folder they were looked for in."""
+    found = [RECORDS / name for name in SHARED if (RECORDS / name).exists()]
+    missing = [name for name in SHARED if not (RECORDS / name).exists()]
+    if missing:
+        print(
+            f"{len(missing)} of the {len(SHARED)} shared records not found in {RECORDS} "
+            f"(ROCKSTUDY_RECORDS moves it), left out: {', '.join(missing)}",
+            file=sys.stderr,
+        )
+    return found
+
+
+def record_counts(names):
+    """'n records (r real, s shipped)' of the record ``names`` (pulses are not counted)."""
+    names = list(names)
+    real = sum(name in SHARED for name in names)
+    shipped = sum(name not in SHARED and name not in PULSES for name in names)
+    return f"{real + shipped} records ({real} real, {shipped} shipped)"
+
+
 def records(seconds):
-    """[(name, t, a_h, a_v or None)] of the shared and the shipped records, windowed."""
+    """[(name, t, a_h, a_v or None)] of the shared records found (:func:`shared_paths`) and
+    the shipped ones, windowed."""
     import rockstudy as rs
     from rockstudy.motions.shipped import write_shipped_suite
 
     out = []
-    for name in SHARED:
-        path = RECORDS / name
-        if not path.exists():
-            continue
+    for path in shared_paths():
+        name = path.name
         if name.endswith(".AT2"):
             rec = rs.motions.Record.from_at2(path)
         else:
@@ -181,6 +205,7 @@ def run(args):
     """Append the reference of every scene below ``--scenes`` not yet in ``--out``."""
     recs = record_motions(args.window)
     names = sources(recs)
+    print(f"sources: {record_counts(names)} and {len(PULSES)} pulses")
     if args.out.exists():  # a line cut by a stopped run is dropped
         text = args.out.read_text()
         args.out.write_text(text[: text.rfind("\n") + 1])
@@ -338,7 +363,8 @@ def report(args):
     counts = sum((regimes(r["ref"]) for r in rows), np.zeros(4, int))
     cpu = sum(r["cpu"] for r in rows)
     print(
-        f"{len(rows)} scenes ({sum(r['source'] in PULSES for r in rows)} pulses), reference "
+        f"{len(rows)} scenes ({sum(r['source'] in PULSES for r in rows)} pulses; on "
+        f"{record_counts({r['source'] for r in rows})}), reference "
         f"rtol {REFERENCE_RTOL:g}: {cpu:.0f} CPU s; {incomplete} stopped at the reference's "
         "cap of phases (left out)"
     )

@@ -24,7 +24,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from contact_accuracy import records
+from contact_accuracy import record_counts, records
 
 from rockstudy.motions import Record
 from rockstudy.structures import Block, IsolatedBlock, StackedBlocks
@@ -76,7 +76,8 @@ def main(argv=None):
     args = ap.parse_args(argv)
     recs = suite(args.records, args.n_records)
     kw = dict(step=args.step, tolerance=args.tolerance, scan=args.scan, rtol=args.rtol)
-    print(f"{len(recs)} records ({args.records}): {', '.join(r.name for r in recs)}")
+    names = [r.name for r in recs]
+    print(f"{record_counts(names)} ({args.records}): {', '.join(names)}")
     for kind in args.kinds:
         structures = objects(kind)  # the design's two_body column, as a study gives it
         incremental_dynamic_analysis(recs[:1], structures[:1], **kw)

@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 from bench_closedform import median_time
-from contact_accuracy import records
+from contact_accuracy import record_counts, records
 
 from rockstudy.constants import G
 from rockstudy.dynamics.batch import simulate_batch
@@ -110,7 +110,8 @@ def main(argv=None):
     recs = records(args.seconds)
     rng = np.random.default_rng(2026)
     stacked, single, statue = ratio(recs, args.objects, args.rtol, args.repeat, rng)
-    print(f"{len(recs)} records x {args.objects} objects at rtol {args.rtol:g}")
+    counts = record_counts(r[0] for r in recs)
+    print(f"{counts} x {args.objects} objects at rtol {args.rtol:g}")
     print(f"stacked kernel: {stacked:9.1f} scenes/s")
     print(f"single block  : {single:9.1f} scenes/s")
     print(f"ratio stacked / single: {stacked / single:.1%}")
