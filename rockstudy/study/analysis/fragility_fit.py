@@ -45,7 +45,7 @@ import numpy as np
 from scipy import optimize, special, stats
 
 from ... import _validate
-from ..._warnings import SeparationWarning
+from ..._warnings import SeparationWarning, caller_stacklevel
 
 __all__ = [
     "BAND_COLUMNS",
@@ -235,14 +235,15 @@ def separation_message(kind, low, high, unit="") -> str:
     )
 
 
-def warn_if_separated(where, label, im, n_overturned, n_total, unit="", depth=1) -> tuple:
+def warn_if_separated(where, label, im, n_overturned, n_total, unit="") -> tuple:
     """:func:`separation` of the outcomes of group ``label``, with a
-    :class:`~rockstudy.SeparationWarning` from ``where`` (the public function, ``depth``
-    calls up from the caller) if they have no maximum (:data:`NO_MAXIMUM`)."""
+    :class:`~rockstudy.SeparationWarning` from ``where`` (the public function; the warning
+    points at the user's call, :func:`~rockstudy._warnings.caller_stacklevel`) if they have
+    no maximum (:data:`NO_MAXIMUM`)."""
     kind, low, high = separation(im, n_overturned, n_total)
     if kind in NO_MAXIMUM:
         message = f"{where}: group {str(label)!r}: {separation_message(kind, low, high, unit)}"
-        warnings.warn(message, SeparationWarning, stacklevel=2 + depth)
+        warnings.warn(message, SeparationWarning, stacklevel=caller_stacklevel())
     return kind, low, high
 
 
@@ -294,7 +295,7 @@ def fit_binomial(im, n_overturned, n_total, start=None) -> tuple[float, float]:
         return (np.inf, np.nan) if z.sum() == 0 else (0.0, np.nan)
     if kind in NO_MAXIMUM:
         message = separation_message(kind, np.exp(s), np.exp(o))
-        warnings.warn(f"fit_binomial: {message}", SeparationWarning, stacklevel=2)
+        warnings.warn(f"fit_binomial: {message}", SeparationWarning, stacklevel=caller_stacklevel())
         return np.nan, np.nan
     return _binomial_mle(x, z, n, start)
 

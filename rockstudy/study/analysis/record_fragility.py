@@ -27,6 +27,7 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
+from ..._warnings import caller_stacklevel
 from ...motions import measures
 from ...motions.measures import MEASURES, RATIOS
 from ..spec.design_kinds import DESIGN_KINDS, kind_of
@@ -347,11 +348,11 @@ def _exact_intervals(theta, beta, n, conf_level):
 def _warn_equal_capacities(label, theta, n, unit):
     """Warn that the ``n`` capacities of group ``label`` are all ``theta``: beta = 0."""
     warnings.warn(
-        f"ida_fragility: the {n} capacities of group {label!r} are all {theta:.6g} {unit}: "
+        f"ida_fragility: the {n} capacities of group {str(label)!r} are all {theta:.6g} {unit}: "
         "beta = 0 is a step, not a record-to-record dispersion (the same record more than "
         "once in the suite?); its intervals are NaN",
         UserWarning,
-        stacklevel=3,
+        stacklevel=caller_stacklevel(),
     )
 
 
@@ -433,7 +434,7 @@ def ida_fragility(
                     "which they are not (they share the record); give n_boot > 0 to resample "
                     "records",
                     UserWarning,
-                    stacklevel=2,
+                    stacklevel=caller_stacklevel(),
                 )
         x = np.where(cens, t, c)[keep]
         row = _row(label, theta, beta, band, keep.sum(), x, unit, by, cov, method, conf_level)

@@ -59,9 +59,9 @@ import numpy as np
 import xarray as xr
 
 from ... import _validate, risk
+from ..._warnings import UnitsWarning, caller_stacklevel
 from ...constants import G
 from ...risk.units import to_si
-from ...warnings import UnitsWarning
 from ..spec.design_kinds import design_kind, kind_of
 from . import record_fragility as rf
 from .fragility_fit import (
@@ -388,7 +388,9 @@ def object_risk(
     im, period = _check_hazard(ds, hazard)
     off = risk.suite_off_curve(hazard, records_measure(ds, hazard))
     if off is not None:
-        warnings.warn(f"hazard: {off}; check the units of both", UnitsWarning, stacklevel=2)
+        warnings.warn(
+            f"hazard: {off}; check the units of both", UnitsWarning, stacklevel=caller_stacklevel()
+        )
     unit = rf.quoted(im)[0]
     fitter = globals()[kind.risk_fitter](ds, im, period)
     if refit is not None:

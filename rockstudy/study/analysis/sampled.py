@@ -340,7 +340,7 @@ def fragility_samples(
 def _bernoulli_row(name, x, z, by, n_boot, conf_level, rng):
     """The fragility row of one group of samples: fit, intervals, covariance."""
     ones = np.ones(z.size)
-    kind, low, high = warn_if_separated("fragility", name, x, z, ones, depth=2)
+    kind, low, high = warn_if_separated("fragility", name, x, z, ones)
     if kind in NO_MAXIMUM:  # separated or no rise: no maximum, no fit
         return no_maximum_row(name, kind, low, high, z.size, x, by, conf_level)
     theta, beta = fit_binomial(x, z, ones)

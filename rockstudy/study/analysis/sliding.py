@@ -302,12 +302,15 @@ def contact_effect(ds: xr.Dataset, hazard, years: float = 50.0, **kw) -> xr.Data
     return out
 
 
+@per_motion
 def regimes(ds: xr.Dataset) -> pd.DataFrame:
     """Which regime each record drove each object into: the ``regime`` output (the most
     involved regime entered, :data:`REGIME_NAMES`) as names, index (object, record), one
     column (a cloud) or one per level (stripes); "not converged" where the contact model's
     answer did not converge with rtol (``status`` 4), "not run" where a point did not run
-    (or failed otherwise)."""
+    (or failed otherwise). A design over floors and orientations gives the table of each
+    (floor, orientation) under those outer index levels
+    (:func:`~rockstudy.study.analysis.motion_axes.per_motion`)."""
     if "regime" not in ds:
         raise ValueError("ds: holds no regime: run the design with the contact model")
     dims = [k for k in ("structure", "record", "level") if k in ds["regime"].dims]

@@ -14,6 +14,7 @@ import json
 import numpy as np
 import xarray as xr
 
+from .motion_axes import per_motion
 from .risk import object_risk
 
 __all__ = ["isolator_capacities", "over_capacity", "pair_ratios", "study_objects", "study_pairs"]
@@ -75,6 +76,7 @@ def _paired_band(boot_a, boot_b, conf_level):
     return float(lo), float(hi), int(ok.sum())
 
 
+@per_motion
 def pair_ratios(ds: xr.Dataset, hazard, pairs=None, years: float = 50.0, **kw) -> xr.Dataset:
     """What a plinth or an isolator buys: per pair (two-body object, its plain twin), the
     ratio of their annual rates of overturning (two-body / plain: below 1, the plinth or the
@@ -106,7 +108,9 @@ def pair_ratios(ds: xr.Dataset, hazard, pairs=None, years: float = 50.0, **kw) -
         On ``pair`` (the two-body object's name), with ``plain`` (its twin's name):
         ``annual_rate`` and ``status`` of each (``annual_rate_plain``, ``status_plain``),
         ``ratio`` (NaN where either rate is not estimable or both are 0; inf where only the
-        plain one is 0), ``ratio_lo``, ``ratio_hi`` and ``n_resamples``.
+        plain one is 0), ``ratio_lo``, ``ratio_hi`` and ``n_resamples``. A design over
+        floors and orientations gives those of each (floor, orientation), on those
+        dimensions too (:func:`~rockstudy.study.analysis.motion_axes.per_motion`).
     """
     pairs = study_pairs(ds) if pairs is None else [tuple(p) for p in pairs]
     known = set(map(str, ds["structure"].values))
