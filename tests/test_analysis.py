@@ -270,8 +270,9 @@ def test_sobol_of_a_rotation_with_falls_warns():
     ds, names = ishigami_cube(n=2**8)
     over = (np.arange(ds.sizes["sample"]) % 5 == 0).astype(np.int8)
     ds = ds.assign(overturned=("sample", over), max_rotation_ratio=ds["y"])
-    with pytest.warns(UserWarning, match="mix overturning with the rocking amplitude"):
+    with pytest.warns(UserWarning, match="mix overturning with the rocking amplitude") as got:
         analysis.sobol_indices(ds, "max_rotation_ratio", num_resamples=10)
+    assert {w.filename for w in got} == {__file__}, "the warning points at the caller's line"
 
 
 def test_lack_of_fit_holds_its_level_and_rejects_a_probability_that_levels_off():

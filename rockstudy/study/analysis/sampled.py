@@ -24,6 +24,7 @@ import xarray as xr
 from scipy import special
 from scipy.spatial import cKDTree
 
+from ..._warnings import caller_stacklevel
 from ..spec.schema import Study
 from .fragility_fit import (
     BAND_COLUMNS,
@@ -121,7 +122,7 @@ def warn_if_rotation_of_overturned(ds, output, who) -> None:
             "'overturned' for overturning, and the survivors' rotation with "
             "first_order_given_data on ds.where(ds.overturned == 0, drop=True)",
             UserWarning,
-            stacklevel=3,
+            stacklevel=caller_stacklevel(),
         )
 
 
