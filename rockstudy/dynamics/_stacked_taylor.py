@@ -176,3 +176,16 @@ def both_state(w, n, sigma, h, out):
             v = v * sigma + w[Q1 + a, k]
             d = d * sigma + k * w[Q1 + a, k]
         out[a], out[2 + a] = v * sigma + w[Q1 + a, 0], d / h
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def one_body_series(w, c, n, k, y, h):
+    """Keep the scaled series c (order n) of a one-body regime's step of length h from y
+    (:func:`._stacked_steps.one_body_step`, its angle theta = y[k]) as both angles' series
+    for :func:`both_state`: theta_2 = theta_1 of the locked assembly (k = 0), theta_1 at rest
+    under the upper block alone (k = 1)."""
+    for j in range(n + 1):
+        w[Q1 + k, j] = c[j]
+        w[Q2 - k, j] = c[j] if k == 0 else 0.0
+    if k == 1:
+        w[Q1, 0], w[Q1, 1] = y[0], h * y[2]
