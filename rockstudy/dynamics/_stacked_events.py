@@ -31,7 +31,7 @@ from ._stacked_steps import (
     interface_data,
     state_at,
 )
-from ._stacked_taylor import both_state
+from ._stacked_taylor import both_state, series_clear
 from ._taylor import NO_REFCOUNT, ROOT_ITERATIONS, ROOT_TOL
 
 #: Samples of the interpolant per step at which the impacts and peaks are sought.
@@ -256,7 +256,11 @@ def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w, rates):
                 if sig < best:
                     best, kind, iface, corner = sig, EVENT_UPLIFT, k, 1 - 2 * j
             continue
-        sig = impact_fraction(k, s, h, y0, f0, y1, f1, rates[k])
+        if w[K_INFO, 0] == DENSE_TAYLOR and series_clear(w, int(w[K_INFO, 2]), k, s):
+            rates[k, :] = np.nan  # no impact, and no peak for step_peaks
+            sig = 2.0
+        else:
+            sig = impact_fraction(k, s, h, y0, f0, y1, f1, rates[k])
         if sig < best:
             best, kind, iface, corner = sig, EVENT_IMPACT, k, s
         sig = fall_fraction(k, s, h, y0, f0, y1, f1)
