@@ -139,6 +139,8 @@ def main(argv=None):
     print(f"ratio stacked / single: {stacked / single:.1%}")
     print(f"(single block with the statue's columns: {statue:9.1f} scenes/s, ratio ", end="")
     print(f"{stacked / statue:.1%})")
+    if args.ida_records < 1:
+        return
     seconds, fell = ida(recs[: args.ida_records], args.rungs, args.rtol, rng)
     print(
         f"IDA {min(len(recs), args.ida_records)} records x 6 stacked objects x {args.rungs} "
