@@ -11,13 +11,16 @@ synthetic near-fault records shipped with rockstudy (horizontal components only)
    ``simulate_batch(structure=...)`` (the numba kernel, rows in parallel), the single-block
    rows through ``simulate_batch(half_diagonal=, slenderness=)`` with the plinth's columns and
    the same scales (and, for comparison, with the statue's columns), all at ``--rtol``,
-   timed in wall seconds (median of ``--repeat`` after a warm call; the machine is shared).
-   Printed: scenes/s of each over all records and the ratios, all in this one run.
+   timed in wall seconds (median of ``--repeat`` after a warm call; the machine is shared),
+   or with ``--one-thread`` on one numba thread in process seconds (the steadiest measure
+   on a loaded machine). Printed: scenes/s of each over all records and the ratios, all in
+   this one run.
 2. IDA. ``--ida-records`` records x 6 stacked objects x ``--rungs`` scale rungs (the peak
    from 0.5 to 5 g tan(alpha_min) of each object), one ``simulate_batch(structure=...)`` call
    per record; printed: the total wall seconds (and the overturning fraction).
 
     python benchmarks/two_body_speed.py [--objects 40] [--rtol 1e-8] [--repeat 3] [--rungs 15]
+        [--one-thread]
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from __future__ import annotations
 import argparse
 import time
 
+import numba
 import numpy as np
 from bench_closedform import median_time
 from contact_accuracy import record_counts, records
@@ -47,9 +51,9 @@ def assemblies(rng, n):
     return out
 
 
-def ratio(recs, n, rtol, repeat, rng):
+def ratio(recs, n, rtol, repeat, rng, clock=time.perf_counter):
     """(stacked scenes/s, single-block scenes/s with the plinth's columns, with the
-    statue's) over the records."""
+    statue's) over the records, timed on ``clock``."""
     t_stacked = t_single = t_statue = 0.0
     scenes = 0
     for _name, t, a_h, _ in recs:
@@ -65,12 +69,14 @@ def ratio(recs, n, rtol, repeat, rng):
                 structure=pairs, record=rec, scale=scale, rtol=rtol
             ),
             repeat,
+            clock,
         )
         t_single += median_time(
             lambda rec=rec, r1=r1, a1=a1, scale=scale: simulate_batch(
                 half_diagonal=r1, slenderness=a1, record=rec, scale=scale, rtol=rtol
             ),
             repeat,
+            clock,
         )
         r2 = np.array([p.upper.half_diagonal for p in pairs])
         a2 = np.array([p.upper.slenderness for p in pairs])
@@ -79,6 +85,7 @@ def ratio(recs, n, rtol, repeat, rng):
                 half_diagonal=r2, slenderness=a2, record=rec, scale=scale, rtol=rtol
             ),
             repeat,
+            clock,
         )
         scenes += n
     return scenes / t_stacked, scenes / t_single, scenes / t_statue
@@ -106,17 +113,25 @@ def main(argv=None):
     ap.add_argument("--rungs", type=int, default=15)
     ap.add_argument("--ida-records", type=int, default=8)
     ap.add_argument("--seconds", type=float, default=1e9)
+    ap.add_argument("--one-thread", action="store_true")
     args = ap.parse_args(argv)
     recs = records(args.seconds)
     rng = np.random.default_rng(2026)
-    stacked, single, statue = ratio(recs, args.objects, args.rtol, args.repeat, rng)
+    clock = time.perf_counter
+    if args.one_thread:
+        numba.set_num_threads(1)
+        clock = time.process_time
+    stacked, single, statue = ratio(recs, args.objects, args.rtol, args.repeat, rng, clock)
+    where = "one thread, process time" if args.one_thread else "wall time"
     counts = record_counts(r[0] for r in recs)
-    print(f"{counts} x {args.objects} objects at rtol {args.rtol:g}")
+    print(f"{counts} x {args.objects} objects at rtol {args.rtol:g} ({where})")
     print(f"stacked kernel: {stacked:9.1f} scenes/s")
     print(f"single block  : {single:9.1f} scenes/s")
     print(f"ratio stacked / single: {stacked / single:.1%}")
     print(f"(single block with the statue's columns: {statue:9.1f} scenes/s, ratio ", end="")
     print(f"{stacked / statue:.1%})")
+    if args.ida_records < 1:
+        return
     seconds, fell = ida(recs[: args.ida_records], args.rungs, args.rtol, rng)
     print(
         f"IDA {min(len(recs), args.ida_records)} records x 6 stacked objects x {args.rungs} "

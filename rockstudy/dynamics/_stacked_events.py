@@ -20,20 +20,18 @@ from .._roots import newton_bisect
 from ..constants import FALL_ROTATION
 from ._stacked_model import A1, lock_margins
 from ._stacked_steps import (
-    DENSE_NONE,
     DENSE_TAYLOR,
     K_FSUB,
     K_INFO,
     K_SUB,
     dense_state,
     derivative,
-    dop853_step,
     ground,
     interface_at,
     interface_data,
     state_at,
 )
-from ._stacked_taylor import both_state
+from ._stacked_taylor import both_state, series_clear
 from ._taylor import NO_REFCOUNT, ROOT_ITERATIONS, ROOT_TOL
 
 #: Samples of the interpolant per step at which the impacts and peaks are sought.
@@ -64,15 +62,14 @@ def _rate_fdf(x, args):
 
 
 @njit(cache=True, **NO_REFCOUNT)
-def _angle_root(k, s, level, lo, hi, h, y0, f0, y1, f1):
+def _angle_root(k, s, level, lo, hi, h, y0, f0, y1, f1, guess):
     """The fraction in [lo, hi] where s angle_k - level changes sign (> 0 at lo, <= 0 at hi
     for level 0; < 0 at lo, >= 0 at hi otherwise), by safeguarded Newton steps on the
-    interpolant (:func:`rockstudy._roots.newton_bisect`, to ROOT_TOL of the step)."""
+    interpolant (:func:`rockstudy._roots.newton_bisect`, to ROOT_TOL of the step) from
+    ``guess`` (in [lo, hi])."""
     args = (k, s, level, h, y0, f0, y1, f1)
     sign_lo = 1.0 if level == 0.0 else -1.0
-    return newton_bisect(
-        _angle_fdf, args, lo, hi, 0.5 * (lo + hi), sign_lo, ROOT_TOL, ROOT_ITERATIONS
-    )
+    return newton_bisect(_angle_fdf, args, lo, hi, guess, sign_lo, ROOT_TOL, ROOT_ITERATIONS)
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -97,19 +94,23 @@ def impact_fraction(k, s, h, y0, f0, y1, f1, rates):
     hop = _early_return(k, s, h, y0, f0, y1, f1)
     if hop <= 1.0:
         return hop
-    lo, u_lo = 0.0, 1.0
-    rates[0] = s * interface_data(k, y0, f0)[1]
+    x, v, _ = interface_data(k, y0, f0)
+    lo, u_lo, u_prev, rates[0] = 0.0, 1.0, s * x, s * v
     for j in range(1, SAMPLES + 1):
         hi = j / SAMPLES
-        x, v, _ = interface_at(k, hi, h, y0, f0, y1, f1)
+        if j < SAMPLES:
+            x, v, _ = interface_at(k, hi, h, y0, f0, y1, f1)
+        else:  # the interpolant's end is the step's
+            x, v, _ = interface_data(k, y1, f1)
         u, rates[j] = s * x, s * v
         if u <= 0.0:
-            return _angle_root(k, s, 0.0, lo, hi, h, y0, f0, y1, f1)
+            guess = lo + (hi - lo) * u_prev / (u_prev - u) if u_prev > 0.0 else 0.5 * (lo + hi)
+            return _angle_root(k, s, 0.0, lo, hi, h, y0, f0, y1, f1, guess)
         if rates[j - 1] < 0.0 <= rates[j]:  # a trough between the samples
             mid = _rate_root(k, s, lo, hi, h, y0, f0, y1, f1, False)
             if s * interface_at(k, mid, h, y0, f0, y1, f1)[0] <= 0.0 < u_lo:
-                return _angle_root(k, s, 0.0, lo, mid, h, y0, f0, y1, f1)
-        lo, u_lo = hi, u
+                return _angle_root(k, s, 0.0, lo, mid, h, y0, f0, y1, f1, 0.5 * (lo + mid))
+        lo, u_lo, u_prev = hi, u, u
     return 2.0
 
 
@@ -128,16 +129,16 @@ def _early_return(k, s, h, y0, f0, y1, f1):
     hi = 1.5 * tau / h
     if not hi < 1.0 / SAMPLES or s * interface_at(k, hi, h, y0, f0, y1, f1)[0] > 0.0:
         return 2.0
-    return _angle_root(k, s, 0.0, 0.0, hi, h, y0, f0, y1, f1)
+    return _angle_root(k, s, 0.0, 0.0, hi, h, y0, f0, y1, f1, tau / h)
 
 
 @njit(cache=True, **NO_REFCOUNT)
 def fall_fraction(k, s, h, y0, f0, y1, f1):
     """The fraction at which s angle_k reaches :data:`FALL_ROTATION` (2.0 if it does not by
     the step's end)."""
-    if s * interface_at(k, 1.0, h, y0, f0, y1, f1)[0] < FALL_ROTATION:
+    if s * interface_data(k, y1, f1)[0] < FALL_ROTATION:
         return 2.0
-    return _angle_root(k, s, FALL_ROTATION, 0.0, 1.0, h, y0, f0, y1, f1)
+    return _angle_root(k, s, FALL_ROTATION, 0.0, 1.0, h, y0, f0, y1, f1, 0.5)
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -184,20 +185,17 @@ def _true_margin(g, regime, mot, t, y0, f0, dt, j, tmp, w):
 @njit(cache=True, **NO_REFCOUNT)
 def true_state(g, regime, mot, t, y0, f0, dt, w):
     """The state and its derivative at t + dt inside the last accepted step (from (t, y0)),
-    into w[K_SUB] and w[K_FSUB]: on the step's polynomials after a both-rocking Taylor step
-    (:func:`._stacked_taylor.both_state`), on its dense output after a DOP853 step
-    (:func:`._stacked_steps.dense_state`), else after a true DOP853 step of length dt (a
-    step of length 0 copies the start)."""
+    into w[K_SUB] and w[K_FSUB]: on the step's polynomials after a Taylor step
+    (:func:`._stacked_taylor.both_state`), else on its dense output after a DOP853 step
+    (:func:`._stacked_steps.dense_state`) (a step of length 0 copies the start)."""
     if dt == 0.0:
         for c in range(4):
             w[K_SUB, c], w[K_FSUB, c] = y0[c], f0[c]
         return
     if w[K_INFO, 0] == DENSE_TAYLOR:
         both_state(w, int(w[K_INFO, 2]), dt / w[K_INFO, 1], w[K_INFO, 1], w[K_SUB])
-    elif w[K_INFO, 0] != DENSE_NONE:
-        dense_state(g, regime, mot, t, y0, dt / w[K_INFO, 1], w, w[K_SUB])
     else:
-        dop853_step(g, regime, mot, t, y0, f0, dt, w, K_SUB)
+        dense_state(g, regime, mot, t, y0, dt / w[K_INFO, 1], w, w[K_SUB])
     derivative(g, regime, mot, t + dt, w[K_SUB], w[K_FSUB])
 
 
@@ -258,7 +256,11 @@ def first_event(g, regime, mot, t, h, y0, f0, y1, f1, margins, tmp, w, rates):
                 if sig < best:
                     best, kind, iface, corner = sig, EVENT_UPLIFT, k, 1 - 2 * j
             continue
-        sig = impact_fraction(k, s, h, y0, f0, y1, f1, rates[k])
+        if w[K_INFO, 0] == DENSE_TAYLOR and series_clear(w, int(w[K_INFO, 2]), k, s):
+            rates[k, :] = np.nan  # no impact, and no peak for step_peaks
+            sig = 2.0
+        else:
+            sig = impact_fraction(k, s, h, y0, f0, y1, f1, rates[k])
         if sig < best:
             best, kind, iface, corner = sig, EVENT_IMPACT, k, s
         sig = fall_fraction(k, s, h, y0, f0, y1, f1)

@@ -100,14 +100,15 @@ def resolve_impact(g, y, iv, k, v, margins):
 
 
 @njit(cache=True)
-def _rest_lift(m0, m1, mot, t):
+def _rest_lift(m0, m1, mot, t, hint):
     """The reference's lift test at rest: -min of the normalised margins m0 + u_g'' m1 (> 0
-    where an interface lifts); -1 from the end of the motion on."""
+    where an interface lifts); -1 from the end of the motion on. ``hint``: a record segment
+    at or near that of t (the search for it starts there)."""
     if t >= mot[1][3]:
         return -1.0
-    seg = mot[4]
+    seg = hint
     if mot[0] == KIND_RECORD:
-        seg = segment_index(mot[2], t, seg)
+        seg = segment_index(mot[2], t, hint)
     ug = ground((mot[0], mot[1], mot[2], mot[3], seg), t)
     worst = np.inf
     for j in range(4):
@@ -116,14 +117,14 @@ def _rest_lift(m0, m1, mot, t):
 
 
 @njit(cache=True)
-def _first_lift(m0, m1, mot, lo, hi):
+def _first_lift(m0, m1, mot, lo, hi, hint):
     """The first double in (lo, hi] where the lift test is > 0 (not at lo, at hi), by
-    bisection to adjacent doubles."""
+    bisection to adjacent doubles (``hint``: the record segment of lo)."""
     for _ in range(REST_BISECTIONS):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
-        if _rest_lift(m0, m1, mot, mid) > 0.0:
+        if _rest_lift(m0, m1, mot, mid, hint) > 0.0:
             hi = mid
         else:
             lo = mid
@@ -176,26 +177,41 @@ def uplift_from_rest(g, mot, t0, tmp):
     zero[:] = 0.0
     lock_margins(g, zero, 1, 1, True, True, 0.0, tmp[4:8])
     lock_margins(g, zero, 1, 1, True, True, 1.0, tmp[8:12])
-    m0, m1 = tmp[4:8].copy(), tmp[8:12] - tmp[4:8]
-    t_up = math.inf
-    if _rest_lift(m0, m1, mot, t0) > 0.0:
-        t_up = t0
-    else:
-        lo = t0
-        for i in range(_grid_start(mot, t0), _grid_size(mot) + 1):
-            hi = _grid_point(mot, i) if i < _grid_size(mot) else mot[1][3]
-            if hi <= lo and i < _grid_size(mot):
-                continue
-            if _rest_lift(m0, m1, mot, hi) > 0.0:
-                t_up = hi if hi <= lo else _first_lift(m0, m1, mot, lo, hi)
-                break
-            lo = hi
+    m0, m1 = tmp[4:8], tmp[8:12]
+    for j in range(4):
+        m1[j] -= m0[j]
+    t_up, seg = _scan_lift(m0, m1, mot, t0)
     if t_up == math.inf:
         return t_up, -1, 0
-    lift = _rest_lift(m0, m1, mot, t_up)
+    lift = _rest_lift(m0, m1, mot, t_up, seg)
+    seg = segment_index(mot[2], t_up, seg) if mot[0] == KIND_RECORD else 0
+    ug = ground((mot[0], mot[1], mot[2], mot[3], seg), t_up)
     for j in range(4):  # the first margin at the minimum, in the reference's order
-        seg = segment_index(mot[2], t_up, mot[4]) if mot[0] == KIND_RECORD else 0
-        ug = ground((mot[0], mot[1], mot[2], mot[3], seg), t_up)
         if -(m0[j] + ug * m1[j]) == lift:
             return t_up, j // 2, 1 - 2 * (j % 2)
     return t_up, 0, 1
+
+
+@njit(cache=True)
+def _scan_lift(m0, m1, mot, t0):
+    """(the first instant at or after t0 where the lift test of :func:`_rest_lift` is > 0,
+    a record segment at or before it): the scan points from t0 on, then
+    :func:`_first_lift` in the cell where it turns positive; (inf, -) if it never does
+    before the motion ends. Each scan point's segment is its own index (O(1) a point)."""
+    i0 = _grid_start(mot, t0)
+    hint = i0 if mot[0] == KIND_RECORD else mot[4]
+    if _rest_lift(m0, m1, mot, t0, hint) > 0.0:
+        return t0, hint
+    lo, n = t0, _grid_size(mot)
+    for i in range(i0, n + 1):
+        hi = _grid_point(mot, i) if i < n else mot[1][3]
+        if hi <= lo and i < n:
+            continue
+        seg = min(i, n - 2) if mot[0] == KIND_RECORD else hint
+        if _rest_lift(m0, m1, mot, hi, seg) > 0.0:
+            if hi <= lo:
+                return hi, seg
+            cell = max(i - 1, i0) if mot[0] == KIND_RECORD else hint
+            return _first_lift(m0, m1, mot, lo, hi, cell), cell
+        lo = hi
+    return math.inf, hint

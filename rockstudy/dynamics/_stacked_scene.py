@@ -33,7 +33,6 @@ from ._stacked_events import (
 from ._stacked_impact import REST_BISECTIONS, resolve_impact, scan_cell_end, uplift_from_rest
 from ._stacked_model import P1, P2, lock_margins
 from ._stacked_steps import (
-    DENSE_NONE,
     DENSE_STAGES,
     DENSE_TAYLOR,
     K_END,
@@ -42,12 +41,13 @@ from ._stacked_steps import (
     derivative,
     dop853_step,
     ground,
+    interface_data,
     one_body_form,
     one_body_step,
     step_error,
     work_array,
 )
-from ._stacked_taylor import both_step
+from ._stacked_taylor import both_step, one_body_series
 from ._taylor import NO_REFCOUNT, work_arrays
 from .constants import (
     FIRST_STEP,
@@ -75,6 +75,10 @@ TAYLOR_TOL = TAYLOR_TOL_FRACTION * TOL_SAFETY
 
 #: Longest step, in units of 1/p_max: the events of a step are sought on its interpolant.
 STEP_CAP = 0.5
+
+#: The first step of a phase that starts with a rebound, in units of the rebound's hop time
+#: on the start's parabola (:func:`_hop_step`): the hop ends inside it.
+HOP_STEP = 1.5
 
 #: A phase's ends besides its events (:data:`._stacked_events.EVENT_NONE`...).
 PHASE_END, PHASE_MAX_STEPS = 10, 11
@@ -142,10 +146,12 @@ def _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, y1):
 def _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w):
     """A Taylor step from t to t1 (= t + hs) on a record's segment or after the motion, its
     end into w[K_END]: (error ratio, order) of a both-rocking step
-    (:func:`._stacked_taylor.both_step`, its series kept in w), (error ratio, -1) of a
-    one-body one (:func:`_one_body_step`)."""
+    (:func:`._stacked_taylor.both_step`) or of a one-body one (:func:`_one_body_step`), its
+    series kept in w (:func:`._stacked_taylor.one_body_series`)."""
     if form[0] >= 0:
-        return _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, w[K_END]), -1
+        err, n = _one_body_step(g, form, mot, t, hs, t1, y, f0, tol, tw, w[K_END])
+        one_body_series(w, tw[0], n, form[0], y, hs)
+        return err, n
     u0, u1 = (ground(mot, t), ground(mot, t1)) if t < mot[1][3] else (0.0, 0.0)
     tol *= TAYLOR_TOL / TOL_FRACTION
     return both_step(g, y, hs, regime[0], regime[1], u0, u1, tol, w, w[K_END])
@@ -158,6 +164,23 @@ def _taylor_accepted(err, hs, h, last):
     if not err <= 1.0:  # rejected (or NaN)
         return False, 0.5 * hs
     return True, (max(h, 2.0 * hs) if last else 2.0 * hs)
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _hop_step(regime, y, f0):
+    """The first step of a phase in which a rocking interface leaves zero (an impact's
+    rebound): HOP_STEP times its hop's duration on the start's parabola (u' > 0 > u''), so
+    that the hop of a chatter ends inside one short step of low order; inf if none."""
+    s1, s2, flat0, flat1 = regime
+    hop = math.inf
+    for k in range(2):
+        if (flat0, flat1)[k]:
+            continue
+        s = (s1, s2)[k]
+        x, v, a = interface_data(k, y, f0)
+        if x == 0.0 and s * v > 0.0 and s * a < 0.0:
+            hop = min(hop, HOP_STEP * 2.0 * v / -a)
+    return hop
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -182,27 +205,29 @@ def run_phase(g, mot, iv, y, st, tol, max_steps, peaks, w, margins, tmp, rates, 
     f0 = tmp[12:16]
     derivative(g, regime, mot, t, y, f0)
     form, dur = one_body_form(g, regime), mot[1][3]
+    hop = _hop_step(regime, y, f0)
     for _ in range(max_steps):
         stop, seg = _next_stop(mot, t, t_end)
         if t >= stop:
             st[0], st[1], st[3] = t, h, seg
             return PHASE_END, -1, 0
         mot = (mot[0], mot[1], mot[2], mot[3], seg)
-        last = min(h, cap) >= stop - t
-        hs = stop - t if last else min(h, cap)
-        t1 = stop if last else t + hs
+        short = hop < min(h, cap)  # a hop's step: h kept for the steps after it
+        last = min(h, cap, hop) >= stop - t
+        hs = stop - t if last else min(h, cap, hop)
+        t1, hop = (stop if last else t + hs), math.inf
         y1, f1 = w[K_END], w[K_FEND]
         if mot[0] == KIND_RECORD or t >= dur:
             err, n = _taylor_step(g, form, regime, mot, t, hs, t1, y, f0, tol, tw, w)
             derivative(g, regime, mot, t1, y1, f1)
-            ok, h = _taylor_accepted(err, hs, h, last)
-            w[K_INFO, 0], w[K_INFO, 1], w[K_INFO, 2] = DENSE_NONE if n < 0 else DENSE_TAYLOR, hs, n
+            ok, h = _taylor_accepted(err, hs, h, last or short)
+            w[K_INFO, 0], w[K_INFO, 1], w[K_INFO, 2] = DENSE_TAYLOR, hs, n
         else:
             dop853_step(g, regime, mot, t, y, f0, hs, w, K_END)
             derivative(g, regime, mot, t1, y1, f1)
             for c in range(4):
                 w[12, c] = f1[c]
-            ok, h = _accepted(g, hs, y, y1, w, tol, h, last)
+            ok, h = _accepted(g, hs, y, y1, w, tol, h, last or short)
             w[K_INFO, 0], w[K_INFO, 1] = DENSE_STAGES, hs
         if not ok:
             continue

@@ -40,9 +40,10 @@ _D = np.ascontiguousarray(_DOP853.D, dtype=float)
 K_TMP, K_END, K_FEND, K_SUB, K_FSUB, K_DENSE, K_INFO = 16, 17, 18, 19, 20, 21, 28
 #: The first of the 14 rows of the both-rocking Taylor step (:mod:`._stacked_taylor`).
 K_BOTH = 29
-#: Kinds of the last accepted step in w[K_INFO, 0] (its length in w[K_INFO, 1]): a one-body
-#: Taylor step (its inner states come from true sub-steps), a DOP853 step, one whose dense
-#: output is computed, a both-rocking Taylor step (its order in w[K_INFO, 2]).
+#: Kinds of the last accepted step in w[K_INFO, 0] (its length in w[K_INFO, 1]): none yet,
+#: a DOP853 step, one whose dense
+#: output is computed, a Taylor step (its order in w[K_INFO, 2], its series in the rows of
+#: :mod:`._stacked_taylor`).
 DENSE_NONE, DENSE_STAGES, DENSE_READY, DENSE_TAYLOR = 0.0, 1.0, 2.0, 3.0
 
 
@@ -198,11 +199,11 @@ def one_body_form(g, regime):
 def one_body_step(g, form, y, h, a0, a1, dd0, tol, tw, out):
     """One Taylor step of length h of a one-body regime (:func:`one_body_form`) under
     u_g'' linear from a0 to a1 [m/s^2] (:func:`._taylor.taylor_coefficients`, the
-    single-block kernel's record step): its end state into ``out``; returns the ratio of its
-    truncation-error bound to the scales tol (ATOL_FRACTION alpha_min + ...) of
-    :func:`step_error` (<= 1 accepts). ``dd0``: the angle's acceleration at the start as
-    the regime computes it (so that a body lifting from rest rises as its lift test said;
-    NaN: the series' own)."""
+    single-block kernel's record step): its end state into ``out``, its scaled series in
+    tw[0]; returns (the ratio of its truncation-error bound to the scales tol
+    (ATOL_FRACTION alpha_min + ...) of :func:`step_error` (<= 1 accepts), its order).
+    ``dd0``: the angle's acceleration at the start as the regime computes it (so that a
+    body lifting from rest rises as its lift test said; NaN: the series' own)."""
     k, big_p, beta = form
     th, om = y[k], y[2 + k]
     a_min, p_max = min(g[A1], g[A2]), max(g[P1], g[P2])
@@ -218,4 +219,4 @@ def one_body_step(g, form, y, h, a0, a1, dd0, tol, tw, out):
     out[k], out[2 + k] = x, dx / h
     if k == 0:
         out[1], out[3] = x, dx / h
-    return err
+    return err, n

@@ -176,3 +176,36 @@ def both_state(w, n, sigma, h, out):
             v = v * sigma + w[Q1 + a, k]
             d = d * sigma + k * w[Q1 + a, k]
         out[a], out[2 + a] = v * sigma + w[Q1 + a, 0], d / h
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def one_body_series(w, c, n, k, y, h):
+    """Keep the scaled series c (order n) of a one-body regime's step of length h from y
+    (:func:`._stacked_steps.one_body_step`, its angle theta = y[k]) as both angles' series
+    for :func:`both_state`: theta_2 = theta_1 of the locked assembly (k = 0), theta_1 at rest
+    under the upper block alone (k = 1)."""
+    for j in range(n + 1):
+        w[Q1 + k, j] = c[j]
+        w[Q2 - k, j] = c[j] if k == 0 else 0.0
+    if k == 1:
+        w[Q1, 0], w[Q1, 1] = y[0], h * y[2]
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def series_clear(w, n, k, s):
+    """Whether interface k (rocking on side s) stays off zero with a rate of one sign
+    throughout the last Taylor step (its scaled series of order n in w[Q1], w[Q2]; the
+    interface's angle theta_1 for k = 0, phi = theta_2 - theta_1 for k = 1): no impact,
+    trough or peak inside it. |sum_j c_j sigma^j| <= sum_j |c_j| on [0, 1] bounds the
+    angle's excursion and the rate's change, so s c_0 > sum_{j>=1} |c_j| and |c_1| >
+    sum_{j>=2} j |c_j| prove it for the series."""
+    c0 = w[Q1, 0] if k == 0 else w[Q2, 0] - w[Q1, 0]
+    c1 = w[Q1, 1] if k == 0 else w[Q2, 1] - w[Q1, 1]
+    if not s * c0 > 0.0:
+        return False
+    spread, slope = abs(c1), 0.0
+    for j in range(2, n + 1):
+        c = abs(w[Q1, j] if k == 0 else w[Q2, j] - w[Q1, j])
+        spread += c
+        slope += j * c
+    return s * c0 > spread and abs(c1) > slope
