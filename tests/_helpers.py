@@ -629,3 +629,22 @@ def wide_runs(scales, flags, step):
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
     wide = scales[stops] >= scales[starts] * (1.0 + step)
     return list(scales[stops][wide])
+
+
+def random_stacked_scene(rng, seconds=(1.0, 2.0), peak=(1.0, 3.0)):
+    """A random plinth and statue (plinth alpha 0.15-0.35, R 0.6-2 m; statue alpha 0.12-0.3,
+    R 0.3-1.2 m and no wider than 0.9 of the plinth; density ratio 0.3-3) and a generated
+    record at 0.02 s: ``seconds`` of smoothed white noise under a sine envelope, peaking at
+    ``peak`` times G tan(min alpha) (G = 9.81 m/s^2, rockstudy.constants)."""
+    from rockstudy.constants import G
+    from rockstudy.motions.records import Record
+    from rockstudy.structures import Block, StackedBlocks
+
+    a1, r1, a2 = rng.uniform(0.15, 0.35), rng.uniform(0.6, 2.0), rng.uniform(0.12, 0.3)
+    r2 = min(rng.uniform(0.3, 1.2), 0.9 * r1 * np.sin(a1) / np.sin(a2))
+    pair = StackedBlocks(Block(r1, a1), Block(r2, a2), rng.uniform(0.3, 3.0))
+    n = int(rng.uniform(*seconds) / 0.02)
+    t = np.arange(n) * 0.02
+    acc = np.convolve(rng.normal(size=n), np.ones(5) / 5, "same") * np.sin(np.pi * t / t[-1])
+    acc *= G * np.tan(min(a1, a2)) * rng.uniform(*peak) / np.abs(acc).max()
+    return pair, Record(np.r_[acc, 0.0], dt=0.02)

@@ -332,7 +332,8 @@ def simulate_batch(
     structure : StackedBlocks or IsolatedBlock, or a sequence of one of them, optional
         A two-body system (one, or one per row) instead of the block columns (refused beside
         it): its outputs are those :func:`rockstudy.simulate` names for it
-        (:mod:`.two_body_batch`).
+        (:mod:`.two_body_batch`), and on request ``conditioning``
+        (:data:`.two_body_batch.CONDITIONING`: the rows run twice).
 
     Returns
     -------

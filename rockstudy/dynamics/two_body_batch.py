@@ -17,8 +17,10 @@ from ..motions.records import Record
 from ..structures.isolated import IsolatedBlock
 from ..structures.stacked import StackedBlocks
 from ._stacked_batch import kernel_rows
+from .conditioning import perturbed
 
 __all__ = [
+    "CONDITIONING",
     "ISOLATED_OUTPUTS",
     "OVERTURNED_BODY",
     "ROW_FUNCTIONS",
@@ -55,6 +57,26 @@ ISOLATED_OUTPUTS = (
     "n_impacts",
     "status",
 )
+
+
+#: The opt-in output of both classes (twice the cost: every row runs again with its
+#: amplitude times 1 + 1e-9, :func:`.conditioning.perturbed`): the largest change of a peak
+#: rotation over |peak| + :data:`PEAK_FLOOR` alpha of its body (the house's accuracy measure),
+#: inf where the overturning decision or the overturned body changes. Above
+#: :data:`.conditioning.ILL_CONDITIONED` no solver determines the row's peaks better.
+CONDITIONING = "conditioning"
+
+#: The floor of a peak in :data:`CONDITIONING`, a fraction of its body's alpha: a body that
+#: barely moves (a peak of 1e-25 rad is rounding) has no relative change of its own.
+PEAK_FLOOR = 1e-2
+
+
+def _peaks(structure) -> dict:
+    """{peak output: the slenderness of its body} of a two-body structure."""
+    if isinstance(structure, StackedBlocks):
+        lower, upper = structure.lower.slenderness, structure.upper.slenderness
+        return {"max_rotation_lower": lower, "max_rotation_upper": upper}
+    return {"max_rotation": structure.block.slenderness}
 
 
 def row_motions(n, pulse="sine", amplitude=None, period=None, cycles=1, record=None, scale=1.0):
@@ -114,6 +136,23 @@ def isolated_rows(structures, motions, rtol, max_steps) -> dict:
     out = run_rows(structures, motions, rtol, max_steps, MAX_IMPACTS)
     columns = (O_THETA, O_OVER, O_X, O_TIME, O_IMPACTS, O_STATUS)
     return _typed({k: out[:, c] for k, c in zip(ISOLATED_OUTPUTS, columns, strict=True)})
+
+
+def conditioning_of(rows, structures, motions, rtol, max_steps, cols) -> np.ndarray:
+    """The :data:`CONDITIONING` of each row whose outputs are ``cols``: the rows run again
+    through ``rows`` with each motion's amplitude times 1 + 1e-9, and the largest change
+    of a peak over |peak| + :data:`PEAK_FLOOR` alpha; inf where the decision or the
+    overturned body changes."""
+    twin = rows(structures, [perturbed(m) for m in motions], rtol, max_steps)
+    alphas = [_peaks(s) for s in structures]
+    change = np.zeros(len(structures))
+    for name in alphas[0]:
+        floor = PEAK_FLOOR * np.array([a[name] for a in alphas])
+        change = np.maximum(change, np.abs(twin[name] - cols[name]) / (np.abs(cols[name]) + floor))
+    moved = cols["overturned"] != twin["overturned"]
+    if "overturned_body" in cols:
+        moved |= cols["overturned_body"] != twin["overturned_body"]
+    return np.where(moved, np.inf, change)
 
 
 _DTYPES = {"overturned": bool, "overturned_body": np.int8, "n_impacts": np.int64}
@@ -187,15 +226,19 @@ def two_body_batch(args: dict):
     structures = _structures(structure, n)
     rows, names = ROW_FUNCTIONS[type(structures[0])]
     wanted = names if outputs is None else ((outputs,) if isinstance(outputs, str) else outputs)
-    unknown = sorted(set(wanted) - set(names))
+    unknown = sorted(set(wanted) - {*names, CONDITIONING})
     if unknown:
         raise ValueError(
             f"outputs: unknown name(s) {unknown} for {type(structures[0]).__name__}; "
-            f"allowed: {list(names)}"
+            f"allowed: {[*names, CONDITIONING]}"
         )
     motions = row_motions(n, args["pulse"], record=record, **columns)
     cols = rows(structures, motions, args["rtol"], args["max_steps"])
-    result = {k: cols[k] for k in names if k in wanted or k == "status"}
+    if CONDITIONING in wanted:
+        cols[CONDITIONING] = conditioning_of(
+            rows, structures, motions, args["rtol"], args["max_steps"], cols
+        )
+    result = {k: cols[k] for k in (*names, CONDITIONING) if k in wanted or k == "status"}
     if not args["as_dataset"]:
         return result
     motion = ("scale",) if record is not None else ("amplitude", "period", "cycles")
