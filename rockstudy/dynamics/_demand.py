@@ -16,11 +16,9 @@ uplift, after an impact; read off the series' first coefficients), theta, theta_
 summed from the step's series (no sine or cosine per sample); where the largest of a step's
 samples, or the vertex of the parabola through it and its neighbours, reaches the largest
 ratio so far, it is refined by parabolic interpolation (:func:`_parabolic`) between its
-neighbours. Next to a phase's first or last sample that refinement is left out where the
-bound of the step's ratio (:func:`_below_best`) shows that none of its samples can count.
-The demand is the largest ratio, with the impulse ratio of the impacts, (1 - eta) / ((1 +
-eta) tan alpha), if the block struck the ground; the block lifts off where F_v <= 0 at a
-sample (demand inf).
+neighbours. The demand is the largest ratio, with the impulse ratio of the impacts,
+(1 - eta) / ((1 + eta) tan alpha), if the block struck the ground; the block lifts off where
+F_v <= 0 at a sample (demand inf).
 
 What needs no evaluation: a block at rest has ``|u_h''|`` / gamma <= tan alpha (else it
 lifts), and the ratio is exactly tan alpha at uplift (a sample), so the rests never set the
@@ -117,7 +115,7 @@ def _sample(w, ta, tau, step):
     it: the current one (``step`` = (t0, hs, n, k, s, p, alpha, mot), its series in w:
     :func:`_series_at`) or, before t0, the step before (w[ROW_PREV], its t0, hs, n, k in
     ``ta``; S and C from theta)."""
-    t0, hs, n, k, s, p, alpha, mot, _, _ = step
+    t0, hs, n, k, s, p, alpha, mot = step
     if tau < t0:
         t0, hs, n, k = ta.d_prev_t, ta.d_prev_hs, ta.d_prev_n, ta.d_prev_k
         th, d, _ = poly_value(w[ROW_PREV], n, (tau - t0) / hs)
@@ -171,7 +169,7 @@ def _sample_end(w, tau, end, step):
     ``end`` = (theta, theta_dot) is known: S = sin x and C = cos x as the sums of their
     series (to order n - 2, within the step's tolerance: their next terms are of the size of
     the last two of theta's, which the step's error test bounds), the ground at tau [s]."""
-    t0, hs, n, k, s, p, alpha, mot, _, _ = step
+    t0, hs, n, k, s, p, alpha, mot = step
     s0 = s1 = c0 = c1 = 0.0
     for j in range(0, n - 2, 2):  # two sums each: shorter dependency chains
         s0 += w[ROW_S, j]
@@ -195,7 +193,7 @@ def _sample_start(w, step):
     """:func:`_sample` at the start of the current step (unit step time 0), where its series
     start: theta, its derivative, S and C are their first coefficients (what
     :func:`_series_at` sums at x = 0, without the sums), the ground at the step's start."""
-    t0, hs, n, k, s, p, alpha, mot, _, _ = step
+    t0, hs, n, k, s, p, alpha, mot = step
     kind, mp, times, samples, vsamples = mot
     a_h = a_v = 0.0
     if t0 < mp[3]:
@@ -285,19 +283,6 @@ def _parabolic(w, ta, x, f, step):
             x2, f2 = xv, r
 
 
-@njit(cache=True, fastmath=FMA, **NO_REFCOUNT)
-def _bracket_below_best(w, ta, t_lo, step):
-    """Whether no sample from t_lo [s] to the end of the current step can count: t_lo on that
-    step, whose bound (:func:`_below_best`) was not already tried (``step``'s last element),
-    clears it. The refinement of a phase's first or last sample (:func:`_refine_window`,
-    :func:`_close`) samples only there, and one that cannot raise the largest ratio nor
-    bring F_v to 0 is left out: the demand and the lift-off stay as they were."""
-    t0, hs, n, k, s, p, alpha, mot, t_end, tried = step
-    if tried or t_lo < t0:
-        return False
-    return _below_best(ta, w, n, t0, hs, t_end, s, p, alpha, mot, k)
-
-
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _refine_window(w, ta, tc, fc, step):
     """Refine the middle sample of the grid's last three (a, b in ``ta``, c = (tc, fc)) where
@@ -312,8 +297,6 @@ def _refine_window(w, ta, tc, fc, step):
         if ta.d_ca != over or _vertex(t_a, fa, tb, fb, tc, fc) < (ta.d_over if over else ta.d_best):
             return
         _parabolic(w, ta, (t_a, tb, tc), (fa, fb, fc), step)
-        return
-    if _bracket_below_best(w, ta, tb, step):
         return
     near = tb + START_OFFSET * (tc - tb)
     r, f_v, u = _sample(w, ta, near, step)
@@ -330,8 +313,6 @@ def _close(w, ta, step):
     t_a, fa, tb, fb = ta.d_ta, ta.d_fa, ta.d_tb, ta.d_fb
     ta.d_fa = ta.d_fb = -np.inf
     if not (math.isfinite(fa) and math.isfinite(fb)) or ta.d_ca != ta.d_cb:
-        return
-    if _bracket_below_best(w, ta, t_a, step):
         return
     near = tb - START_OFFSET * (tb - t_a)
     r, f_v, u = _sample(w, ta, near, step)
@@ -383,12 +364,11 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
     none of its samples can count; a record's step, sampled at its end only, is sampled
     without the bound, which costs more than that one sample (the demand's share of a
     record scene's CPU fell from 43 % to 31 % of the bare kernel's)."""
+    step = (t, hs, n, k, s, p, alpha, mot)
     fresh = 0
     kind, mp = mot[0], mot[1]
     inside = 0 if kind == KIND_RECORD and t < mp[3] else INTERIOR
-    tried = inside != 0 and end[0] == end[0]  # the step's bound tried (on its samples)
-    step = (t, hs, n, k, s, p, alpha, mot, t_end, tried)
-    if tried and _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
+    if inside and end[0] == end[0] and _below_best(ta, w, n, t, hs, t_end, s, p, alpha, mot, k):
         _close(w, ta, step)  # the grid ends at the step's start
         _keep_over(ta)  # the block is below alpha
         fresh = 1  # the next step sampled starts a new grid
@@ -401,9 +381,8 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
             _push(w, ta, tau, step, _sample(w, ta, tau, step))
         if end[0] == end[0]:
             _push(w, ta, t_end, step, _sample_end(w, t_end, end, step))
-        else:
+        else:  # an impact or the overturning ends the phase
             _push(w, ta, t_end, step, _sample(w, ta, t_end, step))
-        if end[0] != end[0]:  # an impact or the overturning ends the phase
             _close(w, ta, step)
     for j in range(n + 1):
         w[ROW_PREV, j] = w[ROW_C, j]
