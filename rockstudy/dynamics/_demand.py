@@ -12,12 +12,13 @@ x = alpha s - theta, S = sin x, C = cos x, gamma = g + u_v'' and R theta_ddot = 
 
 On every accepted Taylor step the ratio ``|F_h|`` / F_v is evaluated on the step polynomial
 at :data:`INTERIOR` points and the step's end (its start too where a rocking phase starts: at
-uplift, after an impact), theta, theta_dot, S and C summed from the step's series (no sine or
-cosine per sample); where the largest of a step's samples, or the vertex of the parabola
-through it and its neighbours, reaches the largest ratio so far, it is refined by a golden
-section search (:data:`GOLDEN_ITERATIONS`) between its neighbours. The demand is the largest
-ratio, with the impulse ratio of the impacts, (1 - eta) / ((1 + eta) tan alpha), if the block
-struck the ground; the block lifts off where F_v <= 0 at a sample (demand inf).
+uplift, after an impact; read off the series' first coefficients), theta, theta_dot, S and C
+summed from the step's series (no sine or cosine per sample); where the largest of a step's
+samples, or the vertex of the parabola through it and its neighbours, reaches the largest
+ratio so far, it is refined by parabolic interpolation (:func:`_parabolic`) between its
+neighbours. The demand is the largest ratio, with the impulse ratio of the impacts,
+(1 - eta) / ((1 + eta) tan alpha), if the block struck the ground; the block lifts off where
+F_v <= 0 at a sample (demand inf).
 
 What needs no evaluation: a block at rest has ``|u_h''|`` / gamma <= tan alpha (else it
 lifts), and the ratio is exactly tan alpha at uplift (a sample), so the rests never set the
@@ -187,6 +188,21 @@ def _sample_end(w, tau, end, step):
     return ratio, f_v, s * end[0]
 
 
+@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+def _sample_start(w, step):
+    """:func:`_sample` at the start of the current step (unit step time 0), where its series
+    start: theta, its derivative, S and C are their first coefficients (what
+    :func:`_series_at` sums at x = 0, without the sums), the ground at the step's start."""
+    t0, hs, n, k, s, p, alpha, mot = step
+    kind, mp, times, samples, vsamples = mot
+    a_h = a_v = 0.0
+    if t0 < mp[3]:
+        a_h = _ground(kind, mp, times, samples, t0, k)
+        a_v = vertical_acceleration(kind, mp, times, vsamples, t0, k)
+    ratio, f_v = _ratio(w[ROW_S, 0], w[ROW_C_SERIES, 0], w[ROW_C, 1] / hs, a_h, a_v, p)
+    return ratio, f_v, s * w[ROW_C, 0]
+
+
 @njit(cache=True, inline="always")
 def _take(ta, ratio, f_v, over):
     """Count a sample: beyond alpha (``over``) held apart; below it, the held ones kept (the
@@ -306,18 +322,14 @@ def _close(w, ta, step):
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
-def _push(w, ta, tau, step, end=(np.nan, np.nan)):
-    """Evaluate, count and add to the grid the sample at tau [s] (in time order), with the
-    sample at ``|theta|`` = alpha before it where the two lie on either side of alpha (the
-    end of the response that counts if the block falls from there); refine the grid's local
-    maximum (:func:`_refine_window`). ``end``: (theta, theta_dot) where tau is the current
-    step's full end (:func:`_sample_end`), NaN elsewhere. Inlined, as
+def _push(w, ta, tau, step, sample):
+    """Count and add to the grid the sample (ratio, F_v / m, u = s theta) taken at tau [s]
+    (in time order), with the sample at ``|theta|`` = alpha before it where the two lie on
+    either side of alpha (the end of the response that counts if the block falls from
+    there); refine the grid's local maximum (:func:`_refine_window`). Inlined, as
     :func:`_refine_window`: their calls, with the step's flattened arguments, cost a pulse's
     demand about a third of its time (measured on single-thread CPU time)."""
-    if end[0] == end[0]:
-        r, f_v, u = _sample_end(w, tau, end, step)
-    else:
-        r, f_v, u = _sample(w, ta, tau, step)
+    r, f_v, u = sample
     alpha = step[6]
     over = 1.0 if u > alpha else 0.0
     if math.isfinite(ta.d_fb) and over != ta.d_cb:
@@ -363,11 +375,14 @@ def demand_step(ta, w, n, t, hs, t_end, s, p, alpha, mot, k, end):
     else:
         if ta.d_fresh != 0:  # a rocking phase starts: a new grid
             _close(w, ta, step)
-            _push(w, ta, t, step)
+            _push(w, ta, t, step, _sample_start(w, step))
         for j in range(1, inside + 1):
-            _push(w, ta, t + (t_end - t) * j / (inside + 1), step)
-        _push(w, ta, t_end, step, end)
-        if end[0] != end[0]:  # an impact or the overturning ends the phase
+            tau = t + (t_end - t) * j / (inside + 1)
+            _push(w, ta, tau, step, _sample(w, ta, tau, step))
+        if end[0] == end[0]:
+            _push(w, ta, t_end, step, _sample_end(w, t_end, end, step))
+        else:  # an impact or the overturning ends the phase
+            _push(w, ta, t_end, step, _sample(w, ta, t_end, step))
             _close(w, ta, step)
     for j in range(n + 1):
         w[ROW_PREV, j] = w[ROW_C, j]
