@@ -14,7 +14,8 @@ The force events are first bounded over the whole step from its series, without 
 cosine or an evaluation of the polynomial (:func:`_forces_away`; the ground term and the
 rotational acceleration it drives bounded together, as one polynomial, so that they cancel):
 where every g = mu_s N - ``|F|`` and N stays above 0 throughout, no crossing can exist and
-none is looked for (the outcome the evaluations below would give, to the bit). Otherwise
+none is looked for (the outcome the evaluations below would give, to the bit, on the first
+step of a regime too: a bound above 0 there rules out a g at or below 0 at its start). Otherwise
 they are screened on three points of the step (its ends and its middle): where every g
 there exceeds :data:`FORCE_MARGIN` times its spread over them, no crossing is looked for;
 otherwise (and on the first step of a regime, where the regime's start may violate a force
@@ -291,7 +292,7 @@ def rock_step(w, prev, blk, gr, th, om, side, hs, tol, fresh):
         ev, s_ev = cs.EV_IMPACT, s_imp
     elif side * th1 >= FALL_ROTATION:
         ev, s_ev = cs.EV_FALL, poly_root(c, n, side * FALL_ROTATION, -side, OF_VALUE, 0.0, 1.0)
-    if fresh or not _forces_away(w, n, hs, blk, gr):
+    if not _forces_away(w, n, hs, blk, gr):
         ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev, prev)
     else:
         ev_f, s_f = cs.EV_NONE, 2.0
