@@ -11,15 +11,17 @@ events on the contact forces, slip (``|F|`` = mu_s N) and lift-off (N = 0), on t
 from its value and derivatives, the ground interpolated linearly).
 
 The force events are first bounded over the whole step from its series, without a sine, a
-cosine or an evaluation of the polynomial (:func:`_forces_away`): where every g = mu_s N -
-``|F|`` and N stays above 0 throughout, no crossing can exist and none is looked for (the
-outcome the evaluations below would give, to the bit). Otherwise they are screened on three
-points of the step (its ends and its middle): where every g there exceeds
-:data:`FORCE_MARGIN` times its spread over them, no crossing is looked for; otherwise (and
-on the first step of a regime, where the regime's start may violate a force condition at
-once) g is sampled at the DOP853 steps' points (:data:`._contact_steps.EVENT_POINTS`, and
-:data:`._contact_steps.FRESH_POINTS` on a first step) and its first crossing bisected on the
-polynomial to the ulp of the step.
+cosine or an evaluation of the polynomial (:func:`_forces_away`; the ground term and the
+rotational acceleration it drives bounded together, as one polynomial, so that they cancel):
+where every g = mu_s N - ``|F|`` and N stays above 0 throughout, no crossing can exist and
+none is looked for (the outcome the evaluations below would give, to the bit, on the first
+step of a regime too: a bound above 0 there rules out a g at or below 0 at its start). Otherwise
+they are screened on three points of the step (its ends and its middle): where every g
+there exceeds :data:`FORCE_MARGIN` times its spread over them, no crossing is looked for;
+otherwise (and on the first step of a regime, where the regime's start may violate a force
+condition at once) g is sampled at the DOP853 steps' points
+(:data:`._contact_steps.EVENT_POINTS`, and :data:`._contact_steps.FRESH_POINTS` on a first
+step) and its first crossing bisected on the polynomial to the ulp of the step.
 """
 
 from __future__ import annotations
@@ -80,25 +82,6 @@ def rock_force_events(c, n, x, hs, side, static, radius, alpha, gr):
     return static * f_v - f_h, static * f_v + f_h, f_v
 
 
-@njit(cache=True, inline="always", **NO_REFCOUNT)
-def _series_spans(c, n):
-    """Over the step (x in [0, 1]): the radius of theta about c_0, and the (lo, hi) of the
-    polynomial's first and second x-derivatives, each term c_k x^k (k >= 1) of its sign
-    between 0 and its value at x = 1."""
-    r_th = abs(c[1])
-    d_lo = d_hi = c[1]
-    dd_lo = dd_hi = 2.0 * c[2]
-    for k in range(2, n + 1):
-        ck = c[k]
-        r_th += abs(ck)
-        dk = k * ck
-        d_lo, d_hi = d_lo + min(dk, 0.0), d_hi + max(dk, 0.0)
-        if k >= 3:
-            ddk = (k - 1) * dk
-            dd_lo, dd_hi = dd_lo + min(ddk, 0.0), dd_hi + max(ddk, 0.0)
-    return r_th, d_lo, d_hi, dd_lo, dd_hi
-
-
 @njit(cache=True, inline="always")
 def _trig_span(a, b, r):
     """The interval of a cos(d) + b sin(d) over ``|d|`` <= r (the sine or cosine of an angle
@@ -107,35 +90,102 @@ def _trig_span(a, b, r):
     return a - e, a + e
 
 
+@njit(cache=True, inline="always", **NO_REFCOUNT)
+def _series_spans(c, n):
+    """Over the step (x in [0, 1]): the radius of theta about c_0; the (lo, hi) of the
+    polynomial's first x-derivative (each term of its sign between 0 and its value at
+    x = 1); and its second x-derivative's coefficients e_0, e_1, e_2 and the sums of the
+    negative and of the positive ones of higher order (e_j = (j + 1) (j + 2) c_{j+2})."""
+    r_th = abs(c[1])
+    d_lo = d_hi = c[1]
+    neg = pos = 0.0
+    for k in range(2, n + 1):
+        ck = c[k]
+        r_th += abs(ck)
+        dk = k * ck
+        d_lo, d_hi = d_lo + min(dk, 0.0), d_hi + max(dk, 0.0)
+        if k >= 5:
+            ddk = (k - 1) * dk
+            neg, pos = neg + min(ddk, 0.0), pos + max(ddk, 0.0)
+    e = (2.0 * c[2], 6.0 * c[3], 12.0 * c[4] if n >= 4 else 0.0)
+    return r_th, d_lo, d_hi, e, neg, pos
+
+
+@njit(cache=True, inline="always")
+def _floor(a0, a1, a2, tail):
+    """A lower bound over x in [0, 1] of a0 + a1 x + a2 x^2 + (terms of higher order whose
+    negative coefficients sum to ``tail``): the quadratic's exact minimum plus ``tail``."""
+    low = min(0.0, a1 + a2)
+    if a2 > 0.0 and 0.0 < -a1 < 2.0 * a2:
+        low = -a1 * a1 / (4.0 * a2)
+    return a0 + low + tail
+
+
+@njit(cache=True, inline="always")
+def _force_floor(k0, k1, wgt, e, neg, pos, rest):
+    """A lower bound over the step of k0 + k1 x + wgt theta''(x) (theta'' the polynomial's
+    second x-derivative, of coefficients ``e``, ``neg`` and ``pos`` as :func:`_series_spans`
+    gives them) plus ``rest`` (the lower bound of the remaining terms)."""
+    tail = wgt * neg if wgt >= 0.0 else wgt * pos
+    return _floor(k0 + wgt * e[0], k1 + wgt * e[1], wgt * e[2], tail) + rest
+
+
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _forces_away(w, n, hs, blk, gr):
     """Whether every force event's g (:func:`rock_force_events`) stays above 0 throughout
-    the step, by a bound over it (no evaluation, no sine or cosine): intervals of theta_dot^2
-    and theta_ddot from the polynomial's coefficients (:func:`_series_spans`), of S = sin x
-    and C = cos x (x = alpha s - theta; s sin(phi) = S, cos(phi) = C in
-    :func:`.slide_rock.contact_forces`) about their values at the start (w[ROW_S, 0],
-    w[ROW_C_SERIES, 0]), and of the ground between its ends; each g's lower bound must
-    exceed :data:`._demand.BOUND_MARGIN` times the forces' size (the rounding of the
-    evaluations it stands for)."""
+    the step, by a bound over it (no evaluation, no sine or cosine).
+
+    With q = R / hs^2, theta' and theta'' the polynomial's x-derivatives, S = sin x and
+    C = cos x (x = alpha s - theta; s sin(phi) = S, cos(phi) = C in
+    :func:`.slide_rock.contact_forces`), S = S_0 + dS and C = C_0 + dC about their values at
+    the step's start (w[ROW_S, 0], w[ROW_C_SERIES, 0]):
+
+    .. math::
+
+       \\mu N \\mp F = [\\mu (g + a_v) \\mp a_h + q (\\mu S_0 \\mp C_0) \\theta'']
+       + q \\theta'' (\\mu dS \\mp dC) - q \\theta'^2 (\\mu C \\pm S),
+
+    and N likewise. The bracket, a polynomial in x (the ground linear), is bounded as one
+    (:func:`_force_floor`): the ground acceleration and the rotational acceleration it
+    drives cancel in it; the rest by intervals (``|dS|``, ``|dC|`` from theta's radius
+    about c_0, :func:`_trig_span`; theta'^2 from its range). Each g's lower bound must exceed
+    :data:`._demand.BOUND_MARGIN` times the forces' size (the rounding of the evaluations it
+    stands for)."""
     c = w[ROW_C]
-    r_th, d_lo, d_hi, dd_lo, dd_hi = _series_spans(c, n)
+    r_th, d_lo, d_hi, e, neg, pos = _series_spans(c, n)
     s0, c0 = w[ROW_S, 0], w[ROW_C_SERIES, 0]
     sl, sh = _trig_span(s0, c0, r_th)
     cl, ch = _trig_span(c0, s0, r_th)
     q = blk.radius / (hs * hs)
-    tl, th = q * dd_lo, q * dd_hi  # R theta_ddot
     wl, wh = _square(d_lo, d_hi)
     wl, wh = q * wl, q * wh  # R theta_dot^2
+    rdd = q * (abs(e[0]) + abs(e[1]) + abs(e[2]) + pos - neg)  # >= R |theta_ddot|
+    ds, dc = sh - s0, ch - c0  # >= |dS|, |dC|
     a_h0, a_h1, a_v0, a_v1 = gr
-    tc, ws = _product(tl, th, cl, ch), _product(wl, wh, sl, sh)
-    h_lo = min(a_h0, a_h1) + tc[0] + ws[0]
-    h_hi = max(a_h0, a_h1) + tc[1] + ws[1]
-    ts, wc = _product(tl, th, sl, sh), _product(wl, wh, cl, ch)
-    v_lo = G + min(a_v0, a_v1) + ts[0] - wc[1]
-    v_hi = G + max(a_v0, a_v1) + ts[1] - wc[0]
     mu = blk.static
-    size = BOUND_MARGIN * (max(-h_lo, h_hi) + (1.0 + mu) * max(-v_lo, v_hi))
-    return v_lo > size and mu * v_lo - h_hi > size and mu * v_lo + h_lo > size
+    v0, dv, dh = G + a_v0, a_v1 - a_v0, a_h1 - a_h0
+    g1 = _force_floor(
+        mu * v0 - a_h0,
+        mu * dv - dh,
+        q * (mu * s0 - c0),
+        e,
+        neg,
+        pos,
+        -rdd * (mu * ds + dc) - _product(wl, wh, mu * cl + sl, mu * ch + sh)[1],
+    )
+    g2 = _force_floor(
+        mu * v0 + a_h0,
+        mu * dv + dh,
+        q * (mu * s0 + c0),
+        e,
+        neg,
+        pos,
+        -rdd * (mu * ds + dc) - _product(wl, wh, mu * cl - sh, mu * ch - sl)[1],
+    )
+    g3 = _force_floor(v0, dv, q * s0, e, neg, pos, -rdd * ds - _product(wl, wh, cl, ch)[1])
+    ground = G + max(abs(a_v0), abs(a_v1)) + max(abs(a_h0), abs(a_h1))
+    size = BOUND_MARGIN * (1.0 + mu) * (ground + rdd + wh)
+    return g3 > size and g1 > size and g2 > size
 
 
 @njit(cache=True, **NO_REFCOUNT)
@@ -242,7 +292,7 @@ def rock_step(w, prev, blk, gr, th, om, side, hs, tol, fresh):
         ev, s_ev = cs.EV_IMPACT, s_imp
     elif side * th1 >= FALL_ROTATION:
         ev, s_ev = cs.EV_FALL, poly_root(c, n, side * FALL_ROTATION, -side, OF_VALUE, 0.0, 1.0)
-    if fresh or not _forces_away(w, n, hs, blk, gr):
+    if not _forces_away(w, n, hs, blk, gr):
         ev_f, s_f = first_force_event(c, n, hs, side, blk, gr, fresh, s_ev, prev)
     else:
         ev_f, s_f = cs.EV_NONE, 2.0
