@@ -134,9 +134,11 @@ def test_design_groups_and_layouts():
 
 
 @pytest.fixture(scope="module")
-def reference_run(tmp_path_factory):
+def reference_run(tmp_path_factory, client):
+    """The pulse study run on the session's in-process client (threads): the runs of worker
+    processes below must give the same results."""
     out = tmp_path_factory.mktemp("ref") / "ref.zarr"
-    report = run_study(validate_text(study_text(chunk=100)), out, workers=1, progress=False)
+    report = run_study(validate_text(study_text(chunk=100)), out, client=client, progress=False)
     return out, report
 
 
@@ -154,12 +156,12 @@ def test_results_do_not_depend_on_chunks_or_workers(reference_run, tmp_path):
     np.testing.assert_array_equal(nc["max_rotation"].values, ds["max_rotation"].values)
 
 
-def test_failed_samples_are_recorded(tmp_path):
+def test_failed_samples_are_recorded(tmp_path, client):
     out = tmp_path / "fail.zarr"
     report = run_study(
         validate_text(study_text(chunk=200, max_steps=3)),
         out,
-        workers=1,
+        client=client,
         progress=False,
         max_failed=1.0,
     )
@@ -178,15 +180,14 @@ def test_the_run_says_how_much_of_its_time_was_compiling(tmp_path, monkeypatch, 
 
     (tmp_path / "s.toml").write_text(study_text(chunk=300))
     real = runner.prime_study
-    assert (
-        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "a.zarr"), "--quiet"])
-        == 0
-    )
+
+    def run(out):  # one worker process: the compile and its summary are the client's
+        argv = ["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / out), "--quiet"]
+        return cli_main(argv + ["--workers", "1"])
+
+    assert run("a.zarr") == 0
     capsys.readouterr()
-    assert (
-        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "c.zarr"), "--quiet"])
-        == 0
-    )
+    assert run("c.zarr") == 0
     assert "compiling" not in capsys.readouterr().out  # all cached by the first run
 
     def cold(*args):  # as the priming reports a compile of 2.5 s
@@ -194,26 +195,23 @@ def test_the_run_says_how_much_of_its_time_was_compiling(tmp_path, monkeypatch, 
         return {"compiled": 7, "seconds": 2.5}
 
     monkeypatch.setattr(runner, "prime_study", cold)
-    assert (
-        cli_main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "b.zarr"), "--quiet"])
-        == 0
-    )
+    assert run("b.zarr") == 0
     line = capsys.readouterr().out.splitlines()[0]
     assert "computed 2 chunks in " in line and "s (2.5 s of it compiling kernels, once);" in line
 
 
-def test_resume_refuses_another_study(reference_run):
+def test_resume_refuses_another_study(reference_run, client):
     ref, _ = reference_run
     with pytest.raises(ValueError, match="different study"):
         run_study(
             validate_text(study_text(chunk=100).replace("seed = 7", "seed = 8")),
             ref,
             resume=True,
-            workers=1,
+            client=client,
             progress=False,
         )
     with pytest.raises(FileExistsError):
-        run_study(validate_text(study_text(chunk=100)), ref, workers=1, progress=False)
+        run_study(validate_text(study_text(chunk=100)), ref, client=client, progress=False)
 
 
 def _status(path):
@@ -232,11 +230,11 @@ def _wait_for(predicate, timeout):
     return False
 
 
-def test_sigkill_then_resume_is_bit_identical(tmp_path):
+def test_sigkill_then_resume_is_bit_identical(tmp_path, client):
     study = tmp_path / "slow.toml"
     study.write_text(SLOW.format(chunk=40, n=1200))
-    full = tmp_path / "full.zarr"
-    assert cli_main(["run", str(study), "--out", str(full), "--workers", "2", "--quiet"]) == 0
+    full = tmp_path / "full.zarr"  # uninterrupted, on the session's in-process client
+    run_study(validate_text(study.read_text()), full, client=client, progress=False)
     killed = tmp_path / "killed.zarr"
     proc = subprocess.Popen(
         [ROCKSTUDY, "run", str(study), "--out", str(killed), "--workers", "2", "--quiet"],
@@ -264,7 +262,7 @@ def test_sigkill_then_resume_is_bit_identical(tmp_path):
     assert_same(outputs(full), outputs(killed))
 
 
-def test_distributed_run_survives_a_killed_worker(tmp_path):
+def test_distributed_run_survives_a_killed_worker(tmp_path, client):
     sched_file = tmp_path / "scheduler.json"
     env = {**os.environ, "NUMBA_NUM_THREADS": "1"}
     procs = [
@@ -311,8 +309,8 @@ def test_distributed_run_survives_a_killed_worker(tmp_path):
             )
         from distributed import Client
 
-        with Client(scheduler_file=str(sched_file)) as client:
-            client.wait_for_workers(2, timeout=60)
+        with Client(scheduler_file=str(sched_file)) as remote:
+            remote.wait_for_workers(2, timeout=60)
         study = tmp_path / "slow.toml"
         study.write_text(SLOW.format(chunk=40, n=800))
         out = tmp_path / "dist.zarr"
@@ -337,7 +335,7 @@ def test_distributed_run_survives_a_killed_worker(tmp_path):
         assert run.returncode == 0, stderr
         assert np.all(_status(out) == 1)
         ref = tmp_path / "ref.zarr"
-        run_study(validate_text(study.read_text()), ref, workers=2, progress=False)
+        run_study(validate_text(study.read_text()), ref, client=client, progress=False)
         assert_same(outputs(ref), outputs(out))
     finally:
         for p in procs:
@@ -348,7 +346,7 @@ def test_distributed_run_survives_a_killed_worker(tmp_path):
             p.wait()
 
 
-def test_grid_study_cube_holds_the_engine_results(tmp_path):
+def test_grid_study_cube_holds_the_engine_results(tmp_path, client):
     from rockstudy import simulate_batch
     from rockstudy.study import open_result
 
@@ -367,7 +365,7 @@ def test_grid_study_cube_holds_the_engine_results(tmp_path):
         )
     )
     out = tmp_path / "grid.zarr"
-    run_study(validate_text(text), out, workers=1, progress=False)
+    run_study(validate_text(text), out, client=client, progress=False)
     for cube in (open_result(out), open_result(out.with_suffix(".nc"))):
         assert cube["max_rotation"].dims == ("amplitude_ratio", "period")
         A, T = np.meshgrid(cube.amplitude_ratio.values, cube.period.values, indexing="ij")
@@ -380,7 +378,7 @@ def test_grid_study_cube_holds_the_engine_results(tmp_path):
         np.testing.assert_array_equal(cube["n_impacts"].values.ravel(), direct["n_impacts"])
 
 
-def test_auto_study_meets_its_tolerance(tmp_path):
+def test_auto_study_meets_its_tolerance(tmp_path, client):
     """The shipped method="auto" study (rtol 1e-2), cut to 2000 samples: every sample records
     the model that ran, and >= 99 % are within 1 % of Housner's max rotation (kernel at
     rtol 1e-12) with the same overturning decision."""
@@ -390,7 +388,7 @@ def test_auto_study_meets_its_tolerance(tmp_path):
 
     text = (ROOT / "studies" / "auto_method.toml").read_text().replace("n = 20000", "n = 2000")
     out = tmp_path / "auto.zarr"
-    run_study(validate_text(text), out, workers=1, progress=False)
+    run_study(validate_text(text), out, client=client, progress=False)
     cube = open_result(out).compute()
     assert set(np.unique(cube["model"].values)) == {0, 1, 2}
     ref = simulate_batch(
