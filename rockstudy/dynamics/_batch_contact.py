@@ -48,21 +48,19 @@ def contact_rows(rows, codes, method, rtol, max_steps, kernel):
     ``max_steps`` has a NaN demand, ``lift_off`` False and True in the third array (the batch
     gives it status 1); so has a row whose kernel reached it."""
     p, alpha, eta, kind, mp, times, samples, vsamples = rows
-    if kind == mk.KIND_RECORD:
-        psi = uplift_ratio(mp[:, 0], alpha, samples, vsamples)
-    else:
-        psi = np.abs(mp[:, 0]) / (G * np.tan(alpha))
-    demand = psi * np.tan(alpha)  # at rest throughout: max |u_h''| / (g + u_v'')
-    lift_off = np.zeros(p.size, bool)
-    limited = np.zeros(p.size, bool)
-    linear_rows = codes == _auto.MODEL_LINEAR  # lift at g alpha, below g tan(alpha)
-    lifts = psi >= np.where(linear_rows, alpha / np.tan(alpha), 1.0)
-    computed = ~np.isnan(kernel["friction_demand"])
-    demand[computed] = kernel["friction_demand"][computed]
-    lift_off[computed] = kernel["lift_off"][computed] != 0
     failed = kernel["status"] != 0
-    demand[failed], lift_off[failed], limited[failed] = np.nan, False, True
-    for i in np.flatnonzero(lifts & ~computed & ~failed):
+    computed = ~np.isnan(kernel["friction_demand"])
+    demand = np.where(failed, np.nan, kernel["friction_demand"])
+    lift_off = computed & ~failed & (kernel["lift_off"] != 0)
+    limited = failed.copy()
+    rest = np.flatnonzero(~computed & ~failed)  # the rows whose demand the kernel left
+    if not rest.size:
+        return demand, lift_off, limited
+    psi = _uplift_ratio(rows, rest)
+    demand[rest] = psi * np.tan(alpha[rest])  # at rest throughout: max |u_h''| / (g + u_v'')
+    linear_rows = codes[rest] == _auto.MODEL_LINEAR  # lift at g alpha, below g tan(alpha)
+    lifts = psi >= np.where(linear_rows, alpha[rest] / np.tan(alpha[rest]), 1.0)
+    for i in rest[lifts]:
         motion = _RowMotion((kind, mp[i], times, samples, vsamples))
         linear = codes[i] == _auto.MODEL_LINEAR
         run = _linear_exact if linear else _kernel
@@ -79,3 +77,13 @@ def contact_rows(rows, codes, method, rtol, max_steps, kernel):
         )
         demand[i], lift_off[i] = check.friction_demand, check.lift_off
     return demand, lift_off, limited
+
+
+def _uplift_ratio(rows, idx):
+    """max |u_h''| / ((g + u_v'') tan alpha) of the rows ``idx`` of ``rows`` (as
+    :func:`contact_rows` takes them): a record's by :func:`._vertical.uplift_ratio`, a
+    pulse's |amplitude| / (g tan alpha)."""
+    p, alpha, eta, kind, mp, times, samples, vsamples = rows
+    if kind == mk.KIND_RECORD:
+        return uplift_ratio(mp[idx, 0], alpha[idx], samples, vsamples)
+    return np.abs(mp[idx, 0]) / (G * np.tan(alpha[idx]))

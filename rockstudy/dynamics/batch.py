@@ -499,11 +499,12 @@ def _friction_arguments(friction) -> dict:
 def _friction_columns(friction, n) -> tuple:
     """(mu_s, mu_k), each of length n, from ``friction`` (:func:`simulate_batch`): in
     (0, MAX_FRICTION], mu_k <= mu_s; a ValueError naming the argument otherwise."""
-    pair = friction if isinstance(friction, tuple) else (friction, friction)
-    names = ("friction[0]", "friction[1]") if isinstance(friction, tuple) else ("friction",) * 2
+    if not isinstance(friction, tuple):  # one coefficient: mu_k = mu_s
+        static = _column("friction", friction, n, 0.0, MAX_FRICTION, high_open=False)
+        return static, static.copy()
     static, kinetic = (
         _column(name, value, n, 0.0, MAX_FRICTION, high_open=False)
-        for name, value in zip(names, pair, strict=True)
+        for name, value in zip(("friction[0]", "friction[1]"), friction, strict=True)
     )
     if np.any(kinetic > static):
         i = int(np.flatnonzero(kinetic > static)[0])
@@ -526,13 +527,13 @@ def _add_contact_model(cols, rows, mu, model, motions, rtol):
     chosen = _beyond_housner(cols, mu[0]) if model == "auto" else np.ones(n, bool)
     cols.update(_no_slip(cols))
     idx = np.flatnonzero(chosen)
+    if not idx.size:  # Housner's model answered every row
+        return
     kernel = outputs.names("kernel")
     untimed = [name for name in kernel if "contact" not in outputs.OUTPUTS[name].models]
     for name in untimed:  # the kernel outputs the contact model leaves out
         cols[name][idx] = outputs.OUTPUTS[name].fill
     cols["model"][idx] = MODEL_CONTACT
-    if not idx.size:
-        return
     found, referred = contact_model.contact_rows(
         p[idx],
         alpha[idx],
