@@ -283,16 +283,26 @@ def _parabolic(w, ta, x, f, step):
             x2, f2 = xv, r
 
 
-@njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
+@njit(cache=True, inline="always", **NO_REFCOUNT)
 def _refine_window(w, ta, tc, fc, step):
     """Refine the middle sample of the grid's last three (a, b in ``ta``, c = (tc, fc)) where
-    it is a local maximum, all three on one side of alpha, that may exceed the largest ratio
-    of that side so far; a at the start of a rocking phase (none: f -inf) refines from b, the
-    phase's first sample, by the slope START_OFFSET of the way to c."""
+    it is a local maximum (:func:`_refine_peak`). Only this test is inlined (it runs on every
+    sample); the refinement, rarer, is a call: inlined at each of :func:`demand_step`'s four
+    :func:`_push` it cost the phase loop most of its compile time."""
+    fb = ta.d_fb
+    if fb >= fc and fb >= ta.d_fa and math.isfinite(fb):
+        _refine_peak(w, ta, tc, fc, step)
+
+
+@njit(cache=True, **NO_REFCOUNT)
+def _refine_peak(w, ta, tc, fc, step):
+    """Refine the grid's local maximum b (a, b in ``ta``, c = (tc, fc)) where all three lie
+    on one side of alpha and it may exceed the largest ratio of that side so far; a at the
+    start of a rocking phase (none: f -inf) refines from b, the phase's first sample, by the
+    slope START_OFFSET of the way to c. Compiled without ``fastmath``, as the phase loop it
+    was inlined into (the same roundings)."""
     t_a, fa, tb, fb = ta.d_ta, ta.d_fa, ta.d_tb, ta.d_fb
     over = ta.d_cb
-    if not (fb >= fc and fb >= fa and math.isfinite(fb)):
-        return
     if math.isfinite(fa):
         if ta.d_ca != over or _vertex(t_a, fa, tb, fb, tc, fc) < (ta.d_over if over else ta.d_best):
             return
@@ -321,25 +331,35 @@ def _close(w, ta, step):
         _parabolic(w, ta, (t_a, near, tb), (fa, r, fb), step)
 
 
+@njit(cache=True, **NO_REFCOUNT)
+def _push_crossing(w, ta, tau, step, over):
+    """Count and add to the grid the sample at ``|theta|`` = alpha between the grid's last
+    sample b and the sample at tau [s] on the other side of alpha (``over``: 1.0 where that
+    one lies beyond alpha). A call, not inlined: rare, and inlined at each :func:`_push` it
+    cost the phase loop's compile; without ``fastmath``, as the loop it was inlined into."""
+    t0, hs, n, s, alpha = step[0], step[1], step[2], step[4], step[6]
+    lo = max((ta.d_tb - t0) / hs, 0.0)
+    up = over == 1.0
+    x = poly_root(w[ROW_C], n, s * alpha, -s if up else s, OF_VALUE, lo, (tau - t0) / hs)
+    rc, fvc, _ = _sample(w, ta, t0 + x * hs, step)
+    _take(ta, rc, fvc, False)
+    _shift(ta, t0 + x * hs, rc, 0.0)
+
+
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
 def _push(w, ta, tau, step, sample):
     """Count and add to the grid the sample (ratio, F_v / m, u = s theta) taken at tau [s]
     (in time order), with the sample at ``|theta|`` = alpha before it where the two lie on
-    either side of alpha (the end of the response that counts if the block falls from
-    there); refine the grid's local maximum (:func:`_refine_window`). Inlined, as
-    :func:`_refine_window`: their calls, with the step's flattened arguments, cost a pulse's
-    demand about a third of its time (measured on single-thread CPU time)."""
+    either side of alpha (:func:`_push_crossing`: the end of the response that counts if the
+    block falls from there); refine the grid's local maximum (:func:`_refine_window`).
+    Inlined, as :func:`_refine_window`'s test: their calls, with the step's flattened
+    arguments, cost a pulse's demand about a third of its time (measured on single-thread
+    CPU time)."""
     r, f_v, u = sample
     alpha = step[6]
     over = 1.0 if u > alpha else 0.0
     if math.isfinite(ta.d_fb) and over != ta.d_cb:
-        t0, hs, n, s = step[0], step[1], step[2], step[4]
-        lo = max((ta.d_tb - t0) / hs, 0.0)
-        up = over == 1.0
-        x = poly_root(w[ROW_C], n, s * alpha, -s if up else s, OF_VALUE, lo, (tau - t0) / hs)
-        rc, fvc, _ = _sample(w, ta, t0 + x * hs, step)
-        _take(ta, rc, fvc, False)
-        _shift(ta, t0 + x * hs, rc, 0.0)
+        _push_crossing(w, ta, tau, step, over)
     _take(ta, r, f_v, over == 1.0)
     _refine_window(w, ta, tau, r, step)
     _shift(ta, tau, r, over)
