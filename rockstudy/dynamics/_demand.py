@@ -123,26 +123,28 @@ def _sample(w, ta, tau, step):
         sx, cx = math.sin(x), math.cos(x)
     else:
         th, d, sx, cx = _series_at(w, n, (tau - t0) / hs)
-    a_h = a_v = 0.0
-    kind, mp, times, samples, vsamples = mot
-    if t0 < mp[3]:  # the step lies within the motion
-        a_h = _ground(kind, mp, times, samples, tau, k)
-        a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
+    a_h, a_v = _grounds(mot, t0, tau, k)
     ratio, f_v = _ratio(sx, cx, d / hs, a_h, a_v, p)
     return ratio, f_v, s * th
 
 
 @njit(cache=True, inline="always", **NO_REFCOUNT)
-def _ground(kind, mp, times, samples, tau, k):
-    """u_h'' [m/s^2] at tau [s] (record segment k), as
-    :func:`rockstudy.motions._kernels.ground_acceleration` gives it, without its call where
-    the arithmetic is short: a trigonometric pulse, and a record on one of its samples (where
-    the record's steps end: no interpolation)."""
-    if kind == KIND_TRIG:
-        return mp[0] * math.sin(mp[1] * tau + mp[2]) if 0.0 <= tau <= mp[3] else 0.0
-    if kind == KIND_RECORD:
-        return _record_acceleration(mp, times, samples, tau, k)
-    return ground_acceleration(kind, mp, times, samples, tau, k)
+def _grounds(mot, t0, tau, k):
+    """(u_h'', u_v'') [m/s^2] at tau [s] (record segment k) on a step that starts at t0 [s]:
+    0 on a step after the motion; u_h'' as :func:`rockstudy.motions._kernels.ground_acceleration`
+    gives it, without its call where the arithmetic is short (a trigonometric pulse, and a
+    record on one of its samples, where the record's steps end: no interpolation)."""
+    kind, mp, times, samples, vsamples = mot
+    a_h = a_v = 0.0
+    if t0 < mp[3]:  # the step lies within the motion
+        if kind == KIND_TRIG:
+            a_h = mp[0] * math.sin(mp[1] * tau + mp[2]) if 0.0 <= tau <= mp[3] else 0.0
+        elif kind == KIND_RECORD:
+            a_h = _record_acceleration(mp, times, samples, tau, k)
+        else:
+            a_h = ground_acceleration(kind, mp, times, samples, tau, k)
+        a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
+    return a_h, a_v
 
 
 @njit(cache=True, fastmath=FMA, inline="always", **NO_REFCOUNT)
@@ -179,11 +181,7 @@ def _sample_end(w, tau, end, step):
     if (n - 1) % 2 == 1:
         s0 += w[ROW_S, n - 2]
         c0 += w[ROW_C_SERIES, n - 2]
-    kind, mp, times, samples, vsamples = mot
-    a_h = a_v = 0.0
-    if t0 < mp[3]:
-        a_h = _ground(kind, mp, times, samples, tau, k)
-        a_v = vertical_acceleration(kind, mp, times, vsamples, tau, k)
+    a_h, a_v = _grounds(mot, t0, tau, k)
     ratio, f_v = _ratio(s0 + s1, c0 + c1, end[1], a_h, a_v, p)
     return ratio, f_v, s * end[0]
 
@@ -194,11 +192,7 @@ def _sample_start(w, step):
     start: theta, its derivative, S and C are their first coefficients (what
     :func:`_series_at` sums at x = 0, without the sums), the ground at the step's start."""
     t0, hs, n, k, s, p, alpha, mot = step
-    kind, mp, times, samples, vsamples = mot
-    a_h = a_v = 0.0
-    if t0 < mp[3]:
-        a_h = _ground(kind, mp, times, samples, t0, k)
-        a_v = vertical_acceleration(kind, mp, times, vsamples, t0, k)
+    a_h, a_v = _grounds(mot, t0, t0, k)
     ratio, f_v = _ratio(w[ROW_S, 0], w[ROW_C_SERIES, 0], w[ROW_C, 1] / hs, a_h, a_v, p)
     return ratio, f_v, s * w[ROW_C, 0]
 
